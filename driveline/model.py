@@ -1,0 +1,129 @@
+"""Time-stepping base class shared by every model; the FMU adapters wrap it.
+
+A model holds one attribute per variable of its :class:`~driveline.variables.ModelSpec`.
+``step`` validates parameters, inputs and the step size, advances the model and
+checks its outputs. A refused step leaves the model exactly as it was and returns
+the reasons, so a host can correct the input and carry on.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from abc import ABC, abstractmethod
+from typing import Any, ClassVar
+
+from .variables import ModelSpec, Variable
+
+
+class SteppedModel(ABC):
+    """Base of all co-simulation models: start values, validation, stepping, state."""
+
+    spec: ClassVar[ModelSpec]
+
+    def __init__(self) -> None:
+        self.reset()
+
+    # -- life cycle ---------------------------------------------------------
+    def reset(self) -> None:
+        """Return every variable to its start value and clear the internal state."""
+        for v in self.spec.variables:
+            setattr(self, v.name, v.start)
+        self.time = 0.0
+        self._initialized = False
+        self.reset_internal_state()
+
+    def reset_internal_state(self) -> None:
+        """Hook for models that keep state beyond their variables."""
+
+    def initialize(self, start_time: float) -> list[str]:
+        """Validate parameters and inputs and compute the outputs at ``start_time``."""
+        errors = self.parameter_errors() + self.input_errors()
+        if errors:
+            return errors
+        self.time = start_time
+        snapshot = self.get_state()
+        self.start(start_time)
+        errors = self.output_errors()
+        if errors:
+            self.set_state(snapshot)
+            return errors
+        self._initialized = True
+        return []
+
+    def step(self, current_time: float, step_size: float) -> list[str]:
+        """Advance from ``current_time`` by ``step_size``; return the reasons for a refusal."""
+        if not self._initialized:
+            errors = self.initialize(current_time)
+            if errors:
+                return errors
+        if not (math.isfinite(step_size) and step_size > 0.0):
+            return [f"communication step size must be positive and finite, got {step_size!r}"]
+        errors = self.parameter_errors() + self.input_errors()
+        if errors:
+            return errors
+        snapshot = self.get_state()
+        self.advance(current_time, step_size)
+        errors = self.output_errors()
+        if errors:
+            self.set_state(snapshot)
+            return errors
+        self.time = current_time + step_size
+        return []
+
+    # -- model specific ------------------------------------------------------
+    @abstractmethod
+    def start(self, start_time: float) -> None:
+        """Set internal state and outputs at the start time (parameters and inputs are valid)."""
+
+    @abstractmethod
+    def advance(self, current_time: float, step_size: float) -> None:
+        """Advance internal state and outputs over one valid step."""
+
+    def extra_parameter_errors(self) -> list[str]:
+        """Physical consistency checks beyond each parameter's own range."""
+        return []
+
+    def extra_input_errors(self) -> list[str]:
+        """Input checks that depend on parameters (e.g. an angle against its guard)."""
+        return []
+
+    # -- validation ------------------------------------------------------------
+    def parameter_errors(self) -> list[str]:
+        errors = [e for v in self.spec.of("parameter") if (e := self._range_error(v))]
+        return errors or self.extra_parameter_errors()
+
+    def input_errors(self) -> list[str]:
+        errors = [e for v in self.spec.of("input") if (e := self._range_error(v))]
+        return errors or self.extra_input_errors()
+
+    def output_errors(self) -> list[str]:
+        return [
+            f"output {v.name} is not finite ({getattr(self, v.name)!r}); the step was not taken"
+            for v in self.spec.of("output")
+            if v.type == "Real" and not math.isfinite(getattr(self, v.name))
+        ]
+
+    def _range_error(self, v: Variable) -> str | None:
+        value = getattr(self, v.name)
+        if v.type == "Real" and not math.isfinite(value):
+            return f"{v.causality} {v.name} = {value!r} is not finite"
+        if v.type in ("Real", "Integer"):
+            unit = f" {v.unit}" if v.unit else ""
+            if v.min is not None and value < v.min:
+                return f"{v.causality} {v.name} = {value!r}{unit} is below its minimum {v.min!r}{unit}"
+            if v.max is not None and value > v.max:
+                return f"{v.causality} {v.name} = {value!r}{unit} is above its maximum {v.max!r}{unit}"
+        return None
+
+    # -- state ---------------------------------------------------------------------
+    def get_state(self) -> dict[str, Any]:
+        """A deep copy of everything the model holds (variables and internal state)."""
+        return copy.deepcopy(self.__dict__)
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        self.__dict__.clear()
+        self.__dict__.update(copy.deepcopy(state))
+
+    def outputs(self) -> dict[str, Any]:
+        return {v.name: getattr(self, v.name) for v in self.spec.of("output")}

@@ -1,0 +1,7 @@
+"""Tripod sliding universal coupling (seed 000: Xiu, Chang, Ju, Zheng 2024).
+
+Modules: :mod:`.geometry` (orbit radius, arm lengths), :mod:`.closed_form` (eq 18
+and its consistent derivative), :mod:`.exact` (numerical closed-loop kinematics),
+:mod:`.dynamics` (eqs 20-34), :mod:`.spec` and :mod:`.model` (the FMU's interface
+and time stepping).
+"""

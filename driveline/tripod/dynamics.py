@@ -1,0 +1,73 @@
+"""Forces of the coupling (seed 000, eqs 20-34), neglecting friction and gravity.
+
+Every phi in the seed's formulas is its own angle, ``phi_in + PAPER_PHASE``.
+The reactions follow the seed; where it is wrong we say so (docs/tripod_coupling.md).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .closed_form import paper_angle
+from .exact import exact_pose
+from .geometry import orbit_radius
+
+Array = NDArray[np.float64]
+
+
+def pin_force(torque: ArrayLike, beta: ArrayLike, r: float) -> Array:
+    """Force F on each tripod arm, normal to the arm in the tripod plane [N].
+
+    Eq 24 with the arm lengths of the corrected eq 21: ``F = T0 / (h1 + h2 + h3)
+    = T0 / (3 r + 3 rho)``; the seed prints 3 r - 3 rho.
+    """
+    return np.asarray(torque, dtype=float) / (3.0 * (r + orbit_radius(beta, r)))
+
+
+def plunger_acceleration_sum(phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float) -> Array:
+    """Eq 20 as printed: ``a1 + a2 + a3 = -6 omega^2 rho sin(beta) cos 3 phi`` [m/s^2]."""
+    omega = np.asarray(omega, dtype=float)
+    return -6.0 * omega**2 * orbit_radius(beta, r) * np.sin(beta) * np.cos(3.0 * paper_angle(phi_in))
+
+
+def output_axial_reaction(phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float, m: float) -> Array:
+    """Eq 30: ``R_z'' = -6 m rho omega^2 tan(beta) cos 3 phi`` [N] (output self-aligning bearing)."""
+    omega = np.asarray(omega, dtype=float)
+    return -6.0 * m * orbit_radius(beta, r) * omega**2 * np.tan(beta) * np.cos(3.0 * paper_angle(phi_in))
+
+
+def input_reaction_x(phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float, m: float) -> Array:
+    """Eq 33: ``R_x' = tan(beta) m (a1 + a2 + a3) = -6 m omega^2 rho sin(beta) tan(beta) cos 3 phi`` [N]."""
+    return np.tan(beta) * m * plunger_acceleration_sum(phi_in, beta, omega, r)
+
+
+def input_reaction_y(
+    phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float, l: float, m: float
+) -> Array:
+    """Eq 34: ``R_y' = -(3 m rho^2 omega^2 tan(beta) sin 6 phi) / l`` [N]."""
+    omega = np.asarray(omega, dtype=float)
+    rho = orbit_radius(beta, r)
+    return -3.0 * m * rho**2 * omega**2 * np.tan(beta) * np.sin(6.0 * paper_angle(phi_in)) / l
+
+
+def input_torque(load_torque: ArrayLike, speed_ratio: ArrayLike) -> Array:
+    """Power balance of the lossless coupling: ``T_in omega_in = T_load omega_out`` [N.m].
+
+    Written with the kinematic ratio d(phi_out)/d(phi_in), so it holds at standstill too.
+    """
+    return np.asarray(load_torque, dtype=float) * np.asarray(speed_ratio, dtype=float)
+
+
+def exact_plunger_accelerations(beta: float, r: float, l: float, omega: float, samples: int = 360) -> tuple[Array, Array]:
+    """Plunger accelerations along the grooves from the exact kinematics, at constant omega.
+
+    Returns ``(phi_in, a)`` with ``a`` of shape (samples, 3): the second derivative of each
+    ball centre's Z' travel over one turn, by spectral differentiation (the travel is
+    smooth and 2 pi periodic, so this is exact to round-off for enough samples).
+    """
+    phi = np.linspace(0.0, 2.0 * np.pi, samples, endpoint=False)
+    travel = exact_pose(phi, beta, r, l).plunger_positions
+    harmonic = np.fft.rfftfreq(samples, d=1.0 / samples)[:, None]
+    second_derivative = np.fft.irfft(-(harmonic**2) * np.fft.rfft(travel, axis=0), n=samples, axis=0)
+    return phi, omega**2 * second_derivative

@@ -1,0 +1,65 @@
+"""Geometry of the tripod coupling and the paper's symbols derived from it.
+
+Frames (seed 000, eqs 1-2): the input frame O'X'Y'Z' has Z' along the input shaft;
+the nominal output axis is ``e_out = (-sin beta, 0, cos beta)``, so the bend plane is
+X'Z' and the output shaft leans towards -X'. Groove j (j = 0, 1, 2) of the input
+sleeve runs parallel to Z' at radius r and angle ``phi_in + 2 pi j / 3``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+THIRD_TURN = 2.0 * np.pi / 3.0
+ARM_INDEX = np.arange(3)
+
+
+@dataclass(frozen=True)
+class TripodGeometry:
+    """r: groove radius [m]; l: tripod centre to self-aligning bearing centre S [m];
+    m: plunger mass [kg]. Defaults are the seed's worked example."""
+
+    r: float = 0.026
+    l: float = 0.700
+    m: float = 0.2
+
+    def errors(self) -> list[str]:
+        """Reasons this geometry is not physical (empty when it is)."""
+        problems = []
+        if not self.r > 0.0:
+            problems.append(f"groove radius r = {self.r!r} m must be positive")
+        if not self.l > self.r:
+            problems.append(f"bearing distance l = {self.l!r} m must exceed the groove radius r = {self.r!r} m")
+        if not self.m >= 0.0:
+            problems.append(f"plunger mass m = {self.m!r} kg must not be negative")
+        return problems
+
+
+def orbit_radius(beta: ArrayLike, r: float) -> NDArray[np.float64]:
+    """Radius rho of the tripod centre's orbit, ``rho = r (1 - cos beta) / (2 cos beta)``.
+
+    The paper uses rho without giving it. Cutting the three grooves with the tripod
+    plane (normal to the output axis) gives three points at parametric angles 120 deg
+    apart on an ellipse with semi-axes r / cos(beta) (bend plane) and r. A 120 deg
+    star through three such points has its centre at distance (a - b) / 2 from the
+    ellipse centre, circling it three times per turn, opposite to the shaft.
+    """
+    cos_beta = np.cos(np.asarray(beta, dtype=float))
+    return r * (1.0 - cos_beta) / (2.0 * cos_beta)
+
+
+def arm_lengths(phi: ArrayLike, beta: ArrayLike, r: float) -> NDArray[np.float64]:
+    """Distances h_i from the tripod centre to the ball centres, shape (..., 3).
+
+    Corrected eq 21: ``h_i = r + rho + 2 rho cos 2(phi_in + 2 pi i / 3)``. The seed prints
+    ``r - rho - 2 rho cos 2(phi + 2 pi i / 3)`` with its phi = phi_in + pi/2, whose
+    oscillating part is the same; but the tripod-plane ellipse is longer than r in the
+    bend plane, so the mean arm length is r + rho, not r - rho (checked against
+    :mod:`.exact`).
+    """
+    phi = np.asarray(phi, dtype=float)[..., None]
+    rho = orbit_radius(beta, r)[..., None]
+    return r + rho + 2.0 * rho * np.cos(2.0 * (phi + THIRD_TURN * ARM_INDEX))

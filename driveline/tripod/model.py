@@ -1,0 +1,66 @@
+"""Time stepping of the tripod coupling: integrates phi_in, evaluates kinematics and forces."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..model import SteppedModel
+from . import closed_form, dynamics
+from .exact import exact_pose
+from .geometry import TripodGeometry, orbit_radius
+from .spec import EXACT, SPEC
+
+
+class TripodCouplingModel(SteppedModel):
+    """The ``TripodCoupling`` co-simulation model (inputs held constant over a step)."""
+
+    spec = SPEC
+
+    def reset_internal_state(self) -> None:
+        self._closure: np.ndarray | None = None  # warm start of the exact solver
+
+    def extra_parameter_errors(self) -> list[str]:
+        return TripodGeometry(self.r, self.l, self.m_plunger).errors()
+
+    def extra_input_errors(self) -> list[str]:
+        if self.beta > self.beta_max:
+            return [
+                f"input beta = {math.degrees(self.beta):.6g} deg is above beta_max = "
+                f"{math.degrees(self.beta_max):.6g} deg"
+            ]
+        return []
+
+    def start(self, start_time: float) -> None:
+        self._closure = None
+        self.phi_in = self.phi_in_start
+        self._evaluate()
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        self.phi_in = self.phi_in + self.omega_in * step_size
+        self._evaluate()
+
+    def _evaluate(self) -> None:
+        """Outputs at the current phi_in and inputs."""
+        phi, beta, omega = self.phi_in, self.beta, self.omega_in
+        r, l, m = self.r, self.l, self.m_plunger
+        if self.kinematics == EXACT:
+            pose = exact_pose(phi, beta, r, l, start=self._closure)
+            self._closure = np.concatenate([[pose.phi_out], pose.swing])
+            self.phi_out = float(pose.phi_out)
+            ratio = float(pose.speed_ratio)
+            self.theta = float(pose.cone_angle)
+        else:
+            self.phi_out = phi + float(closed_form.angle_deviation(phi, beta, r, l))
+            ratio = float(closed_form.speed_ratio(phi, beta, r, l))
+            self.theta = math.asin(float(orbit_radius(beta, r)) / l)
+        self.delta_phi = self.phi_out - phi
+        self.omega_out = omega * ratio
+        self.T_in = float(dynamics.input_torque(self.T_load, ratio))
+        self.rho = float(orbit_radius(beta, r))
+        self.F_pin = float(dynamics.pin_force(self.T_load, beta, r))
+        self.a_plunger_sum = float(dynamics.plunger_acceleration_sum(phi, beta, omega, r))
+        self.Rz_out = float(dynamics.output_axial_reaction(phi, beta, omega, r, m))
+        self.Rx_in = float(dynamics.input_reaction_x(phi, beta, omega, r, m))
+        self.Ry_in = float(dynamics.input_reaction_y(phi, beta, omega, r, l, m))

@@ -1,0 +1,52 @@
+"""Interface of the ``TripodCoupling`` FMU: the single source for the FMI 2.0 and 3.0 builds."""
+
+from __future__ import annotations
+
+import math
+
+from ..variables import DefaultExperiment, ModelSpec, Variable
+
+CLOSED_FORM, EXACT = 0, 1
+
+SPEC = ModelSpec(
+    name="TripodCoupling",
+    description=(
+        "Tripod sliding universal coupling with a self-aligning output bearing (Xiu, Chang, Ju, "
+        "Zheng 2024): output angle, speed and torque, pin force and bearing reactions. Angles: "
+        "phi_in = 0 with plunger groove 1 in the bend plane on the outer side of the bend."
+    ),
+    variables=(
+        Variable("r", "parameter", 0.026, "Groove radius r: plunger-groove axis to input axis (seed sec. 2)",
+                 "m", "mm", min=0.0),
+        Variable("l", "parameter", 0.700, "Distance l from the tripod centre to the output self-aligning bearing centre",
+                 "m", "mm", min=0.0),
+        Variable("m_plunger", "parameter", 0.2, "Plunger (sliding pin) mass m, eqs 28-34", "kg", min=0.0),
+        Variable("beta_max", "parameter", math.radians(45.0), "Largest accepted bend angle beta (guard)",
+                 "rad", "deg", min=0.0, max=math.radians(80.0)),
+        Variable("kinematics", "parameter", CLOSED_FORM,
+                 "Kinematics of phi_out: 0 = closed form (eq 18, small r/l), 1 = exact closed-loop solution",
+                 type="Integer", min=CLOSED_FORM, max=EXACT),
+        Variable("phi_in_start", "parameter", 0.0, "Input shaft angle phi_in at the start time", "rad", "deg"),
+        Variable("omega_in", "input", 2000.0 * math.pi / 30.0, "Input shaft speed omega_1 (held over a step)",
+                 "rad/s", "rpm"),
+        Variable("beta", "input", math.radians(30.0), "Bend angle beta between input and output axes",
+                 "rad", "deg", min=0.0, max=math.radians(80.0)),
+        Variable("T_load", "input", 100.0, "Load torque T0 acting on the output shaft (eq 22)", "N.m"),
+        Variable("phi_in", "output", 0.0, "Input shaft angle phi_1, integrated from omega_in", "rad", "deg"),
+        Variable("phi_out", "output", 0.0, "Output shaft angle phi_0 (eq 18 or exact kinematics)", "rad", "deg"),
+        Variable("delta_phi", "output", 0.0, "Angular deviation phi_out - phi_in (eq 18)", "rad", "deg"),
+        Variable("omega_out", "output", 0.0, "Output shaft speed, d(phi_out)/dt (consistent derivative of eq 18)",
+                 "rad/s", "rpm"),
+        Variable("T_in", "output", 0.0, "Input torque from the power balance T_in omega_in = T0 omega_out", "N.m"),
+        Variable("F_pin", "output", 0.0, "Force F on each tripod arm, eq 24 with corrected eq 21: T0/(3r + 3rho)", "N"),
+        Variable("rho", "output", 0.0, "Orbit radius rho of the tripod centre, r(1 - cos beta)/(2 cos beta)",
+                 "m", "mm"),
+        Variable("theta", "output", 0.0, "Cone angle theta of the output shaft about the bearing centre", "rad", "deg"),
+        Variable("a_plunger_sum", "output", 0.0, "Sum of the plunger accelerations a1 + a2 + a3 as printed in eq 20",
+                 "m/s2"),
+        Variable("Rz_out", "output", 0.0, "Axial reaction R_z'' of the output self-aligning bearing, eq 30", "N"),
+        Variable("Rx_in", "output", 0.0, "Reaction R_x' of the input bearing, eq 33", "N"),
+        Variable("Ry_in", "output", 0.0, "Reaction R_y' of the input bearing, eq 34", "N"),
+    ),
+    default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
+)
