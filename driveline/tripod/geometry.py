@@ -45,7 +45,8 @@ def orbit_radius(beta: ArrayLike, r: float) -> NDArray[np.float64]:
     plane (normal to the output axis) gives three points at parametric angles 120 deg
     apart on an ellipse with semi-axes r / cos(beta) (bend plane) and r. A 120 deg
     star through three such points has its centre at distance (a - b) / 2 from the
-    ellipse centre, circling it three times per turn, opposite to the shaft.
+    ellipse centre, ``-rho (cos 3 phi_in, sin 3 phi_in)``: three orbits per turn in the
+    shaft's sense of rotation.
     """
     cos_beta = np.cos(np.asarray(beta, dtype=float))
     return r * (1.0 - cos_beta) / (2.0 * cos_beta)

@@ -1,0 +1,1 @@
+"""fmpy-based harness: run the project's FMUs, write results and figures."""

@@ -1,0 +1,192 @@
+"""The TripodCoupling FMU end to end through fmpy: description, results, bad input, state."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from fmpy import read_model_description, simulate_fmu
+from fmpy.validation import validate_fmu
+
+from driveline.tripod import closed_form, dynamics, geometry
+from driveline.tripod.exact import exact_pose
+from fmu_harness.runner import FmuInstance, StepRefused, simulate
+
+R, L, M = 0.026, 0.700, 0.2
+OMEGA = 2000.0 * math.pi / 30.0
+
+
+def test_validates_clean(tripod_fmu):
+    assert validate_fmu(str(tripod_fmu)) == []
+
+
+def test_model_description_carries_units_ranges_and_structure(tripod_fmu):
+    md = read_model_description(str(tripod_fmu))
+    units = {u.name: u for u in md.unitDefinitions}
+    assert [d.name for d in units["rad"].displayUnits] == ["deg"]
+    assert [d.name for d in units["rad/s"].displayUnits] == ["rpm"]
+    variables = {v.name: v for v in md.modelVariables}
+    assert variables["beta"].unit == "rad" and variables["beta"].displayUnit == "deg"
+    assert variables["omega_out"].displayUnit == "rpm"
+    assert float(variables["beta"].max) == pytest.approx(math.radians(80.0))
+    assert "eq 30" in variables["Rz_out"].description
+    outputs = {v.name for v in md.modelVariables if v.causality == "output"}
+    assert {u.variable.name for u in md.outputs} == outputs
+    assert {u.variable.name for u in md.initialUnknowns} == outputs
+    assert md.defaultExperiment.stopTime is not None
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+
+
+@pytest.mark.parametrize("kinematics", [0, 1])
+def test_outputs_match_the_physics_core(tripod_fmu, kinematics):
+    beta = math.radians(35.0)
+    result = simulate(
+        tripod_fmu, 0.02, 1e-4,
+        inputs={"omega_in": OMEGA, "beta": beta, "T_load": 250.0},
+        start_values={"kinematics": kinematics, "phi_in_start": 0.3},
+    )
+    phi = 0.3 + OMEGA * result["time"]
+    np.testing.assert_allclose(result["phi_in"], phi, rtol=1e-12)
+    if kinematics:
+        reference = exact_pose(phi, beta, R, L)
+        phi_out, ratio = reference.phi_out, reference.speed_ratio
+    else:
+        phi_out = phi + closed_form.angle_deviation(phi, beta, R, L)
+        ratio = closed_form.speed_ratio(phi, beta, R, L)
+    np.testing.assert_allclose(result["phi_out"], phi_out, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(result["omega_out"], OMEGA * ratio, rtol=1e-9)
+    np.testing.assert_allclose(result["T_in"] * OMEGA, 250.0 * result["omega_out"], rtol=1e-12)
+    np.testing.assert_allclose(result["F_pin"], dynamics.pin_force(250.0, beta, R), rtol=1e-12)
+    np.testing.assert_allclose(result["Rz_out"], dynamics.output_axial_reaction(phi, beta, OMEGA, R, M), rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(result["Ry_in"], dynamics.input_reaction_y(phi, beta, OMEGA, R, L, M), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(result["rho"], geometry.orbit_radius(beta, R), rtol=1e-12)
+
+
+@pytest.mark.parametrize("kinematics", [0, 1])
+def test_omega_out_is_the_derivative_of_phi_out(tripod_fmu, kinematics):
+    step = 1e-5
+    result = simulate(tripod_fmu, 0.01, step, inputs={"beta": math.radians(40.0)}, start_values={"kinematics": kinematics})
+    numerical = (result["phi_out"][2:] - result["phi_out"][:-2]) / (2 * step)
+    amplitude = closed_form.deviation_amplitude(math.radians(40.0), R, L)
+    # central differences: truncation step^2/6 * 27 A omega^3, round-off eps * phi / step
+    bound = 1.5 * step**2 / 6 * 27 * amplitude * OMEGA**3 + 1e-15 * 3 / step
+    assert np.abs(numerical - result["omega_out"][1:-1]).max() < bound
+
+
+@pytest.mark.parametrize("kinematics", [0, 1])
+def test_results_do_not_depend_on_the_step_size(tripod_fmu, kinematics):
+    runs = [
+        simulate(tripod_fmu, 0.02, step, inputs={"beta": 0.6}, start_values={"kinematics": kinematics})
+        for step in (1e-3, 1e-4)
+    ]
+    coarse, fine = runs[0], runs[1][::10]
+    np.testing.assert_allclose(coarse["time"], fine["time"], atol=1e-12)
+    # phi_in is integrated exactly (omega held), so only summation round-off differs
+    np.testing.assert_allclose(coarse["phi_out"], fine["phi_out"], rtol=0, atol=1e-12)
+
+
+def test_seed_claims_through_the_fmu(tripod_fmu):
+    period = 2 * math.pi / OMEGA
+    steps = 720
+    result = simulate(tripod_fmu, period, period / steps, inputs={"beta": math.radians(30.0)})[:-1]
+    assert np.abs(result["delta_phi"]).max() < 10 * math.pi / (180 * 60)  # below 10 arcmin
+    spectrum = {name: np.abs(np.fft.rfft(result[name])) for name in ("Rz_out", "Rx_in", "Ry_in", "delta_phi")}
+    assert np.argmax(spectrum["Rz_out"]) == 3
+    assert np.argmax(spectrum["Rx_in"]) == 3
+    assert np.argmax(spectrum["Ry_in"]) == 6
+    assert np.argmax(spectrum["delta_phi"]) == 3
+    straight = simulate(tripod_fmu, period, period / 36, inputs={"beta": 0.0})
+    for name in ("delta_phi", "Rz_out", "Rx_in", "Ry_in", "a_plunger_sum"):
+        assert np.abs(straight[name]).max() == 0.0
+
+
+@pytest.mark.parametrize("omega", [-150.0, 0.0])
+def test_reverse_rotation_and_standstill(tripod_fmu, omega):
+    result = simulate(tripod_fmu, 0.01, 1e-3, inputs={"omega_in": omega, "T_load": 80.0}, start_values={"kinematics": 1})
+    np.testing.assert_allclose(result["phi_in"], omega * result["time"], atol=1e-12)
+    assert np.all(np.isfinite(result["T_in"]))
+    assert np.all(np.abs(result["T_in"] - 80.0) < 80.0 * 0.02)
+
+
+BAD_INPUTS = [
+    ({"beta": math.radians(50.0)}, "beta_max"),
+    ({"beta": -0.1}, "beta"),
+    ({"beta": math.nan}, "beta"),
+    ({"omega_in": math.inf}, "omega_in"),
+    ({"T_load": -math.inf}, "T_load"),
+    ({"omega_in": math.nan}, "omega_in"),
+]
+BAD_PARAMETERS = [
+    ({"r": 0.0}, "r"),
+    ({"r": -0.01}, "r"),
+    ({"l": 0.02}, "l"),
+    ({"m_plunger": -1.0}, "m_plunger"),
+    ({"beta_max": math.radians(85.0)}, "beta_max"),
+    ({"kinematics": 3}, "kinematics"),
+    ({"phi_in_start": math.nan}, "phi_in_start"),
+]
+
+
+@pytest.mark.parametrize("values, name", BAD_INPUTS)
+def test_bad_input_is_refused_with_a_reason_and_the_run_can_go_on(tripod_fmu, values, name):
+    with FmuInstance(tripod_fmu) as fmu:
+        fmu.initialize({"beta": 0.3})
+        fmu.step(1e-3)
+        before = fmu.get(["phi_in", "phi_out"])
+        fmu.set(values)
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1e-3)
+        assert refused.value.status == "Discard"
+        assert any(name in message for message in refused.value.messages)
+        assert fmu.get(["phi_in", "phi_out"]) == before  # the refused step left no trace
+        fmu.time -= 1e-3  # the host retries the same step with a good input
+        fmu.set({"beta": 0.3, "omega_in": OMEGA, "T_load": 100.0})
+        fmu.step(1e-3)
+        assert fmu.get(["phi_in"])[0] == pytest.approx(2 * OMEGA * 1e-3, rel=1e-12)
+
+
+@pytest.mark.parametrize("values, name", BAD_PARAMETERS)
+def test_non_physical_parameter_is_refused(tripod_fmu, values, name):
+    with pytest.raises(StepRefused) as refused:
+        simulate(tripod_fmu, 0.01, 1e-3, start_values=values)
+    assert any(name in message for message in refused.value.messages)
+
+
+@pytest.mark.parametrize("step", [0.0, -1e-3, math.nan])
+def test_bad_step_size_is_refused(tripod_fmu, step):
+    with FmuInstance(tripod_fmu) as fmu:
+        fmu.initialize()
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(step)
+        assert "step size" in refused.value.messages[0]
+
+
+def test_what_plain_simulate_fmu_sees_of_a_refused_step(tripod_fmu):
+    """fmpy's simulate_fmu treats pythonfmu's fmi2Discard as an early end: the run stops short.
+    Our harness raises instead (documented in the README)."""
+    signal = np.array([(0.0, 0.3), (0.005, 1.2)], dtype=[("time", float), ("beta", float)])
+    result = simulate_fmu(str(tripod_fmu), stop_time=0.01, step_size=1e-3, output_interval=1e-3, input=signal)
+    assert result["time"][-1] < 0.01
+
+
+def test_instances_are_independent_and_state_round_trips(tripod_fmu):
+    with FmuInstance(tripod_fmu, "a") as a, FmuInstance(tripod_fmu, "b") as b:
+        a.initialize({"kinematics": 1, "beta": 0.5})
+        b.initialize({"kinematics": 0, "beta": 0.2, "omega_in": -50.0})
+        for _ in range(5):
+            a.step(1e-3)
+            b.step(1e-3)
+        state = a.fmu.getFMUstate()
+        serialized = a.fmu.serializeFMUstate(state)
+        reference = a.run(0.02, 1e-3, outputs=["phi_out", "Rz_out", "theta"])
+        a.fmu.setFMUstate(a.fmu.deSerializeFMUstate(serialized))
+        a.time = 0.005
+        again = a.run(0.02, 1e-3, outputs=["phi_out", "Rz_out", "theta"])
+        assert reference.tobytes() == again.tobytes()  # bit-identical continuation
+        assert b.get(["phi_in"])[0] == pytest.approx(-50.0 * 0.005)
+        a.fmu.freeFMUstate(state)
+        a.reset()
+        a.initialize({"kinematics": 1, "beta": 0.5})
+        a.run(0.005, 1e-3)
+        assert a.run(0.02, 1e-3, outputs=["phi_out", "Rz_out", "theta"]).tobytes() == reference.tobytes()

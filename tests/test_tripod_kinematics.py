@@ -1,0 +1,106 @@
+"""Tripod coupling kinematics: closed forms of the seed against the exact closed-loop solution."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from driveline.tripod import closed_form, exact, geometry
+
+R, L = 0.026, 0.700  # seed 000's worked example
+PHI = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
+ARCMIN = np.pi / (180.0 * 60.0)
+
+
+@pytest.fixture(scope="module", params=[5.0, 15.0, 30.0, 45.0])
+def pose(request: pytest.FixtureRequest) -> tuple[float, exact.ExactPose]:
+    beta = np.radians(request.param)
+    return beta, exact.exact_pose(PHI, beta, R, L)
+
+
+def test_closure_residual_vanishes(pose):
+    beta, p = pose
+    x = np.column_stack([p.phi_out, p.swing])
+    residual = exact._residual(x, PHI, np.full_like(PHI, beta), R, L)
+    assert np.abs(residual).max() < 1e-15  # m^2-scaled residual at round-off
+
+
+def test_orbit_radius_matches_exact_tripod_centre(pose):
+    beta, p = pose
+    axis = np.array([-np.sin(beta), 0.0, np.cos(beta)])
+    offset = p.tripod_centre - np.outer(p.tripod_centre @ axis, axis)
+    radius = np.linalg.norm(offset, axis=1)
+    rho = geometry.orbit_radius(beta, R)
+    # rho is the small-r/l planar result; the exact orbit differs by O(r/l) of rho.
+    assert np.abs(radius / rho - 1.0).max() < R / L
+    # the centre circles three times per turn, in the shaft's sense of rotation
+    angle = np.unwrap(np.arctan2(offset @ np.array([0.0, 1.0, 0.0]), offset @ np.array([np.cos(beta), 0.0, np.sin(beta)])))
+    assert (angle[-1] - angle[0]) == pytest.approx(3.0 * 2.0 * np.pi * (1 - 1 / len(PHI)), rel=1e-3)
+
+
+def test_cone_angle_is_rho_over_l(pose):
+    beta, p = pose
+    assert np.abs(p.cone_angle * L / geometry.orbit_radius(beta, R) - 1.0).max() < R / L
+
+
+def test_eq18_in_project_convention_matches_exact(pose):
+    beta, p = pose
+    amplitude = closed_form.deviation_amplitude(beta, R, L)
+    error = np.abs((p.phi_out - PHI) - closed_form.angle_deviation(PHI, beta, R, L)).max()
+    # measured: 1.3e-5 (10 deg), 3.3e-4 (30 deg), 1.7e-3 (45 deg) of the amplitude
+    assert error < 2.5e-3 * amplitude
+    # eq 18 read with phi = phi_in (groove 1 in the bend plane) would be wrong by ~sqrt(2) A
+    literal = np.abs((p.phi_out - PHI) - amplitude * np.cos(3 * PHI)).max()
+    assert literal > 1.3 * amplitude
+
+
+def test_seed_claim_peak_deviation_below_10_arcmin_at_30_deg():
+    p = exact.exact_pose(PHI, np.radians(30.0), R, L)
+    peak = np.abs(p.phi_out - PHI).max()
+    assert peak < 10 * ARCMIN
+    assert peak / ARCMIN == pytest.approx(2.647, abs=0.01)  # measured 2.647 arcmin
+
+
+def test_zero_bend_angle_gives_zero_deviation():
+    p = exact.exact_pose(PHI, 0.0, R, L)
+    assert np.abs(p.phi_out - PHI).max() < 1e-15
+    assert np.abs(p.cone_angle).max() < 1e-15
+
+
+def test_speed_ratio_is_the_derivative_of_the_angle(pose):
+    beta, p = pose
+    step = PHI[1] - PHI[0]
+    for phi_out, ratio in [
+        (p.phi_out, p.speed_ratio),
+        (PHI + closed_form.angle_deviation(PHI, beta, R, L), closed_form.speed_ratio(PHI, beta, R, L)),
+    ]:
+        numerical = np.gradient(phi_out, step)
+        # central-difference truncation error: step^2 / 6 * max|d3 phi_out| = step^2 / 6 * 27 A (x 1.5)
+        # plus 1e-8 for the exact solver's finite-difference Jacobian (round-off ~ eps / 1e-7)
+        bound = 1.5 * step**2 / 6.0 * 27.0 * closed_form.deviation_amplitude(beta, R, L) + 1e-8
+        assert np.abs(numerical[1:-1] - ratio[1:-1]).max() < bound
+
+
+def test_printed_eq19_is_not_the_derivative_of_eq18():
+    beta = np.radians(30.0)
+    amplitude = closed_form.deviation_amplitude(beta, R, L)
+    printed = 1.0 - 3.0 * amplitude * np.cos(3.0 * closed_form.paper_angle(PHI))
+    assert np.abs(printed - closed_form.speed_ratio(PHI, beta, R, L)).max() > 2.0 * amplitude
+
+
+def test_corrected_eq21_arm_lengths(pose):
+    beta, p = pose
+    rho = geometry.orbit_radius(beta, R)
+    assert np.abs(geometry.arm_lengths(PHI, beta, R) - p.arm_lengths).max() < 0.25 * rho
+    mean = p.arm_lengths.mean()
+    assert abs(mean - (R + rho)) < 0.1 * rho  # corrected mean r + rho
+    assert abs(mean - (R - rho)) > 1.8 * rho  # the seed's r - rho is off by 2 rho
+
+
+def test_warm_started_solve_matches_batch():
+    beta = np.radians(40.0)
+    batch = exact.solve_closure(PHI[:50], beta, R, L)
+    x = None
+    for k in range(50):
+        x = exact.solve_closure(PHI[k], beta, R, L, start=x)
+        np.testing.assert_allclose(x, batch[k], atol=1e-14)
