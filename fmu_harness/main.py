@@ -1,0 +1,25 @@
+"""The main job: simulate the project's FMUs through fmpy and write results and figures.
+
+Usage: ``python -m fmu_harness.main [--models models] [--out results]`` after
+``python build_fmu.py``.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from . import tripod_study
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
+    parser.add_argument("--out", type=Path, default=Path("results"), help="folder for CSV files and figures")
+    args = parser.parse_args(argv)
+    for path in tripod_study.write(args.models / "TripodCoupling.fmu", args.out):
+        print(path)
+
+
+if __name__ == "__main__":
+    main()
