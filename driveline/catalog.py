@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from .cardan.model import CardanJointModel
 from .model import SteppedModel
+from .reducer.model import UniversalReducerModel
 from .tripod.model import TripodCouplingModel
 
 MODELS: dict[str, type[SteppedModel]] = {
     model.spec.name: model
-    for model in (TripodCouplingModel,)
+    for model in (TripodCouplingModel, CardanJointModel, UniversalReducerModel)
 }

@@ -88,6 +88,18 @@ class SteppedModel(ABC):
         """Input checks that depend on parameters (e.g. an angle against its guard)."""
         return []
 
+    def angle_bound_errors(self, name: str, upper: str, lower: str | None = None, note: str = "") -> list[str]:
+        """An input angle against the parameters that bound it, reported in degrees."""
+        value, high = getattr(self, name), getattr(self, upper)
+        low = getattr(self, lower) if lower else -math.inf
+        if low <= value <= high:
+            return []
+        if lower:
+            where = f"outside [{lower}, {upper}] = [{math.degrees(low):.6g}, {math.degrees(high):.6g}] deg"
+        else:
+            where = f"above {upper} = {math.degrees(high):.6g} deg"
+        return [f"input {name} = {math.degrees(value):.6g} deg is {where}{note}"]
+
     # -- validation ------------------------------------------------------------
     def parameter_errors(self) -> list[str]:
         errors = [e for v in self.spec.of("parameter") if (e := self._range_error(v))]
@@ -127,3 +139,24 @@ class SteppedModel(ABC):
 
     def outputs(self) -> dict[str, Any]:
         return {v.name: getattr(self, v.name) for v in self.spec.of("output")}
+
+
+class DrivenShaftModel(SteppedModel):
+    """A model driven by an input shaft: ``phi_in`` integrates the held ``omega_in`` exactly.
+
+    Subclasses have the variables ``phi_in_start``, ``omega_in`` and ``phi_in`` and compute
+    their outputs in :meth:`evaluate`.
+    """
+
+    def start(self, start_time: float) -> None:
+        self.phi_in = self.phi_in_start
+        self.evaluate(start_time)
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        self.phi_in = self.phi_in + self.omega_in * step_size
+        self.evaluate(current_time)
+
+    @abstractmethod
+    def evaluate(self, input_time: float) -> None:
+        """Outputs from the current ``phi_in``, inputs and parameters; ``input_time`` is the
+        communication point at which the host set the inputs (the start of the step)."""

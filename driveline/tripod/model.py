@@ -6,14 +6,14 @@ import math
 
 import numpy as np
 
-from ..model import SteppedModel
+from ..model import DrivenShaftModel
 from . import closed_form, dynamics
 from .exact import exact_pose
 from .geometry import TripodGeometry, orbit_radius
 from .spec import EXACT, SPEC
 
 
-class TripodCouplingModel(SteppedModel):
+class TripodCouplingModel(DrivenShaftModel):
     """The ``TripodCoupling`` co-simulation model (inputs held constant over a step)."""
 
     spec = SPEC
@@ -25,23 +25,13 @@ class TripodCouplingModel(SteppedModel):
         return TripodGeometry(self.r, self.l, self.m_plunger).errors()
 
     def extra_input_errors(self) -> list[str]:
-        if self.beta > self.beta_max:
-            return [
-                f"input beta = {math.degrees(self.beta):.6g} deg is above beta_max = "
-                f"{math.degrees(self.beta_max):.6g} deg"
-            ]
-        return []
+        return self.angle_bound_errors("beta", "beta_max")
 
     def start(self, start_time: float) -> None:
         self._closure = None
-        self.phi_in = self.phi_in_start
-        self._evaluate()
+        super().start(start_time)
 
-    def advance(self, current_time: float, step_size: float) -> None:
-        self.phi_in = self.phi_in + self.omega_in * step_size
-        self._evaluate()
-
-    def _evaluate(self) -> None:
+    def evaluate(self, input_time: float) -> None:
         """Outputs at the current phi_in and inputs."""
         phi, beta, omega = self.phi_in, self.beta, self.omega_in
         r, l, m = self.r, self.l, self.m_plunger

@@ -1,0 +1,52 @@
+"""Time stepping of the Cardan joint: integrates phi_in and evaluates the exact kinematics.
+
+The input speed is held over each step (zero-order hold), so the input angle grows by
+``omega_in * h`` exactly. A held signal has no acceleration of its own, yet a host that
+samples a changing speed means one; the model therefore reports as input acceleration
+a_1 the backward difference of the last two samples,
+``(omega_in(t_k) - omega_in(t_{k-1})) / (t_k - t_{k-1})``, which is exact for a speed ramp,
+and feeds it to the seed's acceleration relation. A change made at the start time
+itself (no interval yet) counts as a new initial condition: a_1 = 0.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ..model import DrivenShaftModel
+from . import kinematics
+from .spec import SPEC
+
+
+class CardanJointModel(DrivenShaftModel):
+    """The ``CardanJoint`` co-simulation model (inputs held constant over a step)."""
+
+    spec = SPEC
+
+    def reset_internal_state(self) -> None:
+        self._omega_sample = 0.0  # omega_in of the last evaluation [rad/s]
+        self._sample_time: float | None = None  # time of that evaluation [s]
+
+    def extra_parameter_errors(self) -> list[str]:
+        if not self.beta_max < 0.5 * math.pi:
+            return [f"parameter beta_max = {math.degrees(self.beta_max):.6g} deg must be below 90 deg"]
+        return []
+
+    def extra_input_errors(self) -> list[str]:
+        return self.angle_bound_errors("beta", "beta_max")
+
+    def evaluate(self, input_time: float) -> None:
+        """Outputs at the current phi_in; a_1 from this and the previous speed sample."""
+        previous = self._sample_time
+        elapsed = input_time - previous if previous is not None else 0.0
+        alpha_in = (self.omega_in - self._omega_sample) / elapsed if elapsed > 0.0 else 0.0
+        self._omega_sample, self._sample_time = self.omega_in, input_time
+        phi, beta, phase = self.phi_in, self.beta, self.phase
+        ratio = float(kinematics.speed_ratio(phi, beta, phase))
+        self.phi_out = float(kinematics.output_angle(phi, beta, phase))
+        self.speed_ratio = ratio
+        self.omega_out = self.omega_in * ratio
+        self.alpha_in = alpha_in
+        self.alpha_out = float(kinematics.output_acceleration(phi, beta, self.omega_in, alpha_in, phase))
+        self.T_in = self.T_load * ratio
+        self.speed_fluctuation = float(kinematics.speed_fluctuation(beta))

@@ -1,0 +1,57 @@
+"""Time stepping of the universal reducer: integrates phi_in; ratio and strength are algebraic.
+
+The input speed is held over each step, so phi_in grows by ``omega_in * h`` and
+``phi_out = phi_in / i`` follows exactly, whatever alpha does between or within steps
+(the RCRCR kinematics do not depend on it). The loads are the seed's quasi-static
+relations at its critical position, evaluated at the current alpha and torque.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ..model import DrivenShaftModel
+from .mechanics import connecting_shaft_loads, cylinder_slide, shaft_stress, transmission_ratio
+from .spec import SPEC
+
+
+class UniversalReducerModel(DrivenShaftModel):
+    """The ``UniversalReducer`` co-simulation model (inputs held constant over a step)."""
+
+    spec = SPEC
+
+    def extra_parameter_errors(self) -> list[str]:
+        problems = []
+        if not self.z1 > self.z2:
+            problems.append(f"parameter z1 = {self.z1} must exceed z2 = {self.z2} (i = z1 / (z1 - z2))")
+        for name in ("module", "e", "r_shaft", "sigma_allow", "alpha_min"):
+            if not getattr(self, name) > 0.0:
+                problems.append(f"parameter {name} = {getattr(self, name)!r} must be positive")
+        if not self.alpha_min <= self.alpha_max < math.pi:
+            problems.append(
+                f"parameters alpha_min = {math.degrees(self.alpha_min):.6g} deg and alpha_max = "
+                f"{math.degrees(self.alpha_max):.6g} deg must satisfy alpha_min <= alpha_max < 180 deg"
+            )
+        return problems
+
+    def extra_input_errors(self) -> list[str]:
+        return self.angle_bound_errors("alpha", "alpha_max", "alpha_min", " (eq 21 is singular at 0 and 180 deg)")
+
+    def evaluate(self, input_time: float) -> None:
+        """Outputs at the current phi_in and inputs."""
+        i = transmission_ratio(self.z1, self.z2)
+        self.speed_ratio = 1.0 / i
+        self.phi_out = self.phi_in / i
+        self.omega_out = self.omega_in / i
+        self.T_in = self.T_load / i
+        self.s_b = float(cylinder_slide(self.phi_in, self.alpha, self.e))
+        geometry = (self.alpha, self.z1, self.z2, self.module, self.e, self.L1)
+        loads = connecting_shaft_loads(self.T_in, *geometry)
+        stress = shaft_stress(loads.M_C, loads.M_C1, self.r_shaft)
+        self.M_E, self.M_C1 = float(loads.M_E), float(loads.M_C1)
+        self.M_B, self.M_C = float(loads.M_B), float(loads.M_C)
+        self.sigma_bend, self.tau_torsion = float(stress.sigma), float(stress.tau)
+        self.sigma_eq = float(stress.sigma_eq)
+        self.utilisation = self.sigma_eq / self.sigma_allow
+        unit = connecting_shaft_loads(1.0, *geometry)
+        self.T_in_allow = self.sigma_allow / float(shaft_stress(unit.M_C, unit.M_C1, self.r_shaft).sigma_eq)
