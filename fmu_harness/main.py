@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from . import tripod_study
+from . import coupling_comparison, tripod_study
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -17,7 +17,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--out", type=Path, default=Path("results"), help="folder for CSV files and figures")
     args = parser.parse_args(argv)
-    for path in tripod_study.write(args.models / "TripodCoupling.fmu", args.out):
+    written = tripod_study.write(args.models / "TripodCoupling.fmu", args.out)
+    written += coupling_comparison.write(args.models, args.out)
+    for path in written:
         print(path)
 
 

@@ -57,7 +57,7 @@ class FmuInstance:
 
     # -- logging -----------------------------------------------------------------
     def _on_log(self, *args: Any) -> None:
-        status, category, message = args[-3:] if len(args) == 5 else (args[2], args[3], args[-1])
+        status, category, message = args[-3:]  # FMI 2.0 passes five arguments, FMI 3.0 four
         decode = lambda b: b.decode("utf-8", "replace") if isinstance(b, bytes) else str(b)  # noqa: E731
         name = STATUS_NAMES[status] if isinstance(status, int) and status < len(STATUS_NAMES) else str(status)
         self.log.append(LogRecord(name, decode(category), decode(message)))
@@ -95,6 +95,22 @@ class FmuInstance:
             else:
                 values.append(self.fmu.getString(reference)[0])
         return values
+
+    # -- FMU state (FMI 2.0 and 3.0 spell the calls differently) -----------------
+    def get_state(self) -> Any:
+        return self.fmu.getFMUState() if self.fmi3 else self.fmu.getFMUstate()
+
+    def set_state(self, state: Any) -> None:
+        (self.fmu.setFMUState if self.fmi3 else self.fmu.setFMUstate)(state)
+
+    def free_state(self, state: Any) -> None:
+        (self.fmu.freeFMUState if self.fmi3 else self.fmu.freeFMUstate)(state)
+
+    def serialize_state(self, state: Any) -> bytes:
+        return bytes(self.fmu.serializeFMUState(state) if self.fmi3 else self.fmu.serializeFMUstate(state))
+
+    def deserialize_state(self, serialized: bytes) -> Any:
+        return (self.fmu.deserializeFMUState if self.fmi3 else self.fmu.deSerializeFMUstate)(serialized)
 
     # -- life cycle --------------------------------------------------------------
     def _call(self, name: str, function: Callable[[], Any]) -> None:
@@ -180,9 +196,12 @@ def simulate(
     start_values: Mapping[str, Any] | None = None,
     outputs: Iterable[str] | None = None,
     start_time: float = 0.0,
+    unzipdir: str | None = None,
 ) -> np.ndarray:
-    """Instantiate, initialise and run one FMU; raises :class:`StepRefused` on any refused call."""
-    with FmuInstance(path) as instance:
+    """Instantiate, initialise and run one FMU; raises :class:`StepRefused` on any refused call.
+
+    ``unzipdir`` reuses an already extracted FMU (kept after the run) instead of extracting it."""
+    with FmuInstance(path, unzipdir=unzipdir) as instance:
         first = {k: (v(start_time) if callable(v) else v) for k, v in (inputs or {}).items()}
         instance.initialize({**(start_values or {}), **first}, start_time)
         return instance.run(stop_time, step_size, inputs, outputs)

@@ -1,0 +1,365 @@
+"""Parameter sweeps of one FMU on Dask distributed: one FMU run per point, one tidy table.
+
+Usage::
+
+    python -m fmu_harness.sweep --grid beta=0:0.7:8 omega_in=100,200,300 r=0.02,0.026
+    python -m fmu_harness.sweep --model CardanJoint --points points.csv --out cardan.parquet
+    python -m fmu_harness.sweep --grid beta=0.1,0.3 --scheduler tcp://host:8786
+
+A grid axis is ``name=v1,v2,...`` or ``name=start:stop:count`` (``count`` values, both ends
+included); the grid is the cartesian product of its axes. A points file is CSV (a header of
+names) or JSON (a list of objects). Each name must be a parameter (set as a start value) or an
+input (held constant) of the FMU. A run lasts ``--turns`` input turns at the point's
+``omega_in`` in ``--steps-per-turn`` steps unless ``--duration`` / ``--step`` are given.
+
+Every point is one :func:`fmu_harness.runner.simulate` call on a worker. The FMU's bytes are
+scattered to the workers once and extracted once per worker process, so workers need no shared
+file system. A refused or crashed run becomes a ``failed`` row with its reason.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import hashlib
+import importlib
+import itertools
+import json
+import math
+import os
+import threading
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv
+import pyarrow.parquet
+from distributed import Client, LocalCluster, get_worker, progress, wait
+from fmpy import extract, read_model_description
+
+from .runner import StepRefused, simulate
+
+Value = float | int | str
+Point = dict[str, Value]
+
+SPEED = "omega_in"
+"""The input whose turns set the default run length."""
+
+STATISTICS: dict[str, Callable[[np.ndarray], Any]] = {
+    "min": np.min,
+    "max": np.max,
+    "mean": np.mean,
+    "p2p": np.ptp,
+    "peak_abs": lambda x: np.max(np.abs(x)),
+}
+GENERIC = ("min", "max", "mean")
+"""Statistics of every Real output of any FMU, as columns ``<output>_<statistic>``."""
+SPECIFIC: dict[str, tuple[tuple[str, str], ...]] = {
+    "TripodCoupling": (
+        ("delta_phi", "peak_abs"),
+        ("Rz_out", "p2p"),
+        ("Rx_in", "p2p"),
+        ("Ry_in", "p2p"),
+        ("omega_out", "p2p"),
+    ),
+}
+"""Further (output, statistic) columns per model name."""
+
+CRITICAL_SPEEDS_MODEL = "CriticalSpeeds"
+MARGIN = "critical_speed_margin"
+
+
+def _value(text: str) -> Value:
+    """A number from its text (int if it reads as one), else the text itself."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def parse_axis(text: str) -> tuple[str, list[Value]]:
+    """``name=v1,v2,...`` or ``name=start:stop:count`` -> (name, values)."""
+    name, sep, values = text.partition("=")
+    if not (sep and name and values):
+        raise ValueError(f"grid axis {text!r}: expected name=v1,v2,... or name=start:stop:count")
+    bounds = values.split(":")
+    if len(bounds) == 3:
+        return name, np.linspace(float(bounds[0]), float(bounds[1]), int(bounds[2])).tolist()
+    return name, [_value(v) for v in values.split(",")]
+
+
+def grid(axes: Mapping[str, Sequence[Value]]) -> list[Point]:
+    """Cartesian product of named value lists, the last axis varying fastest."""
+    return [dict(zip(axes, values)) for values in itertools.product(*axes.values())]
+
+
+def read_points(path: Path) -> list[Point]:
+    """Points from a CSV file (header of names) or a JSON file (list of objects)."""
+    if path.suffix.lower() == ".json":
+        return [dict(point) for point in json.loads(path.read_text())]
+    with path.open(newline="") as handle:
+        return [{k: _value(v) for k, v in row.items()} for row in csv.DictReader(handle)]
+
+
+@dataclass(frozen=True)
+class Timing:
+    """Length and step of every run.
+
+    By default ``turns`` input turns at the point's ``omega_in`` in ``steps_per_turn`` steps;
+    ``duration`` and ``step_size`` [s] override either. An FMU without an ``omega_in`` input
+    runs its default experiment unless both are given.
+    """
+
+    turns: int = 1
+    steps_per_turn: int = 360
+    duration: float | None = None
+    step_size: float | None = None
+
+    def resolve(self, speed: float | None, default: tuple[float, float] | None) -> tuple[float, float]:
+        """(stop time, step size) for a run at input speed ``speed`` [rad/s]."""
+        if self.duration is not None and self.step_size is not None:
+            return self.duration, self.step_size
+        if speed is not None:
+            if not (math.isfinite(speed) and speed != 0.0):
+                raise ValueError(f"a run of whole input turns needs a finite non-zero {SPEED}, got {speed!r}")
+            turn = 2.0 * math.pi / abs(speed)
+            default = self.turns * turn, turn / self.steps_per_turn
+        elif default is None:
+            raise ValueError(f"the FMU has no {SPEED} input and no default experiment: give a duration and step size")
+        return (
+            default[0] if self.duration is None else self.duration,
+            default[1] if self.step_size is None else self.step_size,
+        )
+
+
+@dataclass(frozen=True)
+class Interface:
+    """What a sweep needs of an FMU's model description."""
+
+    model: str
+    causality: dict[str, str]
+    """Causality (``parameter`` or ``input``) of every settable variable."""
+    outputs: tuple[str, ...]
+    """Real outputs, summarised per run."""
+    speed_start: float | None
+    """Start value of the ``omega_in`` input; None without one."""
+    default_experiment: tuple[float, float] | None
+
+    @classmethod
+    def of(cls, path: Path) -> Interface:
+        description = read_model_description(str(path))
+        variables = description.modelVariables
+        speed = [v for v in variables if v.name == SPEED and v.causality == "input"]
+        experiment = description.defaultExperiment
+        return cls(
+            model=description.modelName,
+            causality={v.name: v.causality for v in variables if v.causality in ("parameter", "input")},
+            outputs=tuple(
+                v.name for v in variables if v.causality == "output" and v.type in ("Real", "Float64", "Float32")
+            ),
+            speed_start=float(speed[0].start) if speed and speed[0].start is not None else None,
+            default_experiment=(
+                (float(experiment.stopTime), float(experiment.stepSize))
+                if experiment and experiment.stopTime and experiment.stepSize
+                else None
+            ),
+        )
+
+    def split(self, point: Point) -> tuple[Point, Point]:
+        """(start values, constant inputs) of a point; unknown names raise ValueError."""
+        unknown = sorted(set(point) - set(self.causality))
+        if unknown:
+            raise ValueError(
+                f"{', '.join(unknown)}: no parameter or input of {self.model} "
+                f"(settable: {', '.join(self.causality)})"
+            )
+        parameters = {k: v for k, v in point.items() if self.causality[k] == "parameter"}
+        return parameters, {k: v for k, v in point.items() if self.causality[k] == "input"}
+
+    def speed(self, point: Point) -> float | None:
+        """The point's input speed [rad/s] (its value or the FMU's start value)."""
+        return None if self.speed_start is None else float(point.get(SPEED, self.speed_start))
+
+    def statistics(self) -> list[tuple[str, str]]:
+        """(output, statistic) of every metric column."""
+        generic = [(output, statistic) for output in self.outputs for statistic in GENERIC]
+        return generic + [s for s in SPECIFIC.get(self.model, ()) if s[0] in self.outputs]
+
+    def metric_columns(self) -> list[str]:
+        return [f"{output}_{statistic}" for output, statistic in self.statistics()]
+
+    def run(self, path: Path, point: Point, timing: Timing, unzipdir: str | None = None) -> dict[str, Any]:
+        """One FMU run of ``point``: status, reason and metrics, never an exception."""
+        try:
+            start_values, inputs = self.split(point)
+            stop_time, step_size = timing.resolve(self.speed(point), self.default_experiment)
+            result = simulate(path, stop_time, step_size, inputs, start_values, self.outputs, unzipdir=unzipdir)
+        except Exception as error:  # noqa: BLE001 - any failure of a run is a result of the sweep
+            return failed(error)
+        metrics = {
+            f"{output}_{statistic}": float(STATISTICS[statistic](result[output]))
+            for output, statistic in self.statistics()
+        }
+        return {"status": "ok", "reason": None, **metrics}
+
+
+def failed(error: BaseException) -> dict[str, Any]:
+    """The status and reason columns of a failed run."""
+    reason = str(error) if isinstance(error, StepRefused) else f"{type(error).__name__}: {error}"
+    return {"status": "failed", "reason": reason}
+
+
+@dataclass(frozen=True)
+class ShippedFmu:
+    """An FMU's bytes and interface, scattered once to every worker."""
+
+    interface: Interface
+    digest: str
+    data: bytes
+
+    @classmethod
+    def read(cls, path: Path) -> ShippedFmu:
+        data = path.read_bytes()
+        return cls(Interface.of(path), hashlib.sha256(data).hexdigest(), data)
+
+
+_UNPACKED: dict[str, tuple[Path, str]] = {}
+_UNPACK_LOCK = threading.Lock()
+
+
+def _unpacked(fmu: ShippedFmu) -> tuple[Path, str]:
+    """(FMU file, extracted folder), written once per worker process in the worker's scratch space."""
+    with _UNPACK_LOCK:
+        if fmu.digest not in _UNPACKED:
+            folder = Path(get_worker().local_directory) / f"fmu-{fmu.digest[:16]}"
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / f"{fmu.interface.model}.fmu"
+            path.write_bytes(fmu.data)
+            _UNPACKED[fmu.digest] = path, extract(path, unzipdir=folder / "extracted")
+        return _UNPACKED[fmu.digest]
+
+
+def run_point(fmu: ShippedFmu, point: Point, timing: Timing) -> dict[str, Any]:
+    """Worker task: run one point of the sweep."""
+    path, unzipdir = _unpacked(fmu)
+    return fmu.interface.run(path, point, timing, unzipdir)
+
+
+def critical_speed_margins(speeds: Sequence[float], driveline: Path | None = None) -> list[float] | None:
+    """Relative separation ``(n_c - speed) / speed`` from the nearest forward critical speed
+    ``n_c`` of a driveline (a TOML file of ``driveline.rotor``, default its example), or None
+    unless the catalog holds a ``CriticalSpeeds`` model and the rotor core is importable."""
+    from driveline.catalog import MODELS
+
+    if CRITICAL_SPEEDS_MODEL not in MODELS:
+        return None
+    try:
+        from driveline import rotor
+    except ImportError:
+        return None
+    shaft = rotor.load_driveline(driveline or rotor.example_path())
+    margins: dict[float, float] = {}
+    for speed in set(speeds):
+        nearest = shaft.nearest_order_resonance(abs(speed), orders=(1,), whirl=("forward",)) if speed else None
+        margins[speed] = math.nan if nearest is None else nearest.margin(abs(speed))
+    return [margins[speed] for speed in speeds]
+
+
+def sweep(
+    client: Client,
+    fmu: Path,
+    points: Sequence[Point],
+    timing: Timing = Timing(),
+    show_progress: bool = False,
+    driveline: Path | None = None,
+) -> pa.Table:
+    """Run every point on the client's workers; one row per point, in the order of ``points``.
+
+    Columns: the points' names, ``status`` (ok/failed), ``reason`` (null when ok), the
+    metrics of :meth:`Interface.statistics` (null when failed) and, when available,
+    ``critical_speed_margin`` (see :func:`critical_speed_margins`).
+    """
+    shipped = ShippedFmu.read(fmu)
+    interface = shipped.interface
+    for point in points:
+        interface.split(point)
+    payload = client.scatter(shipped, broadcast=True)
+    futures = [client.submit(run_point, payload, point, timing, pure=False) for point in points]
+    if show_progress:
+        progress(futures)
+    wait(futures)
+    rows = [
+        {**point, **(future.result() if future.status == "finished" else failed(future.exception()))}
+        for point, future in zip(points, futures)
+    ]
+    metrics = interface.metric_columns()
+    names = list(dict.fromkeys(name for point in points for name in point))
+    types = {"status": pa.string(), "reason": pa.string(), **{m: pa.float64() for m in metrics}}
+    columns = [*names, "status", "reason", *metrics]
+    table = pa.table({c: pa.array([row.get(c) for row in rows], types.get(c)) for c in columns})
+    speeds = [interface.speed(point) for point in points]
+    margins = None if interface.speed_start is None else critical_speed_margins(speeds, driveline)
+    return table if margins is None else table.append_column(MARGIN, pa.array(margins, pa.float64()))
+
+
+def write_table(table: pa.Table, path: Path) -> None:
+    """Parquet, or CSV when ``path`` ends in ``.csv``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix.lower() == ".csv":
+        pyarrow.csv.write_csv(table, path)
+    else:
+        pyarrow.parquet.write_table(table, path)
+
+
+@contextmanager
+def open_client(scheduler: str | None = None, workers: int = 2) -> Iterator[Client]:
+    """A client of the scheduler at ``scheduler``, else of a local cluster of ``workers``
+    single-threaded worker processes (closed on exit)."""
+    if scheduler:
+        with Client(scheduler) as client:
+            yield client
+        return
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+        with Client(cluster) as client:
+            yield client
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--grid", nargs="+", metavar="AXIS", help="name=v1,v2,... or name=start:stop:count")
+    source.add_argument("--points", type=Path, help="CSV or JSON file of points")
+    parser.add_argument("--model", default="TripodCoupling", help="FMU name (default TripodCoupling)")
+    parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
+    parser.add_argument("--turns", type=int, default=1, help=f"run length in turns of {SPEED} (default 1)")
+    parser.add_argument("--steps-per-turn", type=int, default=360)
+    parser.add_argument("--duration", type=float, help="run length [s] instead of whole turns")
+    parser.add_argument("--step", type=float, help="communication step size [s]")
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="local cluster size")
+    parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
+    parser.add_argument("--driveline", type=Path, help="driveline TOML for the critical-speed margin")
+    parser.add_argument("--out", type=Path, default=Path("results/sweep.parquet"), help=".parquet or .csv")
+    args = parser.parse_args(argv)
+
+    try:
+        points = grid(dict(map(parse_axis, args.grid))) if args.grid else read_points(args.points)
+    except ValueError as error:
+        parser.error(str(error))
+    timing = Timing(args.turns, args.steps_per_turn, args.duration, args.step)
+    with open_client(args.scheduler, args.workers) as client:
+        print(f"{len(points)} runs of {args.model} on {client.scheduler.address}")
+        table = sweep(client, args.models / f"{args.model}.fmu", points, timing, True, args.driveline)
+    write_table(table, args.out)
+    failures = table.column("status").to_pylist().count("failed")
+    print(f"\n{table.num_rows} runs, {failures} failed -> {args.out}")
+
+
+if __name__ == "__main__":
+    # Dask pickles ``__main__`` functions by value; run the module's own import instead.
+    importlib.import_module(__spec__.name).main()
