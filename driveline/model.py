@@ -31,6 +31,7 @@ class SteppedModel(ABC):
             setattr(self, v.name, v.start)
         self.time = 0.0
         self._initialized = False
+        self._valid_parameters: tuple[Any, ...] | None = None
         self.reset_internal_state()
 
     def reset_internal_state(self) -> None:
@@ -42,11 +43,14 @@ class SteppedModel(ABC):
         if errors:
             return errors
         self.time = start_time
-        snapshot = self.get_state()
-        self.start(start_time)
-        errors = self.output_errors()
+        snapshot = dict(self.__dict__)
+        try:
+            self.start(start_time)
+            errors = self.output_errors()
+        except (ArithmeticError, ValueError) as error:
+            errors = [f"the start values could not be computed ({type(error).__name__}: {error})"]
         if errors:
-            self.set_state(snapshot)
+            self.__dict__.update(snapshot)
             return errors
         self._initialized = True
         return []
@@ -59,14 +63,19 @@ class SteppedModel(ABC):
                 return errors
         if not (math.isfinite(step_size) and step_size > 0.0):
             return [f"communication step size must be positive and finite, got {step_size!r}"]
-        errors = self.parameter_errors() + self.input_errors()
+        parameters = tuple(getattr(self, name) for name in self._parameter_names)
+        errors = (self.parameter_errors() if parameters != self._valid_parameters else []) + self.input_errors()
         if errors:
             return errors
-        snapshot = self.get_state()
-        self.advance(current_time, step_size)
-        errors = self.output_errors()
+        self._valid_parameters = parameters  # NaN never compares equal, so it is always re-checked
+        snapshot = dict(self.__dict__)  # advance() replaces values, never mutates them in place
+        try:
+            self.advance(current_time, step_size)
+            errors = self.output_errors()
+        except (ArithmeticError, ValueError) as error:
+            errors = [f"the step from t = {current_time!r} s could not be computed ({type(error).__name__}: {error})"]
         if errors:
-            self.set_state(snapshot)
+            self.__dict__.update(snapshot)
             return errors
         self.time = current_time + step_size
         return []
@@ -78,7 +87,8 @@ class SteppedModel(ABC):
 
     @abstractmethod
     def advance(self, current_time: float, step_size: float) -> None:
-        """Advance internal state and outputs over one valid step."""
+        """Advance internal state and outputs over one valid step, assigning new values
+        (never mutating held objects in place: a refused step is undone from a shallow copy)."""
 
     def extra_parameter_errors(self) -> list[str]:
         """Physical consistency checks beyond each parameter's own range."""
@@ -101,19 +111,30 @@ class SteppedModel(ABC):
         return [f"input {name} = {math.degrees(value):.6g} deg is {where}{note}"]
 
     # -- validation ------------------------------------------------------------
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        spec = getattr(cls, "spec", None)
+        if spec is not None:
+            cls._parameter_names = tuple(v.name for v in spec.of("parameter"))
+            cls._inputs = spec.of("input")
+            cls._real_outputs = tuple(v.name for v in spec.of("output") if v.type == "Real")
+
     def parameter_errors(self) -> list[str]:
         errors = [e for v in self.spec.of("parameter") if (e := self._range_error(v))]
         return errors or self.extra_parameter_errors()
 
     def input_errors(self) -> list[str]:
-        errors = [e for v in self.spec.of("input") if (e := self._range_error(v))]
+        errors = [e for v in self._inputs if (e := self._range_error(v))]
         return errors or self.extra_input_errors()
 
     def output_errors(self) -> list[str]:
+        values = [getattr(self, name) for name in self._real_outputs]
+        if math.isfinite(math.fsum(values)):
+            return []
         return [
-            f"output {v.name} is not finite ({getattr(self, v.name)!r}); the step was not taken"
-            for v in self.spec.of("output")
-            if v.type == "Real" and not math.isfinite(getattr(self, v.name))
+            f"output {name} is not finite ({value!r}); the step was not taken"
+            for name, value in zip(self._real_outputs, values)
+            if not math.isfinite(value)
         ]
 
     def _range_error(self, v: Variable) -> str | None:

@@ -7,36 +7,37 @@ later (see :data:`PAPER_PHASE`); converted, eq 18 reads ``A sin 3 phi_in``.
 
 from __future__ import annotations
 
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
+import math
 
-PAPER_PHASE = 0.5 * np.pi
+from ..scalar import Real, lib
+
+PAPER_PHASE = 0.5 * math.pi
 """The seed's phi equals ``phi_in + PAPER_PHASE``: its phi = 0 has groove 1 normal to the
 bend plane. Found by fitting eq 18 and eq 21 to the exact kinematics (docs/tripod_coupling.md)."""
 
 
-def paper_angle(phi_in: ArrayLike) -> NDArray[np.float64]:
+def paper_angle(phi_in: Real) -> Real:
     """The seed's phi for the project's input angle."""
-    return np.asarray(phi_in, dtype=float) + PAPER_PHASE
+    return phi_in + PAPER_PHASE
 
 
-def deviation_amplitude(beta: ArrayLike, r: float, l: float) -> NDArray[np.float64]:
+def deviation_amplitude(beta: Real, r: float, l: float) -> Real:
     """Amplitude of eq 18, ``r (1 - cos b) / (2 l (1 + cos b)) tan b`` [rad]."""
-    beta = np.asarray(beta, dtype=float)
-    cos_beta = np.cos(beta)
-    return r * (1.0 - cos_beta) / (2.0 * l * (1.0 + cos_beta)) * np.tan(beta)
+    xp = lib(beta)
+    cos_beta = xp.cos(beta)
+    return r * (1.0 - cos_beta) / (2.0 * l * (1.0 + cos_beta)) * xp.tan(beta)
 
 
-def angle_deviation(phi_in: ArrayLike, beta: ArrayLike, r: float, l: float) -> NDArray[np.float64]:
+def angle_deviation(phi_in: Real, beta: Real, r: float, l: float) -> Real:
     """Eq 18: ``phi_out - phi_in = A(beta) cos 3 phi`` with the seed's phi, i.e. ``A sin 3 phi_in`` [rad]."""
-    return deviation_amplitude(beta, r, l) * np.cos(3.0 * paper_angle(phi_in))
+    return deviation_amplitude(beta, r, l) * lib(phi_in).cos(3.0 * paper_angle(phi_in))
 
 
-def speed_ratio(phi_in: ArrayLike, beta: ArrayLike, r: float, l: float) -> NDArray[np.float64]:
+def speed_ratio(phi_in: Real, beta: Real, r: float, l: float) -> Real:
     """d(phi_out)/d(phi_in) at constant beta, the derivative of eq 18.
 
     ``1 - 3 A sin 3 phi`` with the seed's phi (``1 + 3 A cos 3 phi_in``). The seed's eq 19
     prints ``1 - 3 A cos 3 phi``, which is not the derivative of its own eq 18: it puts
     the speed extremes where the angle deviation peaks.
     """
-    return 1.0 - 3.0 * deviation_amplitude(beta, r, l) * np.sin(3.0 * paper_angle(phi_in))
+    return 1.0 - 3.0 * deviation_amplitude(beta, r, l) * lib(phi_in).sin(3.0 * paper_angle(phi_in))

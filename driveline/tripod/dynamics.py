@@ -7,8 +7,9 @@ The reactions follow the seed; where it is wrong we say so (docs/tripod_coupling
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
+from ..scalar import Real, lib
 from .closed_form import paper_angle
 from .exact import exact_pose
 from .geometry import orbit_radius
@@ -16,47 +17,45 @@ from .geometry import orbit_radius
 Array = NDArray[np.float64]
 
 
-def pin_force(torque: ArrayLike, beta: ArrayLike, r: float) -> Array:
+def pin_force(torque: Real, beta: Real, r: float) -> Real:
     """Force F on each tripod arm, normal to the arm in the tripod plane [N].
 
     Eq 24 with the arm lengths of the corrected eq 21: ``F = T0 / (h1 + h2 + h3)
     = T0 / (3 r + 3 rho)``; the seed prints 3 r - 3 rho.
     """
-    return np.asarray(torque, dtype=float) / (3.0 * (r + orbit_radius(beta, r)))
+    return torque / (3.0 * (r + orbit_radius(beta, r)))
 
 
-def plunger_acceleration_sum(phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float) -> Array:
+def plunger_acceleration_sum(phi_in: Real, beta: Real, omega: Real, r: float) -> Real:
     """Eq 20 as printed: ``a1 + a2 + a3 = -6 omega^2 rho sin(beta) cos 3 phi`` [m/s^2]."""
-    omega = np.asarray(omega, dtype=float)
-    return -6.0 * omega**2 * orbit_radius(beta, r) * np.sin(beta) * np.cos(3.0 * paper_angle(phi_in))
+    xp = lib(phi_in, beta)
+    return -6.0 * omega * omega * orbit_radius(beta, r) * xp.sin(beta) * xp.cos(3.0 * paper_angle(phi_in))
 
 
-def output_axial_reaction(phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float, m: float) -> Array:
+def output_axial_reaction(phi_in: Real, beta: Real, omega: Real, r: float, m: float) -> Real:
     """Eq 30: ``R_z'' = -6 m rho omega^2 tan(beta) cos 3 phi`` [N] (output self-aligning bearing)."""
-    omega = np.asarray(omega, dtype=float)
-    return -6.0 * m * orbit_radius(beta, r) * omega**2 * np.tan(beta) * np.cos(3.0 * paper_angle(phi_in))
+    xp = lib(phi_in, beta)
+    return -6.0 * m * orbit_radius(beta, r) * omega * omega * xp.tan(beta) * xp.cos(3.0 * paper_angle(phi_in))
 
 
-def input_reaction_x(phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float, m: float) -> Array:
+def input_reaction_x(phi_in: Real, beta: Real, omega: Real, r: float, m: float) -> Real:
     """Eq 33: ``R_x' = tan(beta) m (a1 + a2 + a3) = -6 m omega^2 rho sin(beta) tan(beta) cos 3 phi`` [N]."""
-    return np.tan(beta) * m * plunger_acceleration_sum(phi_in, beta, omega, r)
+    return lib(beta).tan(beta) * m * plunger_acceleration_sum(phi_in, beta, omega, r)
 
 
-def input_reaction_y(
-    phi_in: ArrayLike, beta: ArrayLike, omega: ArrayLike, r: float, l: float, m: float
-) -> Array:
+def input_reaction_y(phi_in: Real, beta: Real, omega: Real, r: float, l: float, m: float) -> Real:
     """Eq 34: ``R_y' = -(3 m rho^2 omega^2 tan(beta) sin 6 phi) / l`` [N]."""
-    omega = np.asarray(omega, dtype=float)
+    xp = lib(phi_in, beta)
     rho = orbit_radius(beta, r)
-    return -3.0 * m * rho**2 * omega**2 * np.tan(beta) * np.sin(6.0 * paper_angle(phi_in)) / l
+    return -3.0 * m * rho**2 * omega * omega * xp.tan(beta) * xp.sin(6.0 * paper_angle(phi_in)) / l
 
 
-def input_torque(load_torque: ArrayLike, speed_ratio: ArrayLike) -> Array:
+def input_torque(load_torque: Real, speed_ratio: Real) -> Real:
     """Power balance of the lossless coupling: ``T_in omega_in = T_load omega_out`` [N.m].
 
     Written with the kinematic ratio d(phi_out)/d(phi_in), so it holds at standstill too.
     """
-    return np.asarray(load_torque, dtype=float) * np.asarray(speed_ratio, dtype=float)
+    return load_torque * speed_ratio
 
 
 def exact_plunger_accelerations(beta: float, r: float, l: float, omega: float, samples: int = 360) -> tuple[Array, Array]:
@@ -70,4 +69,4 @@ def exact_plunger_accelerations(beta: float, r: float, l: float, omega: float, s
     travel = exact_pose(phi, beta, r, l).plunger_positions
     harmonic = np.fft.rfftfreq(samples, d=1.0 / samples)[:, None]
     second_derivative = np.fft.irfft(-(harmonic**2) * np.fft.rfft(travel, axis=0), n=samples, axis=0)
-    return phi, omega**2 * second_derivative
+    return phi, omega * omega * second_derivative

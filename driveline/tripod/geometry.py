@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..scalar import Real, lib
+
 THIRD_TURN = 2.0 * np.pi / 3.0
 ARM_INDEX = np.arange(3)
 
@@ -38,7 +40,7 @@ class TripodGeometry:
         return problems
 
 
-def orbit_radius(beta: ArrayLike, r: float) -> NDArray[np.float64]:
+def orbit_radius(beta: Real, r: float) -> Real:
     """Radius rho of the tripod centre's orbit, ``rho = r (1 - cos beta) / (2 cos beta)``.
 
     The paper uses rho without giving it. Cutting the three grooves with the tripod
@@ -48,7 +50,7 @@ def orbit_radius(beta: ArrayLike, r: float) -> NDArray[np.float64]:
     ellipse centre, ``-rho (cos 3 phi_in, sin 3 phi_in)``: three orbits per turn in the
     shaft's sense of rotation.
     """
-    cos_beta = np.cos(np.asarray(beta, dtype=float))
+    cos_beta = lib(beta).cos(beta)
     return r * (1.0 - cos_beta) / (2.0 * cos_beta)
 
 
@@ -62,5 +64,5 @@ def arm_lengths(phi: ArrayLike, beta: ArrayLike, r: float) -> NDArray[np.float64
     :mod:`.exact`).
     """
     phi = np.asarray(phi, dtype=float)[..., None]
-    rho = orbit_radius(beta, r)[..., None]
+    rho = np.asarray(orbit_radius(np.asarray(beta, dtype=float), r))[..., None]
     return r + rho + 2.0 * rho * np.cos(2.0 * (phi + THIRD_TURN * ARM_INDEX))

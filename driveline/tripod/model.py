@@ -35,6 +35,7 @@ class TripodCouplingModel(DrivenShaftModel):
         """Outputs at the current phi_in and inputs."""
         phi, beta, omega = self.phi_in, self.beta, self.omega_in
         r, l, m = self.r, self.l, self.m_plunger
+        rho = orbit_radius(beta, r)
         if self.kinematics == EXACT:
             pose = exact_pose(phi, beta, r, l, start=self._closure)
             self._closure = np.concatenate([[pose.phi_out], pose.swing])
@@ -42,15 +43,15 @@ class TripodCouplingModel(DrivenShaftModel):
             ratio = float(pose.speed_ratio)
             self.theta = float(pose.cone_angle)
         else:
-            self.phi_out = phi + float(closed_form.angle_deviation(phi, beta, r, l))
-            ratio = float(closed_form.speed_ratio(phi, beta, r, l))
-            self.theta = math.asin(float(orbit_radius(beta, r)) / l)
+            self.phi_out = phi + closed_form.angle_deviation(phi, beta, r, l)
+            ratio = closed_form.speed_ratio(phi, beta, r, l)
+            self.theta = math.asin(rho / l)
         self.delta_phi = self.phi_out - phi
         self.omega_out = omega * ratio
-        self.T_in = float(dynamics.input_torque(self.T_load, ratio))
-        self.rho = float(orbit_radius(beta, r))
-        self.F_pin = float(dynamics.pin_force(self.T_load, beta, r))
-        self.a_plunger_sum = float(dynamics.plunger_acceleration_sum(phi, beta, omega, r))
-        self.Rz_out = float(dynamics.output_axial_reaction(phi, beta, omega, r, m))
-        self.Rx_in = float(dynamics.input_reaction_x(phi, beta, omega, r, m))
-        self.Ry_in = float(dynamics.input_reaction_y(phi, beta, omega, r, l, m))
+        self.T_in = dynamics.input_torque(self.T_load, ratio)
+        self.rho = rho
+        self.F_pin = dynamics.pin_force(self.T_load, beta, r)
+        self.a_plunger_sum = dynamics.plunger_acceleration_sum(phi, beta, omega, r)
+        self.Rz_out = dynamics.output_axial_reaction(phi, beta, omega, r, m)
+        self.Rx_in = dynamics.input_reaction_x(phi, beta, omega, r, m)
+        self.Ry_in = dynamics.input_reaction_y(phi, beta, omega, r, l, m)
