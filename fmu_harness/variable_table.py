@@ -1,8 +1,13 @@
-"""Markdown table of a model's variables, from its spec (pasted into README.md, checked by a test)."""
+"""Markdown tables of the models' variables, from their specs.
+
+``python -m fmu_harness.variable_table`` prints them; ``--update README.md`` rewrites the
+part of that file between the ``variables:start`` and ``variables:end`` markers.
+"""
 
 from __future__ import annotations
 
-import sys
+import argparse
+from pathlib import Path
 
 from driveline.catalog import MODELS
 from driveline.variables import ModelSpec
@@ -27,6 +32,25 @@ def markdown(spec: ModelSpec) -> str:
     return "\n".join(lines)
 
 
+START, END = "<!-- variables:start -->", "<!-- variables:end -->"
+
+
+def all_tables() -> str:
+    return "\n\n".join(markdown(model.spec) for model in MODELS.values())
+
+
+def update(path: Path) -> None:
+    text = path.read_text()
+    head, rest = text.split(START, 1)
+    tail = rest.split(END, 1)[1]
+    path.write_text(f"{head}{START}\n{all_tables()}\n{END}{tail}")
+
+
 if __name__ == "__main__":
-    names = sys.argv[1:] or list(MODELS)
-    print("\n\n".join(markdown(MODELS[name].spec) for name in names))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--update", type=Path, help="file whose marked variables section to rewrite")
+    args = parser.parse_args()
+    if args.update:
+        update(args.update)
+    else:
+        print(all_tables())

@@ -29,7 +29,7 @@ def test_model_description_carries_units_ranges_and_structure(tripod_fmu):
     variables = {v.name: v for v in md.modelVariables}
     assert variables["beta"].unit == "rad" and variables["beta"].displayUnit == "deg"
     assert variables["omega_out"].displayUnit == "rpm"
-    assert float(variables["beta"].max) == pytest.approx(math.radians(80.0))
+    assert float(variables["beta"].max) == pytest.approx(math.radians(60.0))
     assert "eq 30" in variables["Rz_out"].description
     outputs = {v.name for v in md.modelVariables if v.causality == "output"}
     assert {u.variable.name for u in md.outputs} == outputs

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from driveline.tripod import closed_form, exact, geometry
+from driveline.tripod import closed_form, exact, geometry, plane_solver
 
 R, L = 0.026, 0.700  # seed 000's worked example
 PHI = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
@@ -104,3 +104,17 @@ def test_warm_started_solve_matches_batch():
     for k in range(50):
         x = exact.solve_closure(PHI[k], beta, R, L, start=x)
         np.testing.assert_allclose(x, batch[k], atol=1e-14)
+
+
+@pytest.mark.parametrize("r_over_l", [0.005, 26 / 700, 0.2])
+@pytest.mark.parametrize("beta_deg", [0.0, 1.0, 30.0, 60.0])
+def test_plane_formulation_agrees_with_the_newton_closure(r_over_l, beta_deg):
+    """Two independent exact formulations (FMU's scalar plane solver, batched 3-unknown Newton),
+    both from a cold start, over a full turn up to the 60 deg guard limit."""
+    beta, r, l = np.radians(beta_deg), R, R / r_over_l
+    reference = exact.exact_pose(PHI[::4], beta, r, l)
+    for k, phi in enumerate(PHI[::4]):
+        phi_out, ratio, axis = plane_solver.solve(float(phi), float(beta), r, l)
+        assert phi_out == pytest.approx(reference.phi_out[k], abs=1e-14)
+        assert ratio == pytest.approx(reference.speed_ratio[k], abs=1e-8)  # FD Jacobians: 1.2e-9 at worst
+        assert np.arcsin(np.hypot(*axis)) == pytest.approx(reference.cone_angle[k], abs=1e-13)

@@ -4,11 +4,8 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ..model import DrivenShaftModel
-from . import closed_form, dynamics
-from .exact import exact_pose
+from . import closed_form, dynamics, plane_solver
 from .geometry import TripodGeometry, orbit_radius
 from .spec import EXACT, SPEC
 
@@ -19,7 +16,7 @@ class TripodCouplingModel(DrivenShaftModel):
     spec = SPEC
 
     def reset_internal_state(self) -> None:
-        self._closure: np.ndarray | None = None  # warm start of the exact solver
+        self._axis: tuple[float, float] | None = None  # warm start of the exact solver
 
     def extra_parameter_errors(self) -> list[str]:
         return TripodGeometry(self.r, self.l, self.m_plunger).errors()
@@ -28,7 +25,7 @@ class TripodCouplingModel(DrivenShaftModel):
         return self.angle_bound_errors("beta", "beta_max")
 
     def start(self, start_time: float) -> None:
-        self._closure = None
+        self._axis = None
         super().start(start_time)
 
     def evaluate(self, input_time: float) -> None:
@@ -37,11 +34,8 @@ class TripodCouplingModel(DrivenShaftModel):
         r, l, m = self.r, self.l, self.m_plunger
         rho = orbit_radius(beta, r)
         if self.kinematics == EXACT:
-            pose = exact_pose(phi, beta, r, l, start=self._closure)
-            self._closure = np.concatenate([[pose.phi_out], pose.swing])
-            self.phi_out = float(pose.phi_out)
-            ratio = float(pose.speed_ratio)
-            self.theta = float(pose.cone_angle)
+            self.phi_out, ratio, self._axis = plane_solver.solve(phi, beta, r, l, self._axis)
+            self.theta = math.asin(math.hypot(*self._axis))
         else:
             self.phi_out = phi + closed_form.angle_deviation(phi, beta, r, l)
             ratio = closed_form.speed_ratio(phi, beta, r, l)
