@@ -20,3 +20,8 @@ Real = Union[float, NDArray[np.float64]]
 def lib(*values: object) -> ModuleType:
     """``math`` when every value is a Python float or int, else ``numpy``."""
     return math if all(type(v) in (float, int) for v in values) else np
+
+
+def arcsin(value: Real) -> Real:
+    """``asin`` of a float or an array (numpy spells it ``arcsin``)."""
+    return math.asin(value) if type(value) is float else np.arcsin(value)

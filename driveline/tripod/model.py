@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import math
-
 from ..model import DrivenShaftModel
-from . import closed_form, dynamics, plane_solver
-from .geometry import TripodGeometry, orbit_radius
-from .spec import EXACT, SPEC
+from .geometry import TripodGeometry
+from .outputs import coupling_outputs
+from .spec import SPEC
 
 
 class TripodCouplingModel(DrivenShaftModel):
@@ -30,22 +28,8 @@ class TripodCouplingModel(DrivenShaftModel):
 
     def evaluate(self, input_time: float) -> None:
         """Outputs at the current phi_in and inputs."""
-        phi, beta, omega = self.phi_in, self.beta, self.omega_in
-        r, l, m = self.r, self.l, self.m_plunger
-        rho = orbit_radius(beta, r)
-        if self.kinematics == EXACT:
-            self.phi_out, ratio, self._axis = plane_solver.solve(phi, beta, r, l, self._axis)
-            self.theta = math.asin(math.hypot(*self._axis))
-        else:
-            self.phi_out = phi + closed_form.angle_deviation(phi, beta, r, l)
-            ratio = closed_form.speed_ratio(phi, beta, r, l)
-            self.theta = math.asin(rho / l)
-        self.delta_phi = self.phi_out - phi
-        self.omega_out = omega * ratio
-        self.T_in = dynamics.input_torque(self.T_load, ratio)
-        self.rho = rho
-        self.F_pin = dynamics.pin_force(self.T_load, beta, r)
-        self.a_plunger_sum = dynamics.plunger_acceleration_sum(phi, beta, omega, r)
-        self.Rz_out = dynamics.output_axial_reaction(phi, beta, omega, r, m)
-        self.Rx_in = dynamics.input_reaction_x(phi, beta, omega, r, m)
-        self.Ry_in = dynamics.input_reaction_y(phi, beta, omega, r, l, m)
+        values, self._axis = coupling_outputs(
+            self.phi_in, self.beta, self.omega_in, self.T_load,
+            self.r, self.l, self.m_plunger, self.kinematics, self._axis,
+        )
+        self.__dict__.update(values)

@@ -1,33 +1,38 @@
-"""Exact kinematics of one configuration in pure Python: the tripod-plane formulation.
+"""Exact kinematics in the tripod-plane formulation, for one configuration or whole arrays.
 
 A second, independent formulation of the closure solved in :mod:`.exact`, built for
-the FMU's per-step cost. The output shaft's axis ``u`` (components ``x, y`` in the
-nominal output frame) fixes the tripod plane (normal to ``u`` through ``P = S - l u``)
-and its frame ``(e1, e2)``, the twist-free rotation of the nominal frame onto ``u``.
-The grooves cut that plane in three points ``c + A (cos chi_j, sin chi_j)``, an affine
-image of the groove circle. Writing ``A z = alpha z + beta conj(z)`` for complex z, the
-120 deg star through the three points has its arms at ``chi_j + arg(alpha)`` and its
-centre at ``c - exp(2i arg alpha) conj(beta) exp(3i chi)`` (checked by substitution).
-The closure holds when that centre is P itself: two equations in ``(x, y)``, solved
-with Newton's method; the output angle is then ``phi_in + arg(alpha)`` in closed form.
+speed: pure ``math`` for one configuration (an FMU step), numpy for arrays (sweeps).
+The output shaft's axis ``u`` (components ``x, y`` in the nominal output frame) fixes the
+tripod plane (normal to ``u`` through ``P = S - l u``) and its frame ``(e1, e2)``, the
+twist-free rotation of the nominal frame onto ``u``. The grooves cut that plane in three
+points ``c + A (cos chi_j, sin chi_j)``, an affine image of the groove circle. Writing
+``A z = alpha z + beta conj(z)`` for complex z, the 120 deg star through the three points
+has its arms at ``chi_j + arg(alpha)`` and its centre at
+``c - exp(2i arg alpha) conj(beta) exp(3i chi)`` (checked by substitution). The closure
+holds when that centre is P itself: two equations in ``(x, y)``, solved with Newton's
+method; the output angle is then ``phi_in + arg(alpha)`` in closed form.
 """
 
 from __future__ import annotations
 
 import cmath
 import math
+from typing import Any
+
+import numpy as np
+
+from ..scalar import Real, lib
 
 FD_STEP = 1e-7  # on the axis components (~rho/l); F is ~l-scaled, so round-off ~1e-10 relative
 TOLERANCE = 1e-15  # on the axis components
 MAX_ITERATIONS = 20
 
 
-def _star_centre(
-    x: float, y: float, chi: float, cb: float, sb: float, r: float, l: float
-) -> tuple[complex, float, complex]:
-    """Star centre relative to P in tripod-plane coordinates [m], arg(alpha) [rad], and the
-    centre's ``exp(3i chi)`` term (its derivative in chi is ``-3i`` times that term)."""
-    z = math.sqrt(1.0 - x * x - y * y)
+def _star_centre(x: Real, y: Real, chi: Real, cb: Real, sb: Real, r: float, l: float, xp: Any) -> tuple[Any, Real, Any]:
+    """Star centre relative to P in tripod-plane coordinates [m] (complex), arg(alpha) [rad], and
+    the centre's ``exp(3i chi)`` term (its derivative in chi is ``-3i`` times that term)."""
+    exp, phase = (cmath.exp, cmath.phase) if xp is math else (np.exp, np.angle)
+    z = xp.sqrt(1.0 - x * x - y * y)
     k = 1.0 / (1.0 + z)
     # twist-free frame onto u = (x, y, z): e1 = (1 - x^2 k, -x y k, -x), e2 = (-x y k, 1 - y^2 k, -y)
     e1x, e1y, e1z = 1.0 - x * x * k, -x * y * k, -x
@@ -41,43 +46,45 @@ def _star_centre(
     f1, f2 = E1z / Uz, E2z / Uz
     a11, a12 = r * (E1x - Ux * f1), r * (e1y - Uy * f1)
     a21, a22 = r * (E2x - Ux * f2), r * (e2y - Uy * f2)
-    c = complex(p_dot_u * f1 - (Px * E1x + Py * e1y + Pz * E1z), p_dot_u * f2 - (Px * E2x + Py * e2y + Pz * E2z))
-    alpha = complex(a11 + a22, a21 - a12) * 0.5
-    beta = complex(a11 - a22, a21 + a12) * 0.5
+    c = (p_dot_u * f1 - (Px * E1x + Py * e1y + Pz * E1z)) + 1j * (p_dot_u * f2 - (Px * E2x + Py * e2y + Pz * E2z))
+    alpha = ((a11 + a22) + 1j * (a21 - a12)) * 0.5
+    beta = ((a11 - a22) + 1j * (a21 + a12)) * 0.5
     turn = alpha / abs(alpha)
-    orbit = turn * turn * beta.conjugate() * cmath.exp(3j * chi)
-    return c - orbit, cmath.phase(alpha), orbit
+    orbit = turn * turn * beta.conjugate() * exp(3j * chi)
+    return c - orbit, phase(alpha), orbit
 
 
-def solve(phi_in: float, beta: float, r: float, l: float, axis: tuple[float, float] | None = None
-          ) -> tuple[float, float, tuple[float, float]]:
-    """``(phi_out, d phi_out / d phi_in, (x, y))`` for one configuration.
+def solve(phi_in: Real, beta: Real, r: float, l: float, axis: tuple[Real, Real] | None = None
+          ) -> tuple[Real, Real, tuple[Real, Real]]:
+    """``(phi_out, d phi_out / d phi_in, (x, y))`` for floats or arrays of (phi_in, beta).
 
     ``axis`` warm-starts the iteration (the previous step's ``(x, y)``); by default the
     small-r/l orbit ``rho (cos 3 phi_in, sin 3 phi_in) / l`` is used.
     """
-    cb, sb = math.cos(beta), math.sin(beta)
+    xp = lib(phi_in, beta)
+    converged = bool if xp is math else np.all
+    cb, sb = xp.cos(beta), xp.sin(beta)
     if axis is None:
         rho_over_l = r * (1.0 - cb) / (2.0 * cb * l)
-        axis = (rho_over_l * math.cos(3.0 * phi_in), rho_over_l * math.sin(3.0 * phi_in))
+        axis = (rho_over_l * xp.cos(3.0 * phi_in), rho_over_l * xp.sin(3.0 * phi_in))
     x, y = axis
     for _ in range(MAX_ITERATIONS):
-        centre, twist, orbit = _star_centre(x, y, phi_in, cb, sb, r, l)
-        centre_x, twist_x, _ = _star_centre(x + FD_STEP, y, phi_in, cb, sb, r, l)
-        centre_y, twist_y, _ = _star_centre(x, y + FD_STEP, phi_in, cb, sb, r, l)
+        centre, twist, orbit = _star_centre(x, y, phi_in, cb, sb, r, l, xp)
+        centre_x, twist_x, _ = _star_centre(x + FD_STEP, y, phi_in, cb, sb, r, l, xp)
+        centre_y, twist_y, _ = _star_centre(x, y + FD_STEP, phi_in, cb, sb, r, l, xp)
         jxx, jyx = (centre_x.real - centre.real) / FD_STEP, (centre_x.imag - centre.imag) / FD_STEP
         jxy, jyy = (centre_y.real - centre.real) / FD_STEP, (centre_y.imag - centre.imag) / FD_STEP
         det = jxx * jyy - jxy * jyx
         dx = (jyy * centre.real - jxy * centre.imag) / det
         dy = (jxx * centre.imag - jyx * centre.real) / det
         x, y = x - dx, y - dy
-        if abs(dx) + abs(dy) <= TOLERANCE:
+        if converged(abs(dx) + abs(dy) <= TOLERANCE):
             break
     else:
         raise ArithmeticError("tripod closure: plane iteration did not converge")
     # The last update moved (x, y) by (-dx, -dy): carry arg(alpha) along to first order.
     gradient_x, gradient_y = (twist_x - twist) / FD_STEP, (twist_y - twist) / FD_STEP
-    twist -= gradient_x * dx + gradient_y * dy
+    twist = twist - (gradient_x * dx + gradient_y * dy)
     # Implicit function theorem: d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit.
     d_chi = -3j * orbit
     dx_dchi = -(jyy * d_chi.real - jxy * d_chi.imag) / det

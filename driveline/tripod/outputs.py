@@ -1,0 +1,46 @@
+"""All outputs of the coupling at once, for one configuration (an FMU step) or whole arrays.
+
+The FMU's model and vectorised sweeps call the same function, so a sweep that needs no
+time stepping gives exactly what stepping the FMU would, without a Python loop.
+"""
+
+from __future__ import annotations
+
+from ..scalar import Real, arcsin, lib
+from . import closed_form, dynamics, plane_solver
+from .geometry import orbit_radius
+from .spec import EXACT
+
+Axis = tuple[Real, Real]
+
+
+def coupling_outputs(
+    phi_in: Real, beta: Real, omega_in: Real, T_load: Real, r: float, l: float, m: float,
+    kinematics: int, axis: Axis | None = None,
+) -> tuple[dict[str, Real], Axis | None]:
+    """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's axis.
+
+    ``axis`` warm-starts the exact solver (kinematics = 1) and is returned updated.
+    """
+    rho = orbit_radius(beta, r)
+    if kinematics == EXACT:
+        phi_out, ratio, axis = plane_solver.solve(phi_in, beta, r, l, axis)
+        theta = arcsin(lib(*axis).hypot(*axis))
+    else:
+        phi_out = phi_in + closed_form.angle_deviation(phi_in, beta, r, l)
+        ratio = closed_form.speed_ratio(phi_in, beta, r, l)
+        theta = arcsin(rho / l)
+    return {
+        "phi_in": phi_in,
+        "phi_out": phi_out,
+        "delta_phi": phi_out - phi_in,
+        "omega_out": omega_in * ratio,
+        "T_in": dynamics.input_torque(T_load, ratio),
+        "F_pin": dynamics.pin_force(T_load, beta, r),
+        "rho": rho,
+        "theta": theta,
+        "a_plunger_sum": dynamics.plunger_acceleration_sum(phi_in, beta, omega_in, r),
+        "Rz_out": dynamics.output_axial_reaction(phi_in, beta, omega_in, r, m),
+        "Rx_in": dynamics.input_reaction_x(phi_in, beta, omega_in, r, m),
+        "Ry_in": dynamics.input_reaction_y(phi_in, beta, omega_in, r, l, m),
+    }, axis
