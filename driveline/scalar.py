@@ -19,7 +19,10 @@ Real = Union[float, NDArray[np.float64]]
 
 def lib(*values: object) -> ModuleType:
     """``math`` when every value is a Python float or int, else ``numpy``."""
-    return math if all(type(v) in (float, int) for v in values) else np
+    for value in values:
+        if type(value) is not float and type(value) is not int:
+            return np
+    return math
 
 
 def arcsin(value: Real) -> Real:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from ..model import DrivenShaftModel
 from .geometry import TripodGeometry
 from .outputs import coupling_outputs
+from .plane_solver import Solution
 from .spec import SPEC
 
 
@@ -14,7 +15,7 @@ class TripodCouplingModel(DrivenShaftModel):
     spec = SPEC
 
     def reset_internal_state(self) -> None:
-        self._axis: tuple[float, float] | None = None  # warm start of the exact solver
+        self._solution: Solution | None = None  # warm start of the exact solver
 
     def extra_parameter_errors(self) -> list[str]:
         return TripodGeometry(self.r, self.l, self.m_plunger).errors()
@@ -23,13 +24,13 @@ class TripodCouplingModel(DrivenShaftModel):
         return self.angle_bound_errors("beta", "beta_max")
 
     def start(self, start_time: float) -> None:
-        self._axis = None
+        self._solution = None
         super().start(start_time)
 
     def evaluate(self, input_time: float) -> None:
         """Outputs at the current phi_in and inputs."""
-        values, self._axis = coupling_outputs(
+        values, self._solution = coupling_outputs(
             self.phi_in, self.beta, self.omega_in, self.T_load,
-            self.r, self.l, self.m_plunger, self.kinematics, self._axis,
+            self.r, self.l, self.m_plunger, self.kinematics, self._solution,
         )
         self.__dict__.update(values)

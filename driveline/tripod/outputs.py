@@ -6,26 +6,23 @@ time stepping gives exactly what stepping the FMU would, without a Python loop.
 
 from __future__ import annotations
 
-from ..scalar import Real, arcsin, lib
+from ..scalar import Real, arcsin
 from . import closed_form, dynamics, plane_solver
 from .geometry import orbit_radius
 from .spec import EXACT
 
-Axis = tuple[Real, Real]
-
-
 def coupling_outputs(
     phi_in: Real, beta: Real, omega_in: Real, T_load: Real, r: float, l: float, m: float,
-    kinematics: int, axis: Axis | None = None,
-) -> tuple[dict[str, Real], Axis | None]:
-    """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's axis.
+    kinematics: int, solution: plane_solver.Solution | None = None,
+) -> tuple[dict[str, Real], plane_solver.Solution | None]:
+    """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's solution.
 
-    ``axis`` warm-starts the exact solver (kinematics = 1) and is returned updated.
+    ``solution`` warm-starts the exact solver (kinematics = 1) and is returned updated.
     """
     rho = orbit_radius(beta, r)
     if kinematics == EXACT:
-        phi_out, ratio, axis = plane_solver.solve(phi_in, beta, r, l, axis)
-        theta = arcsin(lib(*axis).hypot(*axis))
+        phi_out, ratio, solution = plane_solver.solve(phi_in, beta, r, l, solution)
+        theta = solution.cone_angle
     else:
         phi_out = phi_in + closed_form.angle_deviation(phi_in, beta, r, l)
         ratio = closed_form.speed_ratio(phi_in, beta, r, l)
@@ -43,4 +40,4 @@ def coupling_outputs(
         "Rz_out": dynamics.output_axial_reaction(phi_in, beta, omega_in, r, m),
         "Rx_in": dynamics.input_reaction_x(phi_in, beta, omega_in, r, m),
         "Ry_in": dynamics.input_reaction_y(phi_in, beta, omega_in, r, l, m),
-    }, axis
+    }, solution

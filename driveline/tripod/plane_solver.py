@@ -17,14 +17,16 @@ from __future__ import annotations
 
 import cmath
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..scalar import Real, lib
+from ..scalar import Real, arcsin, lib
 
 FD_STEP = 1e-7  # on the axis components (~rho/l); F is ~l-scaled, so round-off ~1e-10 relative
-TOLERANCE = 1e-15  # on the axis components
+# Newton's method with a Jacobian good to ~1e-9 shrinks the update by ~1e-9 per iteration,
+# so after an update below 1e-9 the remaining error of the axis is below 1e-17.
+LAST_UPDATE = 1e-9
 MAX_ITERATIONS = 20
 
 
@@ -54,20 +56,41 @@ def _star_centre(x: Real, y: Real, chi: Real, cb: Real, sb: Real, r: float, l: f
     return c - orbit, phase(alpha), orbit
 
 
-def solve(phi_in: Real, beta: Real, r: float, l: float, axis: tuple[Real, Real] | None = None
-          ) -> tuple[Real, Real, tuple[Real, Real]]:
-    """``(phi_out, d phi_out / d phi_in, (x, y))`` for floats or arrays of (phi_in, beta).
+class Solution(NamedTuple):
+    """The closure at one ``phi_in``: axis components and their derivatives in ``phi_in``."""
 
-    ``axis`` warm-starts the iteration (the previous step's ``(x, y)``); by default the
-    small-r/l orbit ``rho (cos 3 phi_in, sin 3 phi_in) / l`` is used.
+    phi_in: Real
+    x: Real
+    y: Real
+    dx_dphi: Real
+    dy_dphi: Real
+
+    def predict(self, phi_in: Real) -> tuple[Real, Real]:
+        """First-order guess of the axis at another input angle (a Newton start value)."""
+        step = phi_in - self.phi_in
+        return self.x + self.dx_dphi * step, self.y + self.dy_dphi * step
+
+    @property
+    def cone_angle(self) -> Real:
+        """theta, the tilt of the output shaft [rad]."""
+        return arcsin(lib(self.x, self.y).hypot(self.x, self.y))
+
+
+def solve(phi_in: Real, beta: Real, r: float, l: float, start: Solution | None = None
+          ) -> tuple[Real, Real, Solution]:
+    """``(phi_out, d phi_out / d phi_in, solution)`` for floats or arrays of (phi_in, beta).
+
+    ``start`` warm-starts the iteration (the previous step's solution, extrapolated to
+    ``phi_in``); by default the small-r/l orbit ``rho (cos 3 phi_in, sin 3 phi_in) / l``.
     """
     xp = lib(phi_in, beta)
     converged = bool if xp is math else np.all
     cb, sb = xp.cos(beta), xp.sin(beta)
-    if axis is None:
+    if start is None:
         rho_over_l = r * (1.0 - cb) / (2.0 * cb * l)
-        axis = (rho_over_l * xp.cos(3.0 * phi_in), rho_over_l * xp.sin(3.0 * phi_in))
-    x, y = axis
+        x, y = rho_over_l * xp.cos(3.0 * phi_in), rho_over_l * xp.sin(3.0 * phi_in)
+    else:
+        x, y = start.predict(phi_in)
     for _ in range(MAX_ITERATIONS):
         centre, twist, orbit = _star_centre(x, y, phi_in, cb, sb, r, l, xp)
         centre_x, twist_x, _ = _star_centre(x + FD_STEP, y, phi_in, cb, sb, r, l, xp)
@@ -78,7 +101,7 @@ def solve(phi_in: Real, beta: Real, r: float, l: float, axis: tuple[Real, Real] 
         dx = (jyy * centre.real - jxy * centre.imag) / det
         dy = (jxx * centre.imag - jyx * centre.real) / det
         x, y = x - dx, y - dy
-        if converged(abs(dx) + abs(dy) <= TOLERANCE):
+        if converged(abs(dx) + abs(dy) <= LAST_UPDATE):
             break
     else:
         raise ArithmeticError("tripod closure: plane iteration did not converge")
@@ -87,6 +110,7 @@ def solve(phi_in: Real, beta: Real, r: float, l: float, axis: tuple[Real, Real] 
     twist = twist - (gradient_x * dx + gradient_y * dy)
     # Implicit function theorem: d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit.
     d_chi = -3j * orbit
-    dx_dchi = -(jyy * d_chi.real - jxy * d_chi.imag) / det
-    dy_dchi = -(jxx * d_chi.imag - jyx * d_chi.real) / det
-    return phi_in + twist, 1.0 + gradient_x * dx_dchi + gradient_y * dy_dchi, (x, y)
+    dx_dphi = -(jyy * d_chi.real - jxy * d_chi.imag) / det
+    dy_dphi = -(jxx * d_chi.imag - jyx * d_chi.real) / det
+    ratio = 1.0 + gradient_x * dx_dphi + gradient_y * dy_dphi
+    return phi_in + twist, ratio, Solution(phi_in, x, y, dx_dphi, dy_dphi)
