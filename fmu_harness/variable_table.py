@@ -12,6 +12,8 @@ from pathlib import Path
 from driveline.catalog import MODELS
 from driveline.variables import ModelSpec
 
+from .readme import replace_section
+
 
 def _cell(value: object) -> str:
     return "" if value is None else f"{value:.6g}" if isinstance(value, float) else str(value)
@@ -32,18 +34,12 @@ def markdown(spec: ModelSpec) -> str:
     return "\n".join(lines)
 
 
-START, END = "<!-- variables:start -->", "<!-- variables:end -->"
-
-
 def all_tables() -> str:
     return "\n\n".join(markdown(model.spec) for model in MODELS.values())
 
 
 def update(path: Path) -> None:
-    text = path.read_text()
-    head, rest = text.split(START, 1)
-    tail = rest.split(END, 1)[1]
-    path.write_text(f"{head}{START}\n{all_tables()}\n{END}{tail}")
+    replace_section(path, "variables", all_tables())
 
 
 if __name__ == "__main__":

@@ -1,13 +1,14 @@
 """Completes the model description that pythonfmu writes, from the model's spec.
 
 The one place where units, display units, ranges, descriptions and the initial
-unknowns are added; the FMI 2.0 build calls :func:`complete_fmi2`.
+unknowns are added; the FMI 2.0 build calls :func:`complete_fmi2`, the FMI 3.0 build
+:func:`complete_fmi3`.
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from xml.dom.minidom import parseString
+from collections.abc import Callable
 
 from driveline.variables import ModelSpec, Unit, Variable
 
@@ -41,27 +42,58 @@ def _type_attributes(variable: Variable) -> dict[str, str]:
     return attributes
 
 
-def complete_fmi2(xml: bytes, spec: ModelSpec) -> bytes:
-    """Return pythonfmu's FMI 2.0 model description with the spec's details added."""
-    root = ET.fromstring(xml)
+def _complete(
+    root: ET.Element,
+    spec: ModelSpec,
+    variables: list[tuple[ET.Element, ET.Element]],
+    structure: Callable[[ET.Element, list[tuple[int, ET.Element]]], None],
+) -> bytes:
+    """Add units, descriptions and attributes to ``variables`` (pairs of the variable's element
+    and the element that carries unit, min and max, in document order) and rebuild the model
+    structure with ``structure`` from the outputs' 1-based indices and elements."""
     if spec.units:
         unit_definitions = ET.Element("UnitDefinitions")
         unit_definitions.extend(_unit_element("Unit", unit) for unit in spec.units)
         root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions)
-
-    scalars = root.find("ModelVariables").findall("ScalarVariable")
     outputs = []
-    for index, scalar in enumerate(scalars, start=1):
-        variable = spec[scalar.get("name")]
-        scalar.set("description", variable.description)
-        scalar.find(variable.type).attrib.update(_type_attributes(variable))
+    for index, (element, typed) in enumerate(variables, start=1):
+        variable = spec[element.get("name")]
+        element.set("description", variable.description)
+        typed.attrib.update(_type_attributes(variable))
         if variable.causality == "output":
-            outputs.append(str(index))
+            outputs.append((index, element))
+    model_structure = root.find("ModelStructure")
+    for child in list(model_structure):
+        model_structure.remove(child)
+    structure(model_structure, outputs)
+    ET.indent(root)
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
-    structure = root.find("ModelStructure")
-    for child in list(structure):
-        structure.remove(child)
+
+def _fmi2_structure(model_structure: ET.Element, outputs: list[tuple[int, ET.Element]]) -> None:
     if outputs:
         for tag in ("Outputs", "InitialUnknowns"):
-            ET.SubElement(structure, tag).extend(ET.Element("Unknown", index=i) for i in outputs)
-    return parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
+            unknowns = ET.SubElement(model_structure, tag)
+            unknowns.extend(ET.Element("Unknown", index=str(index)) for index, _ in outputs)
+
+
+def _fmi3_structure(model_structure: ET.Element, outputs: list[tuple[int, ET.Element]]) -> None:
+    for tag in ("Output", "InitialUnknown"):
+        model_structure.extend(ET.Element(tag, valueReference=output.get("valueReference")) for _, output in outputs)
+
+
+def complete_fmi2(xml: bytes, spec: ModelSpec) -> bytes:
+    """Return pythonfmu's FMI 2.0 model description with the spec's details added."""
+    root = ET.fromstring(xml)
+    scalars = root.find("ModelVariables").findall("ScalarVariable")
+    variables = [(scalar, scalar.find(spec[scalar.get("name")].type)) for scalar in scalars]
+    return _complete(root, spec, variables, _fmi2_structure)
+
+
+def complete_fmi3(xml: bytes, spec: ModelSpec) -> bytes:
+    """Return pythonfmu3's FMI 3.0 model description with the spec's details added (in FMI 3.0
+    unit, min and max are attributes of the variable element itself; the adapter's independent
+    variable ``time`` is not in the spec)."""
+    root = ET.fromstring(xml)
+    variables = [(element, element) for element in root.find("ModelVariables") if element.get("causality") != "independent"]
+    return _complete(root, spec, variables, _fmi3_structure)

@@ -16,4 +16,4 @@ def test_variable_tables_match_the_specs():
 
 
 def test_readme_holds_the_ci_test_command():
-    assert 'python -m pip install -e ".[test]" && python -m pytest -q' in README
+    assert 'python -m pip install -e ".[test,interop]" && python -m pytest -q' in README

@@ -1,0 +1,197 @@
+"""The driveline system: an SSP 1.0 package of the project's FMUs and a small fmpy master for it.
+
+Usage: ``python -m fmu_harness.system [--models models]`` after ``python build_fmu.py`` (which
+also writes the package): writes ``models/Driveline.ssp`` and prints the last values of the
+system's outputs from the fmpy master.
+
+The system: ``SpeedSource`` (a speed ramp with a superposed sine) drives ``TripodCoupling``'s
+input shaft; ``CriticalSpeeds``, when the catalog has it, watches the coupling's output shaft
+speed through each of its rad/s inputs. Parameter bindings set the ramp, the bend angle, the
+load torque and exact kinematics; every component's bindings form one parameter set named
+after the system (Ecos applies a parameter set by name at initialisation, libcosim applies
+all bindings). The package holds the FMI 2.0 FMUs (libcosim reads no FMI 3.0).
+
+:func:`simulate` is a fixed-step Jacobi master like the importers': all components step from
+t_k together, their inputs set from the connected outputs at t_k.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import zipfile
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+import numpy as np
+
+from driveline.catalog import MODELS
+from driveline.variables import UNITS, ModelSpec, Variable
+
+from .runner import FmuInstance
+
+SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+for prefix, uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
+    ET.register_namespace(prefix, uri)
+
+RPM = math.pi / 30.0
+WATCHER = "CriticalSpeeds"
+
+
+@dataclass(frozen=True)
+class Component:
+    """One FMU instance of the system and its parameter bindings."""
+
+    name: str
+    model: str
+    parameters: Mapping[str, float | int]
+
+    @property
+    def spec(self) -> ModelSpec:
+        return MODELS[self.model].spec
+
+
+@dataclass(frozen=True)
+class Connection:
+    start: tuple[str, str]
+    end: tuple[str, str]
+
+
+@dataclass(frozen=True)
+class System:
+    name: str
+    components: tuple[Component, ...]
+    connections: tuple[Connection, ...]
+    stop_time: float
+    step_size: float
+
+    def component(self, name: str) -> Component:
+        return next(c for c in self.components if c.name == name)
+
+    def outputs(self) -> list[str]:
+        """Every Real output as ``"component.variable"``."""
+        return [f"{c.name}.{v.name}" for c in self.components for v in c.spec.of("output") if v.type == "Real"]
+
+
+def driveline() -> System:
+    """Speed ramp 500 to 3000 rpm in 1 s with a 50 rpm, 5 Hz sine, into a tripod coupling bent
+    20 degrees under 150 N.m; ``CriticalSpeeds`` on the output shaft when it exists."""
+    components = [
+        Component("source", "SpeedSource", {"omega_start": 500.0 * RPM, "ramp_rate": 2500.0 * RPM,
+                                            "sine_amplitude": 50.0 * RPM, "sine_frequency": 5.0}),
+        Component("coupling", "TripodCoupling", {"kinematics": 1, "beta": math.radians(20.0), "T_load": 150.0}),
+    ]
+    connections = [Connection(("source", "omega"), ("coupling", "omega_in"))]
+    if WATCHER in MODELS:
+        components.append(Component("critical", WATCHER, {}))
+        connections += [
+            Connection(("coupling", "omega_out"), ("critical", v.name))
+            for v in MODELS[WATCHER].spec.of("input") if v.unit == "rad/s"
+        ]
+    return System("Driveline", tuple(components), tuple(connections), 1.0, 1e-3)
+
+
+# -- SSP ------------------------------------------------------------------------------------
+def _type_element(variable: Variable) -> ET.Element:
+    return ET.Element(f"{{{SSC}}}{variable.type}", {"unit": variable.unit} if variable.unit and variable.type == "Real" else {})
+
+
+def _component(component: Component, connected: set[str], parameter_set: str) -> ET.Element:
+    element = ET.Element(f"{{{SSD}}}Component", name=component.name, type="application/x-fmu-sharedlibrary",
+                         source=f"resources/{component.model}.fmu")
+    connectors = ET.SubElement(element, f"{{{SSD}}}Connectors")
+    for variable in component.spec.variables:
+        if variable.causality in ("input", "output") and f"{component.name}.{variable.name}" in connected:
+            connector = ET.SubElement(connectors, f"{{{SSD}}}Connector", name=variable.name, kind=variable.causality)
+            connector.append(_type_element(variable))
+    if component.parameters:
+        values = ET.SubElement(ET.SubElement(ET.SubElement(element, f"{{{SSD}}}ParameterBindings"),
+                                             f"{{{SSD}}}ParameterBinding"), f"{{{SSD}}}ParameterValues")
+        parameters = ET.SubElement(ET.SubElement(values, f"{{{SSV}}}ParameterSet", version="1.0", name=parameter_set),
+                                   f"{{{SSV}}}Parameters")
+        for name, value in component.parameters.items():
+            variable = component.spec[name]
+            parameter = ET.SubElement(parameters, f"{{{SSV}}}Parameter", name=name)
+            attributes = {"value": repr(float(value)) if variable.type == "Real" else str(value)}
+            if variable.unit and variable.type == "Real":
+                attributes["unit"] = variable.unit
+            ET.SubElement(parameter, f"{{{SSV}}}{variable.type}", attributes)
+    return element
+
+
+def system_structure(system: System) -> bytes:
+    """The SSP 1.0 ``SystemStructure.ssd`` of ``system``."""
+    root = ET.Element(f"{{{SSD}}}SystemStructureDescription", version="1.0", name=system.name)
+    element = ET.SubElement(root, f"{{{SSD}}}System", name=system.name)
+    connected = {f"{c}.{v}" for connection in system.connections for c, v in (connection.start, connection.end)}
+    ET.SubElement(element, f"{{{SSD}}}Elements").extend(_component(c, connected, system.name) for c in system.components)
+    connections = ET.SubElement(element, f"{{{SSD}}}Connections")
+    for connection in system.connections:
+        ET.SubElement(connections, f"{{{SSD}}}Connection", startElement=connection.start[0],
+                      startConnector=connection.start[1], endElement=connection.end[0], endConnector=connection.end[1])
+    used = {v.unit for c in system.components for v in c.spec.variables if v.unit}
+    units = ET.SubElement(root, f"{{{SSD}}}Units")
+    for unit in (UNITS[name] for name in UNITS if name in used):
+        ET.SubElement(ET.SubElement(units, f"{{{SSC}}}Unit", name=unit.name), f"{{{SSC}}}BaseUnit",
+                      {k: str(v) for k, v in unit.exponents.items()})
+    ET.SubElement(root, f"{{{SSD}}}DefaultExperiment", startTime="0.0", stopTime=repr(system.stop_time))
+    ET.indent(root)
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def write_ssp(system: System, models: Path) -> Path:
+    """``models/<system>.ssp`` with the system structure and the FMI 2.0 FMUs from ``models``."""
+    path = models / f"{system.name}.ssp"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("SystemStructure.ssd", system_structure(system))
+        for model in sorted({c.model for c in system.components}):
+            archive.write(models / f"{model}.fmu", f"resources/{model}.fmu")
+    return path
+
+
+# -- fmpy master ----------------------------------------------------------------------------
+def simulate(system: System, models: Path, outputs: list[str] | None = None) -> np.ndarray:
+    """Run ``system`` with the FMI 2.0 FMUs in ``models``; rows of t_k and ``outputs``
+    (default: all Real outputs) for t_1 ... t_N."""
+    names = outputs or system.outputs()
+    instances = {c.name: FmuInstance(models / f"{c.model}.fmu", c.name) for c in system.components}
+    try:
+        for component in system.components:
+            instances[component.name].initialize(component.parameters)
+
+        def value(name: str) -> float:
+            component, variable = name.split(".", 1)
+            return instances[component].get([variable])[0]
+
+        rows = []
+        for k in range(int(round(system.stop_time / system.step_size))):
+            transfers = [(connection.end, value(".".join(connection.start))) for connection in system.connections]
+            for (component, variable), transferred in transfers:
+                instances[component].set({variable: transferred})
+            for instance in instances.values():
+                instance.time = k * system.step_size
+                instance.step(system.step_size)
+            rows.append([(k + 1) * system.step_size, *(value(name) for name in names)])
+        return np.array(rows)
+    finally:
+        for instance in instances.values():
+            instance.close()
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
+    args = parser.parse_args(argv)
+    system = driveline()
+    print(write_ssp(system, args.models))
+    result = simulate(system, args.models)
+    for name, last in zip(system.outputs(), result[-1, 1:]):
+        print(f"{name} = {last:.9g}")
+
+
+if __name__ == "__main__":
+    main()
