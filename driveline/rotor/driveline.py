@@ -1,0 +1,338 @@
+"""A driveline assembled from elements: whirl frequencies, Campbell data, critical speeds.
+
+All frequencies and speeds are in rad/s. ``spin`` is the shaft speed ``Omega``,
+``w`` a whirl frequency. Forward whirl turns with the spin, backward against it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import transfer
+from .elements import Bearing, ConcentratedMass, EndCondition, ShaftSegment
+from .roots import RootSearchReport, find_roots
+
+FloatArray = NDArray[np.float64]
+Whirl = Literal["forward", "backward"]
+
+#: Grid points per expected root: the bare shaft has one root per pi of the phase
+#: kappa*sqrt(w), and every degree of freedom of a point mass may add one more.
+POINTS_PER_ROOT = 16
+#: Default upper limit of any search [rad/s] (about 955 000 rpm).
+SEARCH_LIMIT = 1.0e5
+
+
+@dataclass(frozen=True)
+class WhirlFrequencies:
+    """Natural whirl frequencies at one spin speed [rad/s], ascending."""
+
+    spin: float
+    forward: FloatArray
+    backward: FloatArray
+
+    @property
+    def all(self) -> FloatArray:
+        return np.sort(np.concatenate([self.forward, self.backward]))
+
+
+@dataclass(frozen=True)
+class CampbellDiagram:
+    """Whirl frequencies over spin speeds: arrays (n_speeds, n_modes), NaN where absent."""
+
+    spins: FloatArray
+    forward: FloatArray
+    backward: FloatArray
+
+
+@dataclass(frozen=True)
+class OrderResonance:
+    """Spin speed at which ``order * spin`` equals a whirl frequency of the given sense."""
+
+    order: int
+    whirl: Whirl
+    spin: float
+
+    @property
+    def frequency(self) -> float:
+        """Excitation (= whirl) frequency ``order * spin`` [rad/s]."""
+        return self.order * self.spin
+
+    def margin(self, spin: float) -> float:
+        """Relative separation ``(self.spin - spin) / spin`` (positive: resonance above)."""
+        return (self.spin - spin) / spin
+
+
+def _speed(name: str, value: float, positive: bool = False) -> float:
+    v = float(value)
+    if not math.isfinite(v) or v < 0.0 or (positive and v == 0.0):
+        bound = "> 0" if positive else ">= 0"
+        raise ValueError(f"{name} must be a finite speed {bound} rad/s, got {value!r}")
+    return v
+
+
+def _as_tuple(items: Iterable, kind: type, name: str) -> tuple:
+    out = tuple(items)
+    for i, it in enumerate(out):
+        if not isinstance(it, kind):
+            raise ValueError(f"{name}[{i}] must be a {kind.__name__}, got {type(it).__name__}")
+    return out
+
+
+@dataclass(frozen=True)
+class Driveline:
+    """Segments in axial order with point elements at the nodes between them.
+
+    Node ``0`` is the left end, node ``k`` the joint after segment ``k-1``, node
+    ``len(segments)`` the right end (as ROSS numbers its nodes). ``left`` and
+    ``right`` are the end conditions; bearings are point elements and may sit at
+    any node, including the ends (then use ``free`` ends, as the seed's Fig. 2).
+    """
+
+    segments: Sequence[ShaftSegment]
+    masses: Sequence[ConcentratedMass] = ()
+    bearings: Sequence[Bearing] = ()
+    left: EndCondition | str = EndCondition.FREE
+    right: EndCondition | str = EndCondition.FREE
+    name: str = ""
+    _chain: transfer.Chain = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        segs = _as_tuple(self.segments, ShaftSegment, "segments")
+        if not segs:
+            raise ValueError("segments: a driveline needs at least one shaft segment")
+        masses = _as_tuple(self.masses, ConcentratedMass, "masses")
+        bearings = _as_tuple(self.bearings, Bearing, "bearings")
+        n_nodes = len(segs) + 1
+        for kind, items in (("masses", masses), ("bearings", bearings)):
+            for i, it in enumerate(items):
+                if it.node >= n_nodes:
+                    raise ValueError(
+                        f"{kind}[{i}].node = {it.node} is out of range: nodes are 0..{n_nodes - 1}"
+                    )
+        ends = []
+        for label, value in (("left", self.left), ("right", self.right)):
+            try:
+                ends.append(EndCondition(value))
+            except ValueError:
+                allowed = ", ".join(e.value for e in EndCondition)
+                raise ValueError(f"{label} end condition {value!r} is not one of: {allowed}") from None
+        object.__setattr__(self, "segments", segs)
+        object.__setattr__(self, "masses", masses)
+        object.__setattr__(self, "bearings", bearings)
+        object.__setattr__(self, "left", ends[0])
+        object.__setattr__(self, "right", ends[1])
+        object.__setattr__(self, "_chain", transfer.Chain.build(segs, masses, bearings, ends[0], ends[1]))
+
+    # -- geometry --------------------------------------------------------------
+    @property
+    def node_positions(self) -> FloatArray:
+        """Axial position of every node [m]."""
+        return np.concatenate([[0.0], np.cumsum([s.length for s in self.segments])])
+
+    @property
+    def total_length(self) -> float:
+        return float(sum(s.length for s in self.segments))
+
+    @property
+    def total_mass(self) -> float:
+        return float(sum(s.mass for s in self.segments) + sum(m.mass for m in self.masses))
+
+    @property
+    def is_isotropic(self) -> bool:
+        """True when every bearing has ``kxx == kyy`` (4x4 complex formulation)."""
+        return self._chain.isotropic
+
+    @property
+    def _kappa(self) -> float:
+        """Phase constant: the bare shaft has a mode every pi of ``kappa * sqrt(w)``."""
+        return float(sum(s.length * (s.mass_per_length / s.bending_stiffness) ** 0.25 for s in self.segments))
+
+    # -- determinant -----------------------------------------------------------
+    def determinant(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
+        """Scaled frequency determinant ``f(w, spin)`` (seed Eq. 31), vectorised.
+
+        Isotropic: signed ``w`` (forward > 0, backward < 0). Anisotropic: ``w > 0``.
+        """
+        return transfer.determinant(self._chain, w, spin)
+
+    def mode_shape(self, w: float, spin: float = 0.0, points_per_segment: int = 8) -> transfer.ModeShape:
+        """Deflection shape at a natural frequency ``w`` (see :func:`transfer.mode_shape`)."""
+        return transfer.mode_shape(self._chain, w, spin, points_per_segment)
+
+    # -- grids and searches ----------------------------------------------------
+    def _grid(self, x_max: float, ratio: float) -> FloatArray:
+        """Search grid on ``(0, x_max]`` for the frequency ``ratio * x``.
+
+        Uniform in the bare-shaft phase ``theta = kappa sqrt(|ratio| x)``. The shaft
+        alone has one root per pi of ``theta``; each translational or rotational
+        degree of freedom of a concentrated mass can add one root anywhere, and the
+        8x8 (anisotropic) determinant holds both whirl senses. The grid has
+        ``POINTS_PER_ROOT`` points per expected root on that count, plus a
+        logarithmic lead-in for heavy masses on soft bearings near zero.
+        """
+        extra = sum((st.mass > 0) + (st.diametral_inertia > 0 or st.polar_inertia > 0) for st in self._chain.stations)
+        per_pi = POINTS_PER_ROOT * (1 + extra) * (1 if self.is_isotropic else 2)
+        kappa = self._kappa * math.sqrt(abs(ratio))
+        theta_max = kappa * math.sqrt(x_max)
+        n = max(math.ceil(theta_max / math.pi * per_pi), 8)
+        # offset by an irrational fraction of a step: pinned-beam roots sit at theta = k pi
+        theta = (np.arange(n) + 0.6180339887498949) * (theta_max / n)
+        theta = np.append(theta, theta_max)  # the scan must reach x_max itself
+        x = (theta / kappa) ** 2
+        lead = np.geomspace(x[0] * 1e-4, x[0], 9)[:-1]
+        return np.concatenate([lead, x])
+
+    def _search(self, g, ratio: float, n: int | None, x_max: float | None, limit: float) -> RootSearchReport:
+        """Roots of ``g(x)`` on (0, x_max], or the first ``n`` roots below ``limit``."""
+        if x_max is not None:
+            return find_roots(g, self._grid(x_max, ratio))
+        if n is None or isinstance(n, bool) or not float(n).is_integer() or n < 1:
+            raise ValueError(f"n must be a positive integer (or give an upper limit), got {n!r}")
+        limit = _speed("limit", limit, positive=True)
+        kappa = self._kappa * math.sqrt(abs(ratio))
+        x_hi = min(((n + 2) * math.pi / kappa) ** 2, limit)
+        while True:
+            rep = find_roots(g, self._grid(x_hi, ratio), max_roots=n)
+            if rep.roots.size >= n or x_hi >= limit:
+                return rep
+            x_hi = min(4.0 * x_hi, limit)
+
+    @staticmethod
+    def _take(roots: FloatArray, n: int | None) -> FloatArray:
+        return roots if n is None else roots[:n]
+
+    def _classify(self, roots: FloatArray, ratio: float) -> list[Whirl]:
+        """Whirl sense of anisotropic modes at ``w = ratio * spin`` (spin = root)."""
+        out: list[Whirl] = []
+        for x in roots:
+            w = ratio * x if ratio != 0 else x
+            shape = self.mode_shape(abs(w), x, points_per_segment=4)
+            out.append("forward" if shape.forward_fraction >= 0.5 else "backward")
+        return out
+
+    # -- results -----------------------------------------------------------------
+    def whirl_frequencies(
+        self, spin: float = 0.0, n: int | None = 4, w_max: float | None = None, limit: float = SEARCH_LIMIT
+    ) -> WhirlFrequencies:
+        """Natural whirl frequencies at spin speed ``spin`` [rad/s].
+
+        Either the first ``n`` of each sense (default 4) or all up to ``w_max``.
+        At ``spin = 0`` both lists hold the same (planar) modes. With anisotropic
+        bearings a mode is forward when its forward circular component carries
+        more than half of ``sum |U|^2``; the ``2 n`` lowest modes are split, so a
+        list may hold fewer than ``n``.
+        """
+        spin = _speed("spin", spin)
+        if w_max is not None:
+            w_max = _speed("w_max", w_max, positive=True)
+            n = None
+        if self.is_isotropic:
+            fwd = self._search(lambda x: self.determinant(x, spin), 1.0, n, w_max, limit).roots
+            if spin == 0.0:
+                bwd = fwd
+            else:
+                bwd = self._search(lambda x: self.determinant(-x, spin), 1.0, n, w_max, limit).roots
+            return WhirlFrequencies(spin, self._take(fwd, n), self._take(bwd, n))
+        nn = None if n is None else 2 * n
+        roots = self._search(lambda x: self.determinant(x, spin), 1.0, nn, w_max, limit).roots
+        if spin == 0.0:  # planar modes at standstill: report each in both lists
+            return WhirlFrequencies(spin, self._take(roots, n), self._take(roots, n))
+        senses = [
+            "forward" if self.mode_shape(w, spin, 4).forward_fraction >= 0.5 else "backward" for w in roots
+        ]
+        fwd = np.array([w for w, s in zip(roots, senses) if s == "forward"])
+        bwd = np.array([w for w, s in zip(roots, senses) if s == "backward"])
+        return WhirlFrequencies(spin, self._take(fwd, n), self._take(bwd, n))
+
+    def campbell(self, spins: ArrayLike, n_modes: int = 4) -> CampbellDiagram:
+        """Campbell diagram data: first ``n_modes`` forward and backward frequencies per speed."""
+        sp = np.atleast_1d(np.asarray(spins, dtype=float))
+        for v in sp:
+            _speed("spins", v)
+        fwd = np.full((sp.size, n_modes), np.nan)
+        bwd = np.full((sp.size, n_modes), np.nan)
+        for i, s in enumerate(sp):
+            r = self.whirl_frequencies(s, n_modes)
+            fwd[i, : r.forward.size] = r.forward[:n_modes]
+            bwd[i, : r.backward.size] = r.backward[:n_modes]
+        return CampbellDiagram(sp, fwd, bwd)
+
+    def order_resonances(
+        self,
+        orders: Iterable[int] = (1,),
+        whirl: Iterable[Whirl] = ("forward",),
+        n: int | None = 3,
+        spin_max: float | None = None,
+        limit: float = SEARCH_LIMIT,
+    ) -> list[OrderResonance]:
+        """Spin speeds where ``order * spin`` equals a whirl frequency, sorted by speed.
+
+        Solved directly as roots of ``f(+-order*spin, spin)`` in ``spin``: order 1
+        forward gives the critical speeds; orders 2 (Cardan joints), 3 and 6
+        (tripod joints) the order resonances. Either the first ``n`` per order and
+        sense, or all up to ``spin_max``.
+        """
+        if spin_max is not None:
+            spin_max = _speed("spin_max", spin_max, positive=True)
+        whirls = tuple(whirl)
+        for wh in whirls:
+            if wh not in ("forward", "backward"):
+                raise ValueError(f"whirl must be 'forward' or 'backward', got {wh!r}")
+        out: list[OrderResonance] = []
+        for k in orders:
+            if isinstance(k, bool) or int(k) != k or k < 1:
+                raise ValueError(f"order must be a positive integer, got {k!r}")
+            k = int(k)
+            if self.is_isotropic:
+                for wh in whirls:
+                    r = k if wh == "forward" else -k
+                    rep = self._search(lambda x, r=r: self.determinant(r * x, x), r, n, spin_max, limit)
+                    out.extend(OrderResonance(k, wh, float(x)) for x in self._take(rep.roots, n))
+            else:
+                nn = None if n is None else 2 * n
+                rep = self._search(lambda x, k=k: self.determinant(k * x, x), k, nn, spin_max, limit)
+                found = {"forward": [], "backward": []}
+                for x, s in zip(rep.roots, self._classify(rep.roots, k)):
+                    found[s].append(float(x))
+                for wh in whirls:
+                    out.extend(OrderResonance(k, wh, x) for x in self._take(np.array(found[wh]), n))
+        return sorted(out, key=lambda r: (r.spin, r.order))
+
+    def critical_speeds(
+        self, n: int | None = 3, whirl: Whirl = "forward", spin_max: float | None = None, limit: float = SEARCH_LIMIT
+    ) -> FloatArray:
+        """Critical speeds [rad/s]: spin speeds with a synchronous whirl frequency.
+
+        ``whirl="forward"`` (default) solves ``f(Omega, Omega) = 0`` directly;
+        ``"backward"`` solves ``f(-Omega, Omega) = 0``. First ``n`` or all up to ``spin_max``.
+        Fewer than ``n`` are returned if no more exist below ``limit`` (a Rayleigh
+        shaft has finitely many forward critical speeds).
+        """
+        res = self.order_resonances((1,), (whirl,), n, spin_max, limit)
+        return np.array([r.spin for r in res])
+
+    def nearest_order_resonance(
+        self,
+        spin: float,
+        orders: Iterable[int] = (1, 2),
+        whirl: Iterable[Whirl] = ("forward", "backward"),
+        limit: float = SEARCH_LIMIT,
+    ) -> OrderResonance | None:
+        """The order resonance whose spin speed is closest to ``spin`` (``None`` if none below ``limit``)."""
+        spin = _speed("spin", spin, positive=True)
+        orders = tuple(orders)
+        whirl = tuple(whirl)
+        span = min(2.0 * spin, limit)
+        # Within (0, 2 spin] any resonance is nearer than all beyond 2 spin.
+        cands = self.order_resonances(orders, whirl, None, span, limit)
+        if not cands:
+            cands = self.order_resonances(orders, whirl, 1, None, limit)
+        if not cands:
+            return None
+        return min(cands, key=lambda r: abs(r.spin - spin))

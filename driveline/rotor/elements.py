@@ -1,0 +1,375 @@
+"""Driveline elements and their transfer matrices (complex whirl coordinates).
+
+Lateral motion is written as ``u = x + i y`` with ``u(z, t) = U(z) exp(i w t)`` in
+the *stationary* frame. ``w`` is the signed whirl frequency: ``w > 0`` is forward
+whirl (same sense as the spin ``Omega``), ``w < 0`` backward whirl. For an isotropic
+rotor every coefficient is then real and one 4x4 real transfer matrix per element
+carries both planes (seed paper, Eqs. 3-7, where the 8x8 matrix is block-diagonal
+with two equal blocks).
+
+State vector at a station (SI units)::
+
+    s = [U, psi, M, V],   psi = U',   M = EI U'',   V = EI U''' + c U'
+
+``V`` is the transverse force *including* the rotary-inertia and gyroscopic couple
+``c U'`` with ``c = rho I (w**2 - 2 Omega w)``; with this choice the segment law is
+``s' = A s`` with ``V' = rho A w**2 U`` and free ends are exactly ``M = V = 0``
+(the seed carries ``EI U'''`` instead, which breaks the free-end condition and the
+force balance between segments of different section).
+
+All matrix builders are vectorised: ``w`` and ``spin`` broadcast to a common shape
+``(n,)`` and the result has shape ``(n, 4, 4)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+__all__ = [
+    "Bearing",
+    "ConcentratedMass",
+    "EndCondition",
+    "ShaftSegment",
+]
+
+
+def _positive(name: str, value: float) -> float:
+    v = float(value)
+    if not math.isfinite(v) or v <= 0.0:
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return v
+
+
+def _non_negative(name: str, value: float) -> float:
+    v = float(value)
+    if not math.isfinite(v) or v < 0.0:
+        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return v
+
+
+def _node(value: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise ValueError(f"node must be an integer >= 0, got {value!r}")
+    return int(value)
+
+
+class EndCondition(str, Enum):
+    """Support at either end of the driveline.
+
+    ``FREE``: ``M = V = 0`` (use with :class:`Bearing` elements, as in the seed's
+    Fig. 2); ``PINNED``: ``U = M = 0`` (rigid simple support); ``CLAMPED``:
+    ``U = psi = 0``.
+    """
+
+    FREE = "free"
+    PINNED = "pinned"
+    CLAMPED = "clamped"
+
+    @property
+    def zero_components(self) -> tuple[int, int]:
+        """Indices of the state components that vanish at this end."""
+        return {"free": (2, 3), "pinned": (0, 2), "clamped": (0, 1)}[self.value]
+
+    @property
+    def free_components(self) -> tuple[int, int]:
+        """Indices of the state components left unknown at this end."""
+        z = self.zero_components
+        i, j = (k for k in range(4) if k not in z)
+        return i, j
+
+
+# ---------------------------------------------------------------------------
+# Stable auxiliary functions for the closed-form field matrix
+# ---------------------------------------------------------------------------
+_SERIES_LIMIT = 0.1  # below this argument the Taylor series is exact to ~1e-16
+
+
+def _sinh_minus_x_over_x3(x: FloatArray) -> FloatArray:
+    """(sinh x - x)/x**3, -> 1/6 at x = 0, without cancellation."""
+    small = x < _SERIES_LIMIT
+    xs = np.where(small, 1.0, x)
+    direct = (np.sinh(xs) - xs) / xs**3
+    x2 = x * x
+    series = 1 / 6 + x2 * (1 / 120 + x2 * (1 / 5040 + x2 / 362880))
+    return np.where(small, series, direct)
+
+
+def _x_minus_sin_over_x3(y: FloatArray) -> FloatArray:
+    """(y - sin y)/y**3, -> 1/6 at y = 0, without cancellation."""
+    small = y < _SERIES_LIMIT
+    ys = np.where(small, 1.0, y)
+    direct = (ys - np.sin(ys)) / ys**3
+    y2 = y * y
+    series = 1 / 6 - y2 * (1 / 120 - y2 * (1 / 5040 - y2 / 362880))
+    return np.where(small, series, direct)
+
+
+def _cosh_minus_1_over_x2(x: FloatArray) -> FloatArray:
+    """(cosh x - 1)/x**2 = 2 sinh(x/2)**2/x**2, -> 1/2 at x = 0."""
+    h = 0.5 * x
+    hs = np.where(h == 0.0, 1.0, h)
+    r = np.where(h == 0.0, 1.0, np.sinh(hs) / hs)
+    return 0.5 * r * r
+
+
+def _1_minus_cos_over_y2(y: FloatArray) -> FloatArray:
+    """(1 - cos y)/y**2 = 2 sin(y/2)**2/y**2, -> 1/2 at y = 0."""
+    r = np.sinc(y / (2.0 * np.pi))
+    return 0.5 * r * r
+
+
+def _betas(a: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Squared wave numbers of ``U'''' + a U'' - b U = 0`` (b >= 0).
+
+    ``beta1**2 = r - a/2`` (hyperbolic), ``beta2**2 = r + a/2`` (trigonometric),
+    ``r = sqrt(a**2/4 + b)``; seed Eqs. (22)-(23). The smaller one is formed as
+    ``b / larger`` to avoid cancellation.
+    """
+    r = np.sqrt(0.25 * a * a + b)
+    big2 = np.where(a >= 0.0, r + 0.5 * a, r - 0.5 * a)
+    safe = np.where(big2 > 0.0, big2, 1.0)
+    small2 = np.where(big2 > 0.0, b / safe, 0.0)
+    b1sq = np.where(a >= 0.0, small2, big2)
+    b2sq = np.where(a >= 0.0, big2, small2)
+    return b1sq, b2sq
+
+
+def beam_field_matrix(
+    length: float, EI: float, mass_per_length: float, c: FloatArray, w: FloatArray
+) -> FloatArray:
+    """Exact transfer matrix ``s(l) = H s(0)`` of ``EI U'''' + c U'' - m' w^2 U = 0``.
+
+    Closed form of ``expm(A l)`` with ``A = [[0,1,0,0],[0,0,1/EI,0],[0,-c,0,1],
+    [m' w^2,0,0,0]]`` built from the four Krylov functions
+    ``C0..C3`` (seed Eqs. 16-20, corrected). Arrays ``c`` and ``w`` share shape (n,).
+    """
+    z = float(length)
+    a = c / EI
+    b = mass_per_length * w * w / EI
+    b1sq, b2sq = _betas(a, b)
+    x = np.sqrt(b1sq) * z
+    y = np.sqrt(b2sq) * z
+    s = b1sq + b2sq
+    pos = s > 0.0
+    s_safe = np.where(pos, s, 1.0)
+    w1 = np.where(pos, b1sq / s_safe, 0.5)
+    w2 = np.where(pos, b2sq / s_safe, 0.5)
+    b_over_s = np.where(pos, b / s_safe, 0.0)
+    g1, g2 = _sinh_minus_x_over_x3(x), _x_minus_sin_over_x3(y)
+    h1, h2 = _cosh_minus_1_over_x2(x), _1_minus_cos_over_y2(y)
+    z2, z3 = z * z, z**3
+    C0 = 1.0 + b_over_s * z2 * (h1 - h2)
+    C1 = z + b_over_s * z3 * (g1 - g2)
+    C2 = z2 * (w1 * h1 + w2 * h2)
+    C3 = z3 * (w1 * g1 + w2 * g2)
+    C1a = C1 - a * C3  # = C2'
+    C0a = C0 - a * C2  # = C2''
+    # Fundamental matrix of the derivatives d = [U, U', U'', U'''].
+    phi = np.empty(np.shape(w) + (4, 4))
+    phi[..., 0, :] = np.stack([C0, C1, C2, C3], axis=-1)
+    phi[..., 1, :] = np.stack([b * C3, C0, C1a, C2], axis=-1)
+    phi[..., 2, :] = np.stack([b * C2, b * C3, C0a, C1a], axis=-1)
+    phi[..., 3, :] = np.stack([b * C1a, b * C2, b * C3 - a * C1a, C0a], axis=-1)
+    # Physical state s = S d with S = [[1,0,0,0],[0,1,0,0],[0,0,EI,0],[0,c,0,EI]].
+    H = np.empty_like(phi)
+    H[..., 0, :] = phi[..., 0, :]
+    H[..., 1, :] = phi[..., 1, :]
+    H[..., 2, :] = EI * phi[..., 2, :]
+    H[..., 3, :] = EI * phi[..., 3, :] + c[..., None] * phi[..., 1, :]
+    # ... times S^-1 = [[1,0,0,0],[0,1,0,0],[0,0,1/EI,0],[0,-c/EI,0,1/EI]].
+    H[..., :, 1] -= (c / EI)[..., None] * H[..., :, 3]
+    H[..., :, 2] /= EI
+    H[..., :, 3] /= EI
+    return H
+
+
+def _broadcast(w: ArrayLike, spin: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    w_arr, s_arr = np.broadcast_arrays(
+        np.atleast_1d(np.asarray(w, dtype=float)), np.atleast_1d(np.asarray(spin, dtype=float))
+    )
+    return w_arr, s_arr
+
+
+@dataclass(frozen=True)
+class ShaftSegment:
+    """Uniform hollow (or solid) shaft segment, Rayleigh beam (seed Fig. 1).
+
+    Parameters are SI: ``length`` [m], ``outer_diameter`` / ``inner_diameter`` [m]
+    (inner 0 for a solid shaft), ``youngs_modulus`` [Pa], ``density`` [kg/m3].
+    ``rotary_inertia`` and ``gyroscopic`` switch the two Rayleigh terms (both on by
+    default; off gives an Euler-Bernoulli beam).
+    """
+
+    length: float
+    outer_diameter: float
+    inner_diameter: float = 0.0
+    youngs_modulus: float = 2.1e11
+    density: float = 7850.0
+    rotary_inertia: bool = True
+    gyroscopic: bool = True
+
+    def __post_init__(self) -> None:
+        _positive("length", self.length)
+        _positive("outer_diameter", self.outer_diameter)
+        _non_negative("inner_diameter", self.inner_diameter)
+        if self.inner_diameter >= self.outer_diameter:
+            raise ValueError(
+                f"inner_diameter ({self.inner_diameter!r}) must be smaller than "
+                f"outer_diameter ({self.outer_diameter!r})"
+            )
+        _positive("youngs_modulus", self.youngs_modulus)
+        _positive("density", self.density)
+
+    @classmethod
+    def from_radii(
+        cls,
+        length: float,
+        outer_radius: float,
+        inner_radius: float = 0.0,
+        youngs_modulus: float = 2.1e11,
+        density: float = 7850.0,
+        **switches: bool,
+    ) -> ShaftSegment:
+        """Build from radii ``r2`` (outer) and ``r1`` (inner), the seed's notation."""
+        return cls(length, 2.0 * outer_radius, 2.0 * inner_radius, youngs_modulus, density, **switches)
+
+    @property
+    def area(self) -> float:
+        """Cross-section area [m2]."""
+        return math.pi / 4.0 * (self.outer_diameter**2 - self.inner_diameter**2)
+
+    @property
+    def second_moment(self) -> float:
+        """Diametral second moment of area ``J`` of seed Eq. (21) [m4]."""
+        return math.pi / 64.0 * (self.outer_diameter**4 - self.inner_diameter**4)
+
+    @property
+    def bending_stiffness(self) -> float:
+        """``EI`` [N m2]."""
+        return self.youngs_modulus * self.second_moment
+
+    @property
+    def mass_per_length(self) -> float:
+        """``rho A`` [kg/m]."""
+        return self.density * self.area
+
+    @property
+    def mass(self) -> float:
+        """Segment mass [kg]."""
+        return self.mass_per_length * self.length
+
+    def couple_coefficient(self, w: FloatArray, spin: FloatArray) -> FloatArray:
+        """``c = rho I w^2 - rho Ip Omega w`` per unit length, with ``Ip = 2 I``."""
+        rI = self.density * self.second_moment
+        c = np.zeros_like(w)
+        if self.rotary_inertia:
+            c = c + rI * w * w
+        if self.gyroscopic:
+            c = c - 2.0 * rI * spin * w
+        return c
+
+    def beta1(self, w: FloatArray, spin: FloatArray) -> FloatArray:
+        """Hyperbolic wave number ``beta1`` (seed Eq. 22) [1/m], elementwise."""
+        EI = self.bending_stiffness
+        a = self.couple_coefficient(w, spin) / EI
+        b = self.mass_per_length * w * w / EI
+        b1sq, _ = _betas(a, b)
+        return np.sqrt(b1sq)
+
+    def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0, length: float | None = None) -> FloatArray:
+        """Field matrix ``H`` (shape (n, 4, 4)) over ``length`` (default: whole segment)."""
+        w_arr, s_arr = _broadcast(w, spin)
+        return beam_field_matrix(
+            self.length if length is None else length,
+            self.bending_stiffness,
+            self.mass_per_length,
+            self.couple_coefficient(w_arr, s_arr),
+            w_arr,
+        )
+
+
+@dataclass(frozen=True)
+class ConcentratedMass:
+    """Rigid concentrated mass at station ``node`` (universal joint, bearing carrier).
+
+    ``mass`` [kg], ``polar_inertia`` Jp and ``diametral_inertia`` Jd [kg m2].
+    Point matrix (seed Eq. 25, corrected for any Jp/Jd ratio)::
+
+        M+ = M- - (Jd w^2 - Jp Omega w) psi,   V+ = V- + m w^2 U
+    """
+
+    node: int
+    mass: float
+    polar_inertia: float = 0.0
+    diametral_inertia: float = 0.0
+
+    def __post_init__(self) -> None:
+        _node(self.node)
+        _non_negative("mass", self.mass)
+        _non_negative("polar_inertia", self.polar_inertia)
+        _non_negative("diametral_inertia", self.diametral_inertia)
+
+    def rotary_term(self, w: FloatArray, spin: FloatArray) -> FloatArray:
+        """``Jd w^2 - Jp Omega w`` [N m]."""
+        return self.diametral_inertia * w * w - self.polar_inertia * spin * w
+
+    def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
+        """Point matrix (shape (n, 4, 4))."""
+        w_arr, s_arr = _broadcast(w, spin)
+        P = np.broadcast_to(np.eye(4), w_arr.shape + (4, 4)).copy()
+        P[..., 2, 1] = -self.rotary_term(w_arr, s_arr)
+        P[..., 3, 0] = self.mass * w_arr * w_arr
+        return P
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """Linear elastic bearing at station ``node``; ``kxx`` [N/m], ``kyy`` (default ``kxx``).
+
+    Isotropic point matrix (seed Eq. 27): ``V+ = V- - k U``. With ``kxx != kyy`` the
+    forward and backward whirl components couple through ``(kxx - kyy)/2`` and the
+    8x8 formulation of :mod:`driveline.rotor.transfer` is used.
+    """
+
+    node: int
+    kxx: float
+    kyy: float | None = None
+
+    def __post_init__(self) -> None:
+        _node(self.node)
+        _non_negative("kxx", self.kxx)
+        if self.kyy is not None:
+            _non_negative("kyy", self.kyy)
+
+    @property
+    def k_yy(self) -> float:
+        """Stiffness in y [N/m]."""
+        return self.kxx if self.kyy is None else float(self.kyy)
+
+    @property
+    def is_isotropic(self) -> bool:
+        return self.kyy is None or float(self.kyy) == float(self.kxx)
+
+    @property
+    def k_mean(self) -> float:
+        """``(kxx + kyy)/2`` acting on each whirl component [N/m]."""
+        return 0.5 * (self.kxx + self.k_yy)
+
+    @property
+    def k_diff(self) -> float:
+        """``(kxx - kyy)/2`` coupling forward and backward whirl [N/m]."""
+        return 0.5 * (self.kxx - self.k_yy)
+
+    def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
+        """Isotropic point matrix (shape (n, 4, 4)) using ``k_mean``."""
+        w_arr, _ = _broadcast(w, spin)
+        P = np.broadcast_to(np.eye(4), w_arr.shape + (4, 4)).copy()
+        P[..., 3, 0] = -self.k_mean
+        return P

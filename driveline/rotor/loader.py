@@ -1,0 +1,277 @@
+"""TOML driveline descriptions and the one-piece propshaft constructor.
+
+File layout (SI units; all tables except ``segments`` optional)::
+
+    name = "two-piece propshaft"
+    left_end = "free"            # free | pinned | clamped
+    right_end = "free"
+
+    [materials.steel]
+    youngs_modulus = 2.1e11      # Pa
+    density = 7850.0             # kg/m3
+
+    [[segments]]                 # in axial order, node k is the start of segment k
+    length = 0.7                 # m
+    outer_diameter = 0.0762      # m   (or outer_radius)
+    wall_thickness = 0.00165     # m   (or inner_diameter / inner_radius; default solid)
+    material = "steel"           # or youngs_modulus and density in the segment
+    # rotary_inertia = true, gyroscopic = true
+
+    [[masses]]
+    node = 0
+    mass = 2.5                   # kg
+    polar_inertia = 0.004        # kg m2
+    diametral_inertia = 0.002    # kg m2
+
+    [[bearings]]
+    node = 0
+    stiffness = 1.0e7            # N/m, isotropic; or kxx and kyy
+
+Every problem raises :class:`ValueError` naming the table, entry and key.
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import tomllib
+
+from .driveline import Driveline
+from .elements import Bearing, ConcentratedMass, EndCondition, ShaftSegment
+
+__all__ = ["example_path", "load_driveline", "loads_driveline", "one_piece_shaft"]
+
+_TOP_KEYS = {"name", "left_end", "right_end", "materials", "segments", "masses", "bearings"}
+_MATERIAL_KEYS = {"youngs_modulus", "density"}
+_SEGMENT_KEYS = {
+    "length", "outer_diameter", "outer_radius", "inner_diameter", "inner_radius",
+    "wall_thickness", "material", "youngs_modulus", "density", "rotary_inertia",
+    "gyroscopic", "label",
+}
+_MASS_KEYS = {"node", "mass", "polar_inertia", "diametral_inertia", "label"}
+_BEARING_KEYS = {"node", "stiffness", "kxx", "kyy", "label"}
+
+
+def _unknown(where: str, table: dict[str, Any], allowed: set[str]) -> None:
+    extra = sorted(set(table) - allowed)
+    if extra:
+        raise ValueError(f"{where}: unknown key {extra[0]!r} (allowed: {', '.join(sorted(allowed))})")
+
+
+def _number(where: str, key: str, value: Any, *, positive: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{where}.{key} must be a number, got {value!r}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{where}.{key} must be finite, got {value!r}")
+    if positive and v <= 0.0:
+        raise ValueError(f"{where}.{key} must be > 0, got {value!r}")
+    if v < 0.0:
+        raise ValueError(f"{where}.{key} must be >= 0, got {value!r}")
+    return v
+
+
+def _node(where: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"{where}.node must be an integer >= 0, got {value!r}")
+    return value
+
+
+def _flag(where: str, key: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise ValueError(f"{where}.{key} must be true or false, got {value!r}")
+    return value
+
+
+def _table_list(data: dict[str, Any], key: str) -> list[dict[str, Any]]:
+    items = data.get(key, [])
+    if not isinstance(items, list) or not all(isinstance(t, dict) for t in items):
+        raise ValueError(f"{key} must be an array of tables ([[{key}]])")
+    return items
+
+
+def _materials(data: dict[str, Any]) -> dict[str, tuple[float, float]]:
+    mats = data.get("materials", {})
+    if not isinstance(mats, dict):
+        raise ValueError("materials must be a table of named materials ([materials.NAME])")
+    out = {}
+    for name, t in mats.items():
+        where = f"materials.{name}"
+        if not isinstance(t, dict):
+            raise ValueError(f"{where} must be a table")
+        _unknown(where, t, _MATERIAL_KEYS)
+        for k in sorted(_MATERIAL_KEYS):
+            if k not in t:
+                raise ValueError(f"{where}: missing key {k!r}")
+        out[name] = (
+            _number(where, "youngs_modulus", t["youngs_modulus"], positive=True),
+            _number(where, "density", t["density"], positive=True),
+        )
+    return out
+
+
+def _segment(i: int, t: dict[str, Any], mats: dict[str, tuple[float, float]]) -> ShaftSegment:
+    where = f"segments[{i}]"
+    _unknown(where, t, _SEGMENT_KEYS)
+    if "length" not in t:
+        raise ValueError(f"{where}: missing key 'length'")
+    length = _number(where, "length", t["length"], positive=True)
+    outer = [k for k in ("outer_diameter", "outer_radius") if k in t]
+    if len(outer) != 1:
+        raise ValueError(f"{where}: give exactly one of 'outer_diameter' or 'outer_radius'")
+    d_out = _number(where, outer[0], t[outer[0]], positive=True) * (2.0 if outer[0] == "outer_radius" else 1.0)
+    inner = [k for k in ("inner_diameter", "inner_radius", "wall_thickness") if k in t]
+    if len(inner) > 1:
+        raise ValueError(f"{where}: give at most one of 'inner_diameter', 'inner_radius', 'wall_thickness'")
+    d_in = 0.0
+    if inner:
+        key = inner[0]
+        v = _number(where, key, t[key])
+        if key == "wall_thickness":
+            if v <= 0.0:
+                raise ValueError(f"{where}.wall_thickness must be > 0, got {t[key]!r}")
+            if 2.0 * v > d_out:
+                raise ValueError(
+                    f"{where}.wall_thickness = {t[key]!r} exceeds half the outer diameter ({d_out / 2!r})"
+                )
+            d_in = max(d_out - 2.0 * v, 0.0)
+        else:
+            d_in = v * (2.0 if key == "inner_radius" else 1.0)
+            if d_in >= d_out:
+                raise ValueError(
+                    f"{where}.{key} = {t[key]!r} must be smaller than the outer size "
+                    f"({outer[0]} = {t[outer[0]]!r})"
+                )
+    E = rho = None
+    if "material" in t:
+        name = t["material"]
+        if not isinstance(name, str) or name not in mats:
+            known = ", ".join(sorted(mats)) or "none defined"
+            raise ValueError(f"{where}.material {name!r} is not a defined material ({known})")
+        E, rho = mats[name]
+    if "youngs_modulus" in t:
+        E = _number(where, "youngs_modulus", t["youngs_modulus"], positive=True)
+    if "density" in t:
+        rho = _number(where, "density", t["density"], positive=True)
+    for key, v in (("youngs_modulus", E), ("density", rho)):
+        if v is None:
+            raise ValueError(f"{where}: missing key {key!r} (or a 'material')")
+    flags = {k: _flag(where, k, t[k]) for k in ("rotary_inertia", "gyroscopic") if k in t}
+    return ShaftSegment(length, d_out, d_in, E, rho, **flags)
+
+
+def _mass(i: int, t: dict[str, Any]) -> ConcentratedMass:
+    where = f"masses[{i}]"
+    _unknown(where, t, _MASS_KEYS)
+    for k in ("node", "mass"):
+        if k not in t:
+            raise ValueError(f"{where}: missing key {k!r}")
+    return ConcentratedMass(
+        _node(where, t["node"]),
+        _number(where, "mass", t["mass"]),
+        _number(where, "polar_inertia", t.get("polar_inertia", 0.0)),
+        _number(where, "diametral_inertia", t.get("diametral_inertia", 0.0)),
+    )
+
+
+def _bearing(i: int, t: dict[str, Any]) -> Bearing:
+    where = f"bearings[{i}]"
+    _unknown(where, t, _BEARING_KEYS)
+    if "node" not in t:
+        raise ValueError(f"{where}: missing key 'node'")
+    node = _node(where, t["node"])
+    if "stiffness" in t:
+        if "kxx" in t or "kyy" in t:
+            raise ValueError(f"{where}: give either 'stiffness' or 'kxx'/'kyy', not both")
+        return Bearing(node, _number(where, "stiffness", t["stiffness"], positive=True))
+    if "kxx" not in t:
+        raise ValueError(f"{where}: missing key 'stiffness' (or 'kxx')")
+    kxx = _number(where, "kxx", t["kxx"], positive=True)
+    kyy = _number(where, "kyy", t["kyy"], positive=True) if "kyy" in t else None
+    return Bearing(node, kxx, kyy)
+
+
+def loads_driveline(text: str, source: str = "<string>") -> Driveline:
+    """Build a :class:`Driveline` from TOML text (see the module docstring for the layout)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{source}: malformed TOML: {exc}") from None
+    _unknown(source, data, _TOP_KEYS)
+    name = data.get("name", "")
+    if not isinstance(name, str):
+        raise ValueError(f"{source}: name must be a string, got {name!r}")
+    ends = []
+    for key in ("left_end", "right_end"):
+        v = data.get(key, "free")
+        allowed = [e.value for e in EndCondition]
+        if v not in allowed:
+            raise ValueError(f"{key} = {v!r} is not one of: {', '.join(allowed)}")
+        ends.append(EndCondition(v))
+    mats = _materials(data)
+    seg_tables = _table_list(data, "segments")
+    if not seg_tables:
+        raise ValueError(f"{source}: at least one [[segments]] table is required")
+    segments = [_segment(i, t, mats) for i, t in enumerate(seg_tables)]
+    masses = [_mass(i, t) for i, t in enumerate(_table_list(data, "masses"))]
+    bearings = [_bearing(i, t) for i, t in enumerate(_table_list(data, "bearings"))]
+    return Driveline(segments, masses, bearings, ends[0], ends[1], name)
+
+
+def load_driveline(path: str | Path) -> Driveline:
+    """Read a TOML driveline description from ``path``."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"cannot read driveline file {p.name!r}: {exc.strerror}") from None
+    return loads_driveline(text, p.name)
+
+
+def example_path(name: str = "two_piece_propshaft") -> Path:
+    """Path of a shipped example description (``data/<name>.toml``)."""
+    p = Path(str(resources.files(__package__).joinpath("data", f"{name}.toml")))
+    if not p.is_file():
+        raise ValueError(f"no shipped example named {name!r}")
+    return p
+
+
+def one_piece_shaft(
+    L_shaft: float,
+    D_outer: float,
+    D_inner: float,
+    E: float,
+    density: float,
+    m_joint: float,
+    Jp_joint: float,
+    Jd_joint: float,
+    k_bearing: float,
+) -> Driveline:
+    """One-piece tube propshaft: a joint mass and an isotropic bearing at each end.
+
+    SI units: lengths [m], ``E`` [Pa], ``density`` [kg/m3], ``m_joint`` [kg],
+    ``Jp_joint``/``Jd_joint`` [kg m2], ``k_bearing`` [N/m]; free ends (the bearings
+    carry the shaft, as in the seed's Fig. 2). Errors name the offending parameter.
+    """
+    vals = {
+        "L_shaft": L_shaft, "D_outer": D_outer, "D_inner": D_inner, "E": E, "density": density,
+        "m_joint": m_joint, "Jp_joint": Jp_joint, "Jd_joint": Jd_joint, "k_bearing": k_bearing,
+    }
+    for k, v in vals.items():
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):
+            raise ValueError(f"{k} must be a finite number, got {v!r}")
+    for k in ("L_shaft", "D_outer", "E", "density", "k_bearing"):
+        if vals[k] <= 0.0:
+            raise ValueError(f"{k} must be > 0, got {vals[k]!r}")
+    for k in ("D_inner", "m_joint", "Jp_joint", "Jd_joint"):
+        if vals[k] < 0.0:
+            raise ValueError(f"{k} must be >= 0, got {vals[k]!r}")
+    if D_inner >= D_outer:
+        raise ValueError(f"D_inner ({D_inner!r}) must be smaller than D_outer ({D_outer!r})")
+    seg = ShaftSegment(float(L_shaft), float(D_outer), float(D_inner), float(E), float(density))
+    masses = [ConcentratedMass(n, float(m_joint), float(Jp_joint), float(Jd_joint)) for n in (0, 1)]
+    bearings = [Bearing(n, float(k_bearing)) for n in (0, 1)]
+    return Driveline([seg], masses, bearings, EndCondition.FREE, EndCondition.FREE, "one-piece propshaft")

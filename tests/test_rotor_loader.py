@@ -1,0 +1,190 @@
+"""TOML loader, one-piece constructor and their error messages."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from driveline.rotor import (
+    Driveline,
+    EndCondition,
+    example_path,
+    load_driveline,
+    loads_driveline,
+    one_piece_shaft,
+)
+
+GOOD = """
+name = "test"
+left_end = "free"
+right_end = "pinned"
+
+[materials.steel]
+youngs_modulus = 2.1e11
+density = 7850.0
+
+[[segments]]
+length = 0.7
+outer_diameter = 0.0762
+wall_thickness = 0.00165
+material = "steel"
+
+[[segments]]
+length = 0.5
+outer_radius = 0.02
+inner_radius = 0.01
+youngs_modulus = 2.0e11
+density = 7800.0
+gyroscopic = false
+
+[[masses]]
+node = 0
+mass = 2.5
+polar_inertia = 0.004
+diametral_inertia = 0.002
+
+[[bearings]]
+node = 0
+stiffness = 1.0e7
+
+[[bearings]]
+node = 1
+kxx = 2.0e6
+kyy = 1.0e6
+"""
+
+
+def test_good_file_round_trip():
+    d = loads_driveline(GOOD)
+    assert d.name == "test" and d.left is EndCondition.FREE and d.right is EndCondition.PINNED
+    s0, s1 = d.segments
+    assert s0.inner_diameter == pytest.approx(0.0762 - 2 * 0.00165, rel=1e-15)  # one subtraction
+    assert (s1.outer_diameter, s1.inner_diameter, s1.youngs_modulus, s1.gyroscopic) == (0.04, 0.02, 2.0e11, False)
+    assert d.masses[0].polar_inertia == 0.004
+    assert d.bearings[1].kxx == 2e6 and d.bearings[1].k_yy == 1e6 and not d.is_isotropic
+
+
+def test_shipped_example_loads_and_solves():
+    d = load_driveline(example_path("two_piece_propshaft"))
+    assert len(d.segments) == 3 and len(d.bearings) == 3
+    cs = d.critical_speeds(3)
+    assert cs.size == 3 and np.all(np.diff(cs) > 0)
+
+
+def test_one_piece_constructor_matches_explicit_toml():
+    d1 = one_piece_shaft(1.4, 0.0762, 0.0729, 2.1e11, 7850.0, 2.5, 0.004, 0.002, 1e7)
+    text = """
+[[segments]]
+length = 1.4
+outer_diameter = 0.0762
+inner_diameter = 0.0729
+youngs_modulus = 2.1e11
+density = 7850.0
+[[masses]]
+node = 0
+mass = 2.5
+polar_inertia = 0.004
+diametral_inertia = 0.002
+[[masses]]
+node = 1
+mass = 2.5
+polar_inertia = 0.004
+diametral_inertia = 0.002
+[[bearings]]
+node = 0
+stiffness = 1e7
+[[bearings]]
+node = 1
+stiffness = 1e7
+"""
+    d2 = loads_driveline(text)
+    assert np.array_equal(d1.critical_speeds(3), d2.critical_speeds(3))
+
+
+def _replace(old: str, new: str) -> str:
+    assert old in GOOD
+    return GOOD.replace(old, new, 1)
+
+
+@pytest.mark.parametrize(
+    "text,fragment",
+    [
+        (_replace("length = 0.7", "length = -0.7"), "segments[0].length"),
+        (_replace("length = 0.7", "length = 0.0"), "segments[0].length"),
+        (_replace("length = 0.7", 'length = "0.7"'), "segments[0].length"),
+        (_replace("length = 0.7", "length = true"), "segments[0].length"),
+        (_replace("length = 0.7", "length = nan"), "segments[0].length"),
+        (_replace("inner_radius = 0.01", "inner_radius = 0.02"), "segments[1].inner_radius"),
+        (_replace("inner_radius = 0.01", "inner_radius = 0.03"), "segments[1].inner_radius"),
+        (_replace("wall_thickness = 0.00165", "wall_thickness = 0.05"), "segments[0].wall_thickness"),
+        (_replace("wall_thickness = 0.00165", "wall_thickness = 0.0"), "segments[0].wall_thickness"),
+        (_replace("density = 7850.0", "density = 0.0"), "materials.steel.density"),
+        (_replace("density = 7800.0", "density = 0"), "segments[1].density"),
+        (_replace("youngs_modulus = 2.0e11", "youngs_modulus = -2.0e11"), "segments[1].youngs_modulus"),
+        (_replace('material = "steel"', 'material = "alu"'), "segments[0].material"),
+        (_replace("length = 0.7", "lenght = 0.7"), "unknown key 'lenght'"),
+        (_replace("outer_radius = 0.02", "outer_radius = 0.02\nouter_diameter = 0.04"), "segments[1]"),
+        (_replace("mass = 2.5", "mass = -2.5"), "masses[0].mass"),
+        (_replace("polar_inertia = 0.004", "polar_inertia = -1"), "masses[0].polar_inertia"),
+        (_replace("diametral_inertia = 0.002", "diametral_inertia = -1"), "masses[0].diametral_inertia"),
+        (_replace("node = 0\nmass", "node = 7\nmass"), "masses[0].node"),
+        (_replace("node = 0\nmass", "node = -1\nmass"), "masses[0].node"),
+        (_replace("node = 0\nmass", "node = 1.5\nmass"), "masses[0].node"),
+        (_replace("stiffness = 1.0e7", "stiffness = -1.0e7"), "bearings[0].stiffness"),
+        (_replace("stiffness = 1.0e7", "stiffness = 1.0e7\nkxx = 1.0"), "bearings[0]"),
+        (_replace("kyy = 1.0e6", "kyy = 0.0"), "bearings[1].kyy"),
+        (_replace("kyy = 1.0e6", "kzz = 1.0e6"), "unknown key 'kzz'"),
+        (_replace('right_end = "pinned"', 'right_end = "welded"'), "right_end"),
+        (_replace('name = "test"', "name = 3"), "name"),
+        (_replace('name = "test"', 'name = "test"\ncolour = "red"'), "unknown key 'colour'"),
+        (GOOD + "\n[[segments]\n", "malformed TOML"),
+        ("left_end = 'free'\n", "segments"),
+        (_replace("[materials.steel]", "[materials.steel]\ncolour = 1"), "materials.steel"),
+    ],
+)
+def test_bad_values_raise_value_error_naming_them(text, fragment):
+    with pytest.raises(ValueError) as exc:
+        loads_driveline(text)
+    assert fragment in str(exc.value)
+
+
+def test_unreadable_file(tmp_path):
+    with pytest.raises(ValueError, match="cannot read"):
+        load_driveline(tmp_path / "missing.toml")
+
+
+def test_file_errors_name_the_file(tmp_path):
+    p = tmp_path / "bad.toml"
+    p.write_text("[[segments]\n", encoding="utf-8")
+    with pytest.raises(ValueError, match="bad.toml: malformed TOML"):
+        load_driveline(p)
+
+
+def test_unknown_example():
+    with pytest.raises(ValueError, match="no shipped example"):
+        example_path("does_not_exist")
+
+
+ARGS = {"L_shaft": 1.4, "D_outer": 0.0762, "D_inner": 0.0729, "E": 2.1e11, "density": 7850.0,
+        "m_joint": 2.5, "Jp_joint": 0.004, "Jd_joint": 0.002, "k_bearing": 1e7}
+
+
+@pytest.mark.parametrize(
+    "name,value",
+    [("L_shaft", -1.0), ("L_shaft", 0.0), ("D_outer", 0.0), ("D_inner", -0.01), ("D_inner", 0.0762),
+     ("D_inner", 0.09), ("E", 0.0), ("density", 0.0), ("density", float("nan")), ("m_joint", -1.0),
+     ("Jp_joint", -1e-3), ("Jd_joint", -1e-3), ("k_bearing", 0.0), ("k_bearing", float("inf"))],
+)
+def test_one_piece_errors_name_the_parameter(name, value):
+    with pytest.raises(ValueError, match=name):
+        one_piece_shaft(**{**ARGS, name: value})
+
+
+def test_driveline_validation():
+    d = one_piece_shaft(**ARGS)
+    with pytest.raises(ValueError, match="out of range"):
+        Driveline(d.segments, d.masses, [*d.bearings, type(d.bearings[0])(5, 1e6)])
+    with pytest.raises(ValueError, match="left end condition"):
+        Driveline(d.segments, left="glued")
+    with pytest.raises(ValueError, match="at least one"):
+        Driveline([])
