@@ -5,10 +5,11 @@ from __future__ import annotations
 from .cardan.model import CardanJointModel
 from .model import SteppedModel
 from .reducer.model import UniversalReducerModel
+from .rotor.model import CriticalSpeedsModel
 from .source.model import SpeedSourceModel
 from .tripod.model import TripodCouplingModel
 
 MODELS: dict[str, type[SteppedModel]] = {
     model.spec.name: model
-    for model in (TripodCouplingModel, CardanJointModel, UniversalReducerModel, SpeedSourceModel)
+    for model in (TripodCouplingModel, CardanJointModel, UniversalReducerModel, CriticalSpeedsModel, SpeedSourceModel)
 }

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from . import coupling_comparison, tripod_study
+from . import coupling_comparison, critical_speed_study, tripod_study
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -19,6 +19,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     written = tripod_study.write(args.models / "TripodCoupling.fmu", args.out)
     written += coupling_comparison.write(args.models, args.out)
+    written += critical_speed_study.write(args.models / "CriticalSpeeds.fmu", args.out)
     for path in written:
         print(path)
 

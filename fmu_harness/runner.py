@@ -122,6 +122,11 @@ class FmuInstance:
             raise StepRefused(name, status, self.time, self.messages_since(start)) from None
 
     def initialize(self, start_values: Mapping[str, Any] | None = None, start_time: float = 0.0) -> None:
+        self.enter_initialization(start_values, start_time)
+        self.exit_initialization()
+
+    def enter_initialization(self, start_values: Mapping[str, Any] | None = None, start_time: float = 0.0) -> None:
+        """Enter initialisation mode and set start values (a master may set more before exiting)."""
         self.time = start_time
         if self.fmi3:
             self.fmu.enterInitializationMode(startTime=start_time)
@@ -129,6 +134,8 @@ class FmuInstance:
             self.fmu.setupExperiment(startTime=start_time)
             self.fmu.enterInitializationMode()
         self.set(start_values or {})
+
+    def exit_initialization(self) -> None:
         self._call("exitInitializationMode", self.fmu.exitInitializationMode)
 
     def step(self, step_size: float) -> None:

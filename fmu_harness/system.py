@@ -11,8 +11,9 @@ load torque and exact kinematics; every component's bindings form one parameter 
 after the system (Ecos applies a parameter set by name at initialisation, libcosim applies
 all bindings). The package holds the FMI 2.0 FMUs (libcosim reads no FMI 3.0).
 
-:func:`simulate` is a fixed-step Jacobi master like the importers': all components step from
-t_k together, their inputs set from the connected outputs at t_k.
+:func:`simulate` is a fixed-step Jacobi master like the importers': connected inputs start
+from the start values of their outputs, then all components step from t_k together, their
+inputs set from the connected outputs at t_k.
 """
 
 from __future__ import annotations
@@ -160,12 +161,19 @@ def simulate(system: System, models: Path, outputs: list[str] | None = None) -> 
     names = outputs or system.outputs()
     instances = {c.name: FmuInstance(models / f"{c.model}.fmu", c.name) for c in system.components}
     try:
-        for component in system.components:
-            instances[component.name].initialize(component.parameters)
 
         def value(name: str) -> float:
             component, variable = name.split(".", 1)
             return instances[component].get([variable])[0]
+
+        # Like the importers: all components enter initialisation, each connection carries the
+        # start value of its output (outputs are computed on exit), then all exit.
+        for component in system.components:
+            instances[component.name].enter_initialization(component.parameters)
+        for connection in system.connections:
+            instances[connection.end[0]].set({connection.end[1]: value(".".join(connection.start))})
+        for instance in instances.values():
+            instance.exit_initialization()
 
         rows = []
         for k in range(int(round(system.stop_time / system.step_size))):

@@ -29,6 +29,8 @@ Run = tuple[dict[str, Any], list[tuple[dict[str, Any], float]]]
 def _plausible(variable: Variable) -> st.SearchStrategy[Any]:
     """Values within 5 % of the start value (or 0.1 of it when it is 0)."""
     start = variable.start
+    if variable.type == "String":
+        return st.just(start)
     if variable.type == "Integer":
         spread = max(1, abs(start) // 20)
         return st.integers(max(start - spread, int(variable.min) if variable.min is not None else INT32[0]),
@@ -39,6 +41,8 @@ def _plausible(variable: Variable) -> st.SearchStrategy[Any]:
 
 def _bad(variable: Variable) -> st.SearchStrategy[Any]:
     """Out-of-range values of ``variable``, and for a Real also non-finite or huge ones."""
+    if variable.type == "String":
+        return st.sampled_from(["x", "missing.toml"])
     below = [variable.min - 1] if variable.min is not None else []
     above = [variable.max + 1] if variable.max is not None else []
     if variable.type == "Integer":

@@ -1,0 +1,69 @@
+"""Interface of the ``CriticalSpeeds`` FMU: the single source for the FMI 2.0 and 3.0 builds."""
+
+from __future__ import annotations
+
+from ..variables import DefaultExperiment, ModelSpec, Variable
+
+STRUCTURE = "Driveline structure (tunable: a change is re-analysed at the next step)"
+
+SPEC = ModelSpec(
+    name="CriticalSpeeds",
+    description=(
+        "Bending critical speeds of a driveline shaft by the transfer matrix method (Hruby, Nahlik "
+        "2021; exact Rayleigh-beam segments with gyroscopic coupling): critical speeds, whirl "
+        "frequencies at the current speed, and the nearest order resonance of the couplings."
+    ),
+    variables=(
+        Variable("L_shaft", "parameter", 1.4, f"{STRUCTURE}: tube length", "m", "mm", min=0.0,
+                 variability="tunable"),
+        Variable("D_outer", "parameter", 0.0762, f"{STRUCTURE}: tube outer diameter", "m", "mm", min=0.0,
+                 variability="tunable"),
+        Variable("D_inner", "parameter", 0.0729, f"{STRUCTURE}: tube inner diameter, below D_outer", "m", "mm",
+                 min=0.0, variability="tunable"),
+        Variable("E", "parameter", 2.1e11, f"{STRUCTURE}: Young's modulus of the tube", "Pa", "MPa", min=0.0,
+                 variability="tunable"),
+        Variable("density", "parameter", 7850.0, f"{STRUCTURE}: density of the tube", "kg/m3", min=0.0,
+                 variability="tunable"),
+        Variable("m_joint", "parameter", 2.5, f"{STRUCTURE}: mass of the joint at each end", "kg", min=0.0,
+                 variability="tunable"),
+        Variable("Jp_joint", "parameter", 0.004, f"{STRUCTURE}: polar moment of inertia of each joint",
+                 "kg.m2", min=0.0, variability="tunable"),
+        Variable("Jd_joint", "parameter", 0.002, f"{STRUCTURE}: diametral moment of inertia of each joint",
+                 "kg.m2", min=0.0, variability="tunable"),
+        Variable("k_bearing", "parameter", 1e7, f"{STRUCTURE}: stiffness of the bearing at each end", "N/m",
+                 min=0.0, variability="tunable"),
+        Variable("layout", "parameter", "",
+                 "Driveline description (TOML) replacing the one-piece tube above: a file path ending in "
+                 "'.toml', or the name of a description shipped in the FMU ('two_piece_propshaft'); "
+                 "empty = the one-piece tube", type="String", variability="tunable"),
+        Variable("orders", "parameter", "1,2,3,6",
+                 "Excitation orders watched for resonance (1, 2: Cardan joints; 3, 6: tripod coupling)",
+                 type="String", variability="tunable"),
+        Variable("band", "parameter", 0.1,
+                 "Warning band: resonance_warning when |omega - resonance speed| < band * resonance speed",
+                 "1", min=0.0, variability="tunable"),
+        Variable("omega_max", "parameter", 1500.0,
+                 "Largest accepted |omega|; the whirl frequencies are tabulated up to it", "rad/s", "rpm",
+                 min=0.0, variability="tunable"),
+        Variable("omega", "input", 300.0, "Current shaft speed (sign ignored)", "rad/s", "rpm"),
+        Variable("omega_crit_1", "output", 0.0, "First forward bending critical speed", "rad/s", "rpm"),
+        Variable("omega_crit_2", "output", 0.0, "Second forward bending critical speed", "rad/s", "rpm"),
+        Variable("omega_crit_3", "output", 0.0, "Third forward bending critical speed", "rad/s", "rpm"),
+        Variable("whirl_forward_1", "output", 0.0, "First forward whirl frequency at the current speed",
+                 "rad/s", "rpm"),
+        Variable("whirl_forward_2", "output", 0.0, "Second forward whirl frequency at the current speed",
+                 "rad/s", "rpm"),
+        Variable("whirl_backward_1", "output", 0.0, "First backward whirl frequency at the current speed",
+                 "rad/s", "rpm"),
+        Variable("whirl_backward_2", "output", 0.0, "Second backward whirl frequency at the current speed",
+                 "rad/s", "rpm"),
+        Variable("speed_ratio", "output", 0.0, "|omega| / omega_crit_1", "1"),
+        Variable("resonance_order", "output", 0, "Order k of the nearest order resonance (k |omega| = whirl)",
+                 type="Integer"),
+        Variable("resonance_speed", "output", 0.0, "Shaft speed of the nearest order resonance", "rad/s", "rpm"),
+        Variable("resonance_margin", "output", 0.0,
+                 "(|omega| - resonance_speed) / resonance_speed: negative below the resonance", "1"),
+        Variable("resonance_warning", "output", False, "True when |resonance_margin| < band", type="Boolean"),
+    ),
+    default_experiment=DefaultExperiment(0.0, 1.0, 1e-2),
+)

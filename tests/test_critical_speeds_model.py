@@ -1,0 +1,105 @@
+"""The CriticalSpeeds model and FMU: lookups against the transfer-matrix core, re-analysis, refusals."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from driveline.rotor import example_path, load_driveline, one_piece_shaft
+from driveline.rotor.model import CriticalSpeedsModel
+from fmu_harness.runner import FmuInstance, StepRefused, simulate
+
+import model_checks
+
+ROTOR_B = dict(L_shaft=1.4, D_outer=0.0762, D_inner=0.0729, E=2.1e11, density=7850.0,
+               m_joint=2.5, Jp_joint=0.004, Jd_joint=0.002, k_bearing=1e7)
+
+
+@pytest.fixture(scope="module")
+def rotor_b():
+    return one_piece_shaft(**ROTOR_B)
+
+
+def test_critical_speeds_and_interpolated_whirl_match_the_core(rotor_b):
+    model = model_checks.started(CriticalSpeedsModel)
+    assert (model.omega_crit_1, model.omega_crit_2, model.omega_crit_3) == tuple(rotor_b.critical_speeds(3))
+    for speed in (0.0, 123.4, 777.7, 1499.0):  # off the spline knots
+        model.omega = -speed  # the sign of the speed is ignored
+        assert model.step(0.0, 0.01) == []
+        direct = rotor_b.whirl_frequencies(speed, 2)
+        interpolated = [model.whirl_forward_1, model.whirl_forward_2, model.whirl_backward_1, model.whirl_backward_2]
+        # cubic splines through 41 Campbell points: measured 3e-14 (this rotor), 1e-12 (two-piece)
+        np.testing.assert_allclose(interpolated, [*direct.forward[:2], *direct.backward[:2]], rtol=1e-9)
+        if speed:
+            nearest = rotor_b.nearest_order_resonance(speed, orders=(1, 2, 3, 6))
+            assert model.resonance_speed == pytest.approx(nearest.spin, rel=1e-12)
+            assert model.resonance_order == nearest.order
+            assert model.resonance_margin == pytest.approx((speed - nearest.spin) / nearest.spin)
+            assert model.resonance_warning == (abs(model.resonance_margin) < 0.1)
+            assert model.speed_ratio == pytest.approx(speed / model.omega_crit_1)
+
+
+def test_analysis_runs_only_when_the_structure_changes():
+    model = model_checks.started(CriticalSpeedsModel)
+    analysis = model._analysis
+    for k in range(5):
+        model.omega = 100.0 + k
+        assert model.step(k * 0.01, 0.01) == []
+    assert model._analysis is analysis
+    model.k_bearing = 2e6  # a softer bearing, mid-run
+    assert model.step(0.05, 0.01) == []
+    assert model._analysis is not analysis
+    assert model.omega_crit_1 == pytest.approx(one_piece_shaft(**{**ROTOR_B, "k_bearing": 2e6}).critical_speeds(1)[0])
+
+
+def test_shipped_layout_by_name():
+    model = model_checks.started(CriticalSpeedsModel, layout="two_piece_propshaft")
+    expected = load_driveline(example_path("two_piece_propshaft")).critical_speeds(3)
+    assert model.omega_crit_1 == expected[0]
+
+
+@pytest.mark.parametrize(
+    "values, fragment",
+    [
+        ({"D_inner": 0.08}, "D_inner"),
+        ({"L_shaft": -1.0}, "L_shaft"),
+        ({"density": 0.0}, "density"),
+        ({"orders": "1,two"}, "'two'"),
+        ({"layout": "missing.toml"}, "missing.toml"),
+        ({"omega_max": 0.0}, "omega_max"),
+    ],
+)
+def test_non_physical_structure_is_refused_with_the_value_named(values, fragment):
+    model = CriticalSpeedsModel()
+    for name, value in values.items():
+        setattr(model, name, value)
+    errors = model.initialize(0.0)
+    assert errors and fragment in errors[0]
+
+
+def test_malformed_description_file_is_refused(tmp_path):
+    broken = tmp_path / "broken.toml"
+    broken.write_text("[[segments]]\nlength = 'long'\n")
+    model = CriticalSpeedsModel()
+    model.layout = str(broken)
+    errors = model.initialize(0.0)
+    assert errors and "length" in errors[0]
+
+
+def test_fmu_follows_a_speed_ramp_and_refuses_overspeed(fmu_dir, rotor_b):
+    path = fmu_dir / "CriticalSpeeds.fmu"
+    result = simulate(path, 1.0, 0.05, inputs={"omega": lambda t: 1400.0 * t})
+    np.testing.assert_allclose(result["omega_crit_1"], rotor_b.critical_speeds(1)[0], rtol=1e-12)
+    np.testing.assert_allclose(result["speed_ratio"][1:], 1400.0 * (result["time"][1:] - 0.05) / result["omega_crit_1"][1:], rtol=1e-12)
+    with FmuInstance(path) as fmu:
+        fmu.initialize({"omega": 100.0})
+        fmu.step(0.01)
+        fmu.set({"omega": 1600.0})
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(0.01)
+    assert "omega_max" in refused.value.messages[0]
+    with pytest.raises(StepRefused) as refused:
+        simulate(path, 0.1, 0.05, start_values={"D_inner": 0.09})
+    assert any("D_inner" in message for message in refused.value.messages)
