@@ -58,8 +58,9 @@ def test_outputs_match_the_physics_core(tripod_fmu, kinematics):
     np.testing.assert_allclose(result["omega_out"], OMEGA * ratio, rtol=1e-9)
     np.testing.assert_allclose(result["T_in"] * OMEGA, 250.0 * result["omega_out"], rtol=1e-12)
     np.testing.assert_allclose(result["F_pin"], dynamics.pin_force(250.0, beta, R), rtol=1e-12)
-    np.testing.assert_allclose(result["Rz_out"], dynamics.output_axial_reaction(phi, beta, OMEGA, R, M), rtol=1e-9, atol=1e-9)
-    np.testing.assert_allclose(result["Ry_in"], dynamics.input_reaction_y(phi, beta, OMEGA, R, L, M), rtol=1e-9, atol=1e-12)
+    reactions = dynamics.reactions(phi, beta, OMEGA, R, L, M)
+    np.testing.assert_allclose(result["Rz_out"], reactions.Rz_out, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(result["Ry_in"], reactions.Ry_in, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(result["rho"], geometry.orbit_radius(beta, R), rtol=1e-12)
 
 

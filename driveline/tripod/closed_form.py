@@ -41,3 +41,11 @@ def speed_ratio(phi_in: Real, beta: Real, r: float, l: float) -> Real:
     the speed extremes where the angle deviation peaks.
     """
     return 1.0 - 3.0 * deviation_amplitude(beta, r, l) * lib(phi_in).sin(3.0 * paper_angle(phi_in))
+
+
+def kinematics(phi_in: Real, beta: Real, r: float, l: float) -> tuple[Real, Real]:
+    """``(phi_out - phi_in, d phi_out / d phi_in)`` of eq 18 and its derivative, sharing terms."""
+    xp = lib(phi_in, beta)
+    amplitude = deviation_amplitude(beta, r, l)
+    phase = 3.0 * paper_angle(phi_in)
+    return amplitude * xp.cos(phase), 1.0 - 3.0 * amplitude * xp.sin(phase)

@@ -6,6 +6,8 @@ The reactions follow the seed; where it is wrong we say so (docs/tripod_coupling
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -26,28 +28,36 @@ def pin_force(torque: Real, beta: Real, r: float) -> Real:
     return torque / (3.0 * (r + orbit_radius(beta, r)))
 
 
-def plunger_acceleration_sum(phi_in: Real, beta: Real, omega: Real, r: float) -> Real:
-    """Eq 20 as printed: ``a1 + a2 + a3 = -6 omega^2 rho sin(beta) cos 3 phi`` [m/s^2]."""
-    xp = lib(phi_in, beta)
-    return -6.0 * omega * omega * orbit_radius(beta, r) * xp.sin(beta) * xp.cos(3.0 * paper_angle(phi_in))
+class Reactions(NamedTuple):
+    """The seed's plunger-acceleration sum and bearing reactions at one or more configurations."""
+
+    a_plunger_sum: Real  # eq 20 [m/s^2]
+    Rz_out: Real  # eq 30, output self-aligning bearing, axial [N]
+    Rx_in: Real  # eq 33, input bearing [N]
+    Ry_in: Real  # eq 34, input bearing [N]
 
 
-def output_axial_reaction(phi_in: Real, beta: Real, omega: Real, r: float, m: float) -> Real:
-    """Eq 30: ``R_z'' = -6 m rho omega^2 tan(beta) cos 3 phi`` [N] (output self-aligning bearing)."""
-    xp = lib(phi_in, beta)
-    return -6.0 * m * orbit_radius(beta, r) * omega * omega * xp.tan(beta) * xp.cos(3.0 * paper_angle(phi_in))
+def reactions(phi_in: Real, beta: Real, omega: Real, r: float, l: float, m: float) -> Reactions:
+    """Eqs 20, 30, 33, 34 as printed, with the seed's phi = ``paper_angle(phi_in)``:
 
-
-def input_reaction_x(phi_in: Real, beta: Real, omega: Real, r: float, m: float) -> Real:
-    """Eq 33: ``R_x' = tan(beta) m (a1 + a2 + a3) = -6 m omega^2 rho sin(beta) tan(beta) cos 3 phi`` [N]."""
-    return lib(beta).tan(beta) * m * plunger_acceleration_sum(phi_in, beta, omega, r)
-
-
-def input_reaction_y(phi_in: Real, beta: Real, omega: Real, r: float, l: float, m: float) -> Real:
-    """Eq 34: ``R_y' = -(3 m rho^2 omega^2 tan(beta) sin 6 phi) / l`` [N]."""
+    * eq 20: ``a1 + a2 + a3 = -6 omega^2 rho sin(beta) cos 3 phi``
+    * eq 30: ``R_z'' = -6 m rho omega^2 tan(beta) cos 3 phi``
+    * eq 33: ``R_x' = tan(beta) m (a1 + a2 + a3)``
+    * eq 34: ``R_y' = -(3 m rho^2 omega^2 tan(beta) sin 6 phi) / l``
+    """
     xp = lib(phi_in, beta)
     rho = orbit_radius(beta, r)
-    return -3.0 * m * rho**2 * omega * omega * xp.tan(beta) * xp.sin(6.0 * paper_angle(phi_in)) / l
+    omega_squared = omega * omega
+    tan_beta = xp.tan(beta)
+    phi = paper_angle(phi_in)
+    cos_3phi = xp.cos(3.0 * phi)
+    a_sum = -6.0 * omega_squared * rho * xp.sin(beta) * cos_3phi
+    return Reactions(
+        a_plunger_sum=a_sum,
+        Rz_out=-6.0 * m * rho * omega_squared * tan_beta * cos_3phi,
+        Rx_in=tan_beta * m * a_sum,
+        Ry_in=-3.0 * m * rho * rho * omega_squared * tan_beta * xp.sin(6.0 * phi) / l,
+    )
 
 
 def input_torque(load_torque: Real, speed_ratio: Real) -> Real:

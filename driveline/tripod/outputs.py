@@ -24,9 +24,10 @@ def coupling_outputs(
         phi_out, ratio, solution = plane_solver.solve(phi_in, beta, r, l, solution)
         theta = solution.cone_angle
     else:
-        phi_out = phi_in + closed_form.angle_deviation(phi_in, beta, r, l)
-        ratio = closed_form.speed_ratio(phi_in, beta, r, l)
+        deviation, ratio = closed_form.kinematics(phi_in, beta, r, l)
+        phi_out = phi_in + deviation
         theta = arcsin(rho / l)
+    a_sum, rz, rx, ry = dynamics.reactions(phi_in, beta, omega_in, r, l, m)
     return {
         "phi_in": phi_in,
         "phi_out": phi_out,
@@ -36,8 +37,8 @@ def coupling_outputs(
         "F_pin": dynamics.pin_force(T_load, beta, r),
         "rho": rho,
         "theta": theta,
-        "a_plunger_sum": dynamics.plunger_acceleration_sum(phi_in, beta, omega_in, r),
-        "Rz_out": dynamics.output_axial_reaction(phi_in, beta, omega_in, r, m),
-        "Rx_in": dynamics.input_reaction_x(phi_in, beta, omega_in, r, m),
-        "Ry_in": dynamics.input_reaction_y(phi_in, beta, omega_in, r, l, m),
+        "a_plunger_sum": a_sum,
+        "Rz_out": rz,
+        "Rx_in": rx,
+        "Ry_in": ry,
     }, solution
