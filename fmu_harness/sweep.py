@@ -38,7 +38,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.csv
 import pyarrow.parquet
-from distributed import Client, LocalCluster, get_worker, progress, wait
+from distributed import Client, Future, LocalCluster, get_worker, progress, wait
 from fmpy import extract, read_model_description
 
 from .runner import StepRefused, simulate
@@ -251,24 +251,36 @@ def run_point(fmu: ShippedFmu, point: Point, timing: Timing) -> dict[str, Any]:
     return fmu.interface.run(path, point, timing, unzipdir)
 
 
-def critical_speed_margins(speeds: Sequence[float], driveline: Path | None = None) -> list[float] | None:
-    """Relative separation ``(n_c - speed) / speed`` from the nearest forward critical speed
-    ``n_c`` of a driveline (a TOML file of ``driveline.rotor``, default its example), or None
-    unless the catalog holds a ``CriticalSpeeds`` model and the rotor core is importable."""
+def _outcome(future: Future) -> dict[str, Any]:
+    """A task's row: its result, or a failure when it raised, lost its worker or was cancelled."""
+    if future.status == "finished":
+        return future.result()
+    if future.status == "error":
+        return failed(future.exception())
+    return {"status": "failed", "reason": f"the Dask task was {future.status}"}
+
+
+def critical_speed_margins(speeds: Sequence[float], layout: str = "") -> list[float] | None:
+    """``(|speed| - n_c) / n_c`` for the nearest forward critical speed ``n_c`` (rotor core
+    ``driveline.rotor``), or None while the catalog holds no ``CriticalSpeeds`` model.
+
+    The driveline is that of the ``CriticalSpeeds`` FMU for its start values, or ``layout`` (its
+    ``layout`` parameter: a TOML file or the name of a shipped description); the sign follows
+    its ``resonance_margin`` (negative below the critical speed)."""
     from driveline.catalog import MODELS
 
     if CRITICAL_SPEEDS_MODEL not in MODELS:
         return None
-    try:
-        from driveline import rotor
-    except ImportError:
-        return None
-    shaft = rotor.load_driveline(driveline or rotor.example_path())
+    from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline
+
+    spec = MODELS[CRITICAL_SPEEDS_MODEL].spec
+    shaft = build_driveline(layout, {name: spec[name].start for name in SHAFT_PARAMETERS})
     margins: dict[float, float] = {}
-    for speed in set(speeds):
-        nearest = shaft.nearest_order_resonance(abs(speed), orders=(1,), whirl=("forward",)) if speed else None
-        margins[speed] = math.nan if nearest is None else nearest.margin(abs(speed))
-    return [margins[speed] for speed in speeds]
+    for speed in set(map(abs, speeds)):
+        valid = math.isfinite(speed) and speed > 0.0
+        nearest = shaft.nearest_order_resonance(speed, orders=(1,), whirl=("forward",)) if valid else None
+        margins[speed] = math.nan if nearest is None else (speed - nearest.spin) / nearest.spin
+    return [margins[abs(speed)] for speed in speeds]
 
 
 def sweep(
@@ -277,7 +289,7 @@ def sweep(
     points: Sequence[Point],
     timing: Timing = Timing(),
     show_progress: bool = False,
-    driveline: Path | None = None,
+    layout: str = "",
 ) -> pa.Table:
     """Run every point on the client's workers; one row per point, in the order of ``points``.
 
@@ -287,24 +299,21 @@ def sweep(
     """
     shipped = ShippedFmu.read(fmu)
     interface = shipped.interface
-    for point in points:
+    for point in points:  # unknown names raise before anything runs
         interface.split(point)
-    payload = client.scatter(shipped, broadcast=True)
+    payload = client.scatter(shipped, broadcast=True, hash=False)
     futures = [client.submit(run_point, payload, point, timing, pure=False) for point in points]
     if show_progress:
         progress(futures)
     wait(futures)
-    rows = [
-        {**point, **(future.result() if future.status == "finished" else failed(future.exception()))}
-        for point, future in zip(points, futures)
-    ]
+    rows = [{**point, **_outcome(future)} for point, future in zip(points, futures)]
     metrics = interface.metric_columns()
     names = list(dict.fromkeys(name for point in points for name in point))
     types = {"status": pa.string(), "reason": pa.string(), **{m: pa.float64() for m in metrics}}
     columns = [*names, "status", "reason", *metrics]
     table = pa.table({c: pa.array([row.get(c) for row in rows], types.get(c)) for c in columns})
     speeds = [interface.speed(point) for point in points]
-    margins = None if interface.speed_start is None else critical_speed_margins(speeds, driveline)
+    margins = None if interface.speed_start is None else critical_speed_margins(speeds, layout)
     return table if margins is None else table.append_column(MARGIN, pa.array(margins, pa.float64()))
 
 
@@ -325,9 +334,9 @@ def open_client(scheduler: str | None = None, workers: int = 2) -> Iterator[Clie
         with Client(scheduler) as client:
             yield client
         return
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
-        with Client(cluster) as client:
-            yield client
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+    with cluster, Client(cluster) as client:
+        yield client
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -343,7 +352,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--step", type=float, help="communication step size [s]")
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
-    parser.add_argument("--driveline", type=Path, help="driveline TOML for the critical-speed margin")
+    parser.add_argument(
+        "--layout", default="", help="driveline of the critical-speed margin: TOML file or shipped name"
+    )
     parser.add_argument("--out", type=Path, default=Path("results/sweep.parquet"), help=".parquet or .csv")
     args = parser.parse_args(argv)
 
@@ -354,7 +365,10 @@ def main(argv: list[str] | None = None) -> None:
     timing = Timing(args.turns, args.steps_per_turn, args.duration, args.step)
     with open_client(args.scheduler, args.workers) as client:
         print(f"{len(points)} runs of {args.model} on {client.scheduler.address}")
-        table = sweep(client, args.models / f"{args.model}.fmu", points, timing, True, args.driveline)
+        try:
+            table = sweep(client, args.models / f"{args.model}.fmu", points, timing, True, args.layout)
+        except ValueError as error:
+            parser.error(str(error))
     write_table(table, args.out)
     failures = table.column("status").to_pylist().count("failed")
     print(f"\n{table.num_rows} runs, {failures} failed -> {args.out}")

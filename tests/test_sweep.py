@@ -1,0 +1,108 @@
+"""Parameter sweeps on a real local Dask cluster (two worker processes) against direct fmpy runs."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pyarrow.csv
+import pyarrow.parquet
+import pytest
+
+from driveline.catalog import MODELS
+from fmu_harness.runner import simulate
+from fmu_harness.sweep import MARGIN, Timing, grid, main, open_client, parse_axis, sweep, write_table
+
+STEPS = 36
+TIMING = Timing(steps_per_turn=STEPS)
+TRIPOD_METRICS = {
+    "delta_phi_peak_abs": lambda r: np.abs(r["delta_phi"]).max(),
+    "Rz_out_p2p": lambda r: r["Rz_out"].max() - r["Rz_out"].min(),
+    "Rx_in_p2p": lambda r: r["Rx_in"].max() - r["Rx_in"].min(),
+    "Ry_in_p2p": lambda r: r["Ry_in"].max() - r["Ry_in"].min(),
+    "omega_out_p2p": lambda r: r["omega_out"].max() - r["omega_out"].min(),
+}
+
+
+@pytest.fixture(scope="module")
+def client():
+    with open_client(workers=2) as client:
+        yield client
+
+
+def direct_metrics(fmu, point: dict) -> dict[str, float]:
+    """The sweep's metrics of one point, from a run in this process."""
+    turn = 2.0 * math.pi / point["omega_in"]
+    inputs = {k: v for k, v in point.items() if k in ("omega_in", "beta", "T_load")}
+    result = simulate(fmu, turn, turn / STEPS, inputs, {k: v for k, v in point.items() if k not in inputs})
+    expected = {name: f(result) for name, f in TRIPOD_METRICS.items()}
+    for name in result.dtype.names[1:]:
+        expected.update({f"{name}_{s}": getattr(result[name], s)() for s in ("min", "max", "mean")})
+    return expected
+
+
+def test_sweep_matches_direct_runs_and_writes_parquet(client, tripod_fmu, tmp_path):
+    points = grid({"beta": [0.2, 0.45, 0.7], "r": [0.02, 0.026], "omega_in": [150.0], "kinematics": [1]})
+    table = sweep(client, tripod_fmu, points, TIMING)
+    rows = table.to_pylist()
+    assert [{k: row[k] for k in points[0]} for row in rows] == points
+    assert {row["status"] for row in rows} == {"ok"} and {row["reason"] for row in rows} == {None}
+    for point, row in zip(points, rows):
+        expected = direct_metrics(tripod_fmu, point)
+        assert set(row) - set(point) - {"status", "reason", MARGIN} == set(expected)
+        off = {
+            k: (row[k], v) for k, v in expected.items() if not math.isclose(row[k], v, rel_tol=1e-12, abs_tol=1e-12)
+        }
+        assert not off, f"{point}: {off}"
+    assert rows[-1]["delta_phi_peak_abs"] > rows[0]["delta_phi_peak_abs"] > 0.0
+    write_table(table, tmp_path / "sweep.parquet")
+    assert pyarrow.parquet.read_table(tmp_path / "sweep.parquet").equals(table)
+
+
+def test_failed_points_are_reported_with_their_reason(client, tripod_fmu):
+    points = [{"beta": 0.3}, {"beta": 0.9}, {"beta": 0.9, "beta_max": 1.0}, {"beta": 0.3, "omega_in": 0.0}]
+    rows = sweep(client, tripod_fmu, points, TIMING).to_pylist()
+    assert [row["status"] for row in rows] == ["ok", "failed", "ok", "failed"]
+    assert "beta_max" in rows[1]["reason"] and "Discard" in rows[1]["reason"]
+    assert rows[3]["reason"].startswith("ValueError: a run of whole input turns needs a finite non-zero omega_in")
+    assert rows[1]["T_in_mean"] is None and rows[3]["T_in_mean"] is None
+    assert rows[0]["T_in_mean"] == pytest.approx(100.0, rel=1e-4) and rows[2]["delta_phi_peak_abs"] > 0.0
+
+
+def test_unknown_names_are_refused_before_running(client, tripod_fmu):
+    with pytest.raises(ValueError, match="phi_out: no parameter or input of TripodCoupling"):
+        sweep(client, tripod_fmu, [{"beta": 0.3}, {"phi_out": 1.0}], TIMING)
+
+
+def test_grid_axes():
+    assert parse_axis("beta=0:0.7:8") == ("beta", np.linspace(0.0, 0.7, 8).tolist())
+    assert parse_axis("kinematics=0,1") == ("kinematics", [0, 1])
+    assert grid({"a": [1, 2], "b": [3.5]}) == [{"a": 1, "b": 3.5}, {"a": 2, "b": 3.5}]
+    with pytest.raises(ValueError, match="expected name=v1,v2"):
+        parse_axis("beta")
+
+
+def test_cli_with_points_file_on_a_running_scheduler(client, fmu_dir, tmp_path):
+    points = tmp_path / "points.json"
+    points.write_text(json.dumps([{"beta": 0.2, "omega_in": 300.0}, {"beta": 0.4, "omega_in": 300.0}]))
+    out = tmp_path / "sweep.csv"
+    main(["--points", str(points), "--models", str(fmu_dir), "--scheduler", client.scheduler.address,
+          "--steps-per-turn", str(STEPS), "--out", str(out)])
+    table = pyarrow.csv.read_csv(out)
+    assert table.column("status").to_pylist() == ["ok", "ok"]
+    assert table.column("beta").to_pylist() == [0.2, 0.4]
+
+
+def test_critical_speed_margin_of_the_critical_speeds_model(client, tripod_fmu, monkeypatch):
+    from driveline.rotor import one_piece_shaft
+    from driveline.rotor.model import SHAFT_PARAMETERS
+
+    spec = MODELS["CriticalSpeeds"].spec
+    critical = one_piece_shaft(*(spec[name].start for name in SHAFT_PARAMETERS)).critical_speeds(4)
+    speeds = [150.0, 700.0, -700.0]
+    table = sweep(client, tripod_fmu, [{"beta": 0.3, "omega_in": s} for s in speeds], TIMING)
+    nearest = [min(critical, key=lambda c: abs(c - abs(s))) for s in speeds]
+    assert table.column(MARGIN).to_pylist() == pytest.approx([(abs(s) - c) / c for s, c in zip(speeds, nearest)])
+    monkeypatch.delitem(MODELS, "CriticalSpeeds")
+    assert MARGIN not in sweep(client, tripod_fmu, [{"beta": 0.3}], TIMING).column_names
