@@ -1,0 +1,44 @@
+"""Time to the first three forward critical speeds of a one-piece propshaft: ours vs ROSS.
+
+``python -m benchmarks.critical_speeds_vs_ross``: the tube propshaft of the tests (OD 76.2 mm,
+wall 1.65 mm, 1.4 m, 2.5 kg joints, 1e7 N/m bearings), built and solved by the transfer matrix
+method and, on the same rotor, by ROSS's ``run_critical_speed`` (24 Rayleigh-beam elements per
+metre, forward lateral modes filtered). Both are timed after a warm-up (ROSS compiles with numba
+on first use), best of several runs; the results must agree to 0.5 %.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from benchmarks.timing import best_of, machine
+from driveline.rotor import one_piece_shaft
+from fmu_harness.ross_reference import E, RHO, ross_forward_critical_speeds
+
+AGREEMENT = 5e-3
+
+
+def ours() -> np.ndarray:
+    return one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7).critical_speeds(3)
+
+
+def ross() -> np.ndarray:
+    return ross_forward_critical_speeds(one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7))
+
+
+def main() -> None:
+    reference, result = ross(), ours()  # warm-up, and the agreement check
+    difference = np.abs(result - reference) / reference
+    if difference.max() > AGREEMENT:
+        raise SystemExit(f"results disagree: ours {result}, ROSS {reference}")
+    ours_time, ross_time = best_of(ours, repeats=20), best_of(ross, repeats=3)
+    print(f"First three forward critical speeds of the tube propshaft; {machine()}")
+    print("| method | time [ms] | critical speeds [rad/s] |")
+    print("|---|---|---|")
+    print(f"| transfer matrix (ours) | {ours_time * 1e3:.1f} | {', '.join(f'{w:.2f}' for w in result)} |")
+    print(f"| ROSS run_critical_speed | {ross_time * 1e3:.0f} | {', '.join(f'{w:.2f}' for w in reference)} |")
+    print(f"ratio {ross_time / ours_time:.0f}x, largest relative difference {difference.max():.1e}")
+
+
+if __name__ == "__main__":
+    main()
