@@ -6,7 +6,11 @@ same answer). ROSS is imported on first use; it is a test dependency, not a runt
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
 import warnings
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -14,8 +18,23 @@ import numpy as np
 from driveline.rotor import Driveline
 
 
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """Silence file descriptor 1, where compiled code prints too."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    with open(os.devnull, "w") as null:
+        os.dup2(null.fileno(), 1)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 1)
+            os.close(saved)
+
+
 def _ross() -> Any:
-    with warnings.catch_warnings():
+    """Import ROSS quietly: it warns, and its CoolProp dependency prints a REFPROP notice."""
+    with warnings.catch_warnings(), _quiet_stdout():
         warnings.simplefilter("ignore")
         import ross
 
