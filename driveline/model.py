@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 from .variables import ModelSpec, Variable
@@ -43,17 +44,9 @@ class SteppedModel(ABC):
         if errors:
             return errors
         self.time = start_time
-        snapshot = dict(self.__dict__)
-        try:
-            self.start(start_time)
-            errors = self.output_errors()
-        except (ArithmeticError, ValueError) as error:
-            errors = [f"the start values could not be computed ({type(error).__name__}: {error})"]
-        if errors:
-            self.__dict__.update(snapshot)
-            return errors
-        self._initialized = True
-        return []
+        errors = self._undoable(lambda: self.start(start_time), "the start values")
+        self._initialized = not errors
+        return errors
 
     def step(self, current_time: float, step_size: float) -> list[str]:
         """Advance from ``current_time`` by ``step_size``; return the reasons for a refusal."""
@@ -68,17 +61,25 @@ class SteppedModel(ABC):
         if errors:
             return errors
         self._valid_parameters = parameters  # NaN never compares equal, so it is always re-checked
-        snapshot = dict(self.__dict__)  # advance() replaces values, never mutates them in place
+        errors = self._undoable(lambda: self.advance(current_time, step_size), f"the step from t = {current_time!r} s")
+        if not errors:
+            self.time = current_time + step_size
+        return errors
+
+    def _undoable(self, action: Callable[[], None], what: str) -> list[str]:
+        """Run ``action``; if it fails arithmetically or leaves a non-finite output, undo it and say why.
+
+        A shallow copy suffices: models replace values, never mutate them in place.
+        """
+        snapshot = dict(self.__dict__)
         try:
-            self.advance(current_time, step_size)
+            action()
             errors = self.output_errors()
         except (ArithmeticError, ValueError) as error:
-            errors = [f"the step from t = {current_time!r} s could not be computed ({type(error).__name__}: {error})"]
+            errors = [f"{what} could not be computed ({type(error).__name__}: {error})"]
         if errors:
             self.__dict__.update(snapshot)
-            return errors
-        self.time = current_time + step_size
-        return []
+        return errors
 
     # -- model specific ------------------------------------------------------
     @abstractmethod
