@@ -30,10 +30,10 @@ LAST_UPDATE = 1e-9
 MAX_ITERATIONS = 20
 
 
-def _star_centre(x: Real, y: Real, chi: Real, cb: Real, sb: Real, r: float, l: float, xp: Any) -> tuple[Any, Real, Any]:
+def _star_centre(x: Real, y: Real, turn3: Any, cb: Real, sb: Real, r: float, l: float, xp: Any) -> tuple[Any, Real, Any]:
     """Star centre relative to P in tripod-plane coordinates [m] (complex), arg(alpha) [rad], and
-    the centre's ``exp(3i chi)`` term (its derivative in chi is ``-3i`` times that term)."""
-    exp, phase = (cmath.exp, cmath.phase) if xp is math else (np.exp, np.angle)
+    the centre's term in ``turn3 = exp(3i chi)`` (its derivative in chi is ``-3i`` times that term)."""
+    phase = cmath.phase if xp is math else np.angle
     z = xp.sqrt(1.0 - x * x - y * y)
     k = 1.0 / (1.0 + z)
     # twist-free frame onto u = (x, y, z): e1 = (1 - x^2 k, -x y k, -x), e2 = (-x y k, 1 - y^2 k, -y)
@@ -52,7 +52,7 @@ def _star_centre(x: Real, y: Real, chi: Real, cb: Real, sb: Real, r: float, l: f
     alpha = ((a11 + a22) + 1j * (a21 - a12)) * 0.5
     beta = ((a11 - a22) + 1j * (a21 + a12)) * 0.5
     turn = alpha / abs(alpha)
-    orbit = turn * turn * beta.conjugate() * exp(3j * chi)
+    orbit = turn * turn * beta.conjugate() * turn3
     return c - orbit, phase(alpha), orbit
 
 
@@ -91,10 +91,11 @@ def solve(phi_in: Real, beta: Real, r: float, l: float, start: Solution | None =
         x, y = rho_over_l * xp.cos(3.0 * phi_in), rho_over_l * xp.sin(3.0 * phi_in)
     else:
         x, y = start.predict(phi_in)
+    turn3 = (cmath.exp if xp is math else np.exp)(3j * phi_in)
     for _ in range(MAX_ITERATIONS):
-        centre, twist, orbit = _star_centre(x, y, phi_in, cb, sb, r, l, xp)
-        centre_x, twist_x, _ = _star_centre(x + FD_STEP, y, phi_in, cb, sb, r, l, xp)
-        centre_y, twist_y, _ = _star_centre(x, y + FD_STEP, phi_in, cb, sb, r, l, xp)
+        centre, twist, orbit = _star_centre(x, y, turn3, cb, sb, r, l, xp)
+        centre_x, twist_x, _ = _star_centre(x + FD_STEP, y, turn3, cb, sb, r, l, xp)
+        centre_y, twist_y, _ = _star_centre(x, y + FD_STEP, turn3, cb, sb, r, l, xp)
         jxx, jyx = (centre_x.real - centre.real) / FD_STEP, (centre_x.imag - centre.imag) / FD_STEP
         jxy, jyy = (centre_y.real - centre.real) / FD_STEP, (centre_y.imag - centre.imag) / FD_STEP
         det = jxx * jyy - jxy * jyx
