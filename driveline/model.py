@@ -122,11 +122,19 @@ class SteppedModel(ABC):
 
     def parameter_errors(self) -> list[str]:
         errors = [e for v in self.spec.of("parameter") if (e := self._range_error(v))]
-        return errors or self.extra_parameter_errors()
+        return errors or self._guarded(self.extra_parameter_errors, "the parameters")
 
     def input_errors(self) -> list[str]:
         errors = [e for v in self._inputs if (e := self._range_error(v))]
-        return errors or self.extra_input_errors()
+        return errors or self._guarded(self.extra_input_errors, "the inputs")
+
+    @staticmethod
+    def _guarded(check: Callable[[], list[str]], what: str) -> list[str]:
+        """A model-specific check; one that fails arithmetically refuses with the reason."""
+        try:
+            return check()
+        except (ArithmeticError, ValueError) as error:
+            return [f"{what} could not be checked ({type(error).__name__}: {error})"]
 
     def output_errors(self) -> list[str]:
         values = [getattr(self, name) for name in self._real_outputs]

@@ -48,6 +48,7 @@ class FmuInstance:
         self.unzipdir = unzipdir or extract(str(self.path))
         self.variables = {v.name: v for v in self.description.modelVariables}
         self.log: list[LogRecord] = []
+        self.fatal = False
         self.fmu = instantiate_fmu(
             self.unzipdir, self.description, "CoSimulation", debug_logging=True, logger=self._on_log
         )
@@ -93,7 +94,8 @@ class FmuInstance:
             elif kind == "Boolean":
                 values.append(self.fmu.getBoolean(reference)[0])
             else:
-                values.append(self.fmu.getString(reference)[0])
+                text = self.fmu.getString(reference)[0]
+                values.append(text.decode("utf-8") if isinstance(text, bytes) else text)
         return values
 
     # -- FMU state (FMI 2.0 and 3.0 spell the calls differently) -----------------
@@ -119,6 +121,7 @@ class FmuInstance:
             function()
         except FMICallException as error:
             status = STATUS_NAMES[error.status] if error.status < len(STATUS_NAMES) else str(error.status)
+            self.fatal = self.fatal or status == "Fatal"
             raise StepRefused(name, status, self.time, self.messages_since(start)) from None
 
     def initialize(self, start_values: Mapping[str, Any] | None = None, start_time: float = 0.0) -> None:
@@ -152,10 +155,12 @@ class FmuInstance:
         self.time = 0.0
 
     def close(self) -> None:
-        try:
-            self.fmu.terminate()
-        except FMICallException:
-            pass
+        """Terminate (unless the FMU reported Fatal: then only freeing is allowed) and free."""
+        if not self.fatal:
+            try:
+                self.fmu.terminate()
+            except FMICallException:
+                pass
         self.fmu.freeInstance()
         if self._owns_unzipdir:
             shutil.rmtree(self.unzipdir, ignore_errors=True)

@@ -88,8 +88,9 @@ class CriticalSpeedsModel(SteppedModel):
             if not self.omega_max > 0.0:
                 raise ValueError(f"parameter omega_max = {self.omega_max!r} rad/s must be positive")
             self._analysis = analyse(driveline, orders, self.omega_max)
-        except ValueError as error:
-            return [f"driveline: {error}"]
+        except (ValueError, ArithmeticError) as error:  # e.g. a diameter of 1e300 overflows
+            return [f"driveline: {error} (a structural parameter is too large or small to analyse)"
+                    if isinstance(error, ArithmeticError) else f"driveline: {error}"]
         self._analysed_for = key
         return []
 
