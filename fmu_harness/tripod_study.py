@@ -41,7 +41,7 @@ def _angle_axis(ax: plt.Axes, ylabel: str, title: str) -> None:
     ax.set_title(title)
     ax.set_xlim(0, 360)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, ncol=3)
+    ax.legend(fontsize=7, ncol=5, loc="upper center", bbox_to_anchor=(0.5, -0.16))
 
 
 def write(fmu: Path, out: Path) -> list[Path]:
@@ -63,7 +63,7 @@ def write(fmu: Path, out: Path) -> list[Path]:
         "tripod_fig13_Ry_in.png": ("Ry_in", 1.0, "R_y' [N]", "Input-bearing reaction, eq 34 (seed fig. 13)"),
     }
     for name, (column, scale, ylabel, title) in figures.items():
-        fig, ax = plt.subplots(figsize=(7, 4))
+        fig, ax = plt.subplots(figsize=(7, 4.6))
         for beta, result in runs.items():
             ax.plot(np.degrees(result["phi_in"]), result[column] * scale, label=f"beta = {beta} deg")
         _angle_axis(ax, ylabel, f"{title}\n2000 rpm, r = 26 mm, l = 700 mm, m = 0.2 kg, exact kinematics")
