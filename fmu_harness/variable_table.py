@@ -15,6 +15,11 @@ from driveline.variables import ModelSpec
 from .readme import replace_section
 
 
+def _escaped(text: str) -> str:
+    """A table cell's text with its pipes escaped (|omega| would end the cell)."""
+    return text.replace("|", "\\|")
+
+
 def _cell(value: object) -> str:
     return "" if value is None else f"{value:.6g}" if isinstance(value, float) else str(value)
 
@@ -29,7 +34,7 @@ def markdown(spec: ModelSpec) -> str:
     for v in spec.variables:
         unit = (v.unit or "") + (f" ({v.display_unit})" if v.display_unit else "")
         lines.append(
-            f"| `{v.name}` | {v.causality} | {unit} | {_cell(v.start)} | {_cell(v.min)} | {_cell(v.max)} | {v.description} |"
+            f"| `{v.name}` | {v.causality} | {unit} | {_cell(v.start)} | {_cell(v.min)} | {_cell(v.max)} | {_escaped(v.description)} |"
         )
     return "\n".join(lines)
 
