@@ -14,18 +14,17 @@ from numpy.typing import NDArray
 from ..scalar import Real, lib
 from .closed_form import paper_angle
 from .exact import exact_pose
-from .geometry import orbit_radius
 
 Array = NDArray[np.float64]
 
 
-def pin_force(torque: Real, beta: Real, r: float) -> Real:
+def pin_force(torque: Real, rho: Real, r: float) -> Real:
     """Force F on each tripod arm, normal to the arm in the tripod plane [N].
 
     Eq 24 with the arm lengths of the corrected eq 21: ``F = T0 / (h1 + h2 + h3)
-    = T0 / (3 r + 3 rho)``; the seed prints 3 r - 3 rho.
+    = T0 / (3 r + 3 rho)``; the seed prints 3 r - 3 rho. ``rho`` from :func:`.geometry.orbit_radius`.
     """
-    return torque / (3.0 * (r + orbit_radius(beta, r)))
+    return torque / (3.0 * (r + rho))
 
 
 class Reactions(NamedTuple):
@@ -37,8 +36,9 @@ class Reactions(NamedTuple):
     Ry_in: Real  # eq 34, input bearing [N]
 
 
-def reactions(phi_in: Real, beta: Real, omega: Real, r: float, l: float, m: float) -> Reactions:
-    """Eqs 20, 30, 33, 34 as printed, with the seed's phi = ``paper_angle(phi_in)``:
+def reactions(phi_in: Real, beta: Real, omega: Real, rho: Real, l: float, m: float) -> Reactions:
+    """Eqs 20, 30, 33, 34 as printed, with the seed's phi = ``paper_angle(phi_in)`` and ``rho``
+    from :func:`.geometry.orbit_radius`:
 
     * eq 20: ``a1 + a2 + a3 = -6 omega^2 rho sin(beta) cos 3 phi``
     * eq 30: ``R_z'' = -6 m rho omega^2 tan(beta) cos 3 phi``
@@ -46,7 +46,6 @@ def reactions(phi_in: Real, beta: Real, omega: Real, r: float, l: float, m: floa
     * eq 34: ``R_y' = -(3 m rho^2 omega^2 tan(beta) sin 6 phi) / l``
     """
     xp = lib(phi_in, beta)
-    rho = orbit_radius(beta, r)
     omega_squared = omega * omega
     tan_beta = xp.tan(beta)
     phi = paper_angle(phi_in)

@@ -27,14 +27,13 @@ def coupling_outputs(
         deviation, ratio = closed_form.kinematics(phi_in, beta, r, l)
         phi_out = phi_in + deviation
         theta = arcsin(rho / l)
-    a_sum, rz, rx, ry = dynamics.reactions(phi_in, beta, omega_in, r, l, m)
+    a_sum, rz, rx, ry = dynamics.reactions(phi_in, beta, omega_in, rho, l, m)
     return {
-        "phi_in": phi_in,
         "phi_out": phi_out,
         "delta_phi": phi_out - phi_in,
         "omega_out": omega_in * ratio,
         "T_in": dynamics.input_torque(T_load, ratio),
-        "F_pin": dynamics.pin_force(T_load, beta, r),
+        "F_pin": dynamics.pin_force(T_load, rho, r),
         "rho": rho,
         "theta": theta,
         "a_plunger_sum": a_sum,
