@@ -15,7 +15,6 @@ method; the output angle is then ``phi_in + arg(alpha)`` in closed form.
 
 from __future__ import annotations
 
-import cmath
 import math
 from typing import Any, NamedTuple
 
@@ -30,30 +29,37 @@ LAST_UPDATE = 1e-9
 MAX_ITERATIONS = 20
 
 
-def _star_centre(x: Real, y: Real, turn3: Any, cb: Real, sb: Real, r: float, l: float, xp: Any) -> tuple[Any, Real, Any]:
-    """Star centre relative to P in tripod-plane coordinates [m] (complex), arg(alpha) [rad], and
-    the centre's term in ``turn3 = exp(3i chi)`` (its derivative in chi is ``-3i`` times that term)."""
-    phase = cmath.phase if xp is math else np.angle
+def _star_centre(
+    x: Real, y: Real, turn3: tuple[Real, Real], cb: Real, sb: Real, r: float, l: float, xp: Any
+) -> tuple[Real, Real, Real, Real, Real]:
+    """Star centre relative to P in tripod-plane coordinates (two components) [m], arg(alpha)
+    [rad], and the centre's term in ``turn3 = exp(3i chi)`` (two components; its derivative in
+    chi is ``-3i`` times that term). Written in real arithmetic, which numpy runs faster.
+
+    With the frame vectors mapped to the input frame by eq 2 (rotations keep dot products):
+    ``P.E1 = -l x``, ``P.E2 = -l y``, ``P.U = l (z - 1)``, so ``c = l ((z - 1) f + (x, y))``.
+    """
     z = xp.sqrt(1.0 - x * x - y * y)
     k = 1.0 / (1.0 + z)
+    xyk = x * y * k
     # twist-free frame onto u = (x, y, z): e1 = (1 - x^2 k, -x y k, -x), e2 = (-x y k, 1 - y^2 k, -y)
-    e1x, e1y, e1z = 1.0 - x * x * k, -x * y * k, -x
-    e2x, e2y, e2z = -x * y * k, 1.0 - y * y * k, -y
-    # eq 2 maps nominal-output-frame vectors to the input frame
-    E1x, E1z = cb * e1x - sb * e1z, sb * e1x + cb * e1z
-    E2x, E2z = cb * e2x - sb * e2z, sb * e2x + cb * e2z
-    Ux, Uy, Uz = cb * x - sb * z, y, sb * x + cb * z
-    Px, Py, Pz = l * (-sb - Ux), -l * Uy, l * (cb - Uz)
-    p_dot_u = l * (-sb * Ux + cb * Uz - 1.0)
+    e1x, e2y = 1.0 - x * x * k, 1.0 - y * y * k
+    # x and z components of e1, e2, u in the input frame (eq 2); y components are unchanged
+    E1x, E1z = cb * e1x + sb * x, sb * e1x - cb * x
+    E2x, E2z = sb * y - cb * xyk, -sb * xyk - cb * y
+    Ux, Uz = cb * x - sb * z, sb * x + cb * z
     f1, f2 = E1z / Uz, E2z / Uz
-    a11, a12 = r * (E1x - Ux * f1), r * (e1y - Uy * f1)
-    a21, a22 = r * (E2x - Ux * f2), r * (e2y - Uy * f2)
-    c = (p_dot_u * f1 - (Px * E1x + Py * e1y + Pz * E1z)) + 1j * (p_dot_u * f2 - (Px * E2x + Py * e2y + Pz * E2z))
-    alpha = ((a11 + a22) + 1j * (a21 - a12)) * 0.5
-    beta = ((a11 - a22) + 1j * (a21 + a12)) * 0.5
-    turn = alpha / abs(alpha)
-    orbit = turn * turn * beta.conjugate() * turn3
-    return c - orbit, phase(alpha), orbit
+    a11, a12 = r * (E1x - Ux * f1), r * (-xyk - y * f1)
+    a21, a22 = r * (E2x - Ux * f2), r * (e2y - y * f2)
+    c1, c2 = l * ((z - 1.0) * f1 + x), l * ((z - 1.0) * f2 + y)
+    # alpha = ((a11 + a22) + i (a21 - a12)) / 2, beta = ((a11 - a22) + i (a21 + a12)) / 2
+    ar, ai = 0.5 * (a11 + a22), 0.5 * (a21 - a12)
+    br, bi = 0.5 * (a11 - a22), 0.5 * (a21 + a12)
+    norm = ar * ar + ai * ai
+    tr, ti = (ar * ar - ai * ai) / norm, 2.0 * ar * ai / norm  # exp(2i arg alpha)
+    qr, qi = tr * br + ti * bi, ti * br - tr * bi  # times conj(beta)
+    orbit_r, orbit_i = qr * turn3[0] - qi * turn3[1], qr * turn3[1] + qi * turn3[0]
+    return c1 - orbit_r, c2 - orbit_i, xp.atan2(ai, ar) if xp is math else np.arctan2(ai, ar), orbit_r, orbit_i
 
 
 class Solution(NamedTuple):
@@ -91,16 +97,16 @@ def solve(phi_in: Real, beta: Real, r: float, l: float, start: Solution | None =
         x, y = rho_over_l * xp.cos(3.0 * phi_in), rho_over_l * xp.sin(3.0 * phi_in)
     else:
         x, y = start.predict(phi_in)
-    turn3 = (cmath.exp if xp is math else np.exp)(3j * phi_in)
+    turn3 = (xp.cos(3.0 * phi_in), xp.sin(3.0 * phi_in))
     for _ in range(MAX_ITERATIONS):
-        centre, twist, orbit = _star_centre(x, y, turn3, cb, sb, r, l, xp)
-        centre_x, twist_x, _ = _star_centre(x + FD_STEP, y, turn3, cb, sb, r, l, xp)
-        centre_y, twist_y, _ = _star_centre(x, y + FD_STEP, turn3, cb, sb, r, l, xp)
-        jxx, jyx = (centre_x.real - centre.real) / FD_STEP, (centre_x.imag - centre.imag) / FD_STEP
-        jxy, jyy = (centre_y.real - centre.real) / FD_STEP, (centre_y.imag - centre.imag) / FD_STEP
+        fx, fy, twist, orbit_r, orbit_i = _star_centre(x, y, turn3, cb, sb, r, l, xp)
+        fx_x, fy_x, twist_x, _, _ = _star_centre(x + FD_STEP, y, turn3, cb, sb, r, l, xp)
+        fx_y, fy_y, twist_y, _, _ = _star_centre(x, y + FD_STEP, turn3, cb, sb, r, l, xp)
+        jxx, jyx = (fx_x - fx) / FD_STEP, (fy_x - fy) / FD_STEP
+        jxy, jyy = (fx_y - fx) / FD_STEP, (fy_y - fy) / FD_STEP
         det = jxx * jyy - jxy * jyx
-        dx = (jyy * centre.real - jxy * centre.imag) / det
-        dy = (jxx * centre.imag - jyx * centre.real) / det
+        dx = (jyy * fx - jxy * fy) / det
+        dy = (jxx * fy - jyx * fx) / det
         x, y = x - dx, y - dy
         if converged(abs(dx) + abs(dy) <= LAST_UPDATE):
             break
@@ -110,8 +116,8 @@ def solve(phi_in: Real, beta: Real, r: float, l: float, start: Solution | None =
     gradient_x, gradient_y = (twist_x - twist) / FD_STEP, (twist_y - twist) / FD_STEP
     twist = twist - (gradient_x * dx + gradient_y * dy)
     # Implicit function theorem: d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit.
-    d_chi = -3j * orbit
-    dx_dphi = -(jyy * d_chi.real - jxy * d_chi.imag) / det
-    dy_dphi = -(jxx * d_chi.imag - jyx * d_chi.real) / det
+    d_chi_x, d_chi_y = 3.0 * orbit_i, -3.0 * orbit_r
+    dx_dphi = -(jyy * d_chi_x - jxy * d_chi_y) / det
+    dy_dphi = -(jxx * d_chi_y - jyx * d_chi_x) / det
     ratio = 1.0 + gradient_x * dx_dphi + gradient_y * dy_dphi
     return phi_in + twist, ratio, Solution(phi_in, x, y, dx_dphi, dy_dphi)
