@@ -30,7 +30,7 @@ def deviation_amplitude(beta: Real, r: float, l: float) -> Real:
 
 def angle_deviation(phi_in: Real, beta: Real, r: float, l: float) -> Real:
     """Eq 18: ``phi_out - phi_in = A(beta) cos 3 phi`` with the seed's phi, i.e. ``A sin 3 phi_in`` [rad]."""
-    return deviation_amplitude(beta, r, l) * lib(phi_in).cos(3.0 * paper_angle(phi_in))
+    return kinematics(phi_in, beta, r, l)[0]
 
 
 def speed_ratio(phi_in: Real, beta: Real, r: float, l: float) -> Real:
@@ -40,7 +40,7 @@ def speed_ratio(phi_in: Real, beta: Real, r: float, l: float) -> Real:
     prints ``1 - 3 A cos 3 phi``, which is not the derivative of its own eq 18: it puts
     the speed extremes where the angle deviation peaks.
     """
-    return 1.0 - 3.0 * deviation_amplitude(beta, r, l) * lib(phi_in).sin(3.0 * paper_angle(phi_in))
+    return kinematics(phi_in, beta, r, l)[1]
 
 
 def kinematics(phi_in: Real, beta: Real, r: float, l: float) -> tuple[Real, Real]:
