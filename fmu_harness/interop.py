@@ -1,8 +1,8 @@
 """Interoperability matrix: every built FMU (FMI 2.0 and 3.0) in every importer.
 
-Usage: ``python -m fmu_harness.interop [--models models] [--readme README.md]`` after
-``python build_fmu.py``. Prints the matrix as markdown; with ``--readme`` it also rewrites that
-file's ``interop`` section (:mod:`fmu_harness.readme`).
+Usage: ``python -m fmu_harness.interop [--models models] [--update docs/interoperability.md]``
+after ``python build_fmu.py``. Prints the matrix as markdown; with ``--update`` it also rewrites
+that page's ``interop`` section (:mod:`fmu_harness.doc_sections`).
 
 Importers: ``fmpy validate``, ``fmutool -input X.fmu -check`` (FMU Manipulation Toolbox),
 and two co-simulation engines, libcosimpy and ecospy, that run the model's standard scenario
@@ -31,7 +31,7 @@ from fmpy.validation import validate_fmu
 from driveline.catalog import MODELS
 
 from . import importers
-from .readme import replace_section
+from .doc_sections import replace_section
 from .runner import FmuInstance
 from .scenario import scenario
 
@@ -177,7 +177,7 @@ def markdown(table: dict[tuple[str, str], dict[str, Outcome]]) -> str:
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
-    parser.add_argument("--readme", type=Path, help="markdown file whose matrix section to regenerate")
+    parser.add_argument("--update", type=Path, metavar="PAGE", help="markdown page whose matrix section to regenerate")
     parser.add_argument("--worker", nargs=2, metavar=("ENGINE", "FMU"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
@@ -190,8 +190,8 @@ def main(argv: list[str] | None = None) -> None:
         for importer, result in row.items():
             if result.deviation is not None:
                 print(f"{name} FMI {version} {importer}: largest relative deviation {result.deviation:.3g}", file=sys.stderr)
-    if args.readme:
-        replace_section(args.readme, "interop", text)
+    if args.update:
+        replace_section(args.update, "interop", text)
 
 
 if __name__ == "__main__":

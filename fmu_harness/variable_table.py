@@ -1,7 +1,8 @@
 """Markdown tables of the models' variables, from their specs.
 
-``python -m fmu_harness.variable_table`` prints them; ``--update README.md`` rewrites the
-part of that file between the ``variables:start`` and ``variables:end`` markers.
+``python -m fmu_harness.variable_table`` prints them; ``--update docs`` rewrites the part of each
+model's page (:func:`fmu_harness.doc_sections.model_page`) between its ``variables:start`` and
+``variables:end`` markers.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from pathlib import Path
 from driveline.catalog import MODELS
 from driveline.variables import ModelSpec
 
-from .readme import replace_section
+from .doc_sections import DOCS, model_page, replace_section
 
 
 def _escaped(text: str) -> str:
@@ -26,8 +27,6 @@ def _cell(value: object) -> str:
 
 def markdown(spec: ModelSpec) -> str:
     lines = [
-        f"#### {spec.name}",
-        "",
         "| name | causality | unit (display) | start | min | max | description |",
         "|---|---|---|---|---|---|---|",
     ]
@@ -40,16 +39,17 @@ def markdown(spec: ModelSpec) -> str:
 
 
 def all_tables() -> str:
-    return "\n\n".join(markdown(model.spec) for model in MODELS.values())
+    return "\n\n".join(f"#### {model.spec.name}\n\n{markdown(model.spec)}" for model in MODELS.values())
 
 
-def update(path: Path) -> None:
-    replace_section(path, "variables", all_tables())
+def update(docs: Path = DOCS) -> None:
+    for name, model in MODELS.items():
+        replace_section(model_page(name, docs), "variables", markdown(model.spec))
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--update", type=Path, help="file whose marked variables section to rewrite")
+    parser.add_argument("--update", type=Path, metavar="DOCS", help="docs folder whose model pages to rewrite")
     args = parser.parse_args()
     if args.update:
         update(args.update)

@@ -97,7 +97,7 @@ WITH_INPUTS = [name for name, model in MODELS.items() if model.spec.of("input")]
 @pytest.mark.parametrize("name", WITH_INPUTS)
 def test_what_plain_simulate_fmu_sees_of_a_refused_step(name, fmi, fmu_path):
     """fmpy's simulate_fmu ends an FMI 2.0 run early and quietly on fmi2Discard, but raises on
-    fmi3Discard (documented in the README)."""
+    fmi3Discard (documented in docs/hosting.md)."""
     stop = MODELS[name].spec.default_experiment.stop_time
     first = MODELS[name].spec.of("input")[0]
     signal = np.array([(0.0, first.start), (stop / 2, first.start), (stop / 2, math.nan)],

@@ -165,7 +165,7 @@ def test_bad_step_size_is_refused(tripod_fmu, step):
 
 def test_what_plain_simulate_fmu_sees_of_a_refused_step(tripod_fmu):
     """fmpy's simulate_fmu treats pythonfmu's fmi2Discard as an early end: the run stops short.
-    Our harness raises instead (documented in the README)."""
+    Our harness raises instead (documented in docs/hosting.md)."""
     signal = np.array([(0.0, 0.3), (0.005, 1.2)], dtype=[("time", float), ("beta", float)])
     result = simulate_fmu(str(tripod_fmu), stop_time=0.01, step_size=1e-3, output_interval=1e-3, input=signal)
     assert result["time"][-1] < 0.01
