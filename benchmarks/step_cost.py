@@ -2,26 +2,22 @@
 
 ``python -m benchmarks.step_cost [MODELS_DIR]``: for each catalog model and FMI version, the
 FMU and a twin with the same variables but no physics (:mod:`minimal_models`) are built
-with ``build_fmu.build``; both are stepped through fmpy's low-level API (set the Real inputs,
-doStep, get the Real outputs, each one batched call) at their default inputs, in alternating
-rounds within one run; the best round of each gives microseconds per step and the ratio.
+with :func:`fmu_harness.build.build`; both are stepped through fmpy's low-level API (set
+the Real inputs, doStep, get the Real outputs, each one batched call) at their default inputs,
+in alternating rounds within one run; the best round of each gives microseconds per step and the ratio.
 """
 
 from __future__ import annotations
 
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path[:0] = [str(HERE.parent), str(HERE)]
-
-import build_fmu  # noqa: E402
-import minimal_models  # noqa: E402  (top-level name: the same module name inside the twin FMUs)
-from benchmarks.timing import machine  # noqa: E402
-from driveline.catalog import MODELS  # noqa: E402
-from fmu_harness.runner import FmuInstance  # noqa: E402
+from benchmarks import minimal_models
+from benchmarks.timing import machine
+from driveline.catalog import MODELS
+from fmu_harness.build import build
+from fmu_harness.runner import FmuInstance
 
 STEPS, ROUNDS = 2000, 7
 VARIANTS = {"TripodCoupling": {"closed form": {"kinematics": 0}, "exact": {"kinematics": 1}}}
@@ -75,10 +71,9 @@ def main() -> None:
         dest = Path(folder)
         for fmi in ("2", "3"):
             for name, model in MODELS.items():
-                fmu = build_fmu.build(name, dest, fmi)
+                fmu = build(name, dest, fmi)
                 twin_name = f"Minimal{name}"
-                twin = build_fmu.build(twin_name, dest, fmi, getattr(minimal_models, twin_name),
-                                       (HERE / "minimal_models.py",))
+                twin = build(twin_name, dest, fmi, getattr(minimal_models, twin_name))
                 inputs = [v.name for v in model.spec.of("input")]
                 for variant, start_values in VARIANTS.get(name, {"default": {}}).items():
                     ours, floor = compare(fmu, twin, start_values, inputs)

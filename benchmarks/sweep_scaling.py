@@ -1,6 +1,6 @@
 """Wall time of one parameter sweep on a local Dask cluster of 1 and of 2 worker processes.
 
-Usage: ``python benchmarks/sweep_scaling.py [--fmu models/TripodCoupling.fmu] [--repeat 3]``
+Usage: ``python -m benchmarks.sweep_scaling [--fmu models/TripodCoupling.fmu] [--repeat 3]``
 after ``python build_fmu.py``. Not part of the test suite. Each measurement starts a fresh
 cluster first and times :func:`fmu_harness.sweep.sweep` from shipping the FMU to the finished
 table (so each worker's first extraction and imports count); the best of ``--repeat``
@@ -10,14 +10,10 @@ alternating measurements is printed, which damps the noise of other load on the 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from fmu_harness.sweep import Timing, grid, open_client, sweep  # noqa: E402
+from fmu_harness.sweep import Timing, grid, open_client, sweep
 
 AXES = {
     "beta": [0.05 * k for k in range(1, 13)],
@@ -44,7 +40,7 @@ def wall_time(fmu: Path, workers: int) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fmu", type=Path, default=ROOT / "models" / "TripodCoupling.fmu")
+    parser.add_argument("--fmu", type=Path, default=Path("models") / "TripodCoupling.fmu")
     parser.add_argument("--repeat", type=int, default=3, help="measurements per cluster size")
     args = parser.parse_args()
     times = [(wall_time(args.fmu, 1), wall_time(args.fmu, 2)) for _ in range(args.repeat)]

@@ -1,9 +1,8 @@
 """Generic FMI 2.0 co-simulation adapter (pythonfmu) around a :class:`SteppedModel`.
 
-Shipped inside every FMI 2.0 FMU next to the ``driveline`` package and
-``model_adapter``. A refused step returns False, which pythonfmu reports as
-fmi2Discard; the reasons go to the FMI logger with status fmi2Error (category
-``logStatusError``).
+Shipped inside every FMI 2.0 FMU next to the model's modules and ``model_adapter``. A
+refused step returns False, which pythonfmu reports as fmi2Discard; the reasons go to the
+FMI logger with status fmi2Error (category ``logStatusError``).
 """
 
 from __future__ import annotations
@@ -15,7 +14,7 @@ from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Intege
 from pythonfmu.default_experiment import DefaultExperiment
 from pythonfmu.enums import Fmi2Status
 
-from model_adapter import ModelAdapter
+from .model_adapter import ModelAdapter
 
 # pythonfmu 0.7's native loader re-executes the FMU script on every fmi2Instantiate and
 # then releases one reference to the script module's globals that it never owned. A
@@ -33,6 +32,7 @@ class ModelSlave(ModelAdapter, Fmi2Slave):
     causalities = Fmi2Causality
     variabilities = Fmi2Variability
     error_status = Fmi2Status.error
+    deploy_command = "pythonfmu deploy"
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)

@@ -1,12 +1,12 @@
 """Generic FMI 3.0 co-simulation adapter (pythonfmu3) around a :class:`SteppedModel`.
 
-Shipped inside every FMI 3.0 FMU next to the ``driveline`` package and
-``model_adapter``. FMI 3.0 wants an independent variable: ``time``, after the spec's
-variables. A refused step returns ``Fmi3StepResult(status=discard)``: pythonfmu3's
-native ``fmi3DoStep`` returns that status, **fmi3Discard**, with ``lastSuccessfulTime`` =
-``currentCommunicationPoint`` and ``terminateSimulation`` false, so the host may retry the
-step. The reasons go to the FMI logger with status fmi3Error (category
-``logStatusError``); pythonfmu3 forwards them whether or not logging was switched on.
+Shipped inside every FMI 3.0 FMU next to the model's modules and ``model_adapter``. FMI
+3.0 wants an independent variable: ``time``, after the spec's variables. A refused step
+returns ``Fmi3StepResult(status=discard)``: pythonfmu3's native ``fmi3DoStep`` returns that
+status, **fmi3Discard**, with ``lastSuccessfulTime`` = ``currentCommunicationPoint`` and
+``terminateSimulation`` false, so the host may retry the step. The reasons go to the FMI
+logger with status fmi3Error (category ``logStatusError``); pythonfmu3 forwards them whether
+or not logging was switched on.
 
 pythonfmu3 0.3.4 drops the ``startTime`` of ``fmi3EnterInitializationMode`` (the Python
 slave never sees it). The model is initialised at t = 0 and, if the first
@@ -22,7 +22,7 @@ from typing import Any
 from pythonfmu3 import Boolean, Fmi3Causality, Fmi3Slave, Fmi3Status, Fmi3StepResult, Fmi3Variability, Float64, Int32, String
 from pythonfmu3.default_experiment import DefaultExperiment
 
-from model_adapter import ModelAdapter
+from .model_adapter import ModelAdapter
 
 
 class ModelSlave(ModelAdapter, Fmi3Slave):
@@ -33,6 +33,7 @@ class ModelSlave(ModelAdapter, Fmi3Slave):
     causalities = Fmi3Causality
     variabilities = Fmi3Variability
     error_status = Fmi3Status.error
+    deploy_command = "pythonfmu3 deploy"
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)

@@ -1,6 +1,6 @@
 """FMI-version-independent half of the FMU adapters: forwards FMI calls to a :class:`SteppedModel`.
 
-Shipped inside every FMU next to the ``driveline`` package. ``fmi2_slave`` (pythonfmu)
+Shipped inside every FMU next to the model's modules. ``fmi2_slave`` (pythonfmu)
 and ``fmi3_slave`` (pythonfmu3) mix :class:`ModelAdapter` into their slave base class
 and supply the version's variable classes, enumerations and error status. No Python
 exception leaves an adapter on a bad input: a refused step logs its reasons with the

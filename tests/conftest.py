@@ -2,18 +2,14 @@
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 from fmpy import extract
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import build_fmu  # noqa: E402
-from fmu_harness.runner import FmuInstance  # noqa: E402
+from fmu_harness import build
+from fmu_harness.runner import FmuInstance
 
 FmuPath = Callable[..., Path]
 
@@ -22,14 +18,14 @@ FmuPath = Callable[..., Path]
 def fmu_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A folder holding freshly built FMUs of all models (FMI 3.0 ones in ``fmi3/``)."""
     dest = tmp_path_factory.mktemp("models")
-    build_fmu.build_all(dest)
+    build.build_all(dest)
     return dest
 
 
 @pytest.fixture(scope="session")
 def fmu_path(fmu_dir: Path) -> FmuPath:
     """``fmu_path(name, version="2")``: the built FMU of catalog model ``name`` for FMI 2.0 or 3.0."""
-    return lambda name, version="2": build_fmu.fmu_path(fmu_dir, name, version)
+    return lambda name, version="2": build.fmu_path(fmu_dir, name, version)
 
 
 @pytest.fixture(scope="session")
@@ -68,4 +64,4 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     if "model_name" in metafunc.fixturenames:
         metafunc.parametrize("model_name", list(MODELS))
     if "fmi" in metafunc.fixturenames:
-        metafunc.parametrize("fmi", list(build_fmu.FMI_VERSIONS))
+        metafunc.parametrize("fmi", list(build.FMI_VERSIONS))

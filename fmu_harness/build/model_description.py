@@ -1,4 +1,4 @@
-"""Completes the model description that pythonfmu writes, from the model's spec.
+"""Completes the model description that pythonfmu or pythonfmu3 writes, from the model's spec.
 
 The one place where units, display units, ranges, descriptions and the initial
 unknowns are added; the FMI 2.0 build calls :func:`complete_fmi2`, the FMI 3.0 build

@@ -1,0 +1,37 @@
+"""Build every FMU of the project, FMI 2.0 into ``models/`` and FMI 3.0 into ``models/fmi3/``.
+
+Usage: ``driveline-fmus build [--dest models] [--fmi 2 3] [--no-references] [NAME ...]`` (or
+``python build_fmu.py ...``). Every model of ``driveline.catalog.MODELS`` becomes one FMU per
+FMI version (:mod:`.fmu`). Then the FMI Cross-Check reference results are written next to
+each FMU (:mod:`fmu_harness.crosscheck`) and, once its FMI 2.0 FMUs are there, the driveline
+system's SSP package (:mod:`fmu_harness.system`).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from driveline.catalog import MODELS
+
+from .. import crosscheck, system
+from .fmu import FMI_VERSIONS, build_all
+
+
+def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Path("models")) -> None:
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
+    parser.add_argument("names", nargs="*", help=f"models to build (default: all of {', '.join(MODELS)})")
+    parser.add_argument("--dest", type=Path, default=dest, help=f"folder of the FMI 2.0 FMUs (default {dest})")
+    parser.add_argument("--fmi", nargs="+", choices=sorted(FMI_VERSIONS), default=sorted(FMI_VERSIONS),
+                        help="FMI versions to build (default: both)")
+    parser.add_argument("--no-references", action="store_true", help="skip the cross-check reference results")
+    args = parser.parse_args(argv)
+    paths = []
+    for fmu in build_all(args.dest, args.names or None, tuple(args.fmi)):
+        paths += [fmu] + ([] if args.no_references else crosscheck.write(fmu))
+    driveline = system.driveline()
+    if all((args.dest / f"{c.model}.fmu").exists() for c in driveline.components):
+        paths.append(system.write_ssp(driveline, args.dest))
+    here = Path.cwd()
+    for path in paths:
+        print(path.relative_to(here) if path.is_relative_to(here) else path)

@@ -1,0 +1,38 @@
+"""``driveline-fmus COMMAND [ARGS]``: the everyday commands in one console script.
+
+``driveline-fmus build`` builds the FMUs, ``run`` runs the main job, ``sweep`` a parameter sweep
+on Dask, ``interop`` the importer matrix; ``driveline-fmus COMMAND --help`` lists a command's
+options. Each command is the ``main`` of the module named in :data:`COMMANDS`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+COMMANDS = {
+    "build": ("fmu_harness.build.command", "build the FMUs (FMI 2.0 and 3.0), their reference results and the SSP system"),
+    "run": ("fmu_harness.main", "the main job: simulate the FMUs, write CSV files and figures"),
+    "sweep": ("fmu_harness.sweep", "a parameter sweep of one FMU on Dask"),
+    "interop": ("fmu_harness.interop", "every FMU in every importer: the interoperability matrix"),
+}
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(
+        prog="driveline-fmus",
+        description="Build, run, sweep and check the driveline FMUs.",
+        epilog="commands:\n" + "".join(f"  {name:<9} {text}\n" for name, (_, text) in COMMANDS.items())
+        + "\n'driveline-fmus COMMAND --help' lists the command's options.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("command", choices=COMMANDS, metavar="COMMAND", help=", ".join(COMMANDS))
+    parser.add_argument("arguments", nargs=argparse.REMAINDER, help="the command's arguments")
+    args = parser.parse_args(argv)
+    sys.argv[0] = f"{parser.prog} {args.command}"  # the command's usage line names it
+    importlib.import_module(COMMANDS[args.command][0]).main(args.arguments)
+
+
+if __name__ == "__main__":
+    main()
