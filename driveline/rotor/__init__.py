@@ -19,7 +19,7 @@ from .driveline import (
     OrderResonance,
     WhirlFrequencies,
 )
-from .elements import Bearing, ConcentratedMass, EndCondition, ShaftSegment
+from .elements import Bearing, ConcentratedMass, EndCondition, PointElement, ShaftSegment
 from .loader import example_path, load_driveline, loads_driveline, one_piece_shaft
 from .transfer import ModeShape
 
@@ -31,6 +31,7 @@ __all__ = [
     "EndCondition",
     "ModeShape",
     "OrderResonance",
+    "PointElement",
     "ShaftSegment",
     "WhirlFrequencies",
     "example_path",

@@ -7,7 +7,7 @@ All frequencies and speeds are in rad/s. ``spin`` is the shaft speed ``Omega``,
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import transfer
-from .elements import Bearing, ConcentratedMass, EndCondition, ShaftSegment
+from .elements import Bearing, ConcentratedMass, EndCondition, PointElement, ShaftSegment
 from .roots import RootSearchReport, find_roots
 
 FloatArray = NDArray[np.float64]
@@ -127,25 +127,16 @@ class Driveline:
         object.__setattr__(self, "bearings", bearings)
         object.__setattr__(self, "left", ends[0])
         object.__setattr__(self, "right", ends[1])
-        object.__setattr__(self, "_chain", transfer.Chain.build(segs, masses, bearings, ends[0], ends[1]))
-
-    # -- geometry --------------------------------------------------------------
-    @property
-    def node_positions(self) -> FloatArray:
-        """Axial position of every node [m]."""
-        return np.concatenate([[0.0], np.cumsum([s.length for s in self.segments])])
+        object.__setattr__(self, "_chain", transfer.Chain.build(segs, self.point_elements, ends[0], ends[1]))
 
     @property
-    def total_length(self) -> float:
-        return float(sum(s.length for s in self.segments))
-
-    @property
-    def total_mass(self) -> float:
-        return float(sum(s.mass for s in self.segments) + sum(m.mass for m in self.masses))
+    def point_elements(self) -> tuple[PointElement, ...]:
+        """Every point element, in the order applied at a node: masses, then bearings."""
+        return (*self.masses, *self.bearings)
 
     @property
     def is_isotropic(self) -> bool:
-        """True when every bearing has ``kxx == kyy`` (4x4 complex formulation)."""
+        """True when every element acts on each whirl component alone (4x4 formulation)."""
         return self._chain.isotropic
 
     @property
@@ -176,7 +167,7 @@ class Driveline:
         ``POINTS_PER_ROOT`` points per expected root on that count, plus a
         logarithmic lead-in for heavy masses on soft bearings near zero.
         """
-        extra = sum((st.mass > 0) + (st.diametral_inertia > 0 or st.polar_inertia > 0) for st in self._chain.stations)
+        extra = sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
         per_pi = POINTS_PER_ROOT * (1 + extra) * (1 if self.is_isotropic else 2)
         kappa = self._kappa * math.sqrt(abs(ratio))
         theta_max = kappa * math.sqrt(x_max)
@@ -207,14 +198,40 @@ class Driveline:
     def _take(roots: FloatArray, n: int | None) -> FloatArray:
         return roots if n is None else roots[:n]
 
-    def _classify(self, roots: FloatArray, ratio: float) -> list[Whirl]:
-        """Whirl sense of anisotropic modes at ``w = ratio * spin`` (spin = root)."""
-        out: list[Whirl] = []
+    def _roots_by_whirl(
+        self,
+        point: Callable[[ArrayLike], tuple[ArrayLike, ArrayLike]],
+        ratio: float,
+        whirls: tuple[Whirl, ...],
+        n: int | None,
+        x_max: float | None,
+        limit: float,
+    ) -> dict[Whirl, FloatArray]:
+        """Roots ``x`` of ``f(w, spin) = 0`` with ``(w, spin) = point(x)``, ``w = ratio * x``, per whirl sense.
+
+        Isotropic: forward at ``+w``, backward at ``-w``, each searched alone.
+        Anisotropic: the ``2 n`` lowest roots at ``w > 0``, each classified by its
+        mode shape (forward when the forward component carries more than half of
+        ``sum |U|^2``).
+        """
+        if self.is_isotropic:
+            out = {}
+            for wh in whirls:
+                sign = 1.0 if wh == "forward" else -1.0
+
+                def g(x: ArrayLike, sign: float = sign) -> FloatArray:
+                    w, spin = point(x)
+                    return self.determinant(sign * w, spin)
+
+                out[wh] = self._take(self._search(g, ratio, n, x_max, limit).roots, n)
+            return out
+        nn = None if n is None else 2 * n
+        roots = self._search(lambda x: self.determinant(*point(x)), ratio, nn, x_max, limit).roots
+        senses = []
         for x in roots:
-            w = ratio * x if ratio != 0 else x
-            shape = self.mode_shape(abs(w), x, points_per_segment=4)
-            out.append("forward" if shape.forward_fraction >= 0.5 else "backward")
-        return out
+            w, spin = point(x)
+            senses.append("forward" if self.mode_shape(w, spin, 4).forward_fraction >= 0.5 else "backward")
+        return {wh: self._take(np.array([x for x, s in zip(roots, senses) if s == wh]), n) for wh in whirls}
 
     # -- results -----------------------------------------------------------------
     def whirl_frequencies(
@@ -232,23 +249,12 @@ class Driveline:
         if w_max is not None:
             w_max = _speed("w_max", w_max, positive=True)
             n = None
-        if self.is_isotropic:
-            fwd = self._search(lambda x: self.determinant(x, spin), 1.0, n, w_max, limit).roots
-            if spin == 0.0:
-                bwd = fwd
-            else:
-                bwd = self._search(lambda x: self.determinant(-x, spin), 1.0, n, w_max, limit).roots
-            return WhirlFrequencies(spin, self._take(fwd, n), self._take(bwd, n))
-        nn = None if n is None else 2 * n
-        roots = self._search(lambda x: self.determinant(x, spin), 1.0, nn, w_max, limit).roots
         if spin == 0.0:  # planar modes at standstill: report each in both lists
-            return WhirlFrequencies(spin, self._take(roots, n), self._take(roots, n))
-        senses = [
-            "forward" if self.mode_shape(w, spin, 4).forward_fraction >= 0.5 else "backward" for w in roots
-        ]
-        fwd = np.array([w for w, s in zip(roots, senses) if s == "forward"])
-        bwd = np.array([w for w, s in zip(roots, senses) if s == "backward"])
-        return WhirlFrequencies(spin, self._take(fwd, n), self._take(bwd, n))
+            nn = n if n is None or self.is_isotropic else 2 * n
+            roots = self._take(self._search(lambda x: self.determinant(x, 0.0), 1.0, nn, w_max, limit).roots, n)
+            return WhirlFrequencies(spin, roots, roots)
+        found = self._roots_by_whirl(lambda x: (x, spin), 1.0, ("forward", "backward"), n, w_max, limit)
+        return WhirlFrequencies(spin, found["forward"], found["backward"])
 
     def campbell(self, spins: ArrayLike, n_modes: int = 4) -> CampbellDiagram:
         """Campbell diagram data: first ``n_modes`` forward and backward frequencies per speed."""
@@ -289,19 +295,8 @@ class Driveline:
             if isinstance(k, bool) or int(k) != k or k < 1:
                 raise ValueError(f"order must be a positive integer, got {k!r}")
             k = int(k)
-            if self.is_isotropic:
-                for wh in whirls:
-                    r = k if wh == "forward" else -k
-                    rep = self._search(lambda x, r=r: self.determinant(r * x, x), r, n, spin_max, limit)
-                    out.extend(OrderResonance(k, wh, float(x)) for x in self._take(rep.roots, n))
-            else:
-                nn = None if n is None else 2 * n
-                rep = self._search(lambda x, k=k: self.determinant(k * x, x), k, nn, spin_max, limit)
-                found = {"forward": [], "backward": []}
-                for x, s in zip(rep.roots, self._classify(rep.roots, k)):
-                    found[s].append(float(x))
-                for wh in whirls:
-                    out.extend(OrderResonance(k, wh, x) for x in self._take(np.array(found[wh]), n))
+            found = self._roots_by_whirl(lambda x, k=k: (k * x, x), k, whirls, n, spin_max, limit)
+            out.extend(OrderResonance(k, wh, float(x)) for wh in whirls for x in found[wh])
         return sorted(out, key=lambda r: (r.spin, r.order))
 
     def critical_speeds(

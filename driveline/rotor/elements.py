@@ -17,13 +17,25 @@ State vector at a station (SI units)::
 (the seed carries ``EI U'''`` instead, which breaks the free-end condition and the
 force balance between segments of different section).
 
+Every element provides, behind one interface (as ROSS's elements provide their
+matrices to its rotor assembly):
+
+* ``transfer_matrix(w, spin)``: the 4x4 matrix for one circular whirl component at
+  the signed frequency ``w`` (isotropic rotor);
+* ``transfer_matrix_pair(w, spin)``: the 8x8 matrix acting on the forward and backward
+  components ``[s_a, s_b]`` of a mode at ``w > 0`` (anisotropic rotor); an element
+  with rotational symmetry acts on each component alone, ``diag(T(w), T(-w))``;
+* ``fe_matrices(...)``: its stiffness, mass and gyroscopic matrices for the
+  finite-element check (:mod:`driveline.rotor.fem`).
+
 All matrix builders are vectorised: ``w`` and ``spin`` broadcast to a common shape
-``(n,)`` and the result has shape ``(n, 4, 4)``.
+``(n,)`` and the result has shape ``(n, 4, 4)`` or ``(n, 8, 8)``.
 """
 
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from enum import Enum
 
@@ -36,6 +48,7 @@ __all__ = [
     "Bearing",
     "ConcentratedMass",
     "EndCondition",
+    "PointElement",
     "ShaftSegment",
 ]
 
@@ -197,6 +210,18 @@ def _broadcast(w: ArrayLike, spin: ArrayLike) -> tuple[FloatArray, FloatArray]:
     return w_arr, s_arr
 
 
+def _pair(forward: FloatArray, backward: FloatArray) -> FloatArray:
+    """Block-diagonal 8x8 matrices ``diag(forward, backward)`` from two (n, 4, 4) stacks."""
+    out = np.zeros(forward.shape[:-2] + (8, 8))
+    out[..., :4, :4] = forward
+    out[..., 4:, 4:] = backward
+    return out
+
+
+def _identity(shape: tuple[int, ...]) -> FloatArray:
+    return np.broadcast_to(np.eye(4), shape + (4, 4)).copy()
+
+
 @dataclass(frozen=True)
 class ShaftSegment:
     """Uniform hollow (or solid) shaft segment, Rayleigh beam (seed Fig. 1).
@@ -227,19 +252,6 @@ class ShaftSegment:
         _positive("youngs_modulus", self.youngs_modulus)
         _positive("density", self.density)
 
-    @classmethod
-    def from_radii(
-        cls,
-        length: float,
-        outer_radius: float,
-        inner_radius: float = 0.0,
-        youngs_modulus: float = 2.1e11,
-        density: float = 7850.0,
-        **switches: bool,
-    ) -> ShaftSegment:
-        """Build from radii ``r2`` (outer) and ``r1`` (inner), the seed's notation."""
-        return cls(length, 2.0 * outer_radius, 2.0 * inner_radius, youngs_modulus, density, **switches)
-
     @property
     def area(self) -> float:
         """Cross-section area [m2]."""
@@ -260,12 +272,7 @@ class ShaftSegment:
         """``rho A`` [kg/m]."""
         return self.density * self.area
 
-    @property
-    def mass(self) -> float:
-        """Segment mass [kg]."""
-        return self.mass_per_length * self.length
-
-    def couple_coefficient(self, w: FloatArray, spin: FloatArray) -> FloatArray:
+    def _couple(self, w: FloatArray, spin: FloatArray) -> FloatArray:
         """``c = rho I w^2 - rho Ip Omega w`` per unit length, with ``Ip = 2 I``."""
         rI = self.density * self.second_moment
         c = np.zeros_like(w)
@@ -278,7 +285,7 @@ class ShaftSegment:
     def beta1(self, w: FloatArray, spin: FloatArray) -> FloatArray:
         """Hyperbolic wave number ``beta1`` (seed Eq. 22) [1/m], elementwise."""
         EI = self.bending_stiffness
-        a = self.couple_coefficient(w, spin) / EI
+        a = self._couple(w, spin) / EI
         b = self.mass_per_length * w * w / EI
         b1sq, _ = _betas(a, b)
         return np.sqrt(b1sq)
@@ -290,13 +297,82 @@ class ShaftSegment:
             self.length if length is None else length,
             self.bending_stiffness,
             self.mass_per_length,
-            self.couple_coefficient(w_arr, s_arr),
+            self._couple(w_arr, s_arr),
             w_arr,
         )
 
+    def transfer_matrix_pair(self, w: ArrayLike, spin: ArrayLike = 0.0, length: float | None = None) -> FloatArray:
+        """``diag(H(w), H(-w))`` (shape (n, 8, 8)): the segment is axisymmetric."""
+        w_arr, s_arr = _broadcast(w, spin)
+        return _pair(self.transfer_matrix(w_arr, s_arr, length), self.transfer_matrix(-w_arr, s_arr, length))
+
+    def fe_matrices(self, n_elements: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``K, M, G`` of ``n_elements`` equal cubic Hermite elements, dofs ``[U, psi]`` per node.
+
+        Translational mass ``Mt``, rotary inertia ``Mr`` (if ``rotary_inertia``) and
+        gyroscopic ``G = 2 Mr`` (if ``gyroscopic``, ``Ip = 2 I``), each of size
+        ``2 (n_elements + 1)``.
+        """
+        h = self.length / n_elements
+        k = self.bending_stiffness / h**3 * np.array(
+            [[12, 6 * h, -12, 6 * h], [6 * h, 4 * h * h, -6 * h, 2 * h * h],
+             [-12, -6 * h, 12, -6 * h], [6 * h, 2 * h * h, -6 * h, 4 * h * h]]
+        )
+        mt = self.mass_per_length * h / 420 * np.array(
+            [[156, 22 * h, 54, -13 * h], [22 * h, 4 * h * h, 13 * h, -3 * h * h],
+             [54, 13 * h, 156, -22 * h], [-13 * h, -3 * h * h, -22 * h, 4 * h * h]]
+        )
+        mr = self.density * self.second_moment / (30 * h) * np.array(
+            [[36, 3 * h, -36, 3 * h], [3 * h, 4 * h * h, -3 * h, -h * h],
+             [-36, -3 * h, 36, -3 * h], [3 * h, -h * h, -3 * h, 4 * h * h]]
+        )
+        m = mt + mr if self.rotary_inertia else mt + 0.0 * mr
+        g = 2.0 * mr if self.gyroscopic else 0.0 * mr
+        n_dof = 2 * (n_elements + 1)
+        K, M, G = np.zeros((n_dof, n_dof)), np.zeros((n_dof, n_dof)), np.zeros((n_dof, n_dof))
+        for e in range(n_elements):
+            block = slice(2 * e, 2 * e + 4)
+            K[block, block] += k
+            M[block, block] += m
+            G[block, block] += g
+        return K, M, G
+
+
+class PointElement(ABC):
+    """An element acting at one node: a jump of the state vector across the node.
+
+    Subclasses are frozen dataclasses with a ``node`` field. ``freedoms`` names the
+    degrees of freedom the element adds to the rotor (each may add one root to the
+    frequency determinant; the root search sizes its grid by them).
+    """
+
+    node: int
+
+    @property
+    def isotropic(self) -> bool:
+        """True when the element acts on each circular whirl component alone."""
+        return True
+
+    @property
+    def freedoms(self) -> frozenset[str]:
+        return frozenset()
+
+    @abstractmethod
+    def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
+        """Point matrix for one whirl component at signed ``w`` (shape (n, 4, 4))."""
+
+    def transfer_matrix_pair(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
+        """Point matrix on ``[s_a, s_b]`` at ``w > 0`` (shape (n, 8, 8)); axisymmetric by default."""
+        w_arr, s_arr = _broadcast(w, spin)
+        return _pair(self.transfer_matrix(w_arr, s_arr), self.transfer_matrix(-w_arr, s_arr))
+
+    @abstractmethod
+    def fe_matrices(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``K, M, G`` (2x2 each) on the dofs ``[U, psi]`` of the element's node."""
+
 
 @dataclass(frozen=True)
-class ConcentratedMass:
+class ConcentratedMass(PointElement):
     """Rigid concentrated mass at station ``node`` (universal joint, bearing carrier).
 
     ``mass`` [kg], ``polar_inertia`` Jp and ``diametral_inertia`` Jd [kg m2].
@@ -316,26 +392,37 @@ class ConcentratedMass:
         _non_negative("polar_inertia", self.polar_inertia)
         _non_negative("diametral_inertia", self.diametral_inertia)
 
-    def rotary_term(self, w: FloatArray, spin: FloatArray) -> FloatArray:
-        """``Jd w^2 - Jp Omega w`` [N m]."""
-        return self.diametral_inertia * w * w - self.polar_inertia * spin * w
+    @property
+    def freedoms(self) -> frozenset[str]:
+        """Translation if ``mass > 0``, tilt if either moment of inertia is."""
+        out = set()
+        if self.mass > 0:
+            out.add("translation")
+        if self.diametral_inertia > 0 or self.polar_inertia > 0:
+            out.add("tilt")
+        return frozenset(out)
 
     def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
-        """Point matrix (shape (n, 4, 4))."""
         w_arr, s_arr = _broadcast(w, spin)
-        P = np.broadcast_to(np.eye(4), w_arr.shape + (4, 4)).copy()
-        P[..., 2, 1] = -self.rotary_term(w_arr, s_arr)
+        P = _identity(w_arr.shape)
+        P[..., 2, 1] = -(self.diametral_inertia * w_arr * w_arr - self.polar_inertia * s_arr * w_arr)
         P[..., 3, 0] = self.mass * w_arr * w_arr
         return P
 
+    def fe_matrices(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return (np.zeros((2, 2)), np.diag([self.mass, self.diametral_inertia]),
+                np.diag([0.0, self.polar_inertia]))
+
 
 @dataclass(frozen=True)
-class Bearing:
+class Bearing(PointElement):
     """Linear elastic bearing at station ``node``; ``kxx`` [N/m], ``kyy`` (default ``kxx``).
 
     Isotropic point matrix (seed Eq. 27): ``V+ = V- - k U``. With ``kxx != kyy`` the
-    forward and backward whirl components couple through ``(kxx - kyy)/2`` and the
-    8x8 formulation of :mod:`driveline.rotor.transfer` is used.
+    forward and backward whirl components couple::
+
+        V_a -= kbar U_a + dk U_b,   V_b -= dk U_a + kbar U_b,
+        kbar = (kxx + kyy)/2,       dk = (kxx - kyy)/2.
     """
 
     node: int
@@ -354,22 +441,24 @@ class Bearing:
         return self.kxx if self.kyy is None else float(self.kyy)
 
     @property
-    def is_isotropic(self) -> bool:
+    def isotropic(self) -> bool:
         return self.kyy is None or float(self.kyy) == float(self.kxx)
 
-    @property
-    def k_mean(self) -> float:
-        """``(kxx + kyy)/2`` acting on each whirl component [N/m]."""
-        return 0.5 * (self.kxx + self.k_yy)
-
-    @property
-    def k_diff(self) -> float:
-        """``(kxx - kyy)/2`` coupling forward and backward whirl [N/m]."""
-        return 0.5 * (self.kxx - self.k_yy)
-
     def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
-        """Isotropic point matrix (shape (n, 4, 4)) using ``k_mean``."""
+        """Point matrix of one whirl component, with the mean stiffness ``kbar``."""
         w_arr, _ = _broadcast(w, spin)
-        P = np.broadcast_to(np.eye(4), w_arr.shape + (4, 4)).copy()
-        P[..., 3, 0] = -self.k_mean
+        P = _identity(w_arr.shape)
+        P[..., 3, 0] = -0.5 * (self.kxx + self.k_yy)
         return P
+
+    def transfer_matrix_pair(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
+        P = super().transfer_matrix_pair(w, spin)
+        dk = 0.5 * (self.kxx - self.k_yy)
+        P[..., 3, 4] = -dk
+        P[..., 7, 0] = -dk
+        return P
+
+    def fe_matrices(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        if not self.isotropic:
+            raise ValueError("the finite-element check covers isotropic bearings only")
+        return np.diag([float(self.kxx), 0.0]), np.zeros((2, 2)), np.zeros((2, 2))

@@ -19,57 +19,34 @@ from .elements import EndCondition
 FloatArray = NDArray[np.float64]
 
 
-def _element(EI: float, m: float, rI: float, h: float, rot: bool) -> tuple[FloatArray, FloatArray, FloatArray]:
-    k = EI / h**3 * np.array(
-        [[12, 6 * h, -12, 6 * h], [6 * h, 4 * h * h, -6 * h, 2 * h * h],
-         [-12, -6 * h, 12, -6 * h], [6 * h, 2 * h * h, -6 * h, 4 * h * h]]
-    )
-    mt = m * h / 420 * np.array(
-        [[156, 22 * h, 54, -13 * h], [22 * h, 4 * h * h, 13 * h, -3 * h * h],
-         [54, 13 * h, 156, -22 * h], [-13 * h, -3 * h * h, -22 * h, 4 * h * h]]
-    )
-    mr = rI / (30 * h) * np.array(
-        [[36, 3 * h, -36, 3 * h], [3 * h, 4 * h * h, -3 * h, -h * h],
-         [-36, -3 * h, 36, -3 * h], [3 * h, -h * h, -3 * h, 4 * h * h]]
-    )
-    return k, mt, mr if rot else 0.0 * mr
-
-
 def assemble(d: Driveline, elements_per_segment: int = 40) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Global ``K, M, G`` with end conditions applied, and the node positions."""
+    """Global ``K, M, G`` with end conditions applied, and the node positions.
+
+    Every element contributes its own ``fe_matrices``: a segment over its
+    ``elements_per_segment`` beam elements, a point element on the two dofs
+    ``[U, psi]`` of its node.
+    """
     n_el = elements_per_segment * len(d.segments)
     n_dof = 2 * (n_el + 1)
     K = np.zeros((n_dof, n_dof))
     M = np.zeros_like(K)
     G = np.zeros_like(K)
-    e = 0
     z = [0.0]
     station_node = [0]
     for seg in d.segments:
+        first = 2 * station_node[-1]
+        block = slice(first, first + 2 * (elements_per_segment + 1))
+        for glob, loc in zip((K, M, G), seg.fe_matrices(elements_per_segment)):
+            glob[block, block] += loc
         h = seg.length / elements_per_segment
-        rI = seg.density * seg.second_moment
-        k, mt, mr = _element(seg.bending_stiffness, seg.mass_per_length, rI, h, seg.rotary_inertia)
-        g = 2.0 * mr if seg.gyroscopic else 0.0 * mr
-        if not seg.rotary_inertia and seg.gyroscopic:
-            g = 2.0 * _element(1.0, 0.0, rI, h, True)[2]
         for _ in range(elements_per_segment):
-            sl = slice(2 * e, 2 * e + 4)
-            K[sl, sl] += k
-            M[sl, sl] += mt + mr
-            G[sl, sl] += g
-            e += 1
             z.append(z[-1] + h)
-        station_node.append(e)
-    for m in d.masses:
-        i = 2 * station_node[m.node]
-        M[i, i] += m.mass
-        M[i + 1, i + 1] += m.diametral_inertia
-        G[i + 1, i + 1] += m.polar_inertia
-    for b in d.bearings:
-        if not b.is_isotropic:
-            raise ValueError("the finite-element check covers isotropic bearings only")
-        i = 2 * station_node[b.node]
-        K[i, i] += b.kxx
+        station_node.append(station_node[-1] + elements_per_segment)
+    for element in d.point_elements:
+        i = 2 * station_node[element.node]
+        for glob, loc in zip((K, M, G), element.fe_matrices()):
+            glob[i:i + 2, i:i + 2] += loc
+    e = station_node[-1]
     fixed: list[int] = []
     for end, node in ((d.left, 0), (d.right, e)):
         if end is EndCondition.PINNED:

@@ -18,20 +18,21 @@ mesh.
 
 For anisotropic bearings the forward (``a``) and backward (``b``) circular
 components ``u = a exp(i w t) + b exp(-i w t)`` are carried together in an 8x8
-real state ``[s_a, s_b]`` (``w > 0``): segments and masses act on ``s_a`` at ``+w``
-and on ``s_b`` at ``-w``; a bearing adds ``-kbar U_a - dk U_b`` to ``V_a`` and
-``-dk U_a - kbar U_b`` to ``V_b`` (``kbar = (kxx+kyy)/2``, ``dk = (kxx-kyy)/2``).
+real state ``[s_a, s_b]`` (``w > 0``) with four propagated columns; every element
+then contributes its ``transfer_matrix_pair`` instead of its ``transfer_matrix``.
+The determinant and the mode shape run the same propagation (:func:`_propagate`).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .elements import Bearing, ConcentratedMass, EndCondition, ShaftSegment
+from .elements import EndCondition, PointElement, ShaftSegment
 
 FloatArray = NDArray[np.float64]
 
@@ -40,26 +41,14 @@ MAX_PIECE_PHASE = 2.0
 
 
 @dataclass(frozen=True)
-class Station:
-    """Point elements lumped at one node (masses and bearings commute)."""
-
-    mass: float = 0.0
-    polar_inertia: float = 0.0
-    diametral_inertia: float = 0.0
-    k_mean: float = 0.0
-    k_diff: float = 0.0
-
-    @property
-    def is_empty(self) -> bool:
-        return not (self.mass or self.polar_inertia or self.diametral_inertia or self.k_mean or self.k_diff)
-
-
-@dataclass(frozen=True)
 class Chain:
-    """Compiled element chain: station 0, segment 0, station 1, ..., station N."""
+    """The elements in propagation order: node 0, segment 0, node 1, ..., node N.
+
+    ``points[k]`` holds the point elements at node ``k`` in the order given.
+    """
 
     segments: tuple[ShaftSegment, ...]
-    stations: tuple[Station, ...]
+    points: tuple[tuple[PointElement, ...], ...]
     left: EndCondition
     right: EndCondition
     isotropic: bool
@@ -68,113 +57,132 @@ class Chain:
 
     @classmethod
     def build(
-        cls,
-        segments: tuple[ShaftSegment, ...],
-        masses: tuple[ConcentratedMass, ...],
-        bearings: tuple[Bearing, ...],
-        left: EndCondition,
-        right: EndCondition,
+        cls, segments: Sequence[ShaftSegment], points: Sequence[PointElement], left: EndCondition, right: EndCondition
     ) -> Chain:
-        n_nodes = len(segments) + 1
-        acc = [[0.0] * 5 for _ in range(n_nodes)]
-        for m in masses:
-            acc[m.node][0] += m.mass
-            acc[m.node][1] += m.polar_inertia
-            acc[m.node][2] += m.diametral_inertia
-        for b in bearings:
-            acc[b.node][3] += b.k_mean
-            acc[b.node][4] += b.k_diff
-        stations = tuple(Station(*a) for a in acc)
+        at_node: list[list[PointElement]] = [[] for _ in range(len(segments) + 1)]
+        for element in points:
+            at_node[element.node].append(element)
         L0 = sum(s.length for s in segments) / len(segments)
         EI0 = segments[0].bending_stiffness
         scale = np.array([1.0 / L0, 1.0, L0 / EI0, L0 * L0 / EI0])
-        isotropic = all(st.k_diff == 0.0 for st in stations)
-        return cls(tuple(segments), stations, left, right, isotropic, scale)
-
-    @property
-    def dim(self) -> int:
-        """State dimension: 4 (isotropic, signed ``w``) or 8 (anisotropic, ``w > 0``)."""
-        return 4 if self.isotropic else 8
-
-
-def _orthonormalize2(Y: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Gram-Schmidt on the two columns of ``Y`` (n, 4, 2); returns ``Q`` and ``log det R``."""
-    y1 = Y[:, :, 0]
-    n1 = np.sqrt(np.einsum("ij,ij->i", y1, y1))
-    q1 = y1 / n1[:, None]
-    y2 = Y[:, :, 1]
-    y2 = y2 - np.einsum("ij,ij->i", q1, y2)[:, None] * q1
-    n2 = np.sqrt(np.einsum("ij,ij->i", y2, y2))
-    q2 = y2 / n2[:, None]
-    out = np.empty_like(Y)
-    out[:, :, 0] = q1
-    out[:, :, 1] = q2
-    return out, np.log(n1 * n2)
+        isotropic = all(element.isotropic for element in points)
+        return cls(tuple(segments), tuple(map(tuple, at_node)), left, right, isotropic, scale)
 
 
 def _orthonormalize(Y: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """QR with a positive diagonal of ``R``: ``Y = Q R`` (orientation kept)."""
+    """``Y = Q R`` with orthonormal columns ``Q`` and a positive diagonal of ``R`` (orientation kept).
+
+    Two columns (isotropic chains): Gram-Schmidt in closed form; four: Householder QR.
+    """
+    if Y.shape[-1] == 2:
+        y1 = Y[:, :, 0]
+        n1 = np.sqrt(np.einsum("ij,ij->i", y1, y1))
+        q1 = y1 / n1[:, None]
+        r12 = np.einsum("ij,ij->i", q1, Y[:, :, 1])
+        y2 = Y[:, :, 1] - r12[:, None] * q1
+        n2 = np.sqrt(np.einsum("ij,ij->i", y2, y2))
+        Q = np.empty_like(Y)
+        Q[:, :, 0] = q1
+        Q[:, :, 1] = y2 / n2[:, None]
+        R = np.zeros(Y.shape[:1] + (2, 2))
+        R[:, 0, 0], R[:, 0, 1], R[:, 1, 1] = n1, r12, n2
+        return Q, R
     Q, R = np.linalg.qr(Y)
     d = np.sign(np.einsum("...ii->...i", R))
     d[d == 0] = 1.0
     return Q * d[..., None, :], R * d[..., :, None]
 
 
-def _orthonormalize_log(Y: FloatArray) -> tuple[FloatArray, FloatArray]:
-    Q, R = _orthonormalize(Y)
-    return Q, np.sum(np.log(np.einsum("...ii->...i", R)), axis=-1)
-
-
-def _apply_station_iso(Y: FloatArray, st: Station, w: FloatArray, spin: FloatArray, sc: FloatArray) -> None:
-    """In place: ``M += -(Jd w^2 - Jp Omega w) psi``, ``V += (m w^2 - k) U`` (scaled state)."""
-    if st.is_empty:
-        return
-    rot = st.diametral_inertia * w * w - st.polar_inertia * spin * w
-    tra = st.mass * w * w - st.k_mean
-    # scaled: s~_i = sc_i s_i  ->  entry (i, j) scales by sc_i / sc_j
-    Y[:, 2, :] -= (rot * (sc[2] / sc[1]))[:, None] * Y[:, 1, :]
-    Y[:, 3, :] += (tra * (sc[3] / sc[0]))[:, None] * Y[:, 0, :]
-
-
-def _apply_station_aniso(Y: FloatArray, st: Station, w: FloatArray, spin: FloatArray, sc: FloatArray) -> None:
-    if st.is_empty:
-        return
-    ka, kd = st.k_mean * sc[3] / sc[0], st.k_diff * sc[3] / sc[0]
-    Ua = Y[:, 0, :].copy()
-    Ub = Y[:, 4, :].copy()
-    for off, ww in ((0, w), (4, -w)):
-        rot = st.diametral_inertia * ww * ww - st.polar_inertia * spin * ww
-        Y[:, off + 2, :] -= (rot * (sc[2] / sc[1]))[:, None] * Y[:, off + 1, :]
-        Y[:, off + 3, :] += (st.mass * ww * ww * sc[3] / sc[0])[:, None] * Y[:, off, :]
-    Y[:, 3, :] -= ka * Ua + kd * Ub
-    Y[:, 7, :] -= kd * Ua + ka * Ub
+def _log_det(R: FloatArray) -> FloatArray:
+    """``log det R`` of triangular factors with a positive diagonal."""
+    return np.sum(np.log(np.einsum("...ii->...i", R)), axis=-1)
 
 
 def _segment_pieces(beta1: FloatArray, length: float) -> int:
     return max(1, math.ceil(float(np.max(beta1, initial=0.0)) * length / MAX_PIECE_PHASE))
 
 
-def _scaled_field(seg: ShaftSegment, w: FloatArray, spin: FloatArray, length: float, sc: FloatArray) -> FloatArray:
-    H = seg.transfer_matrix(w, spin, length)
-    return H * (sc[:, None] / sc[None, :])
-
-
 def _initial(chain: Chain, n: int) -> FloatArray:
     i, j = chain.left.free_components
-    if chain.isotropic:
-        Y = np.zeros((n, 4, 2))
-        Y[:, i, 0] = 1.0
-        Y[:, j, 1] = 1.0
-    else:
-        Y = np.zeros((n, 8, 4))
-        for col, row in enumerate((i, j, 4 + i, 4 + j)):
-            Y[:, row, col] = 1.0
+    rows = (i, j) if chain.isotropic else (i, j, 4 + i, 4 + j)
+    Y = np.zeros((n, 4 * (1 if chain.isotropic else 2), len(rows)))
+    for col, row in enumerate(rows):
+        Y[:, row, col] = 1.0
     return Y
 
 
 def _final_rows(chain: Chain) -> list[int]:
     i, j = chain.right.zero_components
     return [i, j] if chain.isotropic else [i, j, 4 + i, 4 + j]
+
+
+@dataclass
+class _Trace:
+    """Snapshots of the propagated basis for the mode shape: ``(z, Y, R)`` after every step.
+
+    ``R`` is the triangular factor of an orthonormalisation (``None`` when the step
+    was a point matrix, which leaves the coefficients of the basis unchanged).
+    """
+
+    z: list[float] = field(default_factory=list)
+    bases: list[FloatArray] = field(default_factory=list)
+    factors: list[FloatArray | None] = field(default_factory=list)
+
+    def add(self, z: float, Y: FloatArray, R: FloatArray | None) -> None:
+        self.z.append(z)
+        self.bases.append(Y[0].copy())
+        self.factors.append(None if R is None else R[0])
+
+
+def _propagate(
+    chain: Chain, w: FloatArray, spin: FloatArray, min_pieces: int = 1, trace: _Trace | None = None
+) -> tuple[FloatArray, FloatArray]:
+    """Propagate the left-end basis through every element; return ``Y_N`` and its log scale.
+
+    ``Y_N`` is orthonormal; the classical ``C_R P B_L`` equals ``C_R Y_N`` times
+    ``exp(log_scale + sum(beta1 l))``; ``log_scale`` already holds ``-sum(beta1 l)``
+    (for an anisotropic chain the forward and backward components both grow).
+    """
+    pair = not chain.isotropic
+    sc = np.tile(chain.scale, 2) if pair else chain.scale
+    ratio = sc[:, None] / sc[None, :]  # s~_i = sc_i s_i: entry (i, j) scales by sc_i / sc_j
+    Y = _initial(chain, w.size)
+    log_scale = np.zeros(w.size)
+    z = 0.0
+    if trace is not None:
+        trace.add(z, Y, None)
+
+    def points(k: int) -> FloatArray:
+        Yk = Y
+        for element in chain.points[k]:
+            P = element.transfer_matrix_pair(w, spin) if pair else element.transfer_matrix(w, spin)
+            Yk = (P * ratio) @ Yk
+        return Yk
+
+    for k, seg in enumerate(chain.segments):
+        Y = points(k)
+        if trace is not None:
+            trace.add(z, Y, None)
+        growth = seg.beta1(w, spin)
+        log_scale -= growth * seg.length
+        if pair:  # the backward component grows with beta1(-w)
+            backward = seg.beta1(-w, spin)
+            log_scale -= backward * seg.length
+            growth = np.maximum(growth, backward)
+        p = max(_segment_pieces(growth, seg.length), min_pieces)
+        piece = seg.length / p
+        H = (seg.transfer_matrix_pair(w, spin, piece) if pair else seg.transfer_matrix(w, spin, piece)) * ratio
+        for _ in range(p):
+            Y, R = _orthonormalize(H @ Y)
+            log_scale += _log_det(R)
+            z += piece
+            if trace is not None:
+                trace.add(z, Y, R)
+    Y, R = _orthonormalize(points(len(chain.segments)))
+    log_scale += _log_det(R)
+    if trace is not None:
+        trace.add(z, Y, R)
+    return Y, log_scale
 
 
 def determinant(chain: Chain, w: ArrayLike, spin: ArrayLike) -> FloatArray:
@@ -192,55 +200,15 @@ def determinant(chain: Chain, w: ArrayLike, spin: ArrayLike) -> FloatArray:
     chains take ``w > 0`` and return the 8x8-state determinant.
     """
     w_arr, s_arr = np.broadcast_arrays(np.atleast_1d(np.asarray(w, float)), np.atleast_1d(np.asarray(spin, float)))
-    shape = w_arr.shape
-    w1 = w_arr.ravel().copy()
-    s1 = s_arr.ravel().copy()
-    n = w1.size
-    sc = chain.scale
-    Y = _initial(chain, n)
-    iso = chain.isotropic
-    log_scale = np.zeros(n)
-    for k, seg in enumerate(chain.segments):
-        st = chain.stations[k]
-        if iso:
-            _apply_station_iso(Y, st, w1, s1, sc)
-        else:
-            _apply_station_aniso(Y, st, w1, s1, sc)
-        b1 = seg.beta1(w1, s1)
-        log_scale -= b1 * seg.length
-        if not iso:  # the backward component grows with beta1(-w)
-            b1m = seg.beta1(-w1, s1)
-            log_scale -= b1m * seg.length
-            b1 = np.maximum(b1, b1m)
-        p = _segment_pieces(b1, seg.length)
-        piece = seg.length / p
-        Hp = _scaled_field(seg, w1, s1, piece, sc)
-        if not iso:
-            Hm = _scaled_field(seg, -w1, s1, piece, sc)
-        for _ in range(p):
-            if iso:
-                Y, lr = _orthonormalize2(Hp @ Y)
-            else:
-                Y = np.concatenate([Hp @ Y[:, :4, :], Hm @ Y[:, 4:, :]], axis=1)
-                Y, lr = _orthonormalize_log(Y)
-            log_scale += lr
-    st = chain.stations[-1]
-    if iso:
-        _apply_station_iso(Y, st, w1, s1, sc)
-        Y, lr = _orthonormalize2(Y)
-    else:
-        _apply_station_aniso(Y, st, w1, s1, sc)
-        Y, lr = _orthonormalize_log(Y)
-    log_scale += lr
-    rows = _final_rows(chain)
-    sub = Y[:, rows, :]
-    if iso:
+    Y, log_scale = _propagate(chain, w_arr.ravel().copy(), s_arr.ravel().copy())
+    sub = Y[:, _final_rows(chain), :]
+    if chain.isotropic:
         f = sub[:, 0, 0] * sub[:, 1, 1] - sub[:, 0, 1] * sub[:, 1, 0]
     else:
         f = np.linalg.det(sub)
     # keep the factor finite; sign and zeros are unaffected
     f = f * np.exp(np.clip(log_scale, -700.0, 700.0))
-    return f.reshape(shape)
+    return f.reshape(w_arr.shape)
 
 
 @dataclass(frozen=True)
@@ -270,61 +238,23 @@ class ModeShape:
 def mode_shape(chain: Chain, w: float, spin: float, points_per_segment: int = 8) -> ModeShape:
     """Mode shape at a root ``w`` of :func:`determinant` (signed for isotropic chains).
 
-    The same orthonormalised propagation is run once, storing every basis ``Y_k``
-    and triangular factor ``R_k``; the null vector of the end conditions is then
-    mapped back with ``q_k = R_k^-1 q_{k+1}``.
+    The propagation of :func:`determinant` is run once more, keeping every basis
+    ``Y_k`` and triangular factor ``R_k``; the null vector of the end conditions is
+    then mapped back with ``q_k = R_k^-1 q_{k+1}``.
     """
-    wv = np.array([float(w)])
-    sv = np.array([float(spin)])
-    sc = chain.scale
-    iso = chain.isotropic
-    Y = _initial(chain, 1)
-    records: list[tuple[str, float, FloatArray]] = []  # (kind, z, Y) snapshots after each op
-    Rs: list[FloatArray | None] = []
-    z = 0.0
-
-    def station(k: int) -> None:
-        if iso:
-            _apply_station_iso(Y, chain.stations[k], wv, sv, sc)
-        else:
-            _apply_station_aniso(Y, chain.stations[k], wv, sv, sc)
-
-    records.append(("node", z, Y[0].copy()))
-    Rs.append(None)
-    for k, seg in enumerate(chain.segments):
-        station(k)
-        records.append(("node", z, Y[0].copy()))
-        Rs.append(None)
-        b1 = np.maximum(seg.beta1(wv, sv), seg.beta1(-wv, sv))
-        p = max(_segment_pieces(b1, seg.length), points_per_segment)
-        piece = seg.length / p
-        Hp = _scaled_field(seg, wv, sv, piece, sc)
-        Hm = _scaled_field(seg, -wv, sv, piece, sc)
-        for _ in range(p):
-            if iso:
-                Ynew = Hp @ Y
-            else:
-                Ynew = np.concatenate([Hp @ Y[:, :4, :], Hm @ Y[:, 4:, :]], axis=1)
-            Y, R = _orthonormalize(Ynew)
-            z += piece
-            records.append(("piece", z, Y[0].copy()))
-            Rs.append(R[0])
-    station(len(chain.segments))
-    records.append(("node", z, Y[0].copy()))
-    Rs.append(None)
-    rows = _final_rows(chain)
-    _, _, vt = np.linalg.svd(Y[0][rows, :])
+    trace = _Trace()
+    Y, _ = _propagate(chain, np.array([float(w)]), np.array([float(spin)]), points_per_segment, trace)
+    _, _, vt = np.linalg.svd(Y[0][_final_rows(chain), :])
     q = vt[-1]
     coeffs: list[FloatArray] = [q]
-    for R in reversed(Rs[1:]):
+    for R in reversed(trace.factors[1:]):
         q = np.linalg.solve(R, q) if R is not None else q
         coeffs.append(q)
     coeffs.reverse()
-    zs = np.array([r[1] for r in records])
-    states = np.array([rec[2] @ c for rec, c in zip(records, coeffs)])
-    fwd = states[:, 0] / sc[0]
-    bwd = states[:, 4] / sc[0] if not iso else np.zeros_like(fwd)
-    if iso and w < 0:
+    states = np.array([Y_k @ c for Y_k, c in zip(trace.bases, coeffs)])
+    fwd = states[:, 0] / chain.scale[0]
+    bwd = states[:, 4] / chain.scale[0] if not chain.isotropic else np.zeros_like(fwd)
+    if chain.isotropic and w < 0:
         fwd, bwd = bwd, fwd
     peak = max(np.max(np.abs(fwd)), np.max(np.abs(bwd)))
-    return ModeShape(float(w), float(spin), zs, fwd / peak, bwd / peak)
+    return ModeShape(float(w), float(spin), np.array(trace.z), fwd / peak, bwd / peak)
