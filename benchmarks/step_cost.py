@@ -1,10 +1,13 @@
-"""Per-step cost of every FMU against its minimal twin built the same way.
+"""Per-step cost of every FMU against its minimal twin built the same way, and the harness's
+cost against the plain batched fmpy loop.
 
-``python -m benchmarks.step_cost [MODELS_DIR]``: for each catalog model and FMI version, the
-FMU and a twin with the same variables but no physics (:mod:`minimal_models`) are built
-with :func:`fmu_harness.build.build`; both are stepped through fmpy's low-level API (set
-the Real inputs, doStep, get the Real outputs, each one batched call) at their default inputs,
-in alternating rounds within one run; the best round of each gives microseconds per step and the ratio.
+``python -m benchmarks.step_cost``: for each catalog model and FMI version, the FMU and a twin
+with the same variables but no physics (:mod:`minimal_models`) are built with
+:func:`fmu_harness.build.build`; both are stepped through fmpy's low-level API (set the Real inputs, doStep,
+get the Real outputs, each one batched call) at their default inputs. The FMU is also stepped
+by :meth:`fmu_harness.runner.FmuInstance.run` for the same Real outputs, with the inputs given
+as constants (set once) and as functions of time (sampled and set at every step). All run in
+alternating rounds within one run; the best round of each gives microseconds per step.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from benchmarks import minimal_models
 from benchmarks.timing import machine
 from driveline.catalog import MODELS
 from fmu_harness.build import build
-from fmu_harness.runner import FmuInstance
+from fmu_harness.runner import Fmi3Instance, FmuInstance
 
 STEPS, ROUNDS = 2000, 7
 VARIANTS = {"TripodCoupling": {"closed form": {"kinematics": 0}, "exact": {"kinematics": 1}}}
@@ -30,17 +33,17 @@ class Stepper:
     def __init__(self, path: Path, start_values: dict[str, float], inputs: list[str]):
         self.instance = FmuInstance(path)
         self.instance.initialize(start_values)
-        real = ("Real", "Float64")
         references = lambda names: [self.instance.variables[n].valueReference for n in names]  # noqa: E731
         self.inputs = references(inputs)
-        self.outputs = references([n for n in self.instance.outputs() if self.instance.variables[n].type in real])
+        self.outputs = references(real_outputs(self.instance))
         self.values = self.instance.get(inputs)
         self.step_size = float(self.instance.description.defaultExperiment.stepSize)
         self.time = 0.0
 
     def round(self) -> float:
         """Microseconds per step over ``STEPS`` steps."""
-        fmu, fmi3 = self.instance.fmu, self.instance.fmi3
+        fmu = self.instance.fmu
+        fmi3 = isinstance(self.instance, Fmi3Instance)
         set_real = fmu.setFloat64 if fmi3 else fmu.setReal
         get_real = fmu.getFloat64 if fmi3 else fmu.getReal
         start = time.perf_counter()
@@ -52,21 +55,53 @@ class Stepper:
         return (time.perf_counter() - start) / STEPS * 1e6
 
 
-def compare(fmu: Path, twin: Path, start_values: dict[str, float], inputs: list[str]) -> tuple[float, float]:
-    """Best round of each, the two FMUs' rounds alternating so that both see the same load."""
-    ours, floor = Stepper(fmu, start_values, inputs), Stepper(twin, start_values, inputs)
+def real_outputs(instance: FmuInstance) -> list[str]:
+    return [n for n in instance.outputs() if instance.variables[n].type in ("Real", "Float64")]
+
+
+class HarnessStepper:
+    """One FMU instance stepped by the harness's ``run`` for the Real outputs; ``varying``
+    passes the inputs as functions of time, else as constants."""
+
+    def __init__(self, path: Path, start_values: dict[str, float], inputs: list[str], varying: bool):
+        self.instance = FmuInstance(path)
+        self.instance.initialize(start_values)
+        values = dict(zip(inputs, self.instance.get(inputs)))
+        self.inputs = {k: (lambda t, v=v: v) for k, v in values.items()} if varying else values
+        self.outputs = real_outputs(self.instance)
+        self.step_size = float(self.instance.description.defaultExperiment.stepSize)
+
+    def round(self) -> float:
+        """Microseconds per step over ``STEPS`` steps."""
+        stop = self.instance.time + STEPS * self.step_size
+        start = time.perf_counter()
+        self.instance.run(stop, self.step_size, self.inputs, self.outputs)
+        return (time.perf_counter() - start) / STEPS * 1e6
+
+
+def compare(fmu: Path, twin: Path, start_values: dict[str, float], inputs: list[str]) -> list[float]:
+    """Best round of each of: the FMU in the batched fmpy loop, the minimal twin in the same loop,
+    the FMU through the harness with constant inputs and with inputs as functions of time; their
+    rounds alternate so that all see the same load."""
+    steppers = [
+        Stepper(fmu, start_values, inputs),
+        Stepper(twin, start_values, inputs),
+        HarnessStepper(fmu, start_values, inputs, varying=False),
+        HarnessStepper(fmu, start_values, inputs, varying=True),
+    ]
     try:
-        rounds = [(ours.round(), floor.round()) for _ in range(ROUNDS)]
+        rounds = [[stepper.round() for stepper in steppers] for _ in range(ROUNDS)]
     finally:
-        ours.instance.close()
-        floor.instance.close()
-    return min(r[0] for r in rounds), min(r[1] for r in rounds)
+        for stepper in steppers:
+            stepper.instance.close()
+    return [min(column) for column in zip(*rounds)]
 
 
 def main() -> None:
-    print(f"Per-step cost (set inputs, doStep, get outputs) via fmpy; {machine()}")
-    print("| FMU | FMI | variant | us/step | minimal twin us/step | ratio |")
-    print("|---|---|---|---|---|---|")
+    print(f"Per-step cost (set inputs, doStep, get outputs) via fmpy and via the harness; {machine()}")
+    print("| FMU | FMI | variant | fmpy batched us/step | minimal twin us/step | model/twin | "
+          "harness, constant inputs us/step | harness/fmpy | harness, inputs f(t) us/step | harness/fmpy |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as folder:
         dest = Path(folder)
         for fmi in ("2", "3"):
@@ -76,8 +111,9 @@ def main() -> None:
                 twin = build(twin_name, dest, fmi, getattr(minimal_models, twin_name))
                 inputs = [v.name for v in model.spec.of("input")]
                 for variant, start_values in VARIANTS.get(name, {"default": {}}).items():
-                    ours, floor = compare(fmu, twin, start_values, inputs)
-                    print(f"| {name} | {fmi}.0 | {variant} | {ours:.1f} | {floor:.1f} | {ours / floor:.2f} |", flush=True)
+                    ours, floor, constant, varying = compare(fmu, twin, start_values, inputs)
+                    print(f"| {name} | {fmi}.0 | {variant} | {ours:.1f} | {floor:.1f} | {ours / floor:.2f} | "
+                          f"{constant:.1f} | {constant / ours:.2f} | {varying:.1f} | {varying / ours:.2f} |", flush=True)
 
 
 if __name__ == "__main__":

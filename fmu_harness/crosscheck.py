@@ -23,7 +23,7 @@ from fmpy.util import read_csv
 from driveline.catalog import MODELS
 
 from .runner import FmuInstance
-from .scenario import scenario
+from .scenario import scenario, standard_run
 
 REL_TOL = 1e-9
 
@@ -44,8 +44,7 @@ def write(fmu: Path) -> list[Path]:
     name = read_model_description(str(fmu)).modelName
     case = scenario(MODELS[name].spec)
     with FmuInstance(fmu) as instance:
-        instance.initialize(case.input_values(0.0))
-        result = instance.run(case.stop_time, case.step_size, case.signals(), case.outputs)
+        result = standard_run(instance, case.outputs)
     reference = fmu.with_name(f"{name}_ref.csv")
     _write_csv(reference, ["time", *case.outputs], result.view((float, len(result.dtype))))
     options = fmu.with_name(f"{name}_ref.opt")

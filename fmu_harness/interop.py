@@ -33,7 +33,7 @@ from driveline.catalog import MODELS
 from . import importers
 from .doc_sections import replace_section
 from .runner import FmuInstance
-from .scenario import scenario
+from .scenario import scenario, standard_run
 
 TOLERANCE = 1e-9
 RESULT = "interop result: "
@@ -107,8 +107,7 @@ def simulate_in(engine: str, fmu: Path) -> Outcome:
     name = read_model_description(str(fmu)).modelName
     case = scenario(MODELS[name].spec)
     with FmuInstance(fmu) as instance:
-        instance.initialize(case.input_values(0.0))
-        reference = instance.run(case.stop_time, case.step_size, case.signals(), case.outputs)
+        reference = standard_run(instance, case.outputs)
 
     def inputs(time: float) -> dict[str, float]:
         return {f"m.{k}": v for k, v in case.input_values(time).items()}

@@ -1,5 +1,5 @@
 """A standard run of any catalog model, shared by the FMI 2.0/3.0 comparison, the importers
-and the cross-check references.
+and the cross-check references (:func:`standard_run` runs it through fmpy).
 
 Parameters keep their spec start values; every Real input follows a piecewise-linear
 signal through its start value, 3 % below it at half time and 2 % above it at the end.
@@ -9,12 +9,15 @@ importer that interpolates the table linearly feeds the FMU the same values.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from driveline.catalog import MODELS
 from driveline.variables import ModelSpec
+
+from .runner import FmuInstance
 
 INPUT_FACTORS = (1.0, 0.97, 1.02)
 STEPS = 100
@@ -54,3 +57,13 @@ def scenario(spec: ModelSpec) -> Scenario:
     breakpoints = np.array([0.0, 0.5 * stop, stop])
     inputs = {v.name: v.start * np.array(INPUT_FACTORS) for v in spec.of("input") if v.type == "Real"}
     return Scenario(spec, stop, stop / STEPS, breakpoints, inputs)
+
+
+def standard_run(
+    instance: FmuInstance, outputs: Sequence[str] | None = None, stop_time: float | None = None
+) -> np.ndarray:
+    """Initialise ``instance`` and run its model's standard scenario through fmpy, up to
+    ``stop_time`` (default: the whole run); rows of time and ``outputs`` (default: all outputs)."""
+    case = scenario(MODELS[instance.description.modelName].spec)
+    instance.initialize(case.input_values(0.0))
+    return instance.run(stop_time or case.stop_time, case.step_size, case.signals(), outputs)

@@ -13,8 +13,9 @@ input (held constant) of the FMU. A run lasts ``--turns`` input turns at the poi
 ``omega_in`` in ``--steps-per-turn`` steps unless ``--duration`` / ``--step`` are given.
 
 Every point is one :func:`fmu_harness.runner.simulate` call on a worker. The FMU's bytes are
-scattered to the workers once and extracted once per worker process, so workers need no shared
-file system. A refused or crashed run becomes a ``failed`` row with its reason.
+scattered to the workers once, extracted and their model description parsed once per worker
+process, so workers need no shared file system. A refused or crashed run becomes a ``failed``
+row with its reason.
 """
 
 from __future__ import annotations
@@ -40,6 +41,9 @@ import pyarrow.csv
 import pyarrow.parquet
 from distributed import Client, Future, LocalCluster, get_worker, progress, wait
 from fmpy import extract, read_model_description
+from fmpy.model_description import ModelDescription
+
+from driveline.catalog import MODELS
 
 from .runner import StepRefused, simulate
 
@@ -194,12 +198,22 @@ class Interface:
     def metric_columns(self) -> list[str]:
         return [f"{output}_{statistic}" for output, statistic in self.statistics()]
 
-    def run(self, path: Path, point: Point, timing: Timing, unzipdir: str | None = None) -> dict[str, Any]:
-        """One FMU run of ``point``: status, reason and metrics, never an exception."""
+    def run(
+        self,
+        path: Path,
+        point: Point,
+        timing: Timing,
+        unzipdir: str | None = None,
+        description: ModelDescription | None = None,
+    ) -> dict[str, Any]:
+        """One FMU run of ``point``: status, reason and metrics, never an exception. ``unzipdir``
+        and ``description``: the FMU already extracted and its model description parsed."""
         try:
             start_values, inputs = self.split(point)
             stop_time, step_size = timing.resolve(self.speed(point), self.default_experiment)
-            result = simulate(path, stop_time, step_size, inputs, start_values, self.outputs, unzipdir=unzipdir)
+            result = simulate(
+                path, stop_time, step_size, inputs, start_values, self.outputs, unzipdir=unzipdir, description=description
+            )
         except Exception as error:  # noqa: BLE001 - any failure of a run is a result of the sweep
             return failed(error)
         metrics = {
@@ -229,26 +243,36 @@ class ShippedFmu:
         return cls(Interface.of(path), hashlib.sha256(data).hexdigest(), data)
 
 
-_UNPACKED: dict[str, tuple[Path, str]] = {}
+@dataclass(frozen=True)
+class UnpackedFmu:
+    """An FMU on a worker: its file, extracted folder and parsed model description."""
+
+    path: Path
+    unzipdir: str
+    description: ModelDescription
+
+
+_UNPACKED: dict[str, UnpackedFmu] = {}
 _UNPACK_LOCK = threading.Lock()
 
 
-def _unpacked(fmu: ShippedFmu) -> tuple[Path, str]:
-    """(FMU file, extracted folder), written once per worker process in the worker's scratch space."""
+def _unpacked(fmu: ShippedFmu) -> UnpackedFmu:
+    """The FMU written, extracted and parsed once per worker process in the worker's scratch space."""
     with _UNPACK_LOCK:
         if fmu.digest not in _UNPACKED:
             folder = Path(get_worker().local_directory) / f"fmu-{fmu.digest[:16]}"
             folder.mkdir(parents=True, exist_ok=True)
             path = folder / f"{fmu.interface.model}.fmu"
             path.write_bytes(fmu.data)
-            _UNPACKED[fmu.digest] = path, extract(path, unzipdir=folder / "extracted")
+            unzipdir = extract(path, unzipdir=folder / "extracted")
+            _UNPACKED[fmu.digest] = UnpackedFmu(path, unzipdir, read_model_description(unzipdir))
         return _UNPACKED[fmu.digest]
 
 
 def run_point(fmu: ShippedFmu, point: Point, timing: Timing) -> dict[str, Any]:
     """Worker task: run one point of the sweep."""
-    path, unzipdir = _unpacked(fmu)
-    return fmu.interface.run(path, point, timing, unzipdir)
+    unpacked = _unpacked(fmu)
+    return fmu.interface.run(unpacked.path, point, timing, unpacked.unzipdir, unpacked.description)
 
 
 def _outcome(future: Future) -> dict[str, Any]:
@@ -261,26 +285,33 @@ def _outcome(future: Future) -> dict[str, Any]:
 
 
 def critical_speed_margins(speeds: Sequence[float], layout: str = "") -> list[float] | None:
-    """``(|speed| - n_c) / n_c`` for the nearest forward critical speed ``n_c`` (rotor core
-    ``driveline.rotor``), or None while the catalog holds no ``CriticalSpeeds`` model.
+    """``(|speed| - n_c) / n_c`` for the nearest ``n_c`` of the first three forward critical
+    speeds, or None while the catalog holds no ``CriticalSpeeds`` model.
 
-    The driveline is that of the ``CriticalSpeeds`` FMU for its start values, or ``layout`` (its
-    ``layout`` parameter: a TOML file or the name of a shipped description); the sign follows
-    its ``resonance_margin`` (negative below the critical speed)."""
-    from driveline.catalog import MODELS
-
-    if CRITICAL_SPEEDS_MODEL not in MODELS:
+    The critical speeds are the outputs ``omega_crit_1..3`` of the catalog's ``CriticalSpeeds``
+    model, the code its FMU wraps, initialised at its start values with ``layout`` (its
+    ``layout`` parameter: a TOML file or the name of a shipped description): the sweep reads
+    the model through its declared interface only, runs on the client, which may not hold the
+    CriticalSpeeds FMU, and needs no FMU instance for it. The sign follows the model's
+    ``resonance_margin`` (negative below the critical speed); a speed that is zero or not
+    finite has no margin (NaN)."""
+    model_class = MODELS.get(CRITICAL_SPEEDS_MODEL)
+    if model_class is None:
         return None
-    from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline
+    model = model_class()
+    model.layout = layout
+    errors = model.initialize(0.0)
+    if errors:
+        raise ValueError(f"{CRITICAL_SPEEDS_MODEL} with layout {layout!r}: {'; '.join(errors)}")
+    critical = [getattr(model, f"omega_crit_{k}") for k in (1, 2, 3)]
 
-    spec = MODELS[CRITICAL_SPEEDS_MODEL].spec
-    shaft = build_driveline(layout, {name: spec[name].start for name in SHAFT_PARAMETERS})
-    margins: dict[float, float] = {}
-    for speed in set(map(abs, speeds)):
-        valid = math.isfinite(speed) and speed > 0.0
-        nearest = shaft.nearest_order_resonance(speed, orders=(1,), whirl=("forward",)) if valid else None
-        margins[speed] = math.nan if nearest is None else (speed - nearest.spin) / nearest.spin
-    return [margins[abs(speed)] for speed in speeds]
+    def margin(speed: float) -> float:
+        if not (math.isfinite(speed) and speed != 0.0):
+            return math.nan
+        nearest = min(critical, key=lambda c: abs(c - abs(speed)))
+        return (abs(speed) - nearest) / nearest
+
+    return [margin(speed) for speed in speeds]
 
 
 def sweep(

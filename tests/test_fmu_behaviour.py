@@ -12,15 +12,7 @@ from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from driveline.catalog import MODELS
-from fmu_harness.runner import FmuInstance
-from fmu_harness.scenario import scenario
-
-
-def _standard_run(fmu: FmuInstance, model_name: str, stop_time: float | None = None) -> np.ndarray:
-    """Initialise ``fmu`` and run the model's standard scenario (up to ``stop_time``)."""
-    case = scenario(MODELS[model_name].spec)
-    fmu.initialize(case.input_values(0.0))
-    return fmu.run(stop_time or case.stop_time, case.step_size, case.signals())
+from fmu_harness.scenario import scenario, standard_run
 
 
 def test_fmi2_and_fmi3_give_identical_outputs(model_name, open_fmu):
@@ -29,7 +21,7 @@ def test_fmi2_and_fmi3_give_identical_outputs(model_name, open_fmu):
     runs = []
     for fmi in ("2", "3"):
         with open_fmu(model_name, fmi) as fmu:
-            runs.append(_standard_run(fmu, model_name))
+            runs.append(standard_run(fmu))
     assert runs[0].dtype.names == runs[1].dtype.names
     assert runs[0].tobytes() == runs[1].tobytes()
 
@@ -37,7 +29,7 @@ def test_fmi2_and_fmi3_give_identical_outputs(model_name, open_fmu):
 def test_state_round_trips_and_continues_bit_identically(model_name, fmi, open_fmu):
     case = scenario(MODELS[model_name].spec)
     with open_fmu(model_name, fmi) as fmu:
-        _standard_run(fmu, model_name, stop_time=case.stop_time / 2)
+        standard_run(fmu, stop_time=case.stop_time / 2)
         middle = fmu.time
         state = fmu.get_state()
         serialized = fmu.serialize_state(state)
@@ -74,11 +66,11 @@ def test_instances_are_independent(model_name, fmi, open_fmu):
 def test_reset_returns_to_the_start_values(model_name, fmi, open_fmu):
     spec = MODELS[model_name].spec
     with open_fmu(model_name, fmi) as fmu:
-        first = _standard_run(fmu, model_name)
+        first = standard_run(fmu)
         fmu.reset()
         settable = [v.name for v in spec.variables if v.causality != "output"]
         assert fmu.get(settable) == [v.start for v in spec.variables if v.causality != "output"]
-        assert _standard_run(fmu, model_name).tobytes() == first.tobytes()
+        assert standard_run(fmu).tobytes() == first.tobytes()
 
 
 def test_many_instances_in_one_process(fmi, fmu_path):
