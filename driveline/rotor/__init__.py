@@ -19,7 +19,7 @@ from .driveline import (
     OrderResonance,
     WhirlFrequencies,
 )
-from .elements import Bearing, ConcentratedMass, EndCondition, PointElement, ShaftSegment
+from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, PointElement, ShaftSegment
 from .loader import example_path, load_driveline, loads_driveline, one_piece_shaft
 from .transfer import ModeShape
 
@@ -29,6 +29,7 @@ __all__ = [
     "ConcentratedMass",
     "Driveline",
     "EndCondition",
+    "Hinge",
     "ModeShape",
     "OrderResonance",
     "PointElement",

@@ -92,6 +92,8 @@ class Driveline:
     ``len(segments)`` the right end (as ROSS numbers its nodes). ``left`` and
     ``right`` are the end conditions; bearings are point elements and may sit at
     any node, including the ends (then use ``free`` ends, as the seed's Fig. 2).
+    ``joints`` holds further point elements (:class:`Hinge`, ...), applied at their
+    node after its masses and bearings; a hinge must sit at an inner node.
     """
 
     segments: Sequence[ShaftSegment]
@@ -100,6 +102,7 @@ class Driveline:
     left: EndCondition | str = EndCondition.FREE
     right: EndCondition | str = EndCondition.FREE
     name: str = ""
+    joints: Sequence[PointElement] = ()
     _chain: transfer.Chain = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -108,12 +111,18 @@ class Driveline:
             raise ValueError("segments: a driveline needs at least one shaft segment")
         masses = _as_tuple(self.masses, ConcentratedMass, "masses")
         bearings = _as_tuple(self.bearings, Bearing, "bearings")
+        joints = _as_tuple(self.joints, PointElement, "joints")
         n_nodes = len(segs) + 1
-        for kind, items in (("masses", masses), ("bearings", bearings)):
+        for kind, items in (("masses", masses), ("bearings", bearings), ("joints", joints)):
             for i, it in enumerate(items):
                 if it.node >= n_nodes:
                     raise ValueError(
                         f"{kind}[{i}].node = {it.node} is out of range: nodes are 0..{n_nodes - 1}"
+                    )
+                if it.splits_slope and it.node in (0, n_nodes - 1):
+                    raise ValueError(
+                        f"{kind}[{i}].node = {it.node}: a {type(it).__name__.lower()} must sit at an inner "
+                        f"node (1..{n_nodes - 2}), not at an end"
                     )
         ends = []
         for label, value in (("left", self.left), ("right", self.right)):
@@ -125,14 +134,15 @@ class Driveline:
         object.__setattr__(self, "segments", segs)
         object.__setattr__(self, "masses", masses)
         object.__setattr__(self, "bearings", bearings)
+        object.__setattr__(self, "joints", joints)
         object.__setattr__(self, "left", ends[0])
         object.__setattr__(self, "right", ends[1])
         object.__setattr__(self, "_chain", transfer.Chain.build(segs, self.point_elements, ends[0], ends[1]))
 
     @property
     def point_elements(self) -> tuple[PointElement, ...]:
-        """Every point element, in the order applied at a node: masses, then bearings."""
-        return (*self.masses, *self.bearings)
+        """Every point element, in the order applied at a node: masses, bearings, joints."""
+        return (*self.masses, *self.bearings, *self.joints)
 
     @property
     def is_isotropic(self) -> bool:

@@ -48,6 +48,7 @@ __all__ = [
     "Bearing",
     "ConcentratedMass",
     "EndCondition",
+    "Hinge",
     "PointElement",
     "ShaftSegment",
 ]
@@ -368,7 +369,26 @@ class PointElement(ABC):
 
     @abstractmethod
     def fe_matrices(self) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``K, M, G`` (2x2 each) on the dofs ``[U, psi]`` of the element's node."""
+        """``K, M, G`` (2x2 each) on the dofs ``[U, psi]`` of the element's node.
+
+        An element with ``splits_slope`` gives 3x3 matrices on ``[U, psi_in, psi_out]``:
+        the segment to its right then starts from the new slope ``psi_out``.
+        """
+
+    splits_slope = False
+
+    def propagate(
+        self, Y: FloatArray, w: FloatArray, spin: FloatArray, ratio: FloatArray, pair: bool
+    ) -> tuple[FloatArray, FloatArray | None, FloatArray | None]:
+        """Carry the basis ``Y`` (n, 4 or 8, columns) of the scaled state across the element.
+
+        Returns ``(Y_after, T, sign)``: the coefficients of the basis before are
+        ``T q_after`` (``T = None``: unchanged) and the frequency determinant gains the
+        factor ``sign`` (``None``: 1). A point matrix ``P`` gives ``(P Y, None, None)``;
+        ``ratio[i, j] = sc_i / sc_j`` scales a physical matrix to the scaled state.
+        """
+        P = self.transfer_matrix_pair(w, spin) if pair else self.transfer_matrix(w, spin)
+        return (P * ratio) @ Y, None, None
 
 
 @dataclass(frozen=True)
@@ -462,3 +482,72 @@ class Bearing(PointElement):
         if not self.isotropic:
             raise ValueError("the finite-element check covers isotropic bearings only")
         return np.diag([float(self.kxx), 0.0]), np.zeros((2, 2)), np.zeros((2, 2))
+
+
+@dataclass(frozen=True)
+class Hinge(PointElement):
+    """Joint at an inner ``node`` that transmits no bending moment (universal or tripod joint).
+
+    With ``bending_stiffness`` ``k`` [N m/rad] > 0 it is a rotational spring::
+
+        psi+ = psi- + M / k,    U, M, V continuous,
+
+    and ``k = 0`` (default) is a free hinge, ``M = 0`` at the joint with a free slope
+    jump. Masses and bearings at the same node act on its left side. The frequency
+    determinant carries the factor ``k**r`` (``r`` = 1 whirl component, 2 in the
+    anisotropic state), so that it stays an entire function of ``w`` down to ``k = 0``
+    (see :meth:`propagate`).
+    """
+
+    node: int
+    bending_stiffness: float = 0.0
+
+    splits_slope = True
+
+    def __post_init__(self) -> None:
+        _node(self.node)
+        _non_negative("bending_stiffness", self.bending_stiffness)
+
+    @property
+    def freedoms(self) -> frozenset[str]:
+        """The relative tilt of the two sides."""
+        return frozenset({"hinge"})
+
+    def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
+        """Point matrix ``psi+ = psi- + M / k``; a free hinge (``k = 0``) has none."""
+        if self.bending_stiffness == 0.0:
+            raise ValueError("a free hinge has no transfer matrix: the propagation applies M = 0 instead")
+        w_arr, _ = _broadcast(w, spin)
+        P = _identity(w_arr.shape)
+        P[..., 1, 2] = 1.0 / self.bending_stiffness
+        return P
+
+    def fe_matrices(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """A rotational spring ``k`` between ``psi_in`` and ``psi_out`` (3x3 on ``[U, psi_in, psi_out]``)."""
+        k = self.bending_stiffness
+        K = np.array([[0.0, 0.0, 0.0], [0.0, k, -k], [0.0, -k, k]])
+        return K, np.zeros((3, 3)), np.zeros((3, 3))
+
+    def propagate(
+        self, Y: FloatArray, w: FloatArray, spin: FloatArray, ratio: FloatArray, pair: bool
+    ) -> tuple[FloatArray, FloatArray | None, FloatArray | None]:
+        """New basis ``Y_after = P Y T`` scaled by ``k``, finite down to ``k = 0``.
+
+        With ``m = Y[M rows]`` (r x c) and the full QR ``m^T = [Q1 Q2] [R1; 0]``:
+        ``T = [Q2, k Q1]`` gives ``P Y T = [Y Q2, k Y Q1 + E R1^T]`` (``E``: the slope
+        rows), in which ``k`` only multiplies. ``Y Q2`` are the states with ``M = 0``
+        at the joint, ``E R1^T`` the slope jumps. ``det T = k**r det[Q2 Q1]``, and
+        ``det[Q2 Q1] = +-1`` is returned as the sign; ``k**r`` is left in the determinant.
+        """
+        components = (0, 4) if pair else (0,)
+        moment_rows = [c + 2 for c in components]
+        slope_rows = [c + 1 for c in components]
+        r, cols = len(components), Y.shape[-1]
+        k = self.bending_stiffness / ratio[1, 2]  # scaled: psi~ jumps by M~ ratio[1, 2] / k
+        Q, R = np.linalg.qr(np.swapaxes(Y[:, moment_rows, :], 1, 2), mode="complete")
+        T = np.concatenate([Q[:, :, r:], k * Q[:, :, :r]], axis=2)
+        Y_after = Y @ T
+        for i, row in enumerate(slope_rows):
+            Y_after[:, row, cols - r:] += R[:, :r, i]
+        sign = np.sign(np.linalg.det(Q)) * (-1.0) ** (r * (cols - r))
+        return Y_after, T, sign

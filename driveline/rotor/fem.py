@@ -20,42 +20,56 @@ FloatArray = NDArray[np.float64]
 
 
 def assemble(d: Driveline, elements_per_segment: int = 40) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Global ``K, M, G`` with end conditions applied, and the node positions.
+    """Global ``K, M, G`` with end conditions applied, and the axial positions of the beam nodes.
 
     Every element contributes its own ``fe_matrices``: a segment over its
-    ``elements_per_segment`` beam elements, a point element on the two dofs
-    ``[U, psi]`` of its node.
+    ``elements_per_segment`` beam elements, a point element on the dofs ``[U, psi]``
+    of its node; an element that splits the slope (a hinge) adds a dof ``psi_out``,
+    from which the next segment starts. End conditions act on the slope outside
+    the end node's point elements (as in the transfer path).
     """
-    n_el = elements_per_segment * len(d.segments)
-    n_dof = 2 * (n_el + 1)
-    K = np.zeros((n_dof, n_dof))
-    M = np.zeros_like(K)
-    G = np.zeros_like(K)
+    at_node: list[list] = [[] for _ in range(len(d.segments) + 1)]
+    for element in d.point_elements:
+        at_node[element.node].append(element)
+    segment_blocks: list[tuple[list[int], tuple]] = []
+    point_blocks: list[tuple[list[int], tuple]] = []
     z = [0.0]
-    station_node = [0]
-    for seg in d.segments:
-        first = 2 * station_node[-1]
-        block = slice(first, first + 2 * (elements_per_segment + 1))
-        for glob, loc in zip((K, M, G), seg.fe_matrices(elements_per_segment)):
-            glob[block, block] += loc
+    u, psi, n_dof = 0, 1, 2
+    fixed: list[int] = []
+    for node, elements in enumerate(at_node):
+        if node == 0:
+            fixed += _fixed_dofs(d.left, u, psi)
+        for element in elements:
+            dofs = [u, psi]
+            if element.splits_slope:
+                psi, n_dof = n_dof, n_dof + 1
+                dofs.append(psi)
+            point_blocks.append((dofs, element.fe_matrices()))
+        if node == len(d.segments):
+            fixed += _fixed_dofs(d.right, u, psi)
+            break
+        seg = d.segments[node]
+        dofs = [u, psi, *range(n_dof, n_dof + 2 * elements_per_segment)]
+        n_dof += 2 * elements_per_segment
+        u, psi = dofs[-2], dofs[-1]
+        segment_blocks.append((dofs, seg.fe_matrices(elements_per_segment)))
         h = seg.length / elements_per_segment
         for _ in range(elements_per_segment):
             z.append(z[-1] + h)
-        station_node.append(station_node[-1] + elements_per_segment)
-    for element in d.point_elements:
-        i = 2 * station_node[element.node]
-        for glob, loc in zip((K, M, G), element.fe_matrices()):
-            glob[i:i + 2, i:i + 2] += loc
-    e = station_node[-1]
-    fixed: list[int] = []
-    for end, node in ((d.left, 0), (d.right, e)):
-        if end is EndCondition.PINNED:
-            fixed.append(2 * node)
-        elif end is EndCondition.CLAMPED:
-            fixed.extend([2 * node, 2 * node + 1])
+    K = np.zeros((n_dof, n_dof))
+    M = np.zeros_like(K)
+    G = np.zeros_like(K)
+    for dofs, matrices in segment_blocks + point_blocks:
+        block = np.ix_(dofs, dofs)
+        for glob, loc in zip((K, M, G), matrices):
+            glob[block] += loc
     keep = np.setdiff1d(np.arange(n_dof), fixed)
     ix = np.ix_(keep, keep)
     return K[ix], M[ix], G[ix], np.array(z)
+
+
+def _fixed_dofs(end: EndCondition, u: int, psi: int) -> list[int]:
+    return {EndCondition.FREE: [], EndCondition.PINNED: [u], EndCondition.CLAMPED: [u, psi]}[end]
 
 
 def whirl_frequencies(d: Driveline, spin: float = 0.0, elements_per_segment: int = 40) -> FloatArray:

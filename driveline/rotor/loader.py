@@ -27,6 +27,10 @@ File layout (SI units; all tables except ``segments`` optional)::
     node = 0
     stiffness = 1.0e7            # N/m, isotropic; or kxx and kyy
 
+    [[hinges]]                   # moment-free joint at an inner node (universal, tripod)
+    node = 2
+    # bending_stiffness = 0.0    # N m/rad; > 0 makes it a rotational spring
+
 Every problem raises :class:`ValueError` naming the table, entry and key.
 """
 
@@ -40,11 +44,11 @@ from typing import Any
 import tomllib
 
 from .driveline import Driveline
-from .elements import Bearing, ConcentratedMass, EndCondition, ShaftSegment
+from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, ShaftSegment
 
 __all__ = ["example_path", "load_driveline", "loads_driveline", "one_piece_shaft"]
 
-_TOP_KEYS = {"name", "left_end", "right_end", "materials", "segments", "masses", "bearings"}
+_TOP_KEYS = {"name", "left_end", "right_end", "materials", "segments", "masses", "bearings", "hinges"}
 _MATERIAL_KEYS = {"youngs_modulus", "density"}
 _SEGMENT_KEYS = {
     "length", "outer_diameter", "outer_radius", "inner_diameter", "inner_radius",
@@ -53,6 +57,7 @@ _SEGMENT_KEYS = {
 }
 _MASS_KEYS = {"node", "mass", "polar_inertia", "diametral_inertia", "label"}
 _BEARING_KEYS = {"node", "stiffness", "kxx", "kyy", "label"}
+_HINGE_KEYS = {"node", "bending_stiffness", "label"}
 
 
 def _unknown(where: str, table: dict[str, Any], allowed: set[str]) -> None:
@@ -194,6 +199,14 @@ def _bearing(i: int, t: dict[str, Any]) -> Bearing:
     return Bearing(node, kxx, kyy)
 
 
+def _hinge(i: int, t: dict[str, Any]) -> Hinge:
+    where = f"hinges[{i}]"
+    _unknown(where, t, _HINGE_KEYS)
+    if "node" not in t:
+        raise ValueError(f"{where}: missing key 'node'")
+    return Hinge(_node(where, t["node"]), _number(where, "bending_stiffness", t.get("bending_stiffness", 0.0)))
+
+
 def loads_driveline(text: str, source: str = "<string>") -> Driveline:
     """Build a :class:`Driveline` from TOML text (see the module docstring for the layout)."""
     try:
@@ -218,7 +231,11 @@ def loads_driveline(text: str, source: str = "<string>") -> Driveline:
     segments = [_segment(i, t, mats) for i, t in enumerate(seg_tables)]
     masses = [_mass(i, t) for i, t in enumerate(_table_list(data, "masses"))]
     bearings = [_bearing(i, t) for i, t in enumerate(_table_list(data, "bearings"))]
-    return Driveline(segments, masses, bearings, ends[0], ends[1], name)
+    hinges = [_hinge(i, t) for i, t in enumerate(_table_list(data, "hinges"))]
+    for i, hinge in enumerate(hinges):
+        if not 0 < hinge.node < len(segments):
+            raise ValueError(f"hinges[{i}].node = {hinge.node} must be an inner node (1..{len(segments) - 1})")
+    return Driveline(segments, masses, bearings, ends[0], ends[1], name, hinges)
 
 
 def load_driveline(path: str | Path) -> Driveline:

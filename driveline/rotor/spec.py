@@ -34,7 +34,8 @@ SPEC = ModelSpec(
                  min=0.0, variability="tunable"),
         Variable("layout", "parameter", "",
                  "Driveline description (TOML) replacing the one-piece tube above: a file path ending in "
-                 "'.toml', or the name of a description shipped in the FMU ('two_piece_propshaft'); "
+                 "'.toml', or the name of a description shipped in the FMU ('two_piece_propshaft', or "
+                 "'two_piece_propshaft_hinged' with its centre joint as a hinge); "
                  "empty = the one-piece tube", type="String", variability="tunable"),
         Variable("orders", "parameter", "1,2,3,6",
                  "Excitation orders watched for resonance (1, 2: Cardan joints; 3, 6: tripod coupling)",

@@ -118,51 +118,70 @@ def _final_rows(chain: Chain) -> list[int]:
 
 @dataclass
 class _Trace:
-    """Snapshots of the propagated basis for the mode shape: ``(z, Y, R)`` after every step.
+    """Snapshots of the propagated basis for the mode shape: ``(z, Y, map)`` after every step.
 
-    ``R`` is the triangular factor of an orthonormalisation (``None`` when the step
-    was a point matrix, which leaves the coefficients of the basis unchanged).
+    ``map`` gives the coefficients of the previous basis from those of this one: the
+    triangular factor ``R`` of an orthonormalisation (``q_prev = R^-1 q``), the matrix
+    ``T`` of a point element that changes the basis (``q_prev = T q``), or ``None``
+    for point matrices, which leave the coefficients unchanged.
     """
 
     z: list[float] = field(default_factory=list)
     bases: list[FloatArray] = field(default_factory=list)
-    factors: list[FloatArray | None] = field(default_factory=list)
+    maps: list[tuple[str, FloatArray] | None] = field(default_factory=list)
 
-    def add(self, z: float, Y: FloatArray, R: FloatArray | None) -> None:
+    def add(self, z: float, Y: FloatArray, kind: str = "", matrix: FloatArray | None = None) -> None:
         self.z.append(z)
         self.bases.append(Y[0].copy())
-        self.factors.append(None if R is None else R[0])
+        self.maps.append(None if matrix is None else (kind, matrix[0]))
+
+    def coefficients(self, q: FloatArray) -> list[FloatArray]:
+        """Coefficients of every snapshot's basis, from ``q`` of the last one."""
+        out = [q]
+        for entry in reversed(self.maps[1:]):
+            if entry is not None:
+                kind, matrix = entry
+                q = np.linalg.solve(matrix, q) if kind == "solve" else matrix @ q
+            out.append(q)
+        return out[::-1]
 
 
 def _propagate(
     chain: Chain, w: FloatArray, spin: FloatArray, min_pieces: int = 1, trace: _Trace | None = None
-) -> tuple[FloatArray, FloatArray]:
-    """Propagate the left-end basis through every element; return ``Y_N`` and its log scale.
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Propagate the left-end basis through every element: ``Y_N``, its log scale and sign.
 
-    ``Y_N`` is orthonormal; the classical ``C_R P B_L`` equals ``C_R Y_N`` times
-    ``exp(log_scale + sum(beta1 l))``; ``log_scale`` already holds ``-sum(beta1 l)``
-    (for an anisotropic chain the forward and backward components both grow).
+    ``Y_N`` is orthonormal; the classical ``C_R P B_L`` equals ``sign * C_R Y_N``
+    times ``exp(log_scale + sum(beta1 l))``; ``log_scale`` already holds
+    ``-sum(beta1 l)`` (for an anisotropic chain the forward and backward components
+    both grow), ``sign`` the factors of point elements that change the basis.
     """
     pair = not chain.isotropic
     sc = np.tile(chain.scale, 2) if pair else chain.scale
     ratio = sc[:, None] / sc[None, :]  # s~_i = sc_i s_i: entry (i, j) scales by sc_i / sc_j
     Y = _initial(chain, w.size)
     log_scale = np.zeros(w.size)
+    sign = np.ones(w.size)
     z = 0.0
     if trace is not None:
-        trace.add(z, Y, None)
+        trace.add(z, Y)
 
-    def points(k: int) -> FloatArray:
-        Yk = Y
+    def points(k: int) -> tuple[FloatArray, FloatArray | None]:
+        """The basis after the point elements at node ``k``, and the product of their ``T``."""
+        nonlocal sign
+        Yk, T = Y, None
         for element in chain.points[k]:
-            P = element.transfer_matrix_pair(w, spin) if pair else element.transfer_matrix(w, spin)
-            Yk = (P * ratio) @ Yk
-        return Yk
+            Yk, Te, se = element.propagate(Yk, w, spin, ratio, pair)
+            if Te is not None:
+                T = Te if T is None else T @ Te
+            if se is not None:
+                sign = sign * se
+        return Yk, T
 
     for k, seg in enumerate(chain.segments):
-        Y = points(k)
+        Y, T = points(k)
         if trace is not None:
-            trace.add(z, Y, None)
+            trace.add(z, Y, "multiply", T)
         growth = seg.beta1(w, spin)
         log_scale -= growth * seg.length
         if pair:  # the backward component grows with beta1(-w)
@@ -177,12 +196,15 @@ def _propagate(
             log_scale += _log_det(R)
             z += piece
             if trace is not None:
-                trace.add(z, Y, R)
-    Y, R = _orthonormalize(points(len(chain.segments)))
+                trace.add(z, Y, "solve", R)
+    Y, T = points(len(chain.segments))
+    if trace is not None and T is not None:
+        trace.add(z, Y, "multiply", T)
+    Y, R = _orthonormalize(Y)
     log_scale += _log_det(R)
     if trace is not None:
-        trace.add(z, Y, R)
-    return Y, log_scale
+        trace.add(z, Y, "solve", R)
+    return Y, log_scale, sign
 
 
 def determinant(chain: Chain, w: ArrayLike, spin: ArrayLike) -> FloatArray:
@@ -200,14 +222,14 @@ def determinant(chain: Chain, w: ArrayLike, spin: ArrayLike) -> FloatArray:
     chains take ``w > 0`` and return the 8x8-state determinant.
     """
     w_arr, s_arr = np.broadcast_arrays(np.atleast_1d(np.asarray(w, float)), np.atleast_1d(np.asarray(spin, float)))
-    Y, log_scale = _propagate(chain, w_arr.ravel().copy(), s_arr.ravel().copy())
+    Y, log_scale, sign = _propagate(chain, w_arr.ravel().copy(), s_arr.ravel().copy())
     sub = Y[:, _final_rows(chain), :]
     if chain.isotropic:
         f = sub[:, 0, 0] * sub[:, 1, 1] - sub[:, 0, 1] * sub[:, 1, 0]
     else:
         f = np.linalg.det(sub)
     # keep the factor finite; sign and zeros are unaffected
-    f = f * np.exp(np.clip(log_scale, -700.0, 700.0))
+    f = sign * f * np.exp(np.clip(log_scale, -700.0, 700.0))
     return f.reshape(w_arr.shape)
 
 
@@ -218,7 +240,7 @@ class ModeShape:
     ``z`` [m] axial positions (stations appear twice: before and after their
     point elements); ``forward`` and ``backward`` the real amplitudes of the
     circular whirl components (``backward`` is zero for an isotropic forward mode,
-    and vice versa), normalised to a largest magnitude of 1.
+    and vice versa), normalised so that the largest amplitude is +1.
     """
 
     w: float
@@ -243,18 +265,14 @@ def mode_shape(chain: Chain, w: float, spin: float, points_per_segment: int = 8)
     then mapped back with ``q_k = R_k^-1 q_{k+1}``.
     """
     trace = _Trace()
-    Y, _ = _propagate(chain, np.array([float(w)]), np.array([float(spin)]), points_per_segment, trace)
+    Y, _, _ = _propagate(chain, np.array([float(w)]), np.array([float(spin)]), points_per_segment, trace)
     _, _, vt = np.linalg.svd(Y[0][_final_rows(chain), :])
-    q = vt[-1]
-    coeffs: list[FloatArray] = [q]
-    for R in reversed(trace.factors[1:]):
-        q = np.linalg.solve(R, q) if R is not None else q
-        coeffs.append(q)
-    coeffs.reverse()
+    coeffs = trace.coefficients(vt[-1])
     states = np.array([Y_k @ c for Y_k, c in zip(trace.bases, coeffs)])
     fwd = states[:, 0] / chain.scale[0]
     bwd = states[:, 4] / chain.scale[0] if not chain.isotropic else np.zeros_like(fwd)
     if chain.isotropic and w < 0:
         fwd, bwd = bwd, fwd
-    peak = max(np.max(np.abs(fwd)), np.max(np.abs(bwd)))
+    both = np.concatenate([fwd, bwd])
+    peak = both[np.argmax(np.abs(both))]  # the largest amplitude becomes +1
     return ModeShape(float(w), float(spin), np.array(trace.z), fwd / peak, bwd / peak)
