@@ -31,6 +31,6 @@ class TripodCouplingModel(DrivenShaftModel):
         """Outputs at the current phi_in and inputs."""
         values, self._solution = coupling_outputs(
             self.phi_in, self.beta, self.omega_in, self.T_load,
-            self.r, self.l, self.m_plunger, self.kinematics, self._solution,
+            self.r, self.l, self.m_plunger, self.kinematics, self._solution, self.alpha_in, self.seed_reactions,
         )
         self.__dict__.update(values)

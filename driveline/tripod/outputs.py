@@ -9,35 +9,60 @@ from __future__ import annotations
 from ..scalar import Real, arcsin
 from . import closed_form, dynamics, plane_solver
 from .geometry import orbit_radius
+from .reactions import exact_reactions
+from .reactions_closed_form import leading_order_reactions
 from .spec import EXACT
+
+ARMS = ("1", "2", "3")
+
 
 def coupling_outputs(
     phi_in: Real, beta: Real, omega_in: Real, T_load: Real, r: float, l: float, m: float,
     kinematics: int, solution: plane_solver.Solution | None = None,
+    alpha_in: Real = 0.0, seed_reactions: int = 0,
 ) -> tuple[dict[str, Real], plane_solver.Solution | None]:
     """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's solution.
 
     ``solution`` warm-starts the exact solver (kinematics = 1) and is returned updated.
+    ``kinematics = 1`` gives the exact reactions (:mod:`.reactions`), 0 their closed forms
+    (:mod:`.reactions_closed_form`); ``seed_reactions = 1`` replaces ``a_plunger_sum``,
+    ``Rz_out``, ``Rx_in`` and ``Ry_in`` by the seed's eqs 20, 30, 33 and 34 as printed.
     """
     rho = orbit_radius(beta, r)
+    pin = dynamics.pin_force(T_load, rho, r)
     if kinematics == EXACT:
         phi_out, ratio, solution = plane_solver.solve(phi_in, beta, r, l, solution)
         theta = solution.cone_angle
+        forces = exact_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y)
+        omega_spin = forces.omega_spin
     else:
         deviation, ratio = closed_form.kinematics(phi_in, beta, r, l)
         phi_out = phi_in + deviation
         theta = arcsin(rho / l)
-    a_sum, rz, rx, ry = dynamics.reactions(phi_in, beta, omega_in, rho, l, m)
-    return {
+        forces = leading_order_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, ratio, pin)
+        omega_spin = omega_in * ratio
+    values = {
         "phi_out": phi_out,
         "delta_phi": phi_out - phi_in,
         "omega_out": omega_in * ratio,
-        "T_in": dynamics.input_torque(T_load, ratio),
-        "F_pin": dynamics.pin_force(T_load, rho, r),
+        "omega_spin": omega_spin,
+        "T_in": forces.T_in,
+        "F_pin": pin,
         "rho": rho,
         "theta": theta,
-        "a_plunger_sum": a_sum,
-        "Rz_out": rz,
-        "Rx_in": rx,
-        "Ry_in": ry,
-    }, solution
+        "a_plunger_sum": forces.a_plunger_sum,
+        "Rz_out": forces.Rz_out,
+        "Rx_out": forces.Rx_out,
+        "Ry_out": forces.Ry_out,
+        "Rx_in": forces.Rx_in,
+        "Ry_in": forces.Ry_in,
+        "Mx_in": forces.Mx_in,
+        "My_in": forces.My_in,
+    }
+    for arm, f_arm, f_plunger in zip(ARMS, forces.F_arm, forces.F_plunger):
+        values["F_arm" + arm] = f_arm
+        values["F_plunger" + arm] = f_plunger
+    if seed_reactions:
+        seed = dynamics.reactions(phi_in, beta, omega_in, rho, l, m)
+        values.update(a_plunger_sum=seed.a_plunger_sum, Rz_out=seed.Rz_out, Rx_in=seed.Rx_in, Ry_in=seed.Ry_in)
+    return values, solution

@@ -7,6 +7,14 @@ import math
 from ..variables import DefaultExperiment, ModelSpec, Variable
 
 CLOSED_FORM, EXACT = 0, 1
+ARM_OUTPUTS = tuple(
+    Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N")
+    for name, text in (
+        ("F_arm", "Force of the ball on tripod arm, in the tripod plane normal to the arm (the seed's F)"),
+        ("F_plunger", "Axial force of the ball joint on its plunger along Z', m times its acceleration"),
+    )
+    for j in (1, 2, 3)
+)
 
 SPEC = ModelSpec(
     name="TripodCoupling",
@@ -27,27 +35,49 @@ SPEC = ModelSpec(
         Variable("kinematics", "parameter", CLOSED_FORM,
                  "Kinematics of phi_out: 0 = closed form (eq 18, small r/l), 1 = exact closed-loop solution",
                  type="Integer", min=CLOSED_FORM, max=EXACT),
+        Variable("seed_reactions", "parameter", 0,
+                 "1 = a_plunger_sum, Rz_out, Rx_in, Ry_in from the seed's eqs 20, 30, 33, 34 as printed "
+                 "(for comparison with the paper); 0 = from the force balance",
+                 type="Integer", min=0, max=1),
         Variable("phi_in_start", "parameter", 0.0, "Input shaft angle phi_in at the start time", "rad", "deg"),
         Variable("omega_in", "input", 2000.0 * math.pi / 30.0, "Input shaft speed omega_1 (held over a step)",
                  "rad/s", "rpm"),
         Variable("beta", "input", math.radians(30.0), "Bend angle beta between input and output axes",
                  "rad", "deg", min=0.0, max=math.radians(60.0)),
-        Variable("T_load", "input", 100.0, "Load torque T0 acting on the output shaft (eq 22)", "N.m"),
+        Variable("alpha_in", "input", 0.0,
+                 "Input shaft angular acceleration d(omega_in)/dt: enters the plunger inertia "
+                 "(phi_in advances with the held omega_in)", "rad/s2"),
+        Variable("T_load", "input", 100.0,
+                 "Load torque T0 on the output shaft, about its own axis, resisting its rotation (eq 22)", "N.m"),
         Variable("phi_in", "output", 0.0, "Input shaft angle phi_1, integrated from omega_in", "rad", "deg"),
         Variable("phi_out", "output", 0.0, "Output shaft angle phi_0 (eq 18 or exact kinematics)", "rad", "deg"),
         Variable("delta_phi", "output", 0.0, "Angular deviation phi_out - phi_in (eq 18)", "rad", "deg"),
         Variable("omega_out", "output", 0.0, "Output shaft speed, d(phi_out)/dt (consistent derivative of eq 18)",
                  "rad/s", "rpm"),
-        Variable("T_in", "output", 0.0, "Input torque from the power balance T_in omega_in = T0 omega_out", "N.m"),
+        Variable("omega_spin", "output", 0.0,
+                 "Angular velocity of the output shaft about its own axis (T_in omega_in = T0 omega_spin "
+                 "+ dKE/dt); differs from omega_out by the cone's geometric phase", "rad/s", "rpm"),
+        Variable("T_in", "output", 0.0, "Driving torque on the input shaft about Z', plunger inertia included",
+                 "N.m"),
         Variable("F_pin", "output", 0.0, "Force F on each tripod arm, eq 24 with corrected eq 21: T0/(3r + 3rho)", "N"),
         Variable("rho", "output", 0.0, "Orbit radius rho of the tripod centre, r(1 - cos beta)/(2 cos beta)",
                  "m", "mm"),
         Variable("theta", "output", 0.0, "Cone angle theta of the output shaft about the bearing centre", "rad", "deg"),
-        Variable("a_plunger_sum", "output", 0.0, "Sum of the plunger accelerations a1 + a2 + a3 as printed in eq 20",
+        Variable("a_plunger_sum", "output", 0.0, "Sum a1 + a2 + a3 of the plungers' axial accelerations (eq 20)",
                  "m/s2"),
-        Variable("Rz_out", "output", 0.0, "Axial reaction R_z'' of the output self-aligning bearing, eq 30", "N"),
-        Variable("Rx_in", "output", 0.0, "Reaction R_x' of the input bearing, eq 33", "N"),
-        Variable("Ry_in", "output", 0.0, "Reaction R_y' of the input bearing, eq 34", "N"),
+        Variable("Rz_out", "output", 0.0,
+                 "Output self-aligning bearing on the output shaft: axial force R_z'' along the shaft (eq 30)", "N"),
+        Variable("Rx_out", "output", 0.0,
+                 "Output bearing on the output shaft: radial force along E1 (bend-plane side, normal to the shaft)",
+                 "N"),
+        Variable("Ry_out", "output", 0.0, "Output bearing on the output shaft: radial force along E2 = Y' swung", "N"),
+        Variable("Rx_in", "output", 0.0, "Input bearing on the input shaft: force R_x' along X' (eq 33)", "N"),
+        Variable("Ry_in", "output", 0.0, "Input bearing on the input shaft: force R_y' along Y' (eq 34)", "N"),
+        Variable("Mx_in", "output", 0.0, "Input bearing on the input shaft: moment about X' through the joint centre O",
+                 "N.m"),
+        Variable("My_in", "output", 0.0, "Input bearing on the input shaft: moment about Y' through the joint centre O",
+                 "N.m"),
+        *ARM_OUTPUTS,
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
 )

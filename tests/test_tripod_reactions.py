@@ -1,0 +1,164 @@
+"""Exact reactions of the frictionless coupling (driveline.tripod.reactions) against a second,
+independent path: the Newton closure of driveline.tripod.exact, differentiated spectrally, and
+the balances of the whole mechanism that the algorithm never writes down."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from driveline.tripod import exact, geometry, plane_solver
+from driveline.tripod.reactions import exact_reactions
+from driveline.tripod.reactions_closed_form import leading_order_reactions
+
+R, L, M = 0.026, 0.700, 0.2
+OMEGA = 2000.0 * math.pi / 30.0
+SAMPLES = 240
+PHI = np.linspace(0.0, 2.0 * np.pi, SAMPLES, endpoint=False)
+EZ = np.array([0.0, 0.0, 1.0])
+
+
+def spectral_derivatives(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """First and second derivatives in phi of 2 pi periodic samples (along axis 0)."""
+    harmonic = np.fft.rfftfreq(len(values), d=1.0 / len(values))[:, None]
+    spectrum = np.fft.rfft(values, axis=0)
+    first = np.fft.irfft(1j * harmonic * spectrum, n=len(values), axis=0)
+    return first, np.fft.irfft(-(harmonic**2) * spectrum, n=len(values), axis=0)
+
+
+def reactions_over_a_turn(beta: float, omega: float, omega_dot: float, T_load: float, r: float = R, l: float = L):
+    phi_out, ratio, solution = plane_solver.solve(PHI, np.full_like(PHI, beta), r, l)
+    return exact_reactions(PHI, beta, omega, omega_dot, T_load, r, l, M, solution.x, solution.y)
+
+
+class Mechanism:
+    """Pose quantities from the Newton closure (exact.py), in the input frame."""
+
+    def __init__(self, beta: float, r: float = R, l: float = L):
+        pose = exact.exact_pose(PHI, beta, r, l)
+        self.beta = beta
+        angles = PHI[:, None] + geometry.THIRD_TURN * geometry.ARM_INDEX
+        self.z = pose.plunger_positions
+        self.dz, self.d2z = spectral_derivatives(self.z)
+        self.balls = np.stack([r * np.cos(angles), r * np.sin(angles), self.z], axis=-1)
+        self.S = l * np.array([-np.sin(beta), 0.0, np.cos(beta)])
+        self.U = (self.S - pose.tripod_centre) / l
+        nominal = np.tile(np.eye(3)[:2], (len(PHI), 1, 1))
+        E = exact._bend_apply(np.full(len(PHI), beta), exact._swing_apply(pose.swing, nominal))
+        self.E1, self.E2 = E[:, 0], E[:, 1]
+        self.r = r
+
+    def accelerations(self, omega: float, omega_dot: float) -> np.ndarray:
+        """Ball-centre accelerations (samples, 3 arms, 3)."""
+        radial = self.balls.copy()
+        radial[..., 2] = 0.0
+        tangential = np.cross(EZ, radial)
+        axial = self.d2z * omega**2 + self.dz * omega_dot
+        return -omega**2 * radial + omega_dot * tangential + axial[..., None] * EZ
+
+    def kinetic_energy_rate(self, omega: float, omega_dot: float) -> np.ndarray:
+        zdot = self.dz * omega
+        zddot = self.d2z * omega**2 + self.dz * omega_dot
+        return M * (3 * self.r**2 * omega * omega_dot + np.sum(zdot * zddot, axis=1))
+
+    def output_bearing_force(self, f) -> np.ndarray:
+        return f.Rx_out[:, None] * self.E1 + f.Ry_out[:, None] * self.E2 + f.Rz_out[:, None] * self.U
+
+
+CASES = [(10.0, 0.0, 0.0), (25.0, 500.0, 0.0), (45.0, 500.0, 0.0), (45.0, 500.0, 3.0e4), (30.0, -200.0, -2.0e4)]
+
+
+@pytest.fixture(scope="module", params=[10.0, 25.0, 45.0])
+def mechanism(request) -> Mechanism:
+    return Mechanism(math.radians(request.param))
+
+
+@pytest.mark.parametrize("omega_dot", [0.0, 5.0e4])
+def test_plunger_forces_are_mass_times_the_closure_accelerations(mechanism, omega_dot):
+    f = reactions_over_a_turn(mechanism.beta, OMEGA, omega_dot, 500.0)
+    reference = M * mechanism.accelerations(OMEGA, omega_dot)[..., 2]
+    # both exact; the plane solver's finite-difference Jacobian limits agreement (measured 4e-8 relative)
+    np.testing.assert_allclose(np.column_stack(f.F_plunger), reference, rtol=0, atol=1e-7 * np.abs(reference).max())
+    np.testing.assert_allclose(f.a_plunger_sum, reference.sum(axis=1) / M, rtol=0, atol=1e-7 * np.abs(reference).max() / M)
+
+
+@pytest.mark.parametrize("beta_deg, T_load, omega_dot", CASES)
+def test_power_balance_with_the_shaft_spin(beta_deg, T_load, omega_dot):
+    """T_in omega_in = T_load omega_spin + dKE/dt, KE of the plungers from the Newton closure."""
+    mech = Mechanism(math.radians(beta_deg))
+    f = reactions_over_a_turn(mech.beta, OMEGA, omega_dot, T_load)
+    residual = f.T_in * OMEGA - T_load * f.omega_spin - mech.kinetic_energy_rate(OMEGA, omega_dot)
+    scale = abs(T_load) * OMEGA + M * 3 * R**2 * OMEGA * (OMEGA**2 + abs(omega_dot))
+    assert np.abs(residual).max() < 1e-9 * scale
+
+
+@pytest.mark.parametrize("beta_deg, T_load, omega_dot", CASES)
+def test_whole_mechanism_balances_forces_and_moments_about_the_output_bearing(beta_deg, T_load, omega_dot):
+    """External loads (bearings, drive, load torque) equal the plungers' rate of momentum,
+    in force and in moment about S, all three components."""
+    mech = Mechanism(math.radians(beta_deg))
+    f = reactions_over_a_turn(mech.beta, OMEGA, omega_dot, T_load)
+    inertia = M * mech.accelerations(OMEGA, omega_dot)
+    R_in = np.column_stack([f.Rx_in, f.Ry_in, 0.0 * f.Rx_in])
+    R_out = mech.output_bearing_force(f)
+    force_scale = abs(T_load) / L + M * OMEGA**2 * R
+    np.testing.assert_allclose(R_in + R_out, inertia.sum(axis=1), rtol=0, atol=1e-9 * force_scale)
+    # input and output radial forces are equal and opposite (the plungers' radial inertia cancels)
+    np.testing.assert_allclose(R_in[:, :2], -R_out[:, :2], rtol=0, atol=1e-9 * force_scale)
+    moment = (
+        np.cross(-mech.S, R_in)
+        + np.column_stack([f.Mx_in, f.My_in, f.T_in])
+        - T_load * mech.U
+        - np.sum(np.cross(mech.balls - mech.S, inertia), axis=1)
+    )
+    assert np.abs(moment).max() < 1e-9 * force_scale * L
+
+
+def test_without_bend_only_the_torque_is_carried():
+    for omega_dot in (0.0, 2.0e4):
+        f = reactions_over_a_turn(0.0, OMEGA, omega_dot, 300.0)
+        for name in ("Rx_in", "Ry_in", "Mx_in", "My_in", "Rx_out", "Ry_out", "Rz_out", "a_plunger_sum"):
+            assert np.abs(getattr(f, name)).max() < 1e-9, name
+        np.testing.assert_allclose(f.T_in, 300.0 + 3 * M * R**2 * omega_dot, rtol=1e-12)
+        np.testing.assert_allclose(np.column_stack(f.F_arm), 300.0 / (3 * R), rtol=1e-12)
+
+
+def test_without_load_the_reactions_scale_with_the_speed_squared():
+    beta = math.radians(35.0)
+    slow, fast = reactions_over_a_turn(beta, OMEGA, 0.0, 0.0), reactions_over_a_turn(beta, 2 * OMEGA, 0.0, 0.0)
+    for name in ("Rx_in", "Ry_in", "Mx_in", "My_in", "T_in", "Rx_out", "Ry_out", "Rz_out"):
+        np.testing.assert_allclose(getattr(fast, name), 4 * getattr(slow, name), rtol=1e-9, atol=1e-9)
+
+
+def test_at_standstill_the_load_alone_sets_the_reactions():
+    beta = math.radians(35.0)
+    still = reactions_over_a_turn(beta, 0.0, 0.0, 400.0)
+    assert np.abs(np.column_stack(still.F_plunger)).max() == 0.0
+    # the load terms do not depend on the speed: running minus no-load running is the standstill
+    running = reactions_over_a_turn(beta, OMEGA, 0.0, 400.0)
+    unloaded = reactions_over_a_turn(beta, OMEGA, 0.0, 0.0)
+    for name in ("Rx_in", "Ry_in", "Mx_in", "My_in", "Rx_out", "Ry_out", "Rz_out"):
+        np.testing.assert_allclose(getattr(running, name) - getattr(unloaded, name), getattr(still, name), atol=1e-9)
+    # the mean side force of the load torque, T tan(beta/2) / l, at both bearings
+    assert np.mean(still.Ry_in) == pytest.approx(-400.0 * math.tan(beta / 2) / L, rel=2e-4)
+    assert np.mean(still.Ry_out) == pytest.approx(400.0 * math.tan(beta / 2) / L, rel=2e-4)
+
+
+@pytest.mark.parametrize("beta_deg", [10.0, 25.0, 45.0])
+@pytest.mark.parametrize("omega, omega_dot, T_load", [(OMEGA, 0.0, 0.0), (0.0, 0.0, 500.0), (0.0, 4.0e4, 0.0)])
+def test_closed_forms_are_the_small_r_over_l_limit(beta_deg, omega, omega_dot, T_load):
+    """At r/l = 1e-4 the exact means must equal the leading-order closed forms to ~r/l."""
+    beta, l = math.radians(beta_deg), R / 1e-4
+    f = reactions_over_a_turn(beta, omega, omega_dot, T_load, l=l)
+    ratio = plane_solver.solve(PHI, np.full_like(PHI, beta), R, l)[1]
+    pin = T_load / (3 * (R + geometry.orbit_radius(beta, R)))
+    c = leading_order_reactions(PHI, beta, omega, omega_dot, T_load, R, l, M, ratio, pin)
+    for name in ("Rx_in", "Ry_in", "Mx_in", "My_in", "T_in", "Rx_out", "Ry_out", "Rz_out"):
+        exact_mean, closed_mean = np.mean(getattr(f, name)), np.mean(getattr(c, name))
+        scale = max(np.abs(getattr(f, name)).max(), 1e-12)
+        assert abs(exact_mean - closed_mean) < 1e-3 * scale + 1e-12, name
+    inertia = M * (omega**2 + omega_dot) * R
+    np.testing.assert_allclose(np.column_stack(f.F_plunger), np.column_stack(c.F_plunger), rtol=0, atol=1e-3 * inertia)
+    np.testing.assert_allclose(np.column_stack(f.F_arm), pin, rtol=0, atol=1e-3 * (pin + inertia))
