@@ -1,7 +1,8 @@
-"""Forces of the coupling (seed 000, eqs 20-34), neglecting friction and gravity.
+"""Forces of the coupling as the seed prints them (seed 000, eqs 20-34), neglecting friction and gravity.
 
 Every phi in the seed's formulas is its own angle, ``phi_in + PAPER_PHASE``.
-The reactions follow the seed; where it is wrong we say so (docs/tripod_coupling.md).
+They are wrong (docs/tripod_coupling.md) and reachable only with ``seed_reactions = 1``; the
+force balance is in :mod:`.reactions`.
 """
 
 from __future__ import annotations
