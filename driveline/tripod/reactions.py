@@ -38,24 +38,8 @@ import math
 from typing import NamedTuple
 
 from ..scalar import Real, lib
-from .geometry import THIRD_TURN
 
-Vector = tuple[Real, Real, Real]
-
-
-def _cross(a: Vector, b: Vector) -> Vector:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _dot(a: Vector, b: Vector) -> Real:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def _combine(weights: tuple[Real, Real, Real], vectors: tuple[Vector, Vector, Vector]) -> Vector:
-    """``sum_j weights_j vectors_j``."""
-    w0, w1, w2 = weights
-    v0, v1, v2 = vectors
-    return tuple(w0 * v0[i] + w1 * v1[i] + w2 * v2[i] for i in range(3))  # type: ignore[return-value]
+HALF_ROOT_3 = 0.5 * math.sqrt(3.0)  # sin(2 pi / 3)
 
 
 class ExactReactions(NamedTuple):
@@ -72,7 +56,6 @@ class ExactReactions(NamedTuple):
     Ry_out: Real  # ... radial, along E2
     Rz_out: Real  # ... axial, along the output shaft's axis U
     F_arm: tuple[Real, Real, Real]  # ball on arm j, in the tripod plane (along U x arm)
-    F_arm_axial: tuple[Real, Real, Real]  # ball on arm j, along U
     F_plunger: tuple[Real, Real, Real]  # ball joint on plunger j along Z' = m zddot_j
     a_plunger_sum: Real  # zddot_0 + zddot_1 + zddot_2 [m/s^2]
     omega_spin: Real  # Omega . U, the output shaft's angular velocity about its own axis [rad/s]
@@ -85,93 +68,114 @@ def exact_reactions(
     """Reactions at input angle ``phi_in``, bend ``beta``, input speed ``omega`` and its rate
     ``omega_dot``, for the output-shaft axis ``(x, y, sqrt(1 - x^2 - y^2))`` in the nominal
     output frame that solves the closure (:func:`.plane_solver.solve`). Plain arithmetic on
-    floats or arrays; the algorithm is the module's steps 1-5."""
+    floats or arrays, written out per component (the module's steps 1-5; with ``n_j``
+    horizontal, ``k_j = (d_z e_x, d_z e_y, -(d_x e_x + d_y e_y))`` and
+    ``e_j x n_j = (e_z e_x, e_z e_y, -(e_x^2 + e_y^2))``)."""
     xp = lib(phi_in, beta, x, y)
     cb, sb = xp.cos(beta), xp.sin(beta)
     zn = xp.sqrt(1.0 - x * x - y * y)
     k = 1.0 / (1.0 + zn)
     # twist-free frame (E1, E2, U) of the output shaft, nominal output frame -> input frame (eq 2)
-    e1x, e1y, e1z = 1.0 - x * x * k, -x * y * k, -x
-    e2x, e2y, e2z = -x * y * k, 1.0 - y * y * k, -y
-    E1 = (cb * e1x - sb * e1z, e1y, sb * e1x + cb * e1z)
-    E2 = (cb * e2x - sb * e2z, e2y, sb * e2x + cb * e2z)
-    U = (cb * x - sb * zn, y, sb * x + cb * zn)
-    S = (-l * sb, 0.0 * x, l * cb)
-    P = (S[0] - l * U[0], S[1] - l * U[1], S[2] - l * U[2])
-    p_dot_u = _dot(P, U)
+    e1x, e1y = 1.0 - x * x * k, -x * y * k
+    e2x, e2y = -x * y * k, 1.0 - y * y * k
+    E1x, E1y, E1z = cb * e1x + sb * x, e1y, sb * e1x - cb * x
+    E2x, E2y, E2z = cb * e2x + sb * y, e2y, sb * e2x - cb * y
+    Ux, Uy, Uz = cb * x - sb * zn, y, sb * x + cb * zn
+    Sx, Sz = -l * sb, l * cb
+    Px, Py, Pz = Sx - l * Ux, -l * Uy, Sz - l * Uz
+    p_dot_u = Px * Ux + Py * Uy + Pz * Uz
     omega2 = omega * omega
-    g, b, e, d, n, kk = [], [], [], [], [], []
-    for j in range(3):
-        angle = phi_in + THIRD_TURN * j
-        gj = (r * xp.cos(angle), r * xp.sin(angle), 0.0 * x)
-        # 1. pose: the ball centre on groove j in the tripod plane
-        zj = (p_dot_u - gj[0] * U[0] - gj[1] * U[1]) / U[2]
-        bj = (gj[0], gj[1], zj)
-        ej = (bj[0] - P[0], bj[1] - P[1], bj[2] - P[2])
-        dj = (bj[0] - S[0], bj[1] - S[1], bj[2] - S[2])
-        nj = (ej[1], -ej[0], 0.0 * x)
-        g.append(gj), b.append(bj), e.append(ej), d.append(dj), n.append(nj), kk.append(_cross(dj, nj))
+    c0, s0 = xp.cos(phi_in), xp.sin(phi_in)
+    c1, s1 = -0.5 * c0 - HALF_ROOT_3 * s0, -0.5 * s0 + HALF_ROOT_3 * c0
+    c2, s2 = -0.5 * c0 + HALF_ROOT_3 * s0, -0.5 * s0 - HALF_ROOT_3 * c0
+    arms = []
+    for c, s in ((c0, s0), (c1, s1), (c2, s2)):
+        gx, gy = r * c, r * s
+        # 1. pose: the ball centre b = (gx, gy, bz) on groove j in the tripod plane
+        bz = (p_dot_u - gx * Ux - gy * Uy) / Uz
+        ex, ey, ez = gx - Px, gy - Py, bz - Pz  # e_j = b_j - P, along the arm
+        dx, dy, dz = ex - l * Ux, ey - l * Uy, ez - l * Uz  # d_j = b_j - S
+        exy2 = ex * ex + ey * ey  # |n_j|^2
+        arms.append((gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, dz * ex, dz * ey, -(dx * ex + dy * ey)))
     # Cramer's rule: K v = c  <=>  v = sum_j c_j adj_j / det;  K^T w = c  <=>  w_j = c . adj_j / det
-    adj = (_cross(kk[1], kk[2]), _cross(kk[2], kk[0]), _cross(kk[0], kk[1]))
-    det = _dot(kk[0], adj[0])
+    (k0x, k0y, k0z), (k1x, k1y, k1z), (k2x, k2y, k2z) = (a[10:13] for a in arms)
+    adj = (
+        (k1y * k2z - k1z * k2y, k1z * k2x - k1x * k2z, k1x * k2y - k1y * k2x),
+        (k2y * k0z - k2z * k0y, k2z * k0x - k2x * k0z, k2x * k0y - k2y * k0x),
+        (k0y * k1z - k0z * k1y, k0z * k1x - k0x * k1z, k0x * k1y - k0y * k1x),
+    )
+    inv_det = 1.0 / (k0x * adj[0][0] + k0y * adj[0][1] + k0z * adj[0][2])
 
-    # 2. velocities (e_z x g_j = (-g_y, g_x, 0))
-    spin_rhs = tuple(-omega * (g[j][0] * e[j][0] + g[j][1] * e[j][1]) for j in range(3))
-    Omega = tuple(c / det for c in _combine(spin_rhs, adj))  # type: ignore[arg-type]
-    sigma, zdot = [], []
-    for j in range(3):
-        v = _cross(Omega, d[j])  # type: ignore[arg-type]
-        vx, vy = v[0] + omega * g[j][1], v[1] - omega * g[j][0]
-        s = -(vx * e[j][0] + vy * e[j][1]) / (e[j][0] ** 2 + e[j][1] ** 2)
-        sigma.append(s)
-        zdot.append(v[2] + s * e[j][2])
+    # 2. angular velocity of the output shaft: (e_z x g_j) . n_j = -(g_x e_x + g_y e_y)
+    rhs = [-omega * (a[0] * a[3] + a[1] * a[4]) * inv_det for a in arms]
+    Wx = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
+    Wy = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]
+    Wz = rhs[0] * adj[0][2] + rhs[1] * adj[1][2] + rhs[2] * adj[2][2]
+    W2 = Wx * Wx + Wy * Wy + Wz * Wz
 
-    # 3. accelerations
-    whirl = [_cross(Omega, _cross(Omega, d[j])) for j in range(3)]  # type: ignore[arg-type]
-    coriolis = [_cross(Omega, e[j]) for j in range(3)]  # type: ignore[arg-type]
+    # 3. accelerations: known terms per arm, then K Omegadot = (known . n_j)
     known = []
-    for j in range(3):
-        ax = -omega_dot * g[j][1] - omega2 * g[j][0] - whirl[j][0] - 2.0 * sigma[j] * coriolis[j][0]
-        ay = omega_dot * g[j][0] - omega2 * g[j][1] - whirl[j][1] - 2.0 * sigma[j] * coriolis[j][1]
-        known.append((ax, ay))
-    accel_rhs = tuple(known[j][0] * n[j][0] + known[j][1] * n[j][1] for j in range(3))
-    Omega_dot = tuple(c / det for c in _combine(accel_rhs, adj))  # type: ignore[arg-type]
+    for gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_ in arms:
+        # sliding rate along the arm (sigma e_j = sdot a_j) from the velocity closure
+        vx = Wy * dz - Wz * dy + omega * gy
+        vy = Wz * dx - Wx * dz - omega * gx
+        sigma = -(vx * ex + vy * ey) / exy2
+        wd = Wx * dx + Wy * dy + Wz * dz  # Omega x (Omega x d) = Omega (Omega . d) - d |Omega|^2
+        # whirl + 2 sigma Omega x e
+        hx = Wx * wd - dx * W2 + 2.0 * sigma * (Wy * ez - Wz * ey)
+        hy = Wy * wd - dy * W2 + 2.0 * sigma * (Wz * ex - Wx * ez)
+        hz = Wz * wd - dz * W2 + 2.0 * sigma * (Wx * ey - Wy * ex)
+        ax = -omega_dot * gy - omega2 * gx  # groove point's acceleration, radial and tangential
+        ay = omega_dot * gx - omega2 * gy
+        known.append((ax, ay, hx, hy, hz))
+    rhs = [((kn[0] - kn[2]) * a[4] - (kn[1] - kn[3]) * a[3]) * inv_det for kn, a in zip(known, arms)]
+    Ax = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
+    Ay = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]
+    Az = rhs[0] * adj[0][2] + rhs[1] * adj[1][2] + rhs[2] * adj[2][2]
     zddot = []
-    for j in range(3):
-        w = _cross(Omega_dot, d[j])  # type: ignore[arg-type]
-        wx, wy = w[0] - known[j][0], w[1] - known[j][1]
-        wz = w[2] + whirl[j][2] + 2.0 * sigma[j] * coriolis[j][2]
-        tau = -(wx * e[j][0] + wy * e[j][1]) / (e[j][0] ** 2 + e[j][1] ** 2)
-        zddot.append(wz + tau * e[j][2])
+    for (ax, ay, hx, hy, hz), (gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_) in zip(known, arms):
+        wx = Ay * dz - Az * dy + hx - ax  # Omegadot x d + known = zddot e_z - tau e_j
+        wy = Az * dx - Ax * dz + hy - ay
+        wz = Ax * dy - Ay * dx + hz
+        zddot.append(wz - (wx * ex + wy * ey) / exy2 * ez)
 
-    # 4. forces on the arms
-    q = [_cross(e[j], n[j]) for j in range(3)]
-    mu = [m * zddot[j] / (n[j][0] ** 2 + n[j][1] ** 2) for j in range(3)]
-    inertia_moment = _combine((mu[0], mu[1], mu[2]), tuple(_cross(d[j], q[j]) for j in range(3)))  # type: ignore[arg-type]
-    moment_rhs = tuple(T_load * U[i] - inertia_moment[i] for i in range(3))
-    lam = [_dot(moment_rhs, adj[j]) / det for j in range(3)]  # type: ignore[arg-type]
-    F = [tuple(lam[j] * n[j][i] + mu[j] * q[j][i] for i in range(3)) for j in range(3)]
-
-    # 5. reactions
-    R_out = tuple(-(F[0][i] + F[1][i] + F[2][i]) for i in range(3))
-    N = []
+    # 4. forces on the arms: F_j = lambda_j n_j + mu_j (e_j x n_j), moment balance about S
+    Mx, My, Mz = T_load * Ux, T_load * Uy, T_load * Uz
+    mus = []
+    for a, acc in zip(arms, zddot):
+        gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2 = a[:10]
+        mu = m * acc / exy2
+        qx, qy, qz = ez * ex, ez * ey, -exy2
+        Mx -= mu * (dy * qz - dz * qy)
+        My -= mu * (dz * qx - dx * qz)
+        Mz -= mu * (dx * qy - dy * qx)
+        mus.append(mu)
+    Rx_out = Ry_out = Rz_out = Rx_in = Ry_in = Lx = Ly = Lz = 0.0
+    F_arm = []
     for j in range(3):
-        acc = (-omega_dot * g[j][1] - omega2 * g[j][0], omega_dot * g[j][0] - omega2 * g[j][1], zddot[j])
-        N.append(tuple(m * acc[i] + F[j][i] for i in range(3)))
-    moment_in = _combine((1.0, 1.0, 1.0), tuple(_cross(b[j], N[j]) for j in range(3)))  # type: ignore[arg-type]
-    arm_tangent = [_cross(U, e[j]) for j in range(3)]  # type: ignore[arg-type]
+        gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2 = arms[j][:10]
+        lam = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det
+        mu = mus[j]
+        Fx, Fy, Fz = lam * ey + mu * ez * ex, -lam * ex + mu * ez * ey, -mu * exy2
+        Rx_out, Ry_out, Rz_out = Rx_out - Fx, Ry_out - Fy, Rz_out - Fz
+        # 5. groove force on the plunger N_j = m bddot_j + F_j, its moment about O
+        ax, ay = known[j][:2]
+        Nx, Ny = m * ax + Fx, m * ay + Fy
+        Rx_in, Ry_in = Rx_in + Nx, Ry_in + Ny
+        Lx, Ly, Lz = Lx - bz * Ny, Ly + bz * Nx, Lz + gx * Ny - gy * Nx
+        tx, ty, tz = Uy * ez - Uz * ey, Uz * ex - Ux * ez, Ux * ey - Uy * ex  # U x e_j, in the tripod plane
+        F_arm.append((Fx * tx + Fy * ty + Fz * tz) / xp.sqrt(tx * tx + ty * ty + tz * tz))
     return ExactReactions(
-        Rx_in=N[0][0] + N[1][0] + N[2][0],
-        Ry_in=N[0][1] + N[1][1] + N[2][1],
-        Mx_in=moment_in[0],
-        My_in=moment_in[1],
-        T_in=moment_in[2],
-        Rx_out=_dot(R_out, E1),  # type: ignore[arg-type]
-        Ry_out=_dot(R_out, E2),  # type: ignore[arg-type]
-        Rz_out=_dot(R_out, U),  # type: ignore[arg-type]
-        F_arm=tuple(_dot(F[j], arm_tangent[j]) / xp.sqrt(_dot(arm_tangent[j], arm_tangent[j])) for j in range(3)),  # type: ignore
-        F_arm_axial=tuple(_dot(F[j], U) for j in range(3)),  # type: ignore
-        F_plunger=tuple(m * zddot[j] for j in range(3)),  # type: ignore
+        Rx_in=Rx_in,
+        Ry_in=Ry_in,
+        Mx_in=Lx,
+        My_in=Ly,
+        T_in=Lz,
+        Rx_out=Rx_out * E1x + Ry_out * E1y + Rz_out * E1z,
+        Ry_out=Rx_out * E2x + Ry_out * E2y + Rz_out * E2z,
+        Rz_out=Rx_out * Ux + Ry_out * Uy + Rz_out * Uz,
+        F_arm=(F_arm[0], F_arm[1], F_arm[2]),
+        F_plunger=(m * zddot[0], m * zddot[1], m * zddot[2]),
         a_plunger_sum=zddot[0] + zddot[1] + zddot[2],
-        omega_spin=_dot(Omega, U),  # type: ignore[arg-type]
+        omega_spin=Wx * Ux + Wy * Uy + Wz * Uz,
     )
