@@ -132,34 +132,28 @@ def exact_reactions(
     Ax = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
     Ay = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]
     Az = rhs[0] * adj[0][2] + rhs[1] * adj[1][2] + rhs[2] * adj[2][2]
-    zddot = []
+    # plunger accelerations and 4. the Z' parts of the arm forces, F_j = lambda_j n_j + mu_j (e_j x n_j)
+    zddot, mus = [], []
+    Mx, My, Mz = T_load * Ux, T_load * Uy, T_load * Uz  # moment balance about S, right-hand side
     for (ax, ay, hx, hy, hz), (gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_) in zip(known, arms):
         wx = Ay * dz - Az * dy + hx - ax  # Omegadot x d + known = zddot e_z - tau e_j
         wy = Az * dx - Ax * dz + hy - ay
         wz = Ax * dy - Ay * dx + hz
-        zddot.append(wz - (wx * ex + wy * ey) / exy2 * ez)
-
-    # 4. forces on the arms: F_j = lambda_j n_j + mu_j (e_j x n_j), moment balance about S
-    Mx, My, Mz = T_load * Ux, T_load * Uy, T_load * Uz
-    mus = []
-    for a, acc in zip(arms, zddot):
-        gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2 = a[:10]
+        acc = wz - (wx * ex + wy * ey) / exy2 * ez
         mu = m * acc / exy2
         qx, qy, qz = ez * ex, ez * ey, -exy2
         Mx -= mu * (dy * qz - dz * qy)
         My -= mu * (dz * qx - dx * qz)
         Mz -= mu * (dx * qy - dy * qx)
+        zddot.append(acc)
         mus.append(mu)
     Rx_out = Ry_out = Rz_out = Rx_in = Ry_in = Lx = Ly = Lz = 0.0
     F_arm = []
-    for j in range(3):
-        gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2 = arms[j][:10]
-        lam = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det
-        mu = mus[j]
+    for (gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_), (a0, a1, a2), mu, (ax, ay, *_) in zip(arms, adj, mus, known):
+        lam = (Mx * a0 + My * a1 + Mz * a2) * inv_det
         Fx, Fy, Fz = lam * ey + mu * ez * ex, -lam * ex + mu * ez * ey, -mu * exy2
         Rx_out, Ry_out, Rz_out = Rx_out - Fx, Ry_out - Fy, Rz_out - Fz
         # 5. groove force on the plunger N_j = m bddot_j + F_j, its moment about O
-        ax, ay = known[j][:2]
         Nx, Ny = m * ax + Fx, m * ay + Fy
         Rx_in, Ry_in = Rx_in + Nx, Ry_in + Ny
         Lx, Ly, Lz = Lx - bz * Ny, Ly + bz * Nx, Lz + gx * Ny - gy * Nx
