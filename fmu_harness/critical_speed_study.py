@@ -15,7 +15,7 @@ import numpy as np  # noqa: E402
 from .runner import simulate  # noqa: E402
 
 RPM = 30.0 / math.pi
-ORDERS = (2, 3, 6)
+ORDERS = (2, 3)  # Cardan joints; the tripod coupling excites the 3rd (docs/tripod_coupling.md)
 WHIRL = ("whirl_forward_1", "whirl_forward_2", "whirl_backward_1", "whirl_backward_2")
 
 

@@ -68,6 +68,11 @@ SPECIFIC: dict[str, tuple[tuple[str, str], ...]] = {
         ("Rz_out", "p2p"),
         ("Rx_in", "p2p"),
         ("Ry_in", "p2p"),
+        ("Rx_in", "peak_abs"),
+        ("Ry_in", "peak_abs"),
+        ("Rx_out", "peak_abs"),
+        ("Ry_out", "peak_abs"),
+        ("Rz_out", "peak_abs"),
         ("omega_out", "p2p"),
     ),
 }

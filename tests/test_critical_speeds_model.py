@@ -33,7 +33,7 @@ def test_critical_speeds_and_interpolated_whirl_match_the_core(rotor_b):
         # cubic splines through 41 Campbell points: measured 3e-14 (this rotor), 1e-12 (two-piece)
         np.testing.assert_allclose(interpolated, [*direct.forward[:2], *direct.backward[:2]], rtol=1e-9)
         if speed:
-            nearest = rotor_b.nearest_order_resonance(speed, orders=(1, 2, 3, 6))
+            nearest = rotor_b.nearest_order_resonance(speed, orders=(1, 2, 3))
             assert model.resonance_speed == pytest.approx(nearest.spin, rel=1e-12)
             assert model.resonance_order == nearest.order
             assert model.resonance_margin == pytest.approx((speed - nearest.spin) / nearest.spin)

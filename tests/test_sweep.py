@@ -21,6 +21,11 @@ TRIPOD_METRICS = {
     "Rz_out_p2p": lambda r: r["Rz_out"].max() - r["Rz_out"].min(),
     "Rx_in_p2p": lambda r: r["Rx_in"].max() - r["Rx_in"].min(),
     "Ry_in_p2p": lambda r: r["Ry_in"].max() - r["Ry_in"].min(),
+    "Rx_in_peak_abs": lambda r: np.abs(r["Rx_in"]).max(),
+    "Ry_in_peak_abs": lambda r: np.abs(r["Ry_in"]).max(),
+    "Rx_out_peak_abs": lambda r: np.abs(r["Rx_out"]).max(),
+    "Ry_out_peak_abs": lambda r: np.abs(r["Ry_out"]).max(),
+    "Rz_out_peak_abs": lambda r: np.abs(r["Rz_out"]).max(),
     "omega_out_p2p": lambda r: r["omega_out"].max() - r["omega_out"].min(),
 }
 

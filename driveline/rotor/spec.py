@@ -37,8 +37,8 @@ SPEC = ModelSpec(
                  "'.toml', or the name of a description shipped in the FMU ('two_piece_propshaft', or "
                  "'two_piece_propshaft_hinged' with its centre joint as a hinge); "
                  "empty = the one-piece tube", type="String", variability="tunable"),
-        Variable("orders", "parameter", "1,2,3,6",
-                 "Excitation orders watched for resonance (1, 2: Cardan joints; 3, 6: tripod coupling)",
+        Variable("orders", "parameter", "1,2,3",
+                 "Excitation orders watched for resonance (1, 2: Cardan joints; 3: tripod coupling)",
                  type="String", variability="tunable"),
         Variable("band", "parameter", 0.1,
                  "Warning band: resonance_warning when |omega - resonance speed| < band * resonance speed",
