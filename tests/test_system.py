@@ -93,5 +93,10 @@ def test_importers_run_the_package_like_the_master(engine, driveline_ssp, master
     finally:
         session.close()
     scale = np.maximum(np.abs(master_result).max(axis=0), 1e-300)
+    names = ["time", *driveline.outputs()]
+    # a_plunger_sum cancels three plunger accelerations of ~1e3 m/s^2 down to ~1e-2: its round-off
+    # follows the terms (F_plunger1 / m_plunger), not the sum (measured 4e-9 of the sum)
+    mass = next(v.start for v in driveline.component("coupling").spec.variables if v.name == "m_plunger")
+    scale[names.index("coupling.a_plunger_sum")] = np.abs(master_result[:, names.index("coupling.F_plunger1")]).max() / mass
     deviation = np.abs(result - master_result).max(axis=0) / scale
-    assert deviation.max() <= 1e-9, dict(zip(["time", *driveline.outputs()], deviation))
+    assert deviation.max() <= 1e-9, dict(zip(names, deviation))
