@@ -53,18 +53,19 @@ ROSS_RTOL = 1e-8
 
 
 def ross_rotor(d: Driveline):
-    """The same rotor in ROSS: shear off (Rayleigh beam), undamped bearings."""
+    """The same rotor in ROSS: Timoshenko elements (Cowper's coefficient) where our segment has
+    ``shear``, Rayleigh ones elsewhere; undamped bearings."""
     rs = _ross()
     mat = rs.Material(name="steel_test", rho=RHO, E=E, Poisson=0.3)
     shaft, node_of_station = [], [0]
     for seg in d.segments:
-        if (seg.youngs_modulus, seg.density) != (E, RHO):
-            raise ValueError("the ROSS rebuild supports steel segments only (E = 2.1e11 Pa, rho = 7850 kg/m3)")
+        if (seg.youngs_modulus, seg.density, seg.poisson_ratio) != (E, RHO, 0.3):
+            raise ValueError("the ROSS rebuild supports steel segments only (E = 2.1e11 Pa, rho = 7850 kg/m3, nu = 0.3)")
         n_el = max(4, int(np.ceil(seg.length * ELEMENTS_PER_METRE)))
         shaft += [
             rs.ShaftElement(
                 seg.length / n_el, idl=seg.inner_diameter, odl=seg.outer_diameter, material=mat,
-                shear_effects=False, rotary_inertia=True, gyroscopic=True,
+                shear_effects=seg.shear, shear_method_calc="cowper", rotary_inertia=True, gyroscopic=True,
             )
             for _ in range(n_el)
         ]

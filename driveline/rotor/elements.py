@@ -155,6 +155,38 @@ def _betas(a: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray]:
     return b1sq, b2sq
 
 
+def _krylov(a: FloatArray, b: FloatArray, z: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Fundamental solutions ``C0..C3`` of ``y'''' + a y'' - b y = 0`` at ``z`` (``C_k^(j)(0) = delta_jk``).
+
+    For every root ``lam`` of ``lam**4 + a lam**2 - b`` they give ``exp(lam z) =
+    C0 + C1 lam + C2 lam**2 + C3 lam**3``, hence ``expm(A z) = C0 + C1 A + C2 A**2 + C3 A**3``
+    for any 4x4 ``A`` with that characteristic polynomial. ``b < 0`` (a shear beam
+    above its cut-off) turns ``beta1**2`` negative: the hyperbolic functions of
+    ``beta1`` then become trigonometric ones of ``|beta1|`` (the same entire functions).
+    """
+    b1sq, b2sq = _betas(a, b)
+    x = np.sqrt(np.abs(b1sq)) * z
+    y = np.sqrt(b2sq) * z
+    s = b1sq + b2sq
+    pos = s > 0.0
+    s_safe = np.where(pos, s, 1.0)
+    w1 = np.where(pos, b1sq / s_safe, 0.5)
+    w2 = np.where(pos, b2sq / s_safe, 0.5)
+    b_over_s = np.where(pos, b / s_safe, 0.0)
+    g1, g2 = _sinh_minus_x_over_x3(x), _x_minus_sin_over_x3(y)
+    h1, h2 = _cosh_minus_1_over_x2(x), _1_minus_cos_over_y2(y)
+    trigonometric = b1sq < 0.0
+    if np.any(trigonometric):
+        g1 = np.where(trigonometric, _x_minus_sin_over_x3(x), g1)
+        h1 = np.where(trigonometric, _1_minus_cos_over_y2(x), h1)
+    z2, z3 = z * z, z**3
+    C0 = 1.0 + b_over_s * z2 * (h1 - h2)
+    C1 = z + b_over_s * z3 * (g1 - g2)
+    C2 = z2 * (w1 * h1 + w2 * h2)
+    C3 = z3 * (w1 * g1 + w2 * g2)
+    return C0, C1, C2, C3
+
+
 def beam_field_matrix(
     length: float, EI: float, mass_per_length: float, c: FloatArray, w: FloatArray
 ) -> FloatArray:
@@ -167,22 +199,7 @@ def beam_field_matrix(
     z = float(length)
     a = c / EI
     b = mass_per_length * w * w / EI
-    b1sq, b2sq = _betas(a, b)
-    x = np.sqrt(b1sq) * z
-    y = np.sqrt(b2sq) * z
-    s = b1sq + b2sq
-    pos = s > 0.0
-    s_safe = np.where(pos, s, 1.0)
-    w1 = np.where(pos, b1sq / s_safe, 0.5)
-    w2 = np.where(pos, b2sq / s_safe, 0.5)
-    b_over_s = np.where(pos, b / s_safe, 0.0)
-    g1, g2 = _sinh_minus_x_over_x3(x), _x_minus_sin_over_x3(y)
-    h1, h2 = _cosh_minus_1_over_x2(x), _1_minus_cos_over_y2(y)
-    z2, z3 = z * z, z**3
-    C0 = 1.0 + b_over_s * z2 * (h1 - h2)
-    C1 = z + b_over_s * z3 * (g1 - g2)
-    C2 = z2 * (w1 * h1 + w2 * h2)
-    C3 = z3 * (w1 * g1 + w2 * g2)
+    C0, C1, C2, C3 = _krylov(a, b, z)
     C1a = C1 - a * C3  # = C2'
     C0a = C0 - a * C2  # = C2''
     # Fundamental matrix of the derivatives d = [U, U', U'', U'''].
@@ -202,6 +219,44 @@ def beam_field_matrix(
     H[..., :, 2] /= EI
     H[..., :, 3] /= EI
     return H
+
+
+def shear_beam_field_matrix(
+    length: float, EI: float, mass_per_length: float, shear_stiffness: float, c: FloatArray, w: FloatArray
+) -> FloatArray:
+    """Exact transfer matrix of a spinning Timoshenko beam (shear stiffness ``kappa G A``).
+
+    ``s' = A s`` with ``psi`` the rotation of the cross-section and ``V = -Q``::
+
+        U' = psi - V / (kappa G A),  psi' = M / EI,  M' = V - c psi,  V' = m' w^2 U
+
+    Its characteristic polynomial is ``lam**4 + a lam**2 - b`` with ``a = c/EI + m' w^2 /
+    (kappa G A)`` and ``b = m' w^2 (1 - c / (kappa G A)) / EI``, so ``H = expm(A l) =
+    C0 + C1 A + C2 A**2 + C3 A**3`` with the Krylov functions of :func:`_krylov`.
+    """
+    a, b = _shear_wave_coefficients(EI, mass_per_length, shear_stiffness, c, w)
+    C = _krylov(a, b, float(length))
+    A = np.zeros(np.shape(w) + (4, 4))
+    A[..., 0, 1] = 1.0
+    A[..., 0, 3] = -1.0 / shear_stiffness
+    A[..., 1, 2] = 1.0 / EI
+    A[..., 2, 1] = -c
+    A[..., 2, 3] = 1.0
+    A[..., 3, 0] = mass_per_length * w * w
+    H = C[0][..., None, None] * np.eye(4)
+    power = np.broadcast_to(np.eye(4), A.shape)
+    for Ck in C[1:]:
+        power = power @ A
+        H = H + Ck[..., None, None] * power
+    return H
+
+
+def _shear_wave_coefficients(
+    EI: float, mass_per_length: float, shear_stiffness: float, c: FloatArray, w: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """``a``, ``b`` of ``lam**4 + a lam**2 - b`` for the Timoshenko beam (Rayleigh: ``kappa G A -> inf``)."""
+    inertia = mass_per_length * w * w
+    return c / EI + inertia / shear_stiffness, inertia * (1.0 - c / shear_stiffness) / EI
 
 
 def _broadcast(w: ArrayLike, spin: ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -230,7 +285,9 @@ class ShaftSegment:
     Parameters are SI: ``length`` [m], ``outer_diameter`` / ``inner_diameter`` [m]
     (inner 0 for a solid shaft), ``youngs_modulus`` [Pa], ``density`` [kg/m3].
     ``rotary_inertia`` and ``gyroscopic`` switch the two Rayleigh terms (both on by
-    default; off gives an Euler-Bernoulli beam).
+    default; off gives an Euler-Bernoulli beam). ``shear`` adds shear deformation
+    (Timoshenko beam) with Cowper's shear coefficient of a hollow circle and
+    ``G = E / (2 (1 + poisson_ratio))``.
     """
 
     length: float
@@ -240,6 +297,8 @@ class ShaftSegment:
     density: float = 7850.0
     rotary_inertia: bool = True
     gyroscopic: bool = True
+    shear: bool = False
+    poisson_ratio: float = 0.3
 
     def __post_init__(self) -> None:
         _positive("length", self.length)
@@ -252,6 +311,22 @@ class ShaftSegment:
             )
         _positive("youngs_modulus", self.youngs_modulus)
         _positive("density", self.density)
+        if not -1.0 < float(self.poisson_ratio) < 0.5:
+            raise ValueError(f"poisson_ratio must lie in (-1, 0.5), got {self.poisson_ratio!r}")
+
+    @property
+    def shear_coefficient(self) -> float:
+        """Cowper's ``kappa`` of a hollow circle: ``6 (1 + nu) (1 + m^2)^2 / ((7 + 6 nu) (1 + m^2)^2
+        + (20 + 12 nu) m^2)``, ``m = D_inner / D_outer`` (``6 (1 + nu) / (7 + 6 nu)`` solid)."""
+        nu = self.poisson_ratio
+        m2 = (self.inner_diameter / self.outer_diameter) ** 2
+        r12 = (1.0 + m2) ** 2
+        return 6.0 * (1.0 + nu) * r12 / ((7.0 + 6.0 * nu) * r12 + (20.0 + 12.0 * nu) * m2)
+
+    @property
+    def shear_stiffness(self) -> float:
+        """``kappa G A`` [N]."""
+        return self.shear_coefficient * self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio)) * self.area
 
     @property
     def area(self) -> float:
@@ -286,21 +361,22 @@ class ShaftSegment:
     def beta1(self, w: FloatArray, spin: FloatArray) -> FloatArray:
         """Hyperbolic wave number ``beta1`` (seed Eq. 22) [1/m], elementwise."""
         EI = self.bending_stiffness
-        a = self._couple(w, spin) / EI
-        b = self.mass_per_length * w * w / EI
+        if self.shear:
+            a, b = _shear_wave_coefficients(EI, self.mass_per_length, self.shear_stiffness, self._couple(w, spin), w)
+        else:
+            a = self._couple(w, spin) / EI
+            b = self.mass_per_length * w * w / EI
         b1sq, _ = _betas(a, b)
-        return np.sqrt(b1sq)
+        return np.sqrt(np.maximum(b1sq, 0.0))
 
     def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0, length: float | None = None) -> FloatArray:
         """Field matrix ``H`` (shape (n, 4, 4)) over ``length`` (default: whole segment)."""
         w_arr, s_arr = _broadcast(w, spin)
-        return beam_field_matrix(
-            self.length if length is None else length,
-            self.bending_stiffness,
-            self.mass_per_length,
-            self._couple(w_arr, s_arr),
-            w_arr,
-        )
+        z = self.length if length is None else length
+        c = self._couple(w_arr, s_arr)
+        if self.shear:
+            return shear_beam_field_matrix(z, self.bending_stiffness, self.mass_per_length, self.shear_stiffness, c, w_arr)
+        return beam_field_matrix(z, self.bending_stiffness, self.mass_per_length, c, w_arr)
 
     def transfer_matrix_pair(self, w: ArrayLike, spin: ArrayLike = 0.0, length: float | None = None) -> FloatArray:
         """``diag(H(w), H(-w))`` (shape (n, 8, 8)): the segment is axisymmetric."""
@@ -308,25 +384,33 @@ class ShaftSegment:
         return _pair(self.transfer_matrix(w_arr, s_arr, length), self.transfer_matrix(-w_arr, s_arr, length))
 
     def fe_matrices(self, n_elements: int) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``K, M, G`` of ``n_elements`` equal cubic Hermite elements, dofs ``[U, psi]`` per node.
+        """``K, M, G`` of ``n_elements`` equal beam elements, dofs ``[U, psi]`` per node.
 
+        Cubic Hermite elements (Rayleigh) or, with ``shear``, Timoshenko elements with the
+        shear parameter ``phi = 12 EI / (kappa G A h^2)`` (Przemieniecki's stiffness,
+        translational and rotary mass matrices; ``phi = 0`` gives the Hermite ones).
         Translational mass ``Mt``, rotary inertia ``Mr`` (if ``rotary_inertia``) and
         gyroscopic ``G = 2 Mr`` (if ``gyroscopic``, ``Ip = 2 I``), each of size
         ``2 (n_elements + 1)``.
         """
         h = self.length / n_elements
-        k = self.bending_stiffness / h**3 * np.array(
-            [[12, 6 * h, -12, 6 * h], [6 * h, 4 * h * h, -6 * h, 2 * h * h],
-             [-12, -6 * h, 12, -6 * h], [6 * h, 2 * h * h, -6 * h, 4 * h * h]]
-        )
-        mt = self.mass_per_length * h / 420 * np.array(
-            [[156, 22 * h, 54, -13 * h], [22 * h, 4 * h * h, 13 * h, -3 * h * h],
-             [54, 13 * h, 156, -22 * h], [-13 * h, -3 * h * h, -22 * h, 4 * h * h]]
-        )
-        mr = self.density * self.second_moment / (30 * h) * np.array(
-            [[36, 3 * h, -36, 3 * h], [3 * h, 4 * h * h, -3 * h, -h * h],
-             [-36, -3 * h, 36, -3 * h], [3 * h, -h * h, -3 * h, 4 * h * h]]
-        )
+        phi = 12.0 * self.bending_stiffness / (self.shear_stiffness * h * h) if self.shear else 0.0
+        if phi == 0.0:
+            k = self.bending_stiffness / h**3 * np.array(
+                [[12, 6 * h, -12, 6 * h], [6 * h, 4 * h * h, -6 * h, 2 * h * h],
+                 [-12, -6 * h, 12, -6 * h], [6 * h, 2 * h * h, -6 * h, 4 * h * h]]
+            )
+            mt = self.mass_per_length * h / 420 * np.array(
+                [[156, 22 * h, 54, -13 * h], [22 * h, 4 * h * h, 13 * h, -3 * h * h],
+                 [54, 13 * h, 156, -22 * h], [-13 * h, -3 * h * h, -22 * h, 4 * h * h]]
+            )
+            mr = self.density * self.second_moment / (30 * h) * np.array(
+                [[36, 3 * h, -36, 3 * h], [3 * h, 4 * h * h, -3 * h, -h * h],
+                 [-36, -3 * h, 36, -3 * h], [3 * h, -h * h, -3 * h, 4 * h * h]]
+            )
+        else:
+            k, mt, mr = _shear_element(h, phi, self.bending_stiffness, self.mass_per_length,
+                                       self.density * self.second_moment)
         m = mt + mr if self.rotary_inertia else mt + 0.0 * mr
         g = 2.0 * mr if self.gyroscopic else 0.0 * mr
         n_dof = 2 * (n_elements + 1)
@@ -337,6 +421,39 @@ class ShaftSegment:
             M[block, block] += m
             G[block, block] += g
         return K, M, G
+
+
+def _symmetric_element(d11: float, d12: float, d13: float, d14: float, d22: float, d23: float, d24: float
+                       ) -> FloatArray:
+    """4x4 beam-element matrix on ``[U1, psi1, U2, psi2]`` from its independent entries."""
+    return np.array([[d11, d12, d13, d14], [d12, d22, d23, d24], [d13, d23, d11, -d12], [d14, d24, -d12, d22]])
+
+
+def _shear_element(h: float, phi: float, EI: float, rhoA: float, rhoI: float
+                   ) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Stiffness, translational and rotary mass matrices of a Timoshenko element of length ``h``."""
+    k = EI / ((1 + phi) * h**3) * _symmetric_element(
+        12, 6 * h, -12, 6 * h, (4 + phi) * h * h, -6 * h, (2 - phi) * h * h)
+    p2 = phi * phi
+    mt = rhoA * h / (1 + phi) ** 2 * _symmetric_element(
+        13 / 35 + 7 * phi / 10 + p2 / 3,
+        (11 / 210 + 11 * phi / 120 + p2 / 24) * h,
+        9 / 70 + 3 * phi / 10 + p2 / 6,
+        -(13 / 420 + 3 * phi / 40 + p2 / 24) * h,
+        (1 / 105 + phi / 60 + p2 / 120) * h * h,
+        (13 / 420 + 3 * phi / 40 + p2 / 24) * h,
+        -(1 / 140 + phi / 60 + p2 / 120) * h * h,
+    )
+    mr = rhoI / ((1 + phi) ** 2 * h) * _symmetric_element(
+        6 / 5,
+        (1 / 10 - phi / 2) * h,
+        -6 / 5,
+        (1 / 10 - phi / 2) * h,
+        (2 / 15 + phi / 6 + p2 / 3) * h * h,
+        -(1 / 10 - phi / 2) * h,
+        (-1 / 30 - phi / 6 + p2 / 6) * h * h,
+    )
+    return k, mt, mr
 
 
 class PointElement(ABC):

@@ -16,6 +16,7 @@ File layout (SI units; all tables except ``segments`` optional)::
     wall_thickness = 0.00165     # m   (or inner_diameter / inner_radius; default solid)
     material = "steel"           # or youngs_modulus and density in the segment
     # rotary_inertia = true, gyroscopic = true
+    # shear = false, poisson_ratio = 0.3  (Timoshenko beam, Cowper's shear coefficient)
 
     [[masses]]
     node = 0
@@ -53,7 +54,7 @@ _MATERIAL_KEYS = {"youngs_modulus", "density"}
 _SEGMENT_KEYS = {
     "length", "outer_diameter", "outer_radius", "inner_diameter", "inner_radius",
     "wall_thickness", "material", "youngs_modulus", "density", "rotary_inertia",
-    "gyroscopic", "label",
+    "gyroscopic", "shear", "poisson_ratio", "label",
 }
 _MASS_KEYS = {"node", "mass", "polar_inertia", "diametral_inertia", "label"}
 _BEARING_KEYS = {"node", "stiffness", "kxx", "kyy", "label"}
@@ -164,7 +165,12 @@ def _segment(i: int, t: dict[str, Any], mats: dict[str, tuple[float, float]]) ->
     for key, v in (("youngs_modulus", E), ("density", rho)):
         if v is None:
             raise ValueError(f"{where}: missing key {key!r} (or a 'material')")
-    flags = {k: _flag(where, k, t[k]) for k in ("rotary_inertia", "gyroscopic") if k in t}
+    flags = {k: _flag(where, k, t[k]) for k in ("rotary_inertia", "gyroscopic", "shear") if k in t}
+    if "poisson_ratio" in t:
+        nu = t["poisson_ratio"]
+        if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1.0 < nu < 0.5:
+            raise ValueError(f"{where}.poisson_ratio must be a number in (-1, 0.5), got {nu!r}")
+        flags["poisson_ratio"] = float(nu)
     return ShaftSegment(length, d_out, d_in, E, rho, **flags)
 
 
