@@ -14,7 +14,9 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable
 from typing import Any, ClassVar
 
-from .variables import ModelSpec, Variable
+from .variables import ModelSpec, Relation, Variable
+
+RULES = {"<": "must be below", "<=": "must not exceed", ">": "must exceed", ">=": "must not be below"}
 
 
 class SteppedModel(ABC):
@@ -92,24 +94,13 @@ class SteppedModel(ABC):
         (never mutating held objects in place: a refused step is undone from a shallow copy)."""
 
     def extra_parameter_errors(self) -> list[str]:
-        """Physical consistency checks beyond each parameter's own range."""
+        """Checks the spec cannot declare (e.g. a structural analysis that fails), run once the
+        declared bounds and relations hold."""
         return []
 
     def extra_input_errors(self) -> list[str]:
-        """Input checks that depend on parameters (e.g. an angle against its guard)."""
+        """Input checks the spec cannot declare, run once the declared ones pass."""
         return []
-
-    def angle_bound_errors(self, name: str, upper: str, lower: str | None = None, note: str = "") -> list[str]:
-        """An input angle against the parameters that bound it, reported in degrees."""
-        value, high = getattr(self, name), getattr(self, upper)
-        low = getattr(self, lower) if lower else -math.inf
-        if low <= value <= high:
-            return []
-        if lower:
-            where = f"outside [{lower}, {upper}] = [{math.degrees(low):.6g}, {math.degrees(high):.6g}] deg"
-        else:
-            where = f"above {upper} = {math.degrees(high):.6g} deg"
-        return [f"input {name} = {math.degrees(value):.6g} deg is {where}{note}"]
 
     # -- validation ------------------------------------------------------------
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -119,13 +110,20 @@ class SteppedModel(ABC):
             cls._parameter_names = tuple(v.name for v in spec.of("parameter"))
             cls._inputs = spec.of("input")
             cls._real_outputs = tuple(v.name for v in spec.of("output") if v.type == "Real")
+            cls._input_relations = tuple(r for r in spec.relations if spec.involves_input(r))
+            cls._parameter_relations = tuple(r for r in spec.relations if not spec.involves_input(r))
 
     def parameter_errors(self) -> list[str]:
+        """Each parameter against its bounds, then the relations between parameters, then the
+        model's own checks: each stage only once the one before it passed."""
         errors = [e for v in self.spec.of("parameter") if (e := self._range_error(v))]
+        errors = errors or [e for r in self._parameter_relations if (e := self._relation_error(r))]
         return errors or self._guarded(self.extra_parameter_errors, "the parameters")
 
     def input_errors(self) -> list[str]:
+        """As :meth:`parameter_errors`, for the inputs and the relations involving them."""
         errors = [e for v in self._inputs if (e := self._range_error(v))]
+        errors = errors or [e for r in self._input_relations if (e := self._relation_error(r))]
         return errors or self._guarded(self.extra_input_errors, "the inputs")
 
     @staticmethod
@@ -150,13 +148,31 @@ class SteppedModel(ABC):
         value = getattr(self, v.name)
         if v.type == "Real" and not math.isfinite(value):
             return f"{v.causality} {v.name} = {value!r} is not finite"
-        if v.type in ("Real", "Integer"):
-            unit = f" {v.unit}" if v.unit else ""
-            if v.min is not None and value < v.min:
-                return f"{v.causality} {v.name} = {value!r}{unit} is below its minimum {v.min!r}{unit}"
-            if v.max is not None and value > v.max:
-                return f"{v.causality} {v.name} = {value!r}{unit} is above its maximum {v.max!r}{unit}"
+        if v.type not in ("Real", "Integer"):
+            return None
+        if v.min_exclusive and not value > v.min:
+            return f"{v.causality} {v.name} = {v.shown(value)} must be " + (
+                "positive" if v.min == 0 else f"above {v.shown(v.min)}")
+        if v.max_exclusive and not value < v.max:
+            return f"{v.causality} {v.name} = {v.shown(value)} must be below {v.shown(v.max)}"
+        unit = f" {v.unit}" if v.unit else ""
+        if v.min is not None and value < v.min:
+            return f"{v.causality} {v.name} = {value!r}{unit} is below its minimum {v.min!r}{unit}"
+        if v.max is not None and value > v.max:
+            return f"{v.causality} {v.name} = {value!r}{unit} is above its maximum {v.max!r}{unit}"
         return None
+
+    def _relation_error(self, relation: Relation) -> str | None:
+        left = self.spec[relation.lhs]
+        value = getattr(self, left.name)
+        right = getattr(self, relation.rhs) if isinstance(relation.rhs, str) else relation.rhs
+        if relation.holds(value, right):
+            return None
+        bound = relation.bound(right)
+        named = f"{relation.right_side()} = " if isinstance(relation.rhs, str) else ""
+        reason = f" ({relation.reason})" if relation.reason else ""
+        return (f"{left.causality} {left.name} = {left.shown(value)} {RULES[relation.op]} "
+                f"{named}{left.shown(bound)}{reason}")
 
     # -- state ---------------------------------------------------------------------
     def get_state(self) -> dict[str, Any]:

@@ -1,19 +1,27 @@
-"""Declarative description of a model's interface.
+"""Declarative description of a model's interface and of its valid values.
 
 One :class:`ModelSpec` per model feeds the FMI 2.0 and FMI 3.0 builds alike: the
 adapters register these variables, and the build writes units, display units,
-ranges and descriptions from them into the model description.
+ranges and descriptions from them into the model description. What makes a value valid
+is declared here once, as data: each variable's bounds (inclusive or exclusive) and the
+:class:`Relation` s between variables; :class:`driveline.model.SteppedModel` enforces them.
+The model description carries the bounds as FMI's inclusive ``min``/``max``; an exclusive
+bound is refused by the model alone.
 """
 
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass, field
 from typing import Literal
 
 Causality = Literal["parameter", "input", "output"]
 Variability = Literal["constant", "fixed", "tunable", "discrete", "continuous"]
 VarType = Literal["Real", "Integer", "Boolean", "String"]
+Operator = Literal["<", "<=", ">", ">="]
+
+OPERATORS = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
 
 
 @dataclass(frozen=True)
@@ -58,7 +66,10 @@ UNITS: dict[str, Unit] = {
 
 @dataclass(frozen=True)
 class Variable:
-    """One FMU variable: the single source of its name, causality, unit, range and start."""
+    """One FMU variable: the single source of its name, causality, unit, range and start.
+
+    ``min`` and ``max`` are inclusive unless ``min_exclusive`` / ``max_exclusive`` say otherwise.
+    """
 
     name: str
     causality: Causality
@@ -70,6 +81,8 @@ class Variable:
     max: float | None = None
     type: VarType = "Real"
     variability: Variability | None = None
+    min_exclusive: bool = False
+    max_exclusive: bool = False
 
     def __post_init__(self) -> None:
         if self.unit is not None and self.unit not in UNITS:
@@ -78,6 +91,15 @@ class Variable:
             names = [d.name for d in UNITS[self.unit].display_units] if self.unit else []
             if self.display_unit not in names:
                 raise ValueError(f"{self.name}: {self.display_unit!r} is no display unit of {self.unit!r}")
+        if (self.min_exclusive and self.min is None) or (self.max_exclusive and self.max is None):
+            raise ValueError(f"{self.name}: an exclusive bound needs its value")
+
+    def shown(self, value: float) -> str:
+        """``value`` (SI) as a message shows it: in the display unit if there is one."""
+        if self.display_unit is not None:
+            display = next(d for d in UNITS[self.unit].display_units if d.name == self.display_unit)
+            return f"{display.factor * value + display.offset:.6g} {display.name}"
+        return f"{value!r} {self.unit}" if self.unit not in (None, "1") else repr(value)
 
     @property
     def effective_variability(self) -> Variability:
@@ -90,6 +112,43 @@ class Variable:
 
 
 @dataclass(frozen=True)
+class Relation:
+    """A declared constraint ``lhs op scale * rhs + offset`` (SI values).
+
+    ``lhs`` names a variable, ``rhs`` names one of the same unit or is a constant; ``reason``
+    (optional) is added to the refusal message. A relation involving an input is checked
+    with the inputs, one between parameters with the parameters.
+    """
+
+    lhs: str
+    op: Operator
+    rhs: str | float
+    scale: float = 1.0
+    offset: float = 0.0
+    reason: str = ""
+
+    def holds(self, left: float, right: float) -> bool:
+        """Whether ``left op scale * right + offset`` (``right``: the rhs variable's value, or the constant)."""
+        return OPERATORS[self.op](left, self.bound(right))
+
+    def bound(self, right: float) -> float:
+        """The value ``lhs`` is compared with (``right`` itself, an integer stays one, when
+        neither scaled nor offset)."""
+        return right if self.scale == 1.0 and not self.offset else self.scale * right + self.offset
+
+    def right_side(self) -> str:
+        """The right side as written: ``z1``, ``-omega_max``, ``2 L1 + 0.001``, ``3.14159``."""
+        if not isinstance(self.rhs, str):
+            return f"{self.bound(self.rhs):.6g}"
+        factor = {1.0: "", -1.0: "-"}.get(self.scale, f"{self.scale:g} ")
+        shift = f" {'+' if self.offset > 0 else '-'} {abs(self.offset):g}" if self.offset else ""
+        return f"{factor}{self.rhs}{shift}"
+
+    def __str__(self) -> str:
+        return f"{self.lhs} {self.op} {self.right_side()}"
+
+
+@dataclass(frozen=True)
 class DefaultExperiment:
     start_time: float
     stop_time: float
@@ -99,18 +158,33 @@ class DefaultExperiment:
 
 @dataclass(frozen=True)
 class ModelSpec:
-    """The interface of one model: its FMU name, description, variables and default experiment."""
+    """The interface of one model: its FMU name, description, variables, default experiment and
+    the relations its parameters and inputs must satisfy."""
 
     name: str
     description: str
     variables: tuple[Variable, ...]
     default_experiment: DefaultExperiment
+    relations: tuple[Relation, ...] = ()
 
     def __post_init__(self) -> None:
         names = [v.name for v in self.variables]
         duplicates = {n for n in names if names.count(n) > 1}
         if duplicates:
             raise ValueError(f"{self.name}: duplicate variable names {sorted(duplicates)}")
+        for relation in self.relations:
+            sides = [relation.lhs] + ([relation.rhs] if isinstance(relation.rhs, str) else [])
+            if any(side not in names for side in sides) or relation.op not in OPERATORS:
+                raise ValueError(f"{self.name}: relation {relation} names no variable of the model or no operator")
+            variables = [self[side] for side in sides]
+            if any(v.causality == "output" or v.type not in ("Real", "Integer") for v in variables):
+                raise ValueError(f"{self.name}: relation {relation} must relate numeric parameters or inputs")
+            if len({v.unit for v in variables}) > 1:
+                raise ValueError(f"{self.name}: relation {relation} relates different units")
+
+    def involves_input(self, relation: Relation) -> bool:
+        """Whether ``relation`` is checked with the inputs (it involves one) rather than the parameters."""
+        return any(isinstance(side, str) and self[side].causality == "input" for side in (relation.lhs, relation.rhs))
 
     def of(self, *causalities: Causality) -> tuple[Variable, ...]:
         return tuple(v for v in self.variables if v.causality in causalities)

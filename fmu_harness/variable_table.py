@@ -25,6 +25,22 @@ def _cell(value: object) -> str:
     return "" if value is None else f"{value:.6g}" if isinstance(value, float) else str(value)
 
 
+def _bound(value: float | None, exclusive: bool, sign: str) -> str:
+    """A min or max cell; an exclusive bound is marked ``> 0`` or ``< 90``."""
+    return f"{sign} {_cell(value)}" if exclusive else _cell(value)
+
+
+def constraints(spec: ModelSpec) -> str:
+    """The sentence under a table: the declared relations, and how exclusive bounds reach the FMU."""
+    relations = ", ".join(f"`{r}`" + (f" ({r.reason})" if r.reason else "") for r in spec.relations)
+    exclusive = any(v.min_exclusive or v.max_exclusive for v in spec.variables)
+    parts = [f"Relations the model enforces: {relations}." if relations else ""]
+    if exclusive:
+        parts.append("Bounds marked `>` or `<` are exclusive: the model refuses the bound itself, the model "
+                     "description carries it as FMI's inclusive min or max.")
+    return " ".join(part for part in parts if part)
+
+
 def markdown(spec: ModelSpec) -> str:
     lines = [
         "| name | causality | unit (display) | start | min | max | description |",
@@ -32,10 +48,12 @@ def markdown(spec: ModelSpec) -> str:
     ]
     for v in spec.variables:
         unit = (v.unit or "") + (f" ({v.display_unit})" if v.display_unit else "")
+        low, high = _bound(v.min, v.min_exclusive, ">"), _bound(v.max, v.max_exclusive, "<")
         lines.append(
-            f"| `{v.name}` | {v.causality} | {unit} | {_cell(v.start)} | {_cell(v.min)} | {_cell(v.max)} | {_escaped(v.description)} |"
+            f"| `{v.name}` | {v.causality} | {unit} | {_cell(v.start)} | {low} | {high} | {_escaped(v.description)} |"
         )
-    return "\n".join(lines)
+    note = constraints(spec)
+    return "\n".join(lines + (["", _escaped(note)] if note else []))
 
 
 def all_tables() -> str:

@@ -199,7 +199,7 @@ def test_varying_bend_angle_keeps_the_angle_exact() -> None:
 @pytest.mark.parametrize(
     ("name", "value", "fragment"),
     [
-        ("beta", math.radians(50.0), "input beta = 50 deg is above beta_max = 45 deg"),
+        ("beta", math.radians(50.0), "input beta = 50 deg must not exceed beta_max = 45 deg"),
         ("beta", -0.01, "input beta = -0.01 rad is below its minimum"),
         ("beta", math.nan, "input beta = nan is not finite"),
         ("omega_in", math.inf, "input omega_in = inf is not finite"),
@@ -213,7 +213,7 @@ def test_invalid_input_is_refused_and_leaves_the_state(name: str, value: float, 
 
 @pytest.mark.parametrize(
     ("value", "fragment"),
-    [(0.5 * math.pi, "beta_max = 90 deg must be below 90 deg"), (2.0, "above its maximum")],
+    [(0.5 * math.pi, "beta_max = 90 deg must be below 90 deg"), (2.0, "beta_max = 114.592 deg must be below 90 deg")],
 )
 def test_invalid_beta_max_is_refused(value: float, fragment: str) -> None:
     model = CardanJointModel()

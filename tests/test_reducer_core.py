@@ -218,8 +218,8 @@ def test_strength_outputs_scale_with_the_torque() -> None:
 @pytest.mark.parametrize(
     ("name", "value", "fragment"),
     [
-        ("alpha", math.pi, "input alpha = 180 deg is outside [alpha_min, alpha_max] = [90, 170] deg"),
-        ("alpha", math.radians(60.0), "input alpha = 60 deg is outside"),
+        ("alpha", math.pi, "input alpha = 180 deg must not exceed alpha_max = 170 deg (eq 21 is singular at 0 and"),
+        ("alpha", math.radians(60.0), "input alpha = 60 deg must not be below alpha_min = 90 deg"),
         ("alpha", -0.1, "input alpha = -0.1 rad is below its minimum"),
         ("omega_in", math.nan, "input omega_in = nan is not finite"),
         ("T_load", -math.inf, "input T_load = -inf is not finite"),
@@ -235,10 +235,10 @@ def test_invalid_input_is_refused_and_leaves_the_state(name: str, value: float, 
     [
         (dict(z1=29, z2=29), "parameter z1 = 29 must exceed z2 = 29"),
         (dict(z2=0), "parameter z2 = 0 is below its minimum 1"),
-        (dict(module=0.0), "parameter module = 0.0 must be positive"),
-        (dict(r_shaft=0.0), "parameter r_shaft = 0.0 must be positive"),
-        (dict(alpha_max=math.pi), "alpha_min <= alpha_max < 180 deg"),
-        (dict(alpha_min=2.0, alpha_max=1.9), "alpha_min <= alpha_max < 180 deg"),
+        (dict(module=0.0), "parameter module = 0 mm must be positive"),
+        (dict(r_shaft=0.0), "parameter r_shaft = 0 mm must be positive"),
+        (dict(alpha_max=math.pi), "parameter alpha_max = 180 deg must be below 180 deg"),
+        (dict(alpha_min=2.0, alpha_max=1.9), "parameter alpha_min = 114.592 deg must not exceed alpha_max = 108.862 deg"),
     ],
 )
 def test_invalid_parameters_are_refused(values: dict, fragment: str) -> None:

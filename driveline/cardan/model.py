@@ -11,8 +11,6 @@ itself (no interval yet) counts as a new initial condition: a_1 = 0.
 
 from __future__ import annotations
 
-import math
-
 from ..model import DrivenShaftModel
 from . import kinematics
 from .spec import SPEC
@@ -26,14 +24,6 @@ class CardanJointModel(DrivenShaftModel):
     def reset_internal_state(self) -> None:
         self._omega_sample = 0.0  # omega_in of the last evaluation [rad/s]
         self._sample_time: float | None = None  # time of that evaluation [s]
-
-    def extra_parameter_errors(self) -> list[str]:
-        if not self.beta_max < 0.5 * math.pi:
-            return [f"parameter beta_max = {math.degrees(self.beta_max):.6g} deg must be below 90 deg"]
-        return []
-
-    def extra_input_errors(self) -> list[str]:
-        return self.angle_bound_errors("beta", "beta_max")
 
     def evaluate(self, input_time: float) -> None:
         """Outputs at the current phi_in; a_1 from this and the previous speed sample."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Variable
+from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 SPEC = ModelSpec(
     name="CardanJoint",
@@ -16,7 +16,7 @@ SPEC = ModelSpec(
     variables=(
         Variable("beta_max", "parameter", math.radians(45.0),
                  "Largest accepted bend angle beta (guard, below 90 deg)", "rad", "deg",
-                 min=0.0, max=0.5 * math.pi),
+                 min=0.0, max=0.5 * math.pi, max_exclusive=True),
         Variable("phase", "parameter", 0.0,
                  "Yoke phase: input angle phi_in at which the input yoke lies in the bend plane "
                  "(seed's gamma_1 = phi_in - phase)", "rad", "deg"),
@@ -46,4 +46,5 @@ SPEC = ModelSpec(
                  "Output-speed fluctuation (max - min) / mean = tan beta sin beta at the current beta (C5)", "1"),
     ),
     default_experiment=DefaultExperiment(0.0, 0.12, 1e-4),
+    relations=(Relation("beta", "<=", "beta_max"),),
 )

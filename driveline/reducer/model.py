@@ -8,8 +8,6 @@ relations at its critical position, evaluated at the current alpha and torque.
 
 from __future__ import annotations
 
-import math
-
 from ..model import DrivenShaftModel
 from .mechanics import connecting_shaft_loads, cylinder_slide, shaft_stress, transmission_ratio
 from .spec import SPEC
@@ -19,23 +17,6 @@ class UniversalReducerModel(DrivenShaftModel):
     """The ``UniversalReducer`` co-simulation model (inputs held constant over a step)."""
 
     spec = SPEC
-
-    def extra_parameter_errors(self) -> list[str]:
-        problems = []
-        if not self.z1 > self.z2:
-            problems.append(f"parameter z1 = {self.z1} must exceed z2 = {self.z2} (i = z1 / (z1 - z2))")
-        for name in ("module", "e", "r_shaft", "sigma_allow", "alpha_min"):
-            if not getattr(self, name) > 0.0:
-                problems.append(f"parameter {name} = {getattr(self, name)!r} must be positive")
-        if not self.alpha_min <= self.alpha_max < math.pi:
-            problems.append(
-                f"parameters alpha_min = {math.degrees(self.alpha_min):.6g} deg and alpha_max = "
-                f"{math.degrees(self.alpha_max):.6g} deg must satisfy alpha_min <= alpha_max < 180 deg"
-            )
-        return problems
-
-    def extra_input_errors(self) -> list[str]:
-        return self.angle_bound_errors("alpha", "alpha_max", "alpha_min", " (eq 21 is singular at 0 and 180 deg)")
 
     def evaluate(self, input_time: float) -> None:
         """Outputs at the current phi_in and inputs."""

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Variable
+from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
+
+SINGULAR = "eq 21 is singular at 0 and 180 deg"
 
 SPEC = ModelSpec(
     name="UniversalReducer",
@@ -17,24 +19,26 @@ SPEC = ModelSpec(
     variables=(
         Variable("z1", "parameter", 34, "Centre (internal) gear teeth z1 (table 1)", type="Integer", min=1),
         Variable("z2", "parameter", 29, "Planet gear teeth z2, below z1 (table 1)", type="Integer", min=1),
-        Variable("module", "parameter", 0.002, "Gear module m (table 1; eq 20)", "m", "mm", min=0.0),
+        Variable("module", "parameter", 0.002, "Gear module m (table 1; eq 20)", "m", "mm",
+                 min=0.0, min_exclusive=True),
         Variable("e", "parameter", 0.005,
                  "Eccentricity: offset r = h1 of the connecting shaft from the input and output axes "
-                 "(table 1; eqs 15, 19)", "m", "mm", min=0.0),
+                 "(table 1; eqs 15, 19)", "m", "mm", min=0.0, min_exclusive=True),
         Variable("L1", "parameter", 0.020,
                  "Distance L1 from B and from C to E on the connecting shafts (eq 19); the seed gives no "
                  "value, the start value is a placeholder", "m", "mm", min=0.0),
         Variable("r_shaft", "parameter", 0.015,
-                 "Radius of the connecting shaft checked at C (seed sec. 4.1: 15 mm)", "m", "mm", min=0.0),
+                 "Radius of the connecting shaft checked at C (seed sec. 4.1: 15 mm)", "m", "mm",
+                 min=0.0, min_exclusive=True),
         Variable("sigma_allow", "parameter", 60e6,
                  "Allowable stress [sigma] of the connecting shaft (seed: 45 steel, 60 MPa)", "Pa", "MPa",
-                 min=0.0),
+                 min=0.0, min_exclusive=True),
         Variable("alpha_min", "parameter", math.radians(90.0),
                  "Smallest accepted intersection angle alpha (guard, above 0 deg)", "rad", "deg",
-                 min=0.0, max=math.pi),
+                 min=0.0, max=math.pi, min_exclusive=True),
         Variable("alpha_max", "parameter", math.radians(170.0),
                  "Largest accepted intersection angle alpha (guard, below 180 deg where eq 21 is singular)",
-                 "rad", "deg", min=0.0, max=math.pi),
+                 "rad", "deg", min=0.0, max=math.pi, max_exclusive=True),
         Variable("phi_in_start", "parameter", 0.0, "Input shaft angle phi_in at the start time", "rad", "deg"),
         Variable("omega_in", "input", 1000.0 * math.pi / 30.0,
                  "Input (carrier) speed omega_H (held over a step)", "rad/s", "rpm"),
@@ -64,4 +68,10 @@ SPEC = ModelSpec(
                  "Input torque at which sigma_eq reaches sigma_allow at the current alpha", "N.m"),
     ),
     default_experiment=DefaultExperiment(0.0, 0.5, 1e-3),
+    relations=(
+        Relation("z1", ">", "z2", reason="i = z1 / (z1 - z2)"),
+        Relation("alpha_min", "<=", "alpha_max"),
+        Relation("alpha", ">=", "alpha_min", reason=SINGULAR),
+        Relation("alpha", "<=", "alpha_max", reason=SINGULAR),
+    ),
 )

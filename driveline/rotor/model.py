@@ -85,18 +85,11 @@ class CriticalSpeedsModel(SteppedModel):
         try:
             orders = parse_orders(self.orders)
             driveline = build_driveline(self.layout, {n: getattr(self, n) for n in SHAFT_PARAMETERS})
-            if not self.omega_max > 0.0:
-                raise ValueError(f"parameter omega_max = {self.omega_max!r} rad/s must be positive")
             self._analysis = analyse(driveline, orders, self.omega_max)
         except (ValueError, ArithmeticError) as error:  # e.g. a diameter of 1e300 overflows
             return [f"driveline: {error} (a structural parameter is too large or small to analyse)"
                     if isinstance(error, ArithmeticError) else f"driveline: {error}"]
         self._analysed_for = key
-        return []
-
-    def extra_input_errors(self) -> list[str]:
-        if abs(self.omega) > self.omega_max:
-            return [f"input omega = {self.omega!r} rad/s is beyond omega_max = {self.omega_max!r} rad/s"]
         return []
 
     def start(self, start_time: float) -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..variables import DefaultExperiment, ModelSpec, Variable
+from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 STRUCTURE = "Driveline structure (tunable: a change is re-analysed at the next step)"
 
@@ -14,16 +14,16 @@ SPEC = ModelSpec(
         "frequencies at the current speed, and the nearest order resonance of the couplings."
     ),
     variables=(
-        Variable("L_shaft", "parameter", 1.4, f"{STRUCTURE}: tube length", "m", "mm", min=0.0,
-                 variability="tunable"),
-        Variable("D_outer", "parameter", 0.0762, f"{STRUCTURE}: tube outer diameter", "m", "mm", min=0.0,
-                 variability="tunable"),
+        Variable("L_shaft", "parameter", 1.4, f"{STRUCTURE}: tube length", "m", "mm",
+                 min=0.0, min_exclusive=True, variability="tunable"),
+        Variable("D_outer", "parameter", 0.0762, f"{STRUCTURE}: tube outer diameter", "m", "mm",
+                 min=0.0, min_exclusive=True, variability="tunable"),
         Variable("D_inner", "parameter", 0.0729, f"{STRUCTURE}: tube inner diameter, below D_outer", "m", "mm",
                  min=0.0, variability="tunable"),
-        Variable("E", "parameter", 2.1e11, f"{STRUCTURE}: Young's modulus of the tube", "Pa", "MPa", min=0.0,
-                 variability="tunable"),
-        Variable("density", "parameter", 7850.0, f"{STRUCTURE}: density of the tube", "kg/m3", min=0.0,
-                 variability="tunable"),
+        Variable("E", "parameter", 2.1e11, f"{STRUCTURE}: Young's modulus of the tube", "Pa", "MPa",
+                 min=0.0, min_exclusive=True, variability="tunable"),
+        Variable("density", "parameter", 7850.0, f"{STRUCTURE}: density of the tube", "kg/m3",
+                 min=0.0, min_exclusive=True, variability="tunable"),
         Variable("m_joint", "parameter", 2.5, f"{STRUCTURE}: mass of the joint at each end", "kg", min=0.0,
                  variability="tunable"),
         Variable("Jp_joint", "parameter", 0.004, f"{STRUCTURE}: polar moment of inertia of each joint",
@@ -31,7 +31,7 @@ SPEC = ModelSpec(
         Variable("Jd_joint", "parameter", 0.002, f"{STRUCTURE}: diametral moment of inertia of each joint",
                  "kg.m2", min=0.0, variability="tunable"),
         Variable("k_bearing", "parameter", 1e7, f"{STRUCTURE}: stiffness of the bearing at each end", "N/m",
-                 min=0.0, variability="tunable"),
+                 min=0.0, min_exclusive=True, variability="tunable"),
         Variable("layout", "parameter", "",
                  "Driveline description (TOML) replacing the one-piece tube above: a file path ending in "
                  "'.toml', or the name of a description shipped in the FMU ('two_piece_propshaft', or "
@@ -45,7 +45,7 @@ SPEC = ModelSpec(
                  "1", min=0.0, variability="tunable"),
         Variable("omega_max", "parameter", 1500.0,
                  "Largest accepted |omega|; the whirl frequencies are tabulated up to it", "rad/s", "rpm",
-                 min=0.0, variability="tunable"),
+                 min=0.0, min_exclusive=True, variability="tunable"),
         Variable("omega", "input", 300.0, "Current shaft speed (sign ignored)", "rad/s", "rpm"),
         Variable("omega_crit_1", "output", 0.0, "First forward bending critical speed", "rad/s", "rpm"),
         Variable("omega_crit_2", "output", 0.0, "Second forward bending critical speed", "rad/s", "rpm"),
@@ -67,4 +67,9 @@ SPEC = ModelSpec(
         Variable("resonance_warning", "output", False, "True when |resonance_margin| < band", type="Boolean"),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-2),
+    relations=(
+        Relation("D_inner", "<", "D_outer"),
+        Relation("omega", "<=", "omega_max"),
+        Relation("omega", ">=", "omega_max", scale=-1.0),
+    ),
 )

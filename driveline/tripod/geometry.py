@@ -8,8 +8,6 @@ sleeve runs parallel to Z' at radius r and angle ``phi_in + 2 pi j / 3``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -17,27 +15,6 @@ from ..scalar import Real, lib
 
 THIRD_TURN = 2.0 * np.pi / 3.0
 ARM_INDEX = np.arange(3)
-
-
-@dataclass(frozen=True)
-class TripodGeometry:
-    """r: groove radius [m]; l: tripod centre to self-aligning bearing centre S [m];
-    m: plunger mass [kg]. Defaults are the seed's worked example."""
-
-    r: float = 0.026
-    l: float = 0.700
-    m: float = 0.2
-
-    def errors(self) -> list[str]:
-        """Reasons this geometry is not physical (empty when it is)."""
-        problems = []
-        if not self.r > 0.0:
-            problems.append(f"groove radius r = {self.r!r} m must be positive")
-        if not self.l > self.r:
-            problems.append(f"bearing distance l = {self.l!r} m must exceed the groove radius r = {self.r!r} m")
-        if not self.m >= 0.0:
-            problems.append(f"plunger mass m = {self.m!r} kg must not be negative")
-        return problems
 
 
 def orbit_radius(beta: Real, r: float) -> Real:

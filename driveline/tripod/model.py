@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from ..model import DrivenShaftModel
-from .geometry import TripodGeometry
 from .outputs import coupling_outputs
 from .plane_solver import Solution
 from .spec import SPEC
@@ -16,12 +15,6 @@ class TripodCouplingModel(DrivenShaftModel):
 
     def reset_internal_state(self) -> None:
         self._solution: Solution | None = None  # warm start of the exact solver
-
-    def extra_parameter_errors(self) -> list[str]:
-        return TripodGeometry(self.r, self.l, self.m_plunger).errors()
-
-    def extra_input_errors(self) -> list[str]:
-        return self.angle_bound_errors("beta", "beta_max")
 
     def start(self, start_time: float) -> None:
         self._solution = None

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Variable
+from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 CLOSED_FORM, EXACT = 0, 1
 ARM_OUTPUTS = tuple(
@@ -25,7 +25,7 @@ SPEC = ModelSpec(
     ),
     variables=(
         Variable("r", "parameter", 0.026, "Groove radius r: plunger-groove axis to input axis (seed sec. 2)",
-                 "m", "mm", min=0.0),
+                 "m", "mm", min=0.0, min_exclusive=True),
         Variable("l", "parameter", 0.700, "Distance l from the tripod centre to the output self-aligning bearing centre",
                  "m", "mm", min=0.0),
         Variable("m_plunger", "parameter", 0.2, "Plunger (sliding pin) mass m, eqs 28-34", "kg", min=0.0),
@@ -80,4 +80,8 @@ SPEC = ModelSpec(
         *ARM_OUTPUTS,
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
+    relations=(
+        Relation("l", ">", "r", reason="the bearing centre lies beyond the grooves"),
+        Relation("beta", "<=", "beta_max"),
+    ),
 )

@@ -1,0 +1,142 @@
+"""Validity declared in the spec: exclusive bounds and relations, enforced and worded by the base model."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from driveline.catalog import MODELS
+from driveline.model import SteppedModel
+from driveline.rotor.model import CriticalSpeedsModel
+from driveline.tripod.model import TripodCouplingModel
+from driveline.variables import DefaultExperiment, ModelSpec, Relation, Variable
+from fmu_harness.variable_table import markdown
+
+
+def spec_with(*relations: Relation) -> ModelSpec:
+    return ModelSpec(
+        "Probe", "a model with bounds and relations only",
+        (
+            Variable("gap", "parameter", 0.01, "exclusive minimum", "m", "mm", min=0.0, min_exclusive=True),
+            Variable("ceiling", "parameter", 0.5, "exclusive maximum", "rad", "deg", max=1.0, max_exclusive=True),
+            Variable("limit", "parameter", 2.0, "an inclusive bound", "m", min=0.0),
+            Variable("count", "parameter", 3, "an integer", type="Integer"),
+            Variable("x", "input", 1.0, "an input", "m"),
+            Variable("y", "output", 0.0, "an output", "m"),
+        ),
+        DefaultExperiment(0.0, 1.0, 0.1),
+        relations,
+    )
+
+
+class Probe(SteppedModel):
+    spec = spec_with(
+        Relation("gap", "<", "limit"),
+        Relation("count", ">=", 2.0),
+        Relation("x", "<=", "limit", scale=2.0, offset=0.5, reason="twice the limit and a margin"),
+    )
+
+    def start(self, start_time: float) -> None:
+        self.y = self.x
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        self.y = self.x
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [
+        (dict(gap=0.0), "parameter gap = 0 mm must be positive"),
+        (dict(gap=-1e-3), "parameter gap = -1 mm must be positive"),
+        (dict(ceiling=1.0), "parameter ceiling = 57.2958 deg must be below 57.2958 deg"),
+        (dict(limit=-1.0, x=-3.0), "parameter limit = -1.0 m is below its minimum 0.0 m"),
+        (dict(gap=2.0), "parameter gap = 2000 mm must be below limit = 2000 mm"),
+        (dict(count=1), "parameter count = 1 must not be below 2.0"),
+        (dict(x=4.6), "input x = 4.6 m must not exceed 2 limit + 0.5 = 4.5 m (twice the limit and a margin)"),
+    ],
+)
+def test_a_declared_rule_refuses_with_its_message(values, message):
+    model = Probe()
+    for name, value in values.items():
+        setattr(model, name, value)
+    assert model.initialize(0.0) == [message]
+
+
+@pytest.mark.parametrize(
+    "values",
+    [dict(gap=1e-300), dict(ceiling=math.nextafter(1.0, 0.0)), dict(gap=math.nextafter(2.0, 0.0)), dict(count=2),
+     dict(x=4.5)],
+)
+def test_just_inside_every_rule_is_accepted(values):
+    model = Probe()
+    for name, value in values.items():
+        setattr(model, name, value)
+    assert model.initialize(0.0) == []
+
+
+def test_an_input_relation_refuses_the_step_and_the_corrected_input_steps_on():
+    model = Probe()
+    assert model.step(0.0, 0.1) == []
+    before = model.get_state()
+    model.x = 5.0
+    assert model.step(0.1, 0.1) == ["input x = 5.0 m must not exceed 2 limit + 0.5 = 4.5 m (twice the limit and a margin)"]
+    model.x = before["x"]
+    assert model.get_state() == before and model.step(0.1, 0.1) == []
+
+
+def test_relations_wait_for_the_bounds():
+    """A value out of its own range is reported alone, not again through a relation."""
+    model = Probe()
+    model.gap = math.nan
+    assert model.initialize(0.0) == ["parameter gap = nan is not finite"]
+
+
+@pytest.mark.parametrize(
+    ("relation", "fragment"),
+    [
+        (Relation("gap", "<", "nowhere"), "names no variable"),
+        (Relation("gap", "=", "limit"), "no operator"),
+        (Relation("y", "<", "limit"), "numeric parameters or inputs"),
+        (Relation("gap", "<", "ceiling"), "different units"),
+    ],
+)
+def test_a_spec_refuses_relations_it_cannot_enforce(relation, fragment):
+    with pytest.raises(ValueError, match=fragment):
+        spec_with(relation)
+
+
+def test_an_exclusive_bound_needs_its_value():
+    with pytest.raises(ValueError, match="exclusive"):
+        Variable("v", "parameter", 1.0, "no minimum", min_exclusive=True)
+
+
+def test_the_models_declare_their_rules():
+    tripod = TripodCouplingModel()
+    tripod.l = 0.02
+    assert tripod.initialize(0.0) == [
+        "parameter l = 20 mm must exceed r = 26 mm (the bearing centre lies beyond the grooves)"]
+    rotor = CriticalSpeedsModel()
+    rotor.D_inner = 0.08
+    assert rotor.initialize(0.0) == ["parameter D_inner = 80 mm must be below D_outer = 76.2 mm"]
+    rotor = CriticalSpeedsModel()
+    rotor.omega = -1600.0
+    assert rotor.initialize(0.0) == ["input omega = -15278.9 rpm must not be below -omega_max = -14323.9 rpm"]
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_declarations_are_plain_data(name):
+    """What a code generator reads: names, operators and numbers only."""
+    spec = MODELS[name].spec
+    for relation in spec.relations:
+        assert all(isinstance(value, (str, float, int)) for value in dataclasses.asdict(relation).values())
+    for variable in spec.variables:
+        assert isinstance(variable.min_exclusive, bool) and isinstance(variable.max_exclusive, bool)
+
+
+def test_the_variable_table_shows_the_rules():
+    table = markdown(MODELS["UniversalReducer"].spec)
+    assert "| `module` | parameter | m (mm) | 0.002 | > 0 |  |" in table
+    assert "| `alpha_max` | parameter | rad (deg) | 2.96706 | 0 | < 3.14159 |" in table
+    assert "`z1 > z2` (i = z1 / (z1 - z2))" in table and "inclusive min or max" in table
