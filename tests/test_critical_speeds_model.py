@@ -33,12 +33,28 @@ def test_critical_speeds_and_interpolated_whirl_match_the_core(rotor_b):
         # cubic splines through 41 Campbell points: measured 3e-14 (this rotor), 1e-12 (two-piece)
         np.testing.assert_allclose(interpolated, [*direct.forward[:2], *direct.backward[:2]], rtol=1e-9)
         if speed:
-            nearest = rotor_b.nearest_order_resonance(speed, orders=(1, 2, 3))
-            assert model.resonance_speed == pytest.approx(nearest.spin, rel=1e-12)
-            assert model.resonance_order == nearest.order
-            assert model.resonance_margin == pytest.approx((speed - nearest.spin) / nearest.spin)
-            assert model.resonance_warning == (abs(model.resonance_margin) < 0.1)
+            every = rotor_b.order_resonances((1, 2, 3), ("forward", "backward"), None, 2 * 1500.0)
+            margins = [(speed - r.spin) / r.spin for r in every]
+            closest = every[int(np.argmin(np.abs(margins)))]
+            assert model.resonance_speed == pytest.approx(closest.spin, rel=1e-12)
+            assert (model.resonance_order, model.resonance_whirl) == (closest.order, 1 if closest.whirl == "forward" else -1)
+            assert model.resonance_margin == pytest.approx((speed - closest.spin) / closest.spin)
+            assert model.resonance_count == sum(abs(m) < 0.1 for m in margins)
+            assert model.resonance_warning == (model.resonance_count > 0)
             assert model.speed_ratio == pytest.approx(speed / model.omega_crit_1)
+
+
+def test_every_resonance_in_the_band_counts(fmu_path, fmi):
+    # Two-piece example at 330.5 rad/s with orders 1, 2, 3, 6: the nearest resonance in
+    # rad/s (6x forward at 300.1, margin +10.1 %) lies outside the 10 % band, but the 6x
+    # backward one at 361.6 (-8.6 %) and the 6x forward one at 366.5 (-9.8 %) lie inside.
+    result = simulate(fmu_path("CriticalSpeeds", fmi), 0.02, 0.01, inputs={"omega": lambda t: 330.5},
+                      start_values={"layout": "two_piece_propshaft", "orders": "1,2,3,6"})
+    last = result[-1]
+    assert bool(last["resonance_warning"]) and last["resonance_count"] == 2
+    assert (last["resonance_order"], last["resonance_whirl"]) == (6, -1)
+    assert last["resonance_speed"] == pytest.approx(361.6, abs=0.05)  # the value the issue measured
+    assert last["resonance_margin"] == pytest.approx((330.5 - last["resonance_speed"]) / last["resonance_speed"])
 
 
 def test_analysis_runs_only_when_the_structure_changes():

@@ -32,6 +32,10 @@ class Analysis:
     whirl: CubicSpline  # |omega| -> (forward_1, forward_2, backward_1, backward_2)
     resonances: tuple[OrderResonance, ...]
 
+    @property
+    def resonance_speeds(self) -> np.ndarray:
+        return np.array([r.spin for r in self.resonances])
+
 
 def parse_orders(text: str) -> tuple[int, ...]:
     """'1,2,3,6' -> (1, 2, 3, 6); raises ValueError naming the bad entry."""
@@ -86,6 +90,7 @@ class CriticalSpeedsModel(SteppedModel):
             orders = parse_orders(self.orders)
             driveline = build_driveline(self.layout, {n: getattr(self, n) for n in SHAFT_PARAMETERS})
             self._analysis = analyse(driveline, orders, self.omega_max)
+            self._resonance_speeds = self._analysis.resonance_speeds
         except (ValueError, ArithmeticError) as error:  # e.g. a diameter of 1e300 overflows
             return [f"driveline: {error} (a structural parameter is too large or small to analyse)"
                     if isinstance(error, ArithmeticError) else f"driveline: {error}"]
@@ -106,8 +111,12 @@ class CriticalSpeedsModel(SteppedModel):
         self.whirl_forward_1, self.whirl_forward_2 = float(whirl[0]), float(whirl[1])
         self.whirl_backward_1, self.whirl_backward_2 = float(whirl[2]), float(whirl[3])
         self.speed_ratio = speed / self.omega_crit_1
-        nearest = min(analysis.resonances, key=lambda resonance: abs(resonance.spin - speed))
-        self.resonance_order = nearest.order
-        self.resonance_speed = nearest.spin
-        self.resonance_margin = (speed - nearest.spin) / nearest.spin
-        self.resonance_warning = abs(self.resonance_margin) < self.band
+        margins = (speed - self._resonance_speeds) / self._resonance_speeds
+        closest = int(np.argmin(np.abs(margins)))
+        resonance = analysis.resonances[closest]
+        self.resonance_order = resonance.order
+        self.resonance_whirl = 1 if resonance.whirl == "forward" else -1
+        self.resonance_speed = resonance.spin
+        self.resonance_margin = float(margins[closest])
+        self.resonance_count = int(np.count_nonzero(np.abs(margins) < self.band))
+        self.resonance_warning = self.resonance_count > 0
