@@ -119,3 +119,24 @@ def test_fmu_follows_a_speed_ramp_and_refuses_overspeed(fmu_dir, rotor_b):
     with pytest.raises(StepRefused) as refused:
         simulate(path, 0.1, 0.05, start_values={"D_inner": 0.09})
     assert any("D_inner" in message for message in refused.value.messages)
+
+
+def test_short_shaft_reports_how_many_critical_speeds_it_has(fmu_path, fmi):
+    # A 0.1 m tube has only two forward critical speeds below the 1e5 rad/s search limit:
+    # accepted, counted, and the missing one reads as the limit.
+    result = simulate(fmu_path("CriticalSpeeds", fmi), 0.02, 0.01, start_values={"L_shaft": 0.1})
+    expected = one_piece_shaft(**{**ROTOR_B, "L_shaft": 0.1}).critical_speeds(3)
+    assert expected.size == 2 and result["critical_speed_count"][-1] == 2
+    np.testing.assert_array_equal([result["omega_crit_1"][-1], result["omega_crit_2"][-1]], expected)
+    assert result["omega_crit_3"][-1] == 1e5
+
+
+def test_layout_path_any_case_relative_to_the_working_directory(tmp_path, monkeypatch):
+    (tmp_path / "Shaft.TOML").write_text(example_path("two_piece_propshaft").read_text())
+    monkeypatch.chdir(tmp_path)
+    model = model_checks.started(CriticalSpeedsModel, layout="Shaft.TOML")
+    assert model.omega_crit_1 == load_driveline(example_path("two_piece_propshaft")).critical_speeds(3)[0]
+    broken = CriticalSpeedsModel()
+    broken.layout = "missing.toml"
+    errors = broken.initialize(0.0)
+    assert errors and str(tmp_path / "missing.toml") in errors[0]  # the full path

@@ -245,13 +245,19 @@ def loads_driveline(text: str, source: str = "<string>") -> Driveline:
 
 
 def load_driveline(path: str | Path) -> Driveline:
-    """Read a TOML driveline description from ``path``."""
-    p = Path(path)
+    """Read a TOML driveline description from ``path`` (relative: to the working directory).
+
+    Messages name the file by its absolute path."""
+    p = Path(path).absolute()
     try:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ValueError(f"cannot read driveline file {p.name!r}: {exc.strerror}") from None
-    return loads_driveline(text, p.name)
+        raise ValueError(f"cannot read driveline file {str(p)!r}: {exc.strerror}") from None
+    try:
+        return loads_driveline(text, str(p))
+    except ValueError as exc:
+        message = str(exc)
+        raise ValueError(message if message.startswith(str(p)) else f"{p}: {message}") from None
 
 
 def example_path(name: str = "two_piece_propshaft") -> Path:

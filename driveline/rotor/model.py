@@ -15,7 +15,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from ..model import SteppedModel
-from .driveline import Driveline, OrderResonance
+from .driveline import SEARCH_LIMIT, Driveline, OrderResonance
 from .loader import example_path, load_driveline, one_piece_shaft
 from .spec import SPEC
 
@@ -28,7 +28,8 @@ SHAFT_PARAMETERS = ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", 
 class Analysis:
     """Everything a step needs, for one set of structural parameters."""
 
-    critical_speeds: tuple[float, float, float]
+    critical_speeds: tuple[float, float, float]  # missing ones (beyond the search limit) = the limit
+    critical_speed_count: int
     whirl: CubicSpline  # |omega| -> (forward_1, forward_2, backward_1, backward_2)
     resonances: tuple[OrderResonance, ...]
 
@@ -51,22 +52,24 @@ def build_driveline(layout: str, shaft: dict[str, float]) -> Driveline:
     """The one-piece tube of ``shaft``, or the described layout (file or shipped name)."""
     if not layout:
         return one_piece_shaft(**shaft)
-    return load_driveline(Path(layout) if layout.endswith(".toml") else example_path(layout))
+    return load_driveline(Path(layout) if layout.lower().endswith(".toml") else example_path(layout))
 
 
 def analyse(driveline: Driveline, orders: tuple[int, ...], omega_max: float) -> Analysis:
-    critical = driveline.critical_speeds(3)
-    if critical.size < 3:
-        raise ValueError(f"the driveline has only {critical.size} forward critical speeds below the search limit")
+    """Critical speeds, Campbell table and order resonances; what lies beyond the search limit
+    (a short, stiff shaft) reads as the limit, and the critical speeds found are counted."""
+    found = driveline.critical_speeds(3)
+    critical = tuple(float(w) for w in found) + (SEARCH_LIMIT,) * (3 - found.size)
     spins = np.linspace(0.0, omega_max, CAMPBELL_POINTS)
     campbell = driveline.campbell(spins, WHIRL_MODES)
     table = np.hstack([campbell.forward, campbell.backward])
-    if not np.all(np.isfinite(table)):
-        raise ValueError("fewer than two forward and two backward whirl modes below the search limit")
+    table = np.where(np.isfinite(table), table, SEARCH_LIMIT)  # a mode beyond the limit reads as the limit
     resonances = driveline.order_resonances(orders, ("forward", "backward"), None, 2.0 * omega_max)
     if not resonances:
         resonances = driveline.order_resonances(orders, ("forward",), 1)
-    return Analysis(tuple(float(w) for w in critical), CubicSpline(spins, table), tuple(resonances))
+    if not resonances:
+        raise ValueError(f"no order resonance of the orders {orders} below the search limit {SEARCH_LIMIT:g} rad/s")
+    return Analysis(critical, found.size, CubicSpline(spins, table), tuple(resonances))
 
 
 class CriticalSpeedsModel(SteppedModel):
@@ -107,6 +110,7 @@ class CriticalSpeedsModel(SteppedModel):
         analysis = self._analysis
         speed = abs(self.omega)
         self.omega_crit_1, self.omega_crit_2, self.omega_crit_3 = analysis.critical_speeds
+        self.critical_speed_count = analysis.critical_speed_count
         whirl = analysis.whirl(speed)
         self.whirl_forward_1, self.whirl_forward_2 = float(whirl[0]), float(whirl[1])
         self.whirl_backward_1, self.whirl_backward_2 = float(whirl[2]), float(whirl[3])

@@ -34,7 +34,8 @@ SPEC = ModelSpec(
                  min=0.0, min_exclusive=True, variability="tunable"),
         Variable("layout", "parameter", "",
                  "Driveline description (TOML) replacing the one-piece tube above: a file path ending in "
-                 "'.toml', or the name of a description shipped in the FMU ('two_piece_propshaft', or "
+                 "'.toml' (any case; a relative path is relative to the importing process's working "
+                 "directory), or the name of a description shipped in the FMU ('two_piece_propshaft', or "
                  "'two_piece_propshaft_hinged' with its centre joint as a hinge); "
                  "empty = the one-piece tube", type="String", variability="tunable"),
         Variable("orders", "parameter", "1,2,3",
@@ -47,9 +48,16 @@ SPEC = ModelSpec(
                  "Largest accepted |omega|; the whirl frequencies are tabulated up to it", "rad/s", "rpm",
                  min=0.0, min_exclusive=True, variability="tunable"),
         Variable("omega", "input", 300.0, "Current shaft speed (sign ignored)", "rad/s", "rpm"),
-        Variable("omega_crit_1", "output", 0.0, "First forward bending critical speed", "rad/s", "rpm"),
-        Variable("omega_crit_2", "output", 0.0, "Second forward bending critical speed", "rad/s", "rpm"),
-        Variable("omega_crit_3", "output", 0.0, "Third forward bending critical speed", "rad/s", "rpm"),
+        Variable("omega_crit_1", "output", 0.0,
+                 "First forward bending critical speed (1e5 rad/s when none lies below that search limit)",
+                 "rad/s", "rpm"),
+        Variable("omega_crit_2", "output", 0.0, "Second forward bending critical speed (1e5 rad/s if missing)",
+                 "rad/s", "rpm"),
+        Variable("omega_crit_3", "output", 0.0, "Third forward bending critical speed (1e5 rad/s if missing)",
+                 "rad/s", "rpm"),
+        Variable("critical_speed_count", "output", 0,
+                 "Number of forward critical speeds found below 1e5 rad/s, at most 3 (a short, stiff shaft has "
+                 "fewer)", type="Integer"),
         Variable("whirl_forward_1", "output", 0.0, "First forward whirl frequency at the current speed",
                  "rad/s", "rpm"),
         Variable("whirl_forward_2", "output", 0.0, "Second forward whirl frequency at the current speed",
