@@ -58,7 +58,9 @@ UNITS: dict[str, Unit] = {
         Unit("Pa", {"kg": 1, "m": -1, "s": -2}, (DisplayUnit("MPa", 1e-6),)),
         Unit("kg/m3", {"kg": 1, "m": -3}),
         Unit("kg.m2", {"kg": 1, "m": 2}),
+        Unit("m/s", {"m": 1, "s": -1}),
         Unit("m/s2", {"m": 1, "s": -2}),
+        Unit("W", {"kg": 1, "m": 2, "s": -3}),
         Unit("1", {}),
     )
 }

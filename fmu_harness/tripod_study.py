@@ -90,6 +90,7 @@ def write(fmu: Path, out: Path) -> list[Path]:
 
     files.append(_turn_figure(runs, out / "tripod_reactions_turn.png"))
     files.append(_beta_figure(runs, seed, out / "tripod_reactions_vs_beta.png"))
+    files += friction_figures(fmu, out)
 
     fig, ax = plt.subplots(figsize=(7, 4))
     beta_grid = np.radians(np.linspace(0.0, 45.0, 91))
@@ -175,3 +176,46 @@ def _beta_figure(runs: dict, seed: dict, path: Path) -> Path:
         ax.legend(fontsize=7)
     fig.suptitle("Force balance against the seed, 2000 rpm, r = 26 mm, l = 700 mm, m = 0.2 kg", fontsize=10)
     return _save(fig, path)
+
+
+FRICTION = (0.02, 0.05, 0.1)
+
+
+def friction_figures(fmu: Path, out: Path) -> list[Path]:
+    """Generated axial force over one turn for several mu and beta; its 3rd-order amplitude and
+    the mean efficiency against beta at two loads (mu = 0.05)."""
+    def run(beta: float, load: float, mu: float) -> np.ndarray:
+        period = 2 * math.pi / SPEED
+        return simulate(fmu, period, period / STEPS_PER_TURN,
+                        inputs={"omega_in": SPEED, "beta": math.radians(beta), "T_load": load},
+                        start_values={"kinematics": 1, "mu": mu},
+                        outputs=("phi_in", "Rz_in", "P_friction", "omega_spin"))[:-1]
+
+    fig, ax = plt.subplots(figsize=(8, 5.4))
+    for beta, color in zip((15, 30, 45), ("tab:blue", "tab:orange", "tab:red")):
+        for mu, style in zip(FRICTION, (":", "--", "-")):
+            result = run(beta, 500.0, mu)
+            ax.plot(np.degrees(result["phi_in"]), -result["Rz_in"], style, color=color,
+                    label=f"beta = {beta} deg, mu = {mu}")
+    _angle_axis(ax, "generated axial force -Rz_in [N]",
+                "Generated axial force on the input housing, T_load = 500 N.m, 2000 rpm")
+    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+    files = [_save(fig, out / "tripod_friction_axial_force.png")]
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.6))
+    betas = np.arange(5, 46, 5)
+    for load, marker in ((250.0, "s"), (500.0, "o")):
+        runs = [run(float(beta), load, 0.05) for beta in betas]
+        left.plot(betas, [order_amplitude(-result["Rz_in"]) for result in runs], marker + "-",
+                  label=f"T_load = {load:.0f} N.m")
+        right.plot(betas, [np.mean(load * r["omega_spin"]) / np.mean(load * r["omega_spin"] + r["P_friction"])
+                           for r in runs], marker + "-", label=f"T_load = {load:.0f} N.m")
+    left.set_ylabel("3rd-order amplitude of -Rz_in [N]")
+    right.set_ylabel("mean efficiency [-]")
+    for ax in (left, right):
+        ax.set_xlabel("bend angle beta [deg]")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Friction mu = 0.05 in both sliding pairs, 2000 rpm, r = 26 mm, l = 700 mm, m = 0.2 kg", fontsize=10)
+    files.append(_save(fig, out / "tripod_friction_vs_beta.png"))
+    return files

@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..model import DrivenShaftModel
 from .outputs import coupling_outputs
 from .plane_solver import Solution
-from .spec import SPEC
+from .spec import EXACT, SPEC
 
 
 class TripodCouplingModel(DrivenShaftModel):
@@ -16,6 +16,11 @@ class TripodCouplingModel(DrivenShaftModel):
     def reset_internal_state(self) -> None:
         self._solution: Solution | None = None  # warm start of the exact solver
 
+    def extra_parameter_errors(self) -> list[str]:
+        if self.mu > 0.0 and self.kinematics != EXACT:
+            return [f"friction mu = {self.mu!r} needs the exact kinematics (kinematics = {EXACT})"]
+        return []
+
     def start(self, start_time: float) -> None:
         self._solution = None
         super().start(start_time)
@@ -25,5 +30,6 @@ class TripodCouplingModel(DrivenShaftModel):
         values, self._solution = coupling_outputs(
             self.phi_in, self.beta, self.omega_in, self.T_load,
             self.r, self.l, self.m_plunger, self.kinematics, self._solution, self.alpha_in, self.seed_reactions,
+            self.mu, self.v_slip,
         )
         self.__dict__.update(values)

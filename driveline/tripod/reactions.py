@@ -37,6 +37,8 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+import numpy as np
+
 from ..scalar import Real, lib
 
 HALF_ROOT_3 = 0.5 * math.sqrt(3.0)  # sin(2 pi / 3)
@@ -59,18 +61,21 @@ class ExactReactions(NamedTuple):
     F_plunger: tuple[Real, Real, Real]  # ball joint on plunger j along Z' = m zddot_j
     a_plunger_sum: Real  # zddot_0 + zddot_1 + zddot_2 [m/s^2]
     omega_spin: Real  # Omega . U, the output shaft's angular velocity about its own axis [rad/s]
+    Rz_in: Real = 0.0  # input bearing force on the input shaft along Z' (friction only)
+    P_friction: Real = 0.0  # power dissipated by friction [W]
 
 
 def exact_reactions(
     phi_in: Real, beta: Real, omega: Real, omega_dot: Real, T_load: Real,
-    r: float, l: float, m: float, x: Real, y: Real,
+    r: float, l: float, m: float, x: Real, y: Real, friction: float = 0.0, slip_speed: float = 1e-3,
 ) -> ExactReactions:
     """Reactions at input angle ``phi_in``, bend ``beta``, input speed ``omega`` and its rate
     ``omega_dot``, for the output-shaft axis ``(x, y, sqrt(1 - x^2 - y^2))`` in the nominal
     output frame that solves the closure (:func:`.plane_solver.solve`). Plain arithmetic on
     floats or arrays, written out per component (the module's steps 1-5; with ``n_j``
     horizontal, ``k_j = (d_z e_x, d_z e_y, -(d_x e_x + d_y e_y))`` and
-    ``e_j x n_j = (e_z e_x, e_z e_y, -(e_x^2 + e_y^2))``)."""
+    ``e_j x n_j = (e_z e_x, e_z e_y, -(e_x^2 + e_y^2))``). ``friction`` > 0 adds Coulomb
+    friction in both sliding pairs (:func:`_frictional_balance`); 0 is the frictionless balance."""
     xp = lib(phi_in, beta, x, y)
     cb, sb = xp.cos(beta), xp.sin(beta)
     zn = xp.sqrt(1.0 - x * x - y * y)
@@ -114,7 +119,7 @@ def exact_reactions(
     W2 = Wx * Wx + Wy * Wy + Wz * Wz
 
     # 3. accelerations: known terms per arm, then K Omegadot = (known . n_j)
-    known = []
+    known, slides = [], []
     for gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_ in arms:
         # sliding rate along the arm (sigma e_j = sdot a_j) from the velocity closure
         vx = Wy * dz - Wz * dy + omega * gy
@@ -128,6 +133,7 @@ def exact_reactions(
         ax = -omega_dot * gy - omega2 * gx  # groove point's acceleration, radial and tangential
         ay = omega_dot * gx - omega2 * gy
         known.append((ax, ay, hx, hy, hz))
+        slides.append((Wx * dy - Wy * dx + sigma * ez, sigma))  # (zdot_j, sdot_j / |e_j|)
     rhs = [((kn[0] - kn[2]) * a[4] - (kn[1] - kn[3]) * a[3]) * inv_det for kn, a in zip(known, arms)]
     Ax = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
     Ay = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]
@@ -147,16 +153,23 @@ def exact_reactions(
         Mz -= mu * (dx * qy - dy * qx)
         zddot.append(acc)
         mus.append(mu)
+    lams = [(Mx * a0 + My * a1 + Mz * a2) * inv_det for a0, a1, a2 in adj]
+    slips = grooves = (0.0, 0.0, 0.0)
+    power_loss = 0.0
+    if friction:
+        lams, mus, slips, grooves, power_loss = _frictional_balance(
+            arms, adj, inv_det, known, zddot, slides, (T_load * Ux, T_load * Uy, T_load * Uz), m,
+            friction, slip_speed, lams, mus, xp)
     Rx_out = Ry_out = Rz_out = Rx_in = Ry_in = Lx = Ly = Lz = 0.0
     F_arm = []
-    for (gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_), (a0, a1, a2), mu, (ax, ay, *_) in zip(arms, adj, mus, known):
-        lam = (Mx * a0 + My * a1 + Mz * a2) * inv_det
-        Fx, Fy, Fz = lam * ey + mu * ez * ex, -lam * ex + mu * ez * ey, -mu * exy2
+    for a, lam, mu, slip, groove, (ax, ay, *_) in zip(arms, lams, mus, slips, grooves, known):
+        gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2 = a[:10]
+        Fx, Fy, Fz = lam * ey + mu * ez * ex + slip * ex, -lam * ex + mu * ez * ey + slip * ey, -mu * exy2 + slip * ez
         Rx_out, Ry_out, Rz_out = Rx_out - Fx, Ry_out - Fy, Rz_out - Fz
-        # 5. groove force on the plunger N_j = m bddot_j + F_j, its moment about O
+        # 5. groove force on the plunger N_j = m bddot_j + F_j (+ friction along Z'), its moment about O
         Nx, Ny = m * ax + Fx, m * ay + Fy
         Rx_in, Ry_in = Rx_in + Nx, Ry_in + Ny
-        Lx, Ly, Lz = Lx - bz * Ny, Ly + bz * Nx, Lz + gx * Ny - gy * Nx
+        Lx, Ly, Lz = Lx - bz * Ny + gy * groove, Ly + bz * Nx - gx * groove, Lz + gx * Ny - gy * Nx
         tx, ty, tz = Uy * ez - Uz * ey, Uz * ex - Ux * ez, Ux * ey - Uy * ex  # U x e_j, in the tripod plane
         F_arm.append((Fx * tx + Fy * ty + Fz * tz) / xp.sqrt(tx * tx + ty * ty + tz * tz))
     return ExactReactions(
@@ -172,4 +185,67 @@ def exact_reactions(
         F_plunger=(m * zddot[0], m * zddot[1], m * zddot[2]),
         a_plunger_sum=zddot[0] + zddot[1] + zddot[2],
         omega_spin=Wx * Ux + Wy * Uy + Wz * Uz,
+        Rz_in=grooves[0] + grooves[1] + grooves[2],
+        P_friction=power_loss,
     )
+
+
+FRICTION_TOLERANCE = 1e-13  # relative change of the arm forces at which the balance has converged
+MAX_FRICTION_ITERATIONS = 200
+
+
+def slip_sign(speed: Real, slip_speed: float) -> Real:
+    """Regularised sign of a sliding speed, ``u / sqrt(1 + u^2)`` with ``u = speed / slip_speed``:
+    odd, smooth, within 1 % of the sign above 7 slip speeds."""
+    u = speed / slip_speed
+    return u / (1.0 + u * u) ** 0.5
+
+
+def _frictional_balance(arms, adj, inv_det, known, zddot, slides, load_moment, m, friction, slip_speed,
+                        lams, mus, xp):
+    """Arm forces with Coulomb friction ``friction`` in both sliding pairs of each arm.
+
+    The ball on arm j adds ``phi_j e_j`` along the arm, ``|phi_j e_j| = friction |F_perp|`` opposing
+    the ball's slip along the arm; the groove adds ``g_j e_z`` on plunger j, ``|g_j| = friction
+    |N_xy|`` opposing its slip. The normal forces depend on the friction forces: the coupled
+    balance is solved by successive substitution (a contraction of rate ~friction) from the
+    frictionless forces until the arm forces change by less than FRICTION_TOLERANCE of their
+    size. Returns ``lambda_j``, ``mu_j``, ``phi_j``, ``g_j`` and the dissipated power.
+    """
+    converged = bool if xp is math else np.all
+    Tx, Ty, Tz = load_moment
+    signs = [(slip_sign(zdot, slip_speed), slip_sign(sigma * xp.sqrt(a[9] + a[5] * a[5]), slip_speed))
+             for (zdot, sigma), a in zip(slides, arms)]
+    for _ in range(MAX_FRICTION_ITERATIONS):
+        Mx, My, Mz = Tx, Ty, Tz
+        new_mus, slips, grooves = [], [], []
+        change = scale = 0.0
+        for a, lam, mu, (ax, ay, *_), acc, (groove_sign, arm_sign) in zip(arms, lams, mus, known, zddot, signs):
+            gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2 = a[:10]
+            e2 = exy2 + ez * ez
+            normal = xp.sqrt(exy2 * (lam * lam + mu * mu * e2))  # |lambda n + mu e x n|
+            slip = friction * normal * arm_sign / xp.sqrt(e2)  # phi_j, per unit of |e_j|
+            Nx = m * ax + lam * ey + mu * ez * ex + slip * ex
+            Ny = m * ay - lam * ex + mu * ez * ey + slip * ey
+            groove = -friction * xp.sqrt(Nx * Nx + Ny * Ny) * groove_sign
+            # plunger along Z': groove - F_z = m zddot with F_z = -mu |n|^2 + phi e_z
+            new_mu = (m * acc - groove + slip * ez) / exy2
+            Mx = Mx - new_mu * (dy * -exy2 - dz * ez * ey) - slip * (dy * ez - dz * ey)
+            My = My - new_mu * (dz * ez * ex + dx * exy2) - slip * (dz * ex - dx * ez)
+            Mz = Mz - new_mu * (dx * ez * ey - dy * ez * ex) - slip * (dx * ey - dy * ex)
+            change = change + abs(new_mu - mu) * xp.sqrt(exy2 * e2)
+            scale = scale + normal
+            new_mus.append(new_mu), slips.append(slip), grooves.append(groove)
+        new_lams = [(Mx * a0 + My * a1 + Mz * a2) * inv_det for a0, a1, a2 in adj]
+        for a, lam, new_lam in zip(arms, lams, new_lams):
+            change = change + abs(new_lam - lam) * xp.sqrt(a[9])
+        lams, mus = new_lams, new_mus
+        if converged(change <= FRICTION_TOLERANCE * scale):
+            break
+    else:
+        raise ArithmeticError("tripod friction balance did not converge (friction coefficient too large?)")
+    power = 0.0
+    for (zdot, sigma), slip, groove, a in zip(slides, slips, grooves, arms):
+        # dissipation: -g_j zdot_j (groove) + phi_j sdot_j (arm), sdot_j |e_j| = sigma_j |e_j|^2
+        power = power - groove * zdot + slip * sigma * (a[9] + a[5] * a[5])
+    return lams, mus, slips, grooves, power

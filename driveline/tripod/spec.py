@@ -39,6 +39,12 @@ SPEC = ModelSpec(
                  "1 = a_plunger_sum, Rz_out, Rx_in, Ry_in from the seed's eqs 20, 30, 33, 34 as printed "
                  "(for comparison with the paper); 0 = from the force balance",
                  type="Integer", min=0, max=1),
+        Variable("mu", "parameter", 0.0,
+                 "Coulomb friction coefficient of both sliding pairs per arm (plunger in groove, ball along arm); "
+                 "exact kinematics only", "1", min=0.0),
+        Variable("v_slip", "parameter", 1e-3,
+                 "Slip speed of the friction's regularised sign u/sqrt(1 + u^2), u = sliding speed / v_slip",
+                 "m/s", min=0.0, min_exclusive=True),
         Variable("phi_in_start", "parameter", 0.0, "Input shaft angle phi_in at the start time", "rad", "deg"),
         Variable("omega_in", "input", 2000.0 * math.pi / 30.0, "Input shaft speed omega_1 (held over a step)",
                  "rad/s", "rpm"),
@@ -77,6 +83,13 @@ SPEC = ModelSpec(
                  "N.m"),
         Variable("My_in", "output", 0.0, "Input bearing on the input shaft: moment about Y' through the joint centre O",
                  "N.m"),
+        Variable("Rz_in", "output", 0.0,
+                 "Input bearing on the input shaft: axial force along Z'; the joint's generated axial force "
+                 "on its housing is -Rz_in (friction only)", "N"),
+        Variable("P_friction", "output", 0.0, "Power dissipated by friction in the six sliding pairs", "W"),
+        Variable("efficiency", "output", 1.0,
+                 "Instantaneous efficiency T_load omega_spin / (T_load omega_spin + P_friction); 1 without power flow",
+                 "1"),
         *ARM_OUTPUTS,
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
