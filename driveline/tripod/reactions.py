@@ -28,6 +28,9 @@ groove) and ``k_j = d_j x n_j``, the algorithm is, step by step:
    ``M_in + T_in e_z = sum b_j x N_j``.
 
 Both 3x3 solves use Cramer's rule with the same three cross products of the rows of K.
+With Coulomb friction (``friction`` > 0) step 4 adds a force along each arm and one along each
+groove whose sizes follow the normal forces; :func:`_frictional_balance` repeats step 4 with
+them until the forces settle, and step 5 then includes the grooves' axial friction.
 Input speed and its rate are those at the evaluated instant; beta is constant (its rate is
 not an input).
 """
