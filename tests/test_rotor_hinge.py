@@ -15,7 +15,6 @@ from driveline.rotor import (
     example_path,
     fem,
     load_driveline,
-    loads_driveline,
 )
 from fmu_harness.runner import simulate
 
@@ -125,27 +124,6 @@ def test_hinge_validation():
     with pytest.raises(ValueError, match="free hinge"):
         Hinge(1).transfer_matrix(100.0)
 
-
-
-TWO_SEGMENTS = "[[segments]]\nlength = 0.5\nouter_diameter = 0.04\nyoungs_modulus = 2.1e11\ndensity = 7850.0\n" * 2
-
-
-@pytest.mark.parametrize("table, fragment", [
-    ("node = 0", "hinges[0].node = 0 must be an inner node"),
-    ("node = 2", "hinges[0].node = 2 must be an inner node"),
-    ("node = 1\nbending_stiffness = -1.0", "hinges[0].bending_stiffness"),
-    ("node = 1\nstiff = 1.0", "unknown key 'stiff'"),
-    ("bending_stiffness = 1.0", "hinges[0]: missing key 'node'"),
-])
-def test_hinge_tables_are_checked(table, fragment):
-    with pytest.raises(ValueError) as refused:
-        loads_driveline(f"{TWO_SEGMENTS}[[hinges]]\n{table}\n")
-    assert fragment in str(refused.value)
-
-
-def test_hinge_table_loads():
-    d = loads_driveline(f"{TWO_SEGMENTS}[[hinges]]\nnode = 1\nbending_stiffness = 50.0\n")
-    assert d.joints == (Hinge(1, 50.0),)
 
 
 def test_fmu_analyses_a_hinged_layout(fmu_path, fmi):

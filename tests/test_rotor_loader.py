@@ -8,6 +8,7 @@ import pytest
 from driveline.rotor import (
     Driveline,
     EndCondition,
+    Hinge,
     example_path,
     load_driveline,
     loads_driveline,
@@ -188,3 +189,75 @@ def test_driveline_validation():
         Driveline(d.segments, left="glued")
     with pytest.raises(ValueError, match="at least one"):
         Driveline([])
+
+
+SHAFT = """
+[[segments]]
+length = 0.6
+outer_diameter = 0.0762
+inner_diameter = 0.0729
+youngs_modulus = 2.1e11
+density = 7850.0
+
+[[segments]]
+length = 0.8
+outer_diameter = 0.0762
+inner_diameter = 0.0729
+youngs_modulus = 2.1e11
+density = 7850.0
+
+[[bearings]]
+node = 0
+stiffness = 1.0e7
+
+[[bearings]]
+position = 1.4
+stiffness = 1.0e7
+"""
+
+
+def test_elements_placed_by_position_cut_the_segments():
+    # A mass at 0.35 m and a centre bearing at 1.0 m: the loader cuts both segments; the
+    # same layout written with nodes gives the same numbers (cut lengths are differences of
+    # positions, exact to round-off: 1e-12).
+    by_position = loads_driveline(SHAFT + "[[masses]]\nposition = 0.35\nmass = 3.0\n"
+                                  "[[bearings]]\nposition = 1.0\nstiffness = 5e5\n")
+    assert [s.length for s in by_position.segments] == pytest.approx([0.35, 0.25, 0.4, 0.4], rel=1e-15)
+    assert (by_position.masses[0].node, by_position.bearings[1].node, by_position.bearings[2].node) == (1, 4, 3)
+    by_node = loads_driveline(
+        SHAFT.replace("length = 0.6", "length = 0.35", 1).replace("length = 0.8", "length = 0.25", 1)
+        .replace("position = 1.4", "node = 4")
+        + "[[segments]]\nlength = 0.4\nouter_diameter = 0.0762\ninner_diameter = 0.0729\n"
+          "youngs_modulus = 2.1e11\ndensity = 7850.0\n" * 2
+        + "[[masses]]\nnode = 1\nmass = 3.0\n[[bearings]]\nnode = 3\nstiffness = 5e5\n")
+    np.testing.assert_allclose(by_position.critical_speeds(3), by_node.critical_speeds(3), rtol=1e-12)
+
+
+def test_cutting_a_bare_segment_changes_nothing():
+    # H(l1 + l2) = H(l2) H(l1): a node without elements leaves the roots alone (1e-12).
+    whole = loads_driveline(SHAFT)
+    cut = loads_driveline(SHAFT + "[[masses]]\nposition = 0.9\nmass = 0.0\n")
+    assert len(cut.segments) == 3
+    np.testing.assert_allclose(cut.critical_speeds(3), whole.critical_speeds(3), rtol=1e-12)
+
+
+@pytest.mark.parametrize("table, fragment", [
+    ("[[masses]]\nposition = 1.5\nmass = 1.0\n", "masses[0].position = 1.5 m lies beyond the right end"),
+    ("[[masses]]\nposition = -0.1\nmass = 1.0\n", "masses[0].position must be >= 0"),
+    ("[[masses]]\nnode = 1\nposition = 0.6\nmass = 1.0\n", "masses[0]: give exactly one of 'node' or 'position'"),
+    ("[[hinges]]\nposition = 0.0\n", "hinges[0].position = 0.0 m must be an inner node"),
+    ("[[hinges]]\nnode = 0\n", "hinges[0].node = 0 must be an inner node"),
+    ("[[hinges]]\nnode = 2\n", "hinges[0].node = 2 must be an inner node"),
+    ("[[hinges]]\nnode = 1\nbending_stiffness = -1.0\n", "hinges[0].bending_stiffness"),
+    ("[[hinges]]\nnode = 1\nstiff = 1.0\n", "unknown key 'stiff'"),
+    ("[[hinges]]\nbending_stiffness = 1.0\n", "hinges[0]: give exactly one of 'node' or 'position'"),
+])
+def test_bad_point_tables_are_refused(table, fragment):
+    with pytest.raises(ValueError) as refused:
+        loads_driveline(SHAFT + table)
+    assert fragment in str(refused.value)
+
+
+def test_hinge_table_loads():
+    d = loads_driveline(SHAFT + "[[hinges]]\nnode = 1\nbending_stiffness = 50.0\n")
+    assert d.joints == (Hinge(1, 50.0),)

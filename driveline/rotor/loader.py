@@ -29,7 +29,8 @@ File layout (SI units; all tables except ``segments`` optional)::
     stiffness = 1.0e7            # N/m, isotropic; or kxx and kyy
 
     [[hinges]]                   # moment-free joint at an inner node (universal, tripod)
-    node = 2
+    position = 0.8               # m from the left end, instead of a node: the loader cuts the
+                                 # segment there (masses and bearings too)
     # bending_stiffness = 0.0    # N m/rad; > 0 makes it a rotational spring
 
 Every problem raises :class:`ValueError` naming the table, entry and key.
@@ -37,6 +38,7 @@ Every problem raises :class:`ValueError` naming the table, entry and key.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from importlib import resources
 from pathlib import Path
@@ -56,9 +58,9 @@ _SEGMENT_KEYS = {
     "wall_thickness", "material", "youngs_modulus", "density", "rotary_inertia",
     "gyroscopic", "shear", "poisson_ratio", "label",
 }
-_MASS_KEYS = {"node", "mass", "polar_inertia", "diametral_inertia", "label"}
-_BEARING_KEYS = {"node", "stiffness", "kxx", "kyy", "label"}
-_HINGE_KEYS = {"node", "bending_stiffness", "label"}
+_MASS_KEYS = {"node", "position", "mass", "polar_inertia", "diametral_inertia", "label"}
+_BEARING_KEYS = {"node", "position", "stiffness", "kxx", "kyy", "label"}
+_HINGE_KEYS = {"node", "position", "bending_stiffness", "label"}
 
 
 def _unknown(where: str, table: dict[str, Any], allowed: set[str]) -> None:
@@ -174,26 +176,72 @@ def _segment(i: int, t: dict[str, Any], mats: dict[str, tuple[float, float]]) ->
     return ShaftSegment(length, d_out, d_in, E, rho, **flags)
 
 
-def _mass(i: int, t: dict[str, Any]) -> ConcentratedMass:
+#: A position closer than this to a node [m] is that node (no sliver segment is cut).
+NODE_SNAP = 1e-9
+
+
+def _station(where: str, t: dict[str, Any], n_nodes: int) -> tuple[str, float]:
+    """``("node", k)`` or ``("position", z)`` of a point-element table (exactly one is given)."""
+    if ("node" in t) == ("position" in t):
+        raise ValueError(f"{where}: give exactly one of 'node' or 'position'")
+    if "node" in t:
+        node = _node(where, t["node"])
+        if node >= n_nodes:
+            raise ValueError(f"{where}.node = {node} is out of range: nodes are 0..{n_nodes - 1}")
+        return "node", node
+    return "position", _number(where, "position", t["position"])
+
+
+def _cut(segments: list[ShaftSegment], stations: dict[str, list[tuple[str, float]]]
+         ) -> tuple[list[ShaftSegment], dict[str, list[int]]]:
+    """Split the segments at every position that is not a node; return them and every table's node."""
+    ends = [0.0]
+    for seg in segments:
+        ends.append(ends[-1] + seg.length)
+    cuts: list[set[float]] = [set() for _ in segments]
+    for kind, entries in stations.items():
+        for i, (how, value) in enumerate(entries):
+            if how != "position":
+                continue
+            if value > ends[-1] + NODE_SNAP:
+                raise ValueError(f"{kind}[{i}].position = {value!r} m lies beyond the right end ({ends[-1]!r} m)")
+            k = min(range(len(segments)), key=lambda j: 0.0 if ends[j] <= value <= ends[j + 1] else math.inf)
+            if min(value - ends[k], ends[k + 1] - value) > NODE_SNAP:
+                cuts[k].add(value)
+    new_segments: list[ShaftSegment] = []
+    node_of_old, new_ends = [0], [0.0]
+    for seg, start, stop, inner in zip(segments, ends, ends[1:], cuts):
+        points = [start, *sorted(inner), stop]
+        for left, right in zip(points, points[1:]):
+            new_segments.append(seg if not inner else dataclasses.replace(seg, length=right - left))
+            new_ends.append(right)
+        node_of_old.append(len(new_segments))
+    nodes: dict[str, list[int]] = {}
+    for kind, entries in stations.items():
+        nodes[kind] = [
+            node_of_old[int(value)] if how == "node"
+            else min(range(len(new_ends)), key=lambda j: abs(new_ends[j] - value))
+            for how, value in entries
+        ]
+    return new_segments, nodes
+
+
+def _mass(i: int, t: dict[str, Any], node: int) -> ConcentratedMass:
     where = f"masses[{i}]"
     _unknown(where, t, _MASS_KEYS)
-    for k in ("node", "mass"):
-        if k not in t:
-            raise ValueError(f"{where}: missing key {k!r}")
+    if "mass" not in t:
+        raise ValueError(f"{where}: missing key 'mass'")
     return ConcentratedMass(
-        _node(where, t["node"]),
+        node,
         _number(where, "mass", t["mass"]),
         _number(where, "polar_inertia", t.get("polar_inertia", 0.0)),
         _number(where, "diametral_inertia", t.get("diametral_inertia", 0.0)),
     )
 
 
-def _bearing(i: int, t: dict[str, Any]) -> Bearing:
+def _bearing(i: int, t: dict[str, Any], node: int) -> Bearing:
     where = f"bearings[{i}]"
     _unknown(where, t, _BEARING_KEYS)
-    if "node" not in t:
-        raise ValueError(f"{where}: missing key 'node'")
-    node = _node(where, t["node"])
     if "stiffness" in t:
         if "kxx" in t or "kyy" in t:
             raise ValueError(f"{where}: give either 'stiffness' or 'kxx'/'kyy', not both")
@@ -205,12 +253,13 @@ def _bearing(i: int, t: dict[str, Any]) -> Bearing:
     return Bearing(node, kxx, kyy)
 
 
-def _hinge(i: int, t: dict[str, Any]) -> Hinge:
+def _hinge(i: int, t: dict[str, Any], node: int, n_nodes: int) -> Hinge:
     where = f"hinges[{i}]"
     _unknown(where, t, _HINGE_KEYS)
-    if "node" not in t:
-        raise ValueError(f"{where}: missing key 'node'")
-    return Hinge(_node(where, t["node"]), _number(where, "bending_stiffness", t.get("bending_stiffness", 0.0)))
+    if not 0 < node < n_nodes - 1:
+        at = f"node = {t['node']}" if "node" in t else f"position = {t['position']!r} m"
+        raise ValueError(f"{where}.{at} must be an inner node (1..{n_nodes - 2}), not an end")
+    return Hinge(node, _number(where, "bending_stiffness", t.get("bending_stiffness", 0.0)))
 
 
 def loads_driveline(text: str, source: str = "<string>") -> Driveline:
@@ -235,12 +284,14 @@ def loads_driveline(text: str, source: str = "<string>") -> Driveline:
     if not seg_tables:
         raise ValueError(f"{source}: at least one [[segments]] table is required")
     segments = [_segment(i, t, mats) for i, t in enumerate(seg_tables)]
-    masses = [_mass(i, t) for i, t in enumerate(_table_list(data, "masses"))]
-    bearings = [_bearing(i, t) for i, t in enumerate(_table_list(data, "bearings"))]
-    hinges = [_hinge(i, t) for i, t in enumerate(_table_list(data, "hinges"))]
-    for i, hinge in enumerate(hinges):
-        if not 0 < hinge.node < len(segments):
-            raise ValueError(f"hinges[{i}].node = {hinge.node} must be an inner node (1..{len(segments) - 1})")
+    tables = {kind: _table_list(data, kind) for kind in ("masses", "bearings", "hinges")}
+    stations = {kind: [_station(f"{kind}[{i}]", t, len(segments) + 1) for i, t in enumerate(items)]
+                for kind, items in tables.items()}
+    segments, nodes = _cut(segments, stations)
+    masses = [_mass(i, t, node) for i, (t, node) in enumerate(zip(tables["masses"], nodes["masses"]))]
+    bearings = [_bearing(i, t, node) for i, (t, node) in enumerate(zip(tables["bearings"], nodes["bearings"]))]
+    hinges = [_hinge(i, t, node, len(segments) + 1)
+              for i, (t, node) in enumerate(zip(tables["hinges"], nodes["hinges"]))]
     return Driveline(segments, masses, bearings, ends[0], ends[1], name, hinges)
 
 
