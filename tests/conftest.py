@@ -9,6 +9,7 @@ import pytest
 from fmpy import extract
 
 from fmu_harness import build
+from fmu_harness.build import native
 from fmu_harness.runner import FmuInstance
 
 FmuPath = Callable[..., Path]
@@ -19,6 +20,14 @@ def fmu_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A folder holding freshly built FMUs of all models (FMI 3.0 ones in ``fmi3/``)."""
     dest = tmp_path_factory.mktemp("models")
     build.build_all(dest)
+    return dest
+
+
+@pytest.fixture(scope="session")
+def native_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder holding the freshly built native FMUs (``native/``, ``native/fmi3/``)."""
+    dest = tmp_path_factory.mktemp("native_models")
+    native.build_all(dest)
     return dest
 
 

@@ -16,8 +16,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from driveline.catalog import MODELS
+from driveline.model import SteppedModel
 from driveline.variables import Variable
-from fmu_harness.runner import StepRefused
+from fmu_harness.runner import FmuInstance, StepRefused
 
 INT32 = (-(2**31), 2**31 - 1)
 NON_FINITE = (math.nan, math.inf, -math.inf)
@@ -76,34 +77,43 @@ def _runs(draw: st.DrawFn, model_name: str) -> Run:
     return parameters, steps
 
 
+def run_alongside_the_core(fmu: FmuInstance, model_class: type[SteppedModel], run: Run) -> tuple[list, list]:
+    """Drive ``fmu`` and a fresh core of ``model_class`` through ``run`` in step. A step must be
+    refused by both, with the core's reasons logged as Discard, or by neither; returns the outputs
+    after each accepted step, the FMU's and the core's."""
+    parameters, steps = run
+    outputs = [v.name for v in model_class.spec.of("output")]
+    core = model_class()
+    for name, value in parameters.items():
+        setattr(core, name, value)
+    fmu.initialize(parameters)
+    core.initialize(0.0)
+    fmu_rows, core_rows = [], []
+    for inputs, step_size in steps:
+        fmu.set(inputs)
+        for name, value in inputs.items():
+            setattr(core, name, value)
+        errors = core.step(fmu.time, step_size)
+        if errors:
+            with pytest.raises(StepRefused) as refused:
+                fmu.step(step_size)
+            assert refused.value.status == "Discard"
+            assert refused.value.messages == errors
+        else:
+            fmu.step(step_size)
+            fmu_rows.append(fmu.get(outputs))
+            core_rows.append([getattr(core, name) for name in outputs])
+    return fmu_rows, core_rows
+
+
 # huge but finite values overflow to inf inside numpy on the way to a refused step
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
 def test_random_runs_match_the_core_and_bad_values_are_refused(model_name, fmi, open_fmu):
-    model_class = MODELS[model_name]
-    outputs = [v.name for v in model_class.spec.of("output")]
-
     @settings(max_examples=40, deadline=None)
     @given(run=_runs(model_name))
     def check(run: Run) -> None:
-        parameters, steps = run
-        core = model_class()
-        for name, value in parameters.items():
-            setattr(core, name, value)
         with open_fmu(model_name, fmi) as fmu:
-            fmu.initialize(parameters)
-            core.initialize(0.0)
-            for inputs, step_size in steps:
-                fmu.set(inputs)
-                for name, value in inputs.items():
-                    setattr(core, name, value)
-                errors = core.step(fmu.time, step_size)
-                if errors:
-                    with pytest.raises(StepRefused) as refused:
-                        fmu.step(step_size)
-                    assert refused.value.status == "Discard"
-                    assert refused.value.messages == errors
-                else:
-                    fmu.step(step_size)
-                    assert fmu.get(outputs) == [getattr(core, name) for name in outputs]
+            fmu_rows, core_rows = run_alongside_the_core(fmu, MODELS[model_name], run)
+        assert fmu_rows == core_rows
 
     check()

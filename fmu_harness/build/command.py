@@ -4,7 +4,8 @@ Usage: ``driveline-fmus build [--dest models] [--fmi 2 3] [--no-references] [NAM
 ``python build_fmu.py ...``). Every model of ``driveline.catalog.MODELS`` becomes one FMU per
 FMI version (:mod:`.fmu`). Then the FMI Cross-Check reference results are written next to
 each FMU (:mod:`fmu_harness.crosscheck`) and, once its FMI 2.0 FMUs are there, the driveline
-system's SSP package (:mod:`fmu_harness.system`).
+system's SSP package (:mod:`fmu_harness.system`). The native (C) FMUs of the models with a C port
+go to ``native/`` and ``native/fmi3/`` below ``--dest`` (:mod:`.native`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 from driveline.catalog import MODELS
 
 from .. import crosscheck, system
+from . import native
 from .fmu import FMI_VERSIONS, build_all
 
 
@@ -29,6 +31,7 @@ def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Pa
     paths = []
     for fmu in build_all(args.dest, args.names or None, tuple(args.fmi)):
         paths += [fmu] + ([] if args.no_references else crosscheck.write(fmu))
+    paths += native.build_all(args.dest, args.names or None, tuple(args.fmi))
     driveline = system.driveline()
     if all((args.dest / f"{c.model}.fmu").exists() for c in driveline.components):
         paths.append(system.write_ssp(driveline, args.dest))

@@ -1,0 +1,292 @@
+"""Native (C) co-simulation FMUs, FMI 2.0 and 3.0, generated from the same specs as the Python FMUs.
+
+A model is native when ``fmu_src/native/<model_in_snake_case>.c`` ports its physics; the
+others are skipped. For each native model and FMI version this module
+
+* generates ``model_variables.h``/``.c`` from the spec: the variable table (value reference =
+  position in the spec, as in the Python FMUs) and the range checks' messages, cut from
+  :meth:`driveline.model.SteppedModel._range_error` itself so the wording exists once;
+* generates the model description with the Python FMUs' own completion
+  (:mod:`model_description`: units, display units, min/max, descriptions, model structure), so a
+  host can swap one FMU for the other, plus the sources the FMU carries (FMI 2.0 ``SourceFiles``,
+  FMI 3.0 ``sources/buildDescription.xml``);
+* compiles the shared library with the machine's C compiler (``cc``, or ``$CC``) and the FMI
+  headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU.
+
+FMI 2.0 FMUs land in ``<dest>/native/``, FMI 3.0 ones in ``<dest>/native/fmi3/``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import uuid
+import xml.etree.ElementTree as ET
+import zipfile
+from pathlib import Path
+from types import SimpleNamespace
+
+import fmpy
+
+import fmu_src
+from driveline import __version__
+from driveline.catalog import MODELS
+from driveline.model import SteppedModel
+from driveline.variables import ModelSpec, Variable
+
+from .model_description import complete_fmi2, complete_fmi3
+
+NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
+MODEL_SOURCES = NATIVE_SRC
+SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c")
+LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
+SUBDIR = {"2": "native", "3": "native/fmi3"}
+CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-fPIC", "-O2", "-fvisibility=hidden")
+TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
+LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
+_MARK = "\x00VALUE\x00"
+
+
+def snake_case(name: str) -> str:
+    """``CardanJoint`` -> ``cardan_joint``: the model file's name."""
+    return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
+
+
+def model_source(name: str) -> Path:
+    return MODEL_SOURCES / f"{snake_case(name)}.c"
+
+
+def native_models() -> list[str]:
+    """The catalog models with a C port, in catalog order."""
+    return [name for name in MODELS if model_source(name).exists()]
+
+
+def fmu_path(dest: Path, name: str, fmi: str = "2") -> Path:
+    """Where :func:`build` puts the native FMU of ``name`` for FMI version ``fmi``."""
+    return dest / SUBDIR[fmi] / f"{name}.fmu"
+
+
+def fmi_headers() -> Path:
+    """The FMI 2.0 and 3.0 headers shipped with fmpy."""
+    return Path(fmpy.__file__).parent / "c-code"
+
+
+# -- the variable table in C --------------------------------------------------------------------
+
+
+class _Marked(float):
+    """A float whose repr is a mark: probes where a check puts the value in its message."""
+
+    def __repr__(self) -> str:
+        return _MARK
+
+
+class _MarkedInt(int):
+    def __repr__(self) -> str:
+        return _MARK
+
+
+def _message_parts(variable: Variable, value: float) -> tuple[str, str]:
+    """The range check's message for ``value``, split around the value."""
+    marked = _MarkedInt(value) if variable.type == "Integer" else _Marked(value)
+    message = SteppedModel._range_error(SimpleNamespace(**{variable.name: marked}), variable)
+    if message is None or message.count(_MARK) != 1:
+        raise ValueError(f"{variable.name}: the range check gave no message for {value!r}")
+    before, after = message.split(_MARK)
+    return before, after
+
+
+def _c_string(text: str) -> str:
+    escaped = text.replace("\\", "\\\\").replace('"', '\\"')
+    if any(ord(c) < 32 or ord(c) > 126 for c in escaped):
+        raise ValueError(f"not plain ASCII: {text!r}")
+    return f'"{escaped}"'
+
+
+def _c_double(value: float) -> str:
+    return repr(float(value)) if math.isfinite(value) else ("HUGE_VAL" if value > 0 else "-HUGE_VAL")
+
+
+def _table_entry(variable: Variable) -> str:
+    if variable.type not in ("Real", "Integer"):
+        raise ValueError(f"{variable.name}: the native FMUs hold Real and Integer variables only")
+    step = (lambda x, d: x + d) if variable.type == "Integer" else (lambda x, d: math.nextafter(x, d * math.inf))
+    not_finite = _message_parts(variable, math.nan) if variable.type == "Real" else ("", "")
+    below = _message_parts(variable, step(variable.min, -1)) if variable.min is not None else ("", "")
+    above = _message_parts(variable, step(variable.max, 1)) if variable.max is not None else ("", "")
+    parts = ", ".join("{" + ", ".join(_c_string(p) for p in pair) + "}" for pair in (not_finite, below, above))
+    return (
+        f"    {{{_c_string(variable.name)}, VAR_{variable.type.upper()}, CAUSALITY_{variable.causality.upper()}, "
+        f"{int(variable.effective_variability == 'tunable')}, {_c_double(float(variable.start))}, "
+        f"{int(variable.min is not None)}, {int(variable.max is not None)}, "
+        f"{_c_double(variable.min if variable.min is not None else 0.0)}, "
+        f"{_c_double(variable.max if variable.max is not None else 0.0)}, {parts}}},"
+    )
+
+
+def variable_table(spec: ModelSpec, token: str) -> dict[str, str]:
+    """``model_variables.h`` and ``model_variables.c`` of ``spec``."""
+    names = "\n".join(f"    V_{v.name} = {index}," for index, v in enumerate(spec.variables))
+    header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
+#ifndef MODEL_VARIABLES_H
+#define MODEL_VARIABLES_H
+
+#define MODEL_NAME {_c_string(spec.name)}
+#define MODEL_TOKEN {_c_string(token)}
+#define MODEL_VARIABLE_COUNT {len(spec.variables)}
+
+/* value references */
+enum {{
+{names}
+}};
+
+#endif
+"""
+    entries = "\n".join(_table_entry(v) for v in spec.variables)
+    source = f"""/* Variable table and range-check messages of {spec.name}, generated from its spec: do not edit. */
+#include <math.h>
+
+#include "fmu_instance.h"
+
+const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
+{entries}
+}};
+"""
+    return {"model_variables.h": header, "model_variables.c": source}
+
+
+# -- model description ----------------------------------------------------------------------------
+
+
+def _number(value: float | int) -> str:
+    return repr(float(value)) if isinstance(value, float) else str(value)
+
+
+def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.Element:
+    """The description before :mod:`model_description` completes it (as pythonfmu's is)."""
+    fmi3 = fmi == "3"
+    experiment = spec.default_experiment
+    root = ET.Element("fmiModelDescription", {
+        "fmiVersion": "3.0" if fmi3 else "2.0", "modelName": spec.name,
+        ("instantiationToken" if fmi3 else "guid"): token, "description": spec.description,
+        "author": "driveline-fmus contributors", "license": "MIT", "version": __version__,
+        "generationTool": "driveline-fmus native build", "variableNamingConvention": "structured",
+    })
+    state = "State" if fmi3 else "state"
+    cosimulation = ET.SubElement(root, "CoSimulation", {
+        "modelIdentifier": spec.name, "needsExecutionTool": "false", "canHandleVariableCommunicationStepSize": "true",
+        "canBeInstantiatedOnlyOncePerProcess": "false", f"canGetAndSetFMU{state}": "true",
+        f"canSerializeFMU{state}": "true",
+        **({} if fmi3 else {"canInterpolateInputs": "false", "canNotUseMemoryManagementFunctions": "true"}),
+    })
+    if not fmi3:
+        files = ET.SubElement(cosimulation, "SourceFiles")
+        files.extend(ET.Element("File", name=name) for name in sources)
+    categories = ET.SubElement(root, "LogCategories")
+    for status in LOG_CATEGORIES:
+        ET.SubElement(categories, "Category", name=f"logStatus{status}",
+                      description=f"Log messages with fmi{fmi}{status} status.")
+    ET.SubElement(categories, "Category", name="logAll", description="Log all messages.")
+    ET.SubElement(root, "DefaultExperiment", {
+        "startTime": repr(experiment.start_time), "stopTime": repr(experiment.stop_time),
+        "stepSize": repr(experiment.step_size),
+        **({"tolerance": repr(experiment.tolerance)} if experiment.tolerance is not None else {}),
+    })
+    variables = ET.SubElement(root, "ModelVariables")
+    for reference, v in enumerate(spec.variables):
+        attributes = {"name": v.name, "valueReference": str(reference), "causality": v.causality,
+                      "variability": v.effective_variability}
+        start = {} if v.causality == "output" else {"start": _number(v.start)}
+        if fmi3:
+            ET.SubElement(variables, "Float64" if v.type == "Real" else "Int32", {**attributes, **start})
+        else:
+            ET.SubElement(ET.SubElement(variables, "ScalarVariable", attributes), v.type, start)
+    if fmi3:
+        ET.SubElement(variables, "Float64", name="time", valueReference=str(len(spec.variables)),
+                      causality="independent", variability="continuous", description="Simulation time")
+    ET.SubElement(root, "ModelStructure")
+    return root
+
+
+def model_description(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> bytes:
+    skeleton = ET.tostring(_skeleton(spec, fmi, token, sources), encoding="UTF-8", xml_declaration=True)
+    return (complete_fmi3 if fmi == "3" else complete_fmi2)(skeleton, spec)
+
+
+def build_description(name: str, sources: list[str]) -> bytes:
+    """FMI 3.0 ``sources/buildDescription.xml``: the C sources and their language."""
+    root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
+    configuration = ET.SubElement(root, "BuildConfiguration", modelIdentifier=name)
+    files = ET.SubElement(configuration, "SourceFileSet", language="C99")
+    files.extend(ET.Element("SourceFile", name=source) for source in sources)
+    ET.indent(root)
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+# -- build ------------------------------------------------------------------------------------------
+
+
+def compiler() -> str:
+    found = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    if not found:
+        raise RuntimeError("the native FMUs need a C compiler (cc or gcc; Debian: apt-get install gcc)")
+    return found
+
+
+def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
+    """Every source file the FMU carries, by name, with the token computed from all of them."""
+    files = {source: (NATIVE_SRC / source).read_bytes() for source in (*SHARED_SOURCES, LAYER[fmi])}
+    files[model_file.name] = model_file.read_bytes()
+    spec = MODELS[name].spec
+    untokened = variable_table(spec, "")
+    digest = hashlib.sha256(repr((name, fmi, sorted(files.items()), sorted(untokened.items()))).encode())
+    token = str(uuid.uuid5(TOKEN_NAMESPACE, digest.hexdigest()))
+    files.update({key: text.encode() for key, text in variable_table(spec, token).items()})
+    files["token"] = token.encode()
+    return files
+
+
+def build(name: str, dest: Path, fmi: str = "2", model_file: Path | None = None) -> Path:
+    """Build the native FMU of catalog model ``name`` for FMI ``fmi`` under ``dest``.
+
+    ``model_file`` replaces the model's C port (the benchmarks' no-physics twin)."""
+    spec = MODELS[name].spec
+    files = _sources(name, fmi, model_file or model_source(name))
+    token = files.pop("token").decode()
+    compiled = sorted(source for source in files if source.endswith(".c"))
+    platform = fmpy.platform_tuple if fmi == "3" else fmpy.platform
+    target = fmu_path(dest, name, fmi)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as work:
+        sources = Path(work) / "sources"
+        sources.mkdir()
+        for source, data in files.items():
+            (sources / source).write_bytes(data)
+        library = Path(work) / f"{name}.so"
+        command = [compiler(), *CFLAGS, "-shared", "-I", str(sources), "-I", str(fmi_headers()),
+                   *[str(sources / source) for source in compiled], "-o", str(library), "-lm"]
+        done = subprocess.run(command, capture_output=True, text=True)
+        if done.returncode:
+            raise RuntimeError(f"compiling the native {name} FMU failed:\n{done.stderr}")
+        members = {
+            "modelDescription.xml": model_description(spec, fmi, token, compiled),
+            f"binaries/{platform}/{name}.so": library.read_bytes(),
+            **{f"sources/{source}": data for source, data in files.items()},
+        }
+        if fmi == "3":
+            members["sources/buildDescription.xml"] = build_description(name, compiled)
+        with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
+            for member, data in members.items():
+                archive.writestr(member, data)
+    return target
+
+
+def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] = ("2", "3")) -> list[Path]:
+    """The native FMUs of ``names`` (default: every model with a C port) that have one."""
+    chosen = [name for name in (names or native_models()) if model_source(name).exists()]
+    return [build(name, dest, version) for version in fmi for name in chosen]

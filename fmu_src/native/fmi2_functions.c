@@ -1,0 +1,283 @@
+/* FMI 2.0 co-simulation entry points over the shared core (fmu_instance.c).
+ *
+ * Calls out of sequence, unknown value references, wrong types and bad FMU states return
+ * fmi2Error with a logged reason (the instance then accepts only get, reset, free and set FMU
+ * state, as the standard says); a refused step returns fmi2Discard with the model unchanged and
+ * the host may correct its inputs and step again (fmi2Terminated stays false). Messages reach
+ * the logger as data: its format argument is always "%s".
+ */
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "fmu_instance.h"
+
+/* The instance behind the handle; a NULL handle gets ``result`` (there is no logger to tell). */
+#define INSTANCE(c, result)                                                                                     \
+    Instance *instance = (Instance *)(c);                                                                      \
+    if (instance == NULL) {                                                                                     \
+        return result;                                                                                          \
+    }
+
+static void emit(const Instance *instance, Status status, const char *category, const char *message)
+{
+    fmi2CallbackLogger logger = (fmi2CallbackLogger)instance->host_logger;
+    if (logger != NULL) {
+        logger(instance->host_environment, instance->name, (fmi2Status)status, category, "%s", message);
+    }
+}
+
+const char *fmi2GetTypesPlatform(void)
+{
+    return fmi2TypesPlatform;
+}
+
+const char *fmi2GetVersion(void)
+{
+    return fmi2Version;
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation UNUSED, const fmi2CallbackFunctions *functions,
+                              fmi2Boolean visible UNUSED, fmi2Boolean loggingOn UNUSED)
+{
+    void (*logger)(void) = functions != NULL ? (void (*)(void))functions->logger : NULL;
+    void *environment = functions != NULL ? functions->componentEnvironment : NULL;
+    /* fmuResourceLocation: these models need no resources */
+    if (fmuType != fmi2CoSimulation) {
+        if (logger != NULL) {
+            ((fmi2CallbackLogger)logger)(environment, instanceName ? instanceName : "", fmi2Error, "logStatusError",
+                                         "%s", "fmi2Instantiate: this FMU offers co-simulation only");
+        }
+        return NULL;
+    }
+    return instance_new(instanceName, fmuGUID, "fmi2", emit, logger, environment);
+}
+
+void fmi2FreeInstance(fmi2Component c)
+{
+    instance_free((Instance *)c);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn UNUSED, size_t nCategories,
+                               const fmi2String categories[])
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined UNUSED, fmi2Real tolerance UNUSED,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined UNUSED, fmi2Real stopTime UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_INSTANTIATED), "SetupExperiment")) {
+        return fmi2Error;
+    }
+    instance->start_time = startTime;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+{
+    INSTANCE(c, fmi2Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_INSTANTIATED), "EnterInitializationMode")) {
+        return fmi2Error;
+    }
+    instance->mode = MODE_INITIALIZATION;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+    INSTANCE(c, fmi2Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_INITIALIZATION), "ExitInitializationMode")) {
+        return fmi2Error;
+    }
+    return (fmi2Status)instance_exit_initialization(instance);
+}
+
+fmi2Status fmi2Terminate(fmi2Component c)
+{
+    INSTANCE(c, fmi2Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "Terminate")) {
+        return fmi2Error;
+    }
+    instance->mode = MODE_TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c)
+{
+    INSTANCE(c, fmi2Error)
+    instance_reset(instance);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_get_real(instance, "GetReal", vr, nvr, value);
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[])
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_get_integer(instance, "GetInteger", vr, nvr, value);
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[] UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_no_variables_of(instance, "GetBoolean", vr, nvr, "Boolean", 0);
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[] UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_no_variables_of(instance, "GetString", vr, nvr, "String", 0);
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[])
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_set_real(instance, "SetReal", vr, nvr, value);
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[])
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_set_integer(instance, "SetInteger", vr, nvr, value);
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Boolean value[] UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_no_variables_of(instance, "SetBoolean", vr, nvr, "Boolean", 1);
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[] UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_no_variables_of(instance, "SetString", vr, nvr, "String", 1);
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)state_get(instance, "GetFMUstate", FMUstate);
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)state_set(instance, "SetFMUstate", FMUstate);
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)state_free(instance, "FreeFMUstate", FMUstate);
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate UNUSED, size_t *size)
+{
+    INSTANCE(c, fmi2Error)
+    if (size == NULL) {
+        return (fmi2Status)instance_fail(instance, "fmi2SerializedFMUstateSize: null size pointer",
+                (const char *)NULL);
+    }
+    *size = state_serialized_size();
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)state_serialize(instance, "SerializeFMUstate", FMUstate, serializedState, size);
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *FMUstate)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)state_deserialize(instance, "DeSerializeFMUstate", serializedState, size, FMUstate);
+}
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[] UNUSED,
+                                        size_t nUnknown UNUSED,
+                                        const fmi2ValueReference vKnown_ref[] UNUSED, size_t nKnown UNUSED,
+                                        const fmi2Real dvKnown[] UNUSED, fmi2Real dvUnknown[] UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_unsupported(instance, "GetDirectionalDerivative");
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                       const fmi2Integer order[] UNUSED, const fmi2Real value[] UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_unsupported(instance, "SetRealInputDerivatives");
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                        const fmi2Integer order[] UNUSED, fmi2Real value[] UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_unsupported(instance, "GetRealOutputDerivatives");
+}
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                      fmi2Boolean noSetFMUStatePriorToCurrentPoint UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "DoStep")) {
+        return fmi2Error;
+    }
+    return (fmi2Status)instance_do_step(instance, currentCommunicationPoint, communicationStepSize);
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    INSTANCE(c, fmi2Error)
+    return (fmi2Status)instance_unsupported(instance, "CancelStep");
+}
+
+/* Only what the standard defines for a finished step is available: the last successful time and
+ * fmi2Terminated (always false: a refused step is retryable); any other query gets fmi2Discard. */
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s UNUSED, fmi2Status *value UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
+{
+    INSTANCE(c, fmi2Error)
+    if (s != fmi2LastSuccessfulTime || value == NULL) {
+        return fmi2Discard;
+    }
+    *value = instance->data.time;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s UNUSED, fmi2Integer *value UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
+{
+    INSTANCE(c, fmi2Error)
+    if (s != fmi2Terminated || value == NULL) {
+        return fmi2Discard;
+    }
+    *value = fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s UNUSED, fmi2String *value UNUSED)
+{
+    INSTANCE(c, fmi2Error)
+    return fmi2Discard;
+}

@@ -1,0 +1,532 @@
+/* FMI 3.0 co-simulation entry points over the shared core (fmu_instance.c).
+ *
+ * The model is initialised at the startTime given to fmi3EnterInitializationMode. Misuse returns
+ * fmi3Error with a logged reason (the instance then accepts only get, reset, free and set FMU
+ * state); a refused step returns fmi3Discard with the model unchanged, lastSuccessfulTime =
+ * currentCommunicationPoint and terminateSimulation false. The independent variable ``time``
+ * has the value reference after the spec's variables. Functions of the model exchange and
+ * scheduled execution interfaces, clocks, event mode and derivatives are exported, as the
+ * standard requires, and return fmi3Error (instantiation: NULL).
+ */
+#include <stddef.h>
+
+#include "fmi3Functions.h"
+#include "fmu_instance.h"
+
+/* The instance behind the handle; a NULL handle gets ``result`` (there is no logger to tell). */
+#define INSTANCE(c, result)                                                                                     \
+    Instance *instance = (Instance *)(c);                                                                      \
+    if (instance == NULL) {                                                                                     \
+        return result;                                                                                          \
+    }
+
+static void emit(const Instance *instance, Status status, const char *category, const char *message)
+{
+    fmi3LogMessageCallback logger = (fmi3LogMessageCallback)instance->host_logger;
+    if (logger != NULL) {
+        logger(instance->host_environment, (fmi3Status)status, category, message);
+    }
+}
+
+/* Scalar variables only: one value per value reference. */
+static int counts_match(Instance *instance, const char *function, size_t nvr, size_t nValues)
+{
+    if (nvr != nValues) {
+        instance_fail(instance, "fmi3", function, ": nValues differs from nValueReferences (scalar variables only)",
+                      (const char *)NULL);
+        return 0;
+    }
+    return 1;
+}
+
+const char *fmi3GetVersion(void)
+{
+    return fmi3Version;
+}
+
+fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean loggingOn UNUSED, size_t nCategories,
+                               const fmi3String categories[])
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories);
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName UNUSED, fmi3String instantiationToken UNUSED,
+                                          fmi3String resourcePath UNUSED, fmi3Boolean visible UNUSED,
+                                          fmi3Boolean loggingOn UNUSED,
+                                          fmi3InstanceEnvironment instanceEnvironment,
+                                          fmi3LogMessageCallback logMessage)
+{
+    if (logMessage != NULL) {
+        logMessage(instanceEnvironment, fmi3Error, "logStatusError",
+                   "fmi3InstantiateModelExchange: this FMU offers co-simulation only");
+    }
+    return NULL;
+}
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
+                                         fmi3String resourcePath UNUSED, fmi3Boolean visible UNUSED,
+                                         fmi3Boolean loggingOn UNUSED,
+                                         fmi3Boolean eventModeUsed UNUSED, fmi3Boolean earlyReturnAllowed UNUSED,
+                                         const fmi3ValueReference requiredIntermediateVariables[] UNUSED,
+                                         size_t nRequiredIntermediateVariables UNUSED,
+                                         fmi3InstanceEnvironment instanceEnvironment,
+                                         fmi3LogMessageCallback logMessage,
+                                         fmi3IntermediateUpdateCallback intermediateUpdate UNUSED)
+{
+    /* resourcePath: these models need no resources; eventModeUsed: they have no clocks or events;
+     * loggingOn: every message has status Error and is always logged */
+    return instance_new(instanceName, instantiationToken, "fmi3", emit, (void (*)(void))logMessage,
+                        instanceEnvironment);
+}
+
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName UNUSED, fmi3String instantiationToken UNUSED,
+                                               fmi3String resourcePath UNUSED, fmi3Boolean visible UNUSED,
+                                               fmi3Boolean loggingOn UNUSED,
+                                               fmi3InstanceEnvironment instanceEnvironment,
+                                               fmi3LogMessageCallback logMessage,
+                                               fmi3ClockUpdateCallback clockUpdate UNUSED,
+                                               fmi3LockPreemptionCallback lockPreemption UNUSED,
+                                               fmi3UnlockPreemptionCallback unlockPreemption UNUSED)
+{
+    if (logMessage != NULL) {
+        logMessage(instanceEnvironment, fmi3Error, "logStatusError",
+                   "fmi3InstantiateScheduledExecution: this FMU offers co-simulation only");
+    }
+    return NULL;
+}
+
+void fmi3FreeInstance(fmi3Instance c)
+{
+    instance_free((Instance *)c);
+}
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefined UNUSED,
+                                       fmi3Float64 tolerance UNUSED,
+                                       fmi3Float64 startTime, fmi3Boolean stopTimeDefined UNUSED,
+                                       fmi3Float64 stopTime UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_INSTANTIATED), "EnterInitializationMode")) {
+        return fmi3Error;
+    }
+    instance->start_time = startTime;
+    instance->data.time = startTime;
+    instance->mode = MODE_INITIALIZATION;
+    return fmi3OK;
+}
+
+fmi3Status fmi3ExitInitializationMode(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_INITIALIZATION), "ExitInitializationMode")) {
+        return fmi3Error;
+    }
+    return (fmi3Status)instance_exit_initialization(instance);
+}
+
+fmi3Status fmi3EnterEventMode(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "EnterEventMode");
+}
+
+fmi3Status fmi3Terminate(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "Terminate")) {
+        return fmi3Error;
+    }
+    instance->mode = MODE_TERMINATED;
+    return fmi3OK;
+}
+
+fmi3Status fmi3Reset(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    instance_reset(instance);
+    return fmi3OK;
+}
+
+/* ---- values ------------------------------------------------------------------------------- */
+
+fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
+                          size_t nValues)
+{
+    INSTANCE(c, fmi3Error)
+    if (!counts_match(instance, "GetFloat64", nvr, nValues)) {
+        return fmi3Error;
+    }
+    return (fmi3Status)instance_get_real(instance, "GetFloat64", vr, nvr, values);
+}
+
+fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
+                          size_t nValues)
+{
+    INSTANCE(c, fmi3Error)
+    if (!counts_match(instance, "SetFloat64", nvr, nValues)) {
+        return fmi3Error;
+    }
+    return (fmi3Status)instance_set_real(instance, "SetFloat64", vr, nvr, values);
+}
+
+fmi3Status fmi3GetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 values[], size_t nValues)
+{
+    INSTANCE(c, fmi3Error)
+    if (!counts_match(instance, "GetInt32", nvr, nValues)) {
+        return fmi3Error;
+    }
+    return (fmi3Status)instance_get_integer(instance, "GetInt32", vr, nvr, values);
+}
+
+fmi3Status fmi3SetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 values[],
+                        size_t nValues)
+{
+    INSTANCE(c, fmi3Error)
+    if (!counts_match(instance, "SetInt32", nvr, nValues)) {
+        return fmi3Error;
+    }
+    return (fmi3Status)instance_set_integer(instance, "SetInt32", vr, nvr, values);
+}
+
+/* The types no variable of these models has: every reference is refused by name. */
+#define NO_VARIABLES_OF(Type, CType)                                                                                \
+    fmi3Status fmi3Get##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, CType values[] UNUSED,      \
+                             size_t nValues)                                                                        \
+    {                                                                                                               \
+        INSTANCE(c, fmi3Error)                                                                                      \
+        if (!counts_match(instance, "Get" #Type, nvr, nValues)) {                                                   \
+            return fmi3Error;                                                                                       \
+        }                                                                                                           \
+        return (fmi3Status)instance_no_variables_of(instance, "Get" #Type, vr, nvr, #Type, 0);                      \
+    }                                                                                                               \
+    fmi3Status fmi3Set##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,                             \
+                             const CType values[] UNUSED, size_t nValues)                                           \
+    {                                                                                                               \
+        INSTANCE(c, fmi3Error)                                                                                      \
+        if (!counts_match(instance, "Set" #Type, nvr, nValues)) {                                                   \
+            return fmi3Error;                                                                                       \
+        }                                                                                                           \
+        return (fmi3Status)instance_no_variables_of(instance, "Set" #Type, vr, nvr, #Type, 1);                      \
+    }
+
+NO_VARIABLES_OF(Float32, fmi3Float32)
+NO_VARIABLES_OF(Int8, fmi3Int8)
+NO_VARIABLES_OF(UInt8, fmi3UInt8)
+NO_VARIABLES_OF(Int16, fmi3Int16)
+NO_VARIABLES_OF(UInt16, fmi3UInt16)
+NO_VARIABLES_OF(UInt32, fmi3UInt32)
+NO_VARIABLES_OF(Int64, fmi3Int64)
+NO_VARIABLES_OF(UInt64, fmi3UInt64)
+NO_VARIABLES_OF(Boolean, fmi3Boolean)
+NO_VARIABLES_OF(String, fmi3String)
+
+fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, size_t valueSizes[] UNUSED,
+                         fmi3Binary values[] UNUSED, size_t nValues UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_no_variables_of(instance, "GetBinary", vr, nvr, "Binary", 0);
+}
+
+fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const size_t valueSizes[] UNUSED,
+                         const fmi3Binary values[] UNUSED, size_t nValues UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_no_variables_of(instance, "SetBinary", vr, nvr, "Binary", 1);
+}
+
+fmi3Status fmi3GetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_no_variables_of(instance, "GetClock", vr, nvr, "Clock", 0);
+}
+
+fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_no_variables_of(instance, "SetClock", vr, nvr, "Clock", 1);
+}
+
+/* ---- FMU state ---------------------------------------------------------------------------- */
+
+fmi3Status fmi3GetFMUState(fmi3Instance c, fmi3FMUState *FMUState)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)state_get(instance, "GetFMUState", FMUState);
+}
+
+fmi3Status fmi3SetFMUState(fmi3Instance c, fmi3FMUState FMUState)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)state_set(instance, "SetFMUState", FMUState);
+}
+
+fmi3Status fmi3FreeFMUState(fmi3Instance c, fmi3FMUState *FMUState)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)state_free(instance, "FreeFMUState", FMUState);
+}
+
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance c, fmi3FMUState FMUState UNUSED, size_t *size)
+{
+    INSTANCE(c, fmi3Error)
+    if (size == NULL) {
+        return (fmi3Status)instance_fail(instance, "fmi3SerializedFMUStateSize: null size pointer",
+                (const char *)NULL);
+    }
+    *size = state_serialized_size();
+    return fmi3OK;
+}
+
+fmi3Status fmi3SerializeFMUState(fmi3Instance c, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)state_serialize(instance, "SerializeFMUState", FMUState, (char *)serializedState, size);
+}
+
+fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte serializedState[], size_t size,
+                                   fmi3FMUState *FMUState)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)state_deserialize(instance, "DeserializeFMUState", (const char *)serializedState, size,
+                                         FMUState);
+}
+
+/* ---- stepping ----------------------------------------------------------------------------- */
+
+fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
+                      fmi3Boolean noSetFMUStatePriorToCurrentPoint UNUSED, fmi3Boolean *eventHandlingNeeded,
+                      fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime)
+{
+    Status status;
+    INSTANCE(c, fmi3Error)
+    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "DoStep")) {
+        return fmi3Error;
+    }
+    if (eventHandlingNeeded == NULL || terminateSimulation == NULL || earlyReturn == NULL ||
+        lastSuccessfulTime == NULL) {
+        return (fmi3Status)instance_fail(instance, "fmi3DoStep: null output argument", (const char *)NULL);
+    }
+    status = instance_do_step(instance, currentCommunicationPoint, communicationStepSize);
+    *eventHandlingNeeded = fmi3False;
+    *terminateSimulation = fmi3False;
+    *earlyReturn = fmi3False;
+    *lastSuccessfulTime = status == STATUS_OK ? instance->data.time : currentCommunicationPoint;
+    return (fmi3Status)status;
+}
+
+/* ---- what a co-simulation FMU without events, clocks or derivatives does not offer ----------- */
+
+fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance c, fmi3ValueReference valueReference UNUSED,
+                                               size_t *nDependencies UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetNumberOfVariableDependencies");
+}
+
+fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference dependent UNUSED,
+                                       size_t elementIndicesOfDependent[] UNUSED,
+                                       fmi3ValueReference independents[] UNUSED,
+                                       size_t elementIndicesOfIndependents[] UNUSED,
+                                       fmi3DependencyKind dependencyKinds[] UNUSED,
+                                       size_t nDependencies UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetVariableDependencies");
+}
+
+fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[] UNUSED,
+                                        size_t nUnknowns UNUSED,
+                                        const fmi3ValueReference knowns[] UNUSED, size_t nKnowns UNUSED,
+                                        const fmi3Float64 seed[] UNUSED,
+                                        size_t nSeed UNUSED, fmi3Float64 sensitivity[] UNUSED,
+                                        size_t nSensitivity UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetDirectionalDerivative");
+}
+
+fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unknowns[] UNUSED,
+                                    size_t nUnknowns UNUSED,
+                                    const fmi3ValueReference knowns[] UNUSED, size_t nKnowns UNUSED,
+                                    const fmi3Float64 seed[] UNUSED,
+                                    size_t nSeed UNUSED, fmi3Float64 sensitivity[] UNUSED, size_t nSensitivity UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetAdjointDerivative");
+}
+
+fmi3Status fmi3EnterConfigurationMode(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "EnterConfigurationMode");
+}
+
+fmi3Status fmi3ExitConfigurationMode(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "ExitConfigurationMode");
+}
+
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                  fmi3Float64 intervals[] UNUSED,
+                                  fmi3IntervalQualifier qualifiers[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetIntervalDecimal");
+}
+
+fmi3Status fmi3GetIntervalFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                   fmi3UInt64 counters[] UNUSED,
+                                   fmi3UInt64 resolutions[] UNUSED, fmi3IntervalQualifier qualifiers[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetIntervalFraction");
+}
+
+fmi3Status fmi3GetShiftDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                               fmi3Float64 shifts[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetShiftDecimal");
+}
+
+fmi3Status fmi3GetShiftFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                fmi3UInt64 counters[] UNUSED,
+                                fmi3UInt64 resolutions[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetShiftFraction");
+}
+
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                  const fmi3Float64 intervals[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "SetIntervalDecimal");
+}
+
+fmi3Status fmi3SetIntervalFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                   const fmi3UInt64 counters[] UNUSED, const fmi3UInt64 resolutions[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "SetIntervalFraction");
+}
+
+fmi3Status fmi3SetShiftDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                               const fmi3Float64 shifts[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "SetShiftDecimal");
+}
+
+fmi3Status fmi3SetShiftFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                const fmi3UInt64 counters[] UNUSED, const fmi3UInt64 resolutions[] UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "SetShiftFraction");
+}
+
+fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "EvaluateDiscreteStates");
+}
+
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesNeedUpdate UNUSED,
+                                    fmi3Boolean *terminateSimulation UNUSED,
+                                    fmi3Boolean *nominalsOfContinuousStatesChanged UNUSED,
+                                    fmi3Boolean *valuesOfContinuousStatesChanged UNUSED,
+                                    fmi3Boolean *nextEventTimeDefined UNUSED,
+                                    fmi3Float64 *nextEventTime UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "UpdateDiscreteStates");
+}
+
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "EnterContinuousTimeMode");
+}
+
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUStatePriorToCurrentPoint UNUSED,
+                                       fmi3Boolean *enterEventMode UNUSED, fmi3Boolean *terminateSimulation UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "CompletedIntegratorStep");
+}
+
+fmi3Status fmi3SetTime(fmi3Instance c, fmi3Float64 time UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "SetTime");
+}
+
+fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 continuousStates[] UNUSED,
+                                   size_t nContinuousStates UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "SetContinuousStates");
+}
+
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance c, fmi3Float64 derivatives[] UNUSED,
+                                             size_t nContinuousStates UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetContinuousStateDerivatives");
+}
+
+fmi3Status fmi3GetEventIndicators(fmi3Instance c, fmi3Float64 eventIndicators[] UNUSED,
+                                  size_t nEventIndicators UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetEventIndicators");
+}
+
+fmi3Status fmi3GetContinuousStates(fmi3Instance c, fmi3Float64 continuousStates[] UNUSED,
+                                   size_t nContinuousStates UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetContinuousStates");
+}
+
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance c, fmi3Float64 nominals[] UNUSED,
+                                             size_t nContinuousStates UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetNominalsOfContinuousStates");
+}
+
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance c, size_t *nEventIndicators UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetNumberOfEventIndicators");
+}
+
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance c, size_t *nContinuousStates UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetNumberOfContinuousStates");
+}
+
+fmi3Status fmi3EnterStepMode(fmi3Instance c)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "EnterStepMode");
+}
+
+fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
+                                    const fmi3Int32 orders[] UNUSED, fmi3Float64 values[] UNUSED,
+                                    size_t nValues UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "GetOutputDerivatives");
+}
+
+fmi3Status fmi3ActivateModelPartition(fmi3Instance c, fmi3ValueReference clockReference UNUSED,
+                                      fmi3Float64 activationTime UNUSED)
+{
+    INSTANCE(c, fmi3Error)
+    return (fmi3Status)instance_unsupported(instance, "ActivateModelPartition");
+}

@@ -1,0 +1,888 @@
+/* Shared core of the native co-simulation FMUs: life cycle, checks, stepping, values, FMU state.
+ *
+ * Stepping mirrors driveline/model.py (SteppedModel.initialize, step, _undoable, output_errors),
+ * including the wording of every reason, so a host sees the same refusals from either FMU.
+ */
+#include "fmu_instance.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- text -------------------------------------------------------------------------------- */
+
+static void append_pieces(char *out, size_t size, const char *first, va_list pieces)
+{
+    size_t used = strlen(out);
+    const char *piece;
+    for (piece = first; piece != NULL; piece = va_arg(pieces, const char *)) {
+        size_t length = strlen(piece);
+        if (used + 1 >= size) {
+            break;
+        }
+        if (length > size - 1 - used) {
+            length = size - 1 - used;
+        }
+        memcpy(out + used, piece, length);
+        used += length;
+        out[used] = '\0';
+    }
+}
+
+void messages_add(Messages *out, const char *first, ...)
+{
+    va_list pieces;
+    if (out->count >= FMU_MAX_MESSAGES) {
+        return;
+    }
+    out->text[out->count][0] = '\0';
+    va_start(pieces, first);
+    append_pieces(out->text[out->count], FMU_MESSAGE_SIZE, first, pieces);
+    va_end(pieces);
+    out->count++;
+}
+
+void python_float_repr(double value, char *out, size_t size)
+{
+    char scientific[40], digits[24], text[48], *mark;
+    int precision, exponent, count = 0, used = 0, i;
+    if (isnan(value)) {
+        snprintf(out, size, "nan");
+        return;
+    }
+    if (isinf(value)) {
+        snprintf(out, size, value < 0 ? "-inf" : "inf");
+        return;
+    }
+    for (precision = 1; precision < 17; precision++) { /* the fewest digits that read back */
+        snprintf(scientific, sizeof scientific, "%.*e", precision - 1, value);
+        if (strtod(scientific, NULL) == value) {
+            break;
+        }
+    }
+    snprintf(scientific, sizeof scientific, "%.*e", precision - 1, fabs(value));
+    mark = strchr(scientific, 'e');
+    exponent = atoi(mark + 1);
+    for (i = 0; scientific + i < mark; i++) {
+        if (scientific[i] != '.') {
+            digits[count++] = scientific[i];
+        }
+    }
+    while (count > 1 && digits[count - 1] == '0') {
+        count--;
+    }
+    if (signbit(value)) {
+        text[used++] = '-';
+    }
+    if (exponent < -4 || exponent >= 16) { /* where repr switches to exponent notation */
+        text[used++] = digits[0];
+        if (count > 1) {
+            text[used++] = '.';
+            for (i = 1; i < count; i++) {
+                text[used++] = digits[i];
+            }
+        }
+        used += sprintf(text + used, "e%c%02d", exponent < 0 ? '-' : '+', abs(exponent));
+    } else if (exponent < 0) {
+        text[used++] = '0';
+        text[used++] = '.';
+        for (i = 0; i < -exponent - 1; i++) {
+            text[used++] = '0';
+        }
+        for (i = 0; i < count; i++) {
+            text[used++] = digits[i];
+        }
+    } else {
+        for (i = 0; i <= exponent; i++) {
+            text[used++] = i < count ? digits[i] : '0';
+        }
+        text[used++] = '.';
+        if (count <= exponent + 1) {
+            text[used++] = '0';
+        }
+        for (i = exponent + 1; i < count; i++) {
+            text[used++] = digits[i];
+        }
+    }
+    text[used] = '\0';
+    snprintf(out, size, "%s", text);
+}
+
+void python_g6(double value, char *out, size_t size)
+{
+    if (isnan(value)) {
+        snprintf(out, size, "nan");
+    } else {
+        snprintf(out, size, "%.6g", value);
+    }
+}
+
+double degrees(double radians)
+{
+    return radians * (180.0 / FMU_PI);
+}
+
+static void repr_of(const ModelData *data, int variable, char *out, size_t size)
+{
+    if (model_variables[variable].type == VAR_INTEGER) {
+        snprintf(out, size, "%ld", (long)data->int_value[variable]);
+    } else {
+        python_float_repr(data->real_value[variable], out, size);
+    }
+}
+
+void angle_bound_errors(const ModelData *data, Messages *out, int variable, int upper, int lower, const char *note)
+{
+    double value = data->real_value[variable], high = data->real_value[upper];
+    double low = lower >= 0 ? data->real_value[lower] : -HUGE_VAL;
+    char shown[40], low_deg[40], high_deg[40];
+    if (low <= value && value <= high) {
+        return;
+    }
+    python_g6(degrees(value), shown, sizeof shown);
+    python_g6(degrees(high), high_deg, sizeof high_deg);
+    if (lower >= 0) {
+        python_g6(degrees(low), low_deg, sizeof low_deg);
+        messages_add(out, "input ", model_variables[variable].name, " = ", shown, " deg is outside [",
+                     model_variables[lower].name, ", ", model_variables[upper].name, "] = [", low_deg, ", ", high_deg,
+                     "] deg", note, (const char *)NULL);
+    } else {
+        messages_add(out, "input ", model_variables[variable].name, " = ", shown, " deg is above ",
+                     model_variables[upper].name, " = ", high_deg, " deg", note, (const char *)NULL);
+    }
+}
+
+/* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
+
+static void range_errors(const ModelData *data, Causality causality, Messages *out)
+{
+    int i;
+    char shown[40];
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        const VariableInfo *v = &model_variables[i];
+        const MessageParts *parts = NULL;
+        double value = v->type == VAR_REAL ? data->real_value[i] : (double)data->int_value[i];
+        if (v->causality != causality) {
+            continue;
+        }
+        if (v->type == VAR_REAL && !isfinite(value)) {
+            parts = &v->not_finite;
+        } else if (v->has_min && value < v->min) {
+            parts = &v->below_min;
+        } else if (v->has_max && value > v->max) {
+            parts = &v->above_max;
+        }
+        if (parts != NULL) {
+            repr_of(data, i, shown, sizeof shown);
+            messages_add(out, parts->before, shown, parts->after, (const char *)NULL);
+        }
+    }
+}
+
+static void parameter_errors(const ModelData *data, Messages *out)
+{
+    int before = out->count;
+    range_errors(data, CAUSALITY_PARAMETER, out);
+    if (out->count == before) {
+        model_extra_parameter_errors(data, out);
+    }
+}
+
+static void input_errors(const ModelData *data, Messages *out)
+{
+    int before = out->count;
+    range_errors(data, CAUSALITY_INPUT, out);
+    if (out->count == before) {
+        model_extra_input_errors(data, out);
+    }
+}
+
+typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_OVERFLOW, SUM_OPPOSITE_INFINITIES } SumOutcome;
+
+/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it):
+ * exact partial sums (Shewchuk), an OverflowError when a partial sum of finite values
+ * overflows, a ValueError when +inf and -inf meet, else a finite or non-finite sum. */
+static SumOutcome fsum_outcome(const double values[], int count)
+{
+    double partials[MODEL_VARIABLE_COUNT + 1], special = 0.0, infinities = 0.0;
+    int used = 0, i, j;
+    for (i = 0; i < count; i++) {
+        double x = values[i], original = values[i];
+        int kept = 0;
+        for (j = 0; j < used; j++) {
+            double y = partials[j], high, low;
+            if (fabs(x) < fabs(y)) {
+                double swap = x;
+                x = y;
+                y = swap;
+            }
+            high = x + y;
+            low = y - (high - x);
+            if (low != 0.0) {
+                partials[kept++] = low;
+            }
+            x = high;
+        }
+        used = kept;
+        if (x != 0.0) {
+            if (!isfinite(x)) {
+                if (isfinite(original)) {
+                    return SUM_OVERFLOW;
+                }
+                if (isinf(original)) {
+                    infinities += original;
+                }
+                special += original;
+                used = 0;
+            } else {
+                partials[used++] = x;
+            }
+        }
+    }
+    if (special != 0.0 || isnan(special)) {
+        return isnan(infinities) ? SUM_OPPOSITE_INFINITIES : SUM_NOT_FINITE;
+    }
+    return SUM_FINITE;
+}
+
+/* SteppedModel.output_errors; an arithmetic failure of the sum itself becomes ``failure``. */
+static void output_errors(const ModelData *data, Messages *out, const char **failure)
+{
+    double values[MODEL_VARIABLE_COUNT];
+    int names[MODEL_VARIABLE_COUNT], count = 0, i;
+    char shown[40];
+    SumOutcome outcome;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (model_variables[i].causality == CAUSALITY_OUTPUT && model_variables[i].type == VAR_REAL) {
+            names[count] = i;
+            values[count++] = data->real_value[i];
+        }
+    }
+    outcome = fsum_outcome(values, count);
+    if (outcome == SUM_OVERFLOW) {
+        *failure = "OverflowError: intermediate overflow in fsum";
+    } else if (outcome == SUM_OPPOSITE_INFINITIES) {
+        *failure = "ValueError: -inf + inf in fsum";
+    } else if (outcome == SUM_NOT_FINITE) {
+        for (i = 0; i < count; i++) {
+            if (!isfinite(values[i])) {
+                python_float_repr(values[i], shown, sizeof shown);
+                messages_add(out, "output ", model_variables[names[i]].name, " is not finite (", shown,
+                             "); the step was not taken", (const char *)NULL);
+            }
+        }
+    }
+}
+
+/* ---- stepping (SteppedModel.initialize, step, _undoable) --------------------------------- */
+
+typedef enum { ACTION_START, ACTION_ADVANCE } Action;
+
+static void undoable(Instance *instance, Action action, double time, double step_size, const char *what)
+{
+    ModelData snapshot = instance->data;
+    Messages *out = &instance->messages;
+    int before = out->count;
+    const char *failure =
+        action == ACTION_START ? model_start(&instance->data, time) : model_advance(&instance->data, time, step_size);
+    if (failure == NULL) {
+        output_errors(&instance->data, out, &failure);
+    }
+    if (failure != NULL) {
+        messages_add(out, what, " could not be computed (", failure, ")", (const char *)NULL);
+    }
+    if (out->count != before) {
+        instance->data = snapshot;
+    }
+}
+
+static void initialize(Instance *instance, double start_time)
+{
+    Messages *out = &instance->messages;
+    parameter_errors(&instance->data, out);
+    input_errors(&instance->data, out);
+    if (out->count) {
+        return;
+    }
+    instance->data.time = start_time;
+    undoable(instance, ACTION_START, start_time, 0.0, "the start values");
+    instance->data.initialized = out->count == 0;
+}
+
+static void step(Instance *instance, double current_time, double step_size)
+{
+    Messages *out = &instance->messages;
+    char shown[40], what[80];
+    if (!instance->data.initialized) {
+        initialize(instance, current_time);
+        if (out->count) {
+            return;
+        }
+    }
+    if (!(isfinite(step_size) && step_size > 0.0)) {
+        python_float_repr(step_size, shown, sizeof shown);
+        messages_add(out, "communication step size must be positive and finite, got ", shown, (const char *)NULL);
+        return;
+    }
+    parameter_errors(&instance->data, out);
+    input_errors(&instance->data, out);
+    if (out->count) {
+        return;
+    }
+    python_float_repr(current_time, shown, sizeof shown);
+    snprintf(what, sizeof what, "the step from t = %s s", shown);
+    undoable(instance, ACTION_ADVANCE, current_time, step_size, what);
+    if (out->count == 0) {
+        instance->data.time = current_time + step_size;
+    }
+}
+
+/* ---- logging ------------------------------------------------------------------------------ */
+
+static const char *category_of(Status status)
+{
+    return status == STATUS_ERROR ? "logStatusError" : status == STATUS_DISCARD ? "logStatusDiscard" : "logAll";
+}
+
+void instance_log(Instance *instance, Status status, const char *first, ...)
+{
+    char message[FMU_MESSAGE_SIZE] = "";
+    va_list pieces;
+    va_start(pieces, first);
+    append_pieces(message, sizeof message, first, pieces);
+    va_end(pieces);
+    instance->emit(instance, status, category_of(status), message);
+}
+
+void instance_log_messages(Instance *instance, Status status)
+{
+    int i;
+    for (i = 0; i < instance->messages.count; i++) {
+        instance->emit(instance, status, category_of(status), instance->messages.text[i]);
+    }
+}
+
+Status instance_fail(Instance *instance, const char *first, ...)
+{
+    char message[FMU_MESSAGE_SIZE] = "";
+    va_list pieces;
+    va_start(pieces, first);
+    append_pieces(message, sizeof message, first, pieces);
+    va_end(pieces);
+    instance->emit(instance, STATUS_ERROR, "logStatusError", message);
+    instance->mode = MODE_ERROR;
+    return STATUS_ERROR;
+}
+
+static const char *mode_name(Mode mode)
+{
+    static const char *const names[] = {"Instantiated", "InitializationMode", "StepMode", "Terminated", "Error"};
+    return names[mode];
+}
+
+int instance_allows(Instance *instance, unsigned allowed, const char *function)
+{
+    if (allowed & MODE_BIT(instance->mode)) {
+        return 1;
+    }
+    instance_fail(instance, instance->fmi_prefix, function, " is not allowed in ", mode_name(instance->mode),
+                  instance->mode == MODE_ERROR ? " (after an error only reset, free, set FMU state and get are)" : "",
+                  (const char *)NULL);
+    return 0;
+}
+
+/* ---- life cycle ------------------------------------------------------------------------------ */
+
+void instance_reset(Instance *instance)
+{
+    int i;
+    memset(&instance->data, 0, sizeof instance->data);
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        instance->data.real_value[i] = model_variables[i].start;
+        instance->data.int_value[i] = (int32_t)model_variables[i].start;
+    }
+    model_reset_internal(&instance->data);
+    instance->start_time = 0.0;
+    instance->mode = MODE_INSTANTIATED;
+}
+
+Status instance_exit_initialization(Instance *instance)
+{
+    instance->messages.count = 0;
+    initialize(instance, instance->start_time);
+    instance_log_messages(instance, STATUS_ERROR); /* as the Python FMUs: logged, and OK */
+    instance->mode = MODE_STEP;
+    return STATUS_OK;
+}
+
+Status instance_do_step(Instance *instance, double current_time, double step_size)
+{
+    char shown[40];
+    if (!isfinite(current_time)) {
+        python_float_repr(current_time, shown, sizeof shown);
+        return instance_fail(instance, instance->fmi_prefix, "DoStep: currentCommunicationPoint = ", shown,
+                             " is not finite", (const char *)NULL);
+    }
+    instance->messages.count = 0;
+    step(instance, current_time, step_size);
+    if (instance->messages.count) {
+        instance_log_messages(instance, STATUS_ERROR);
+        return STATUS_DISCARD;
+    }
+    return STATUS_OK;
+}
+
+/* ---- values ------------------------------------------------------------------------------- */
+
+static const char *type_name(VariableType type)
+{
+    return type == VAR_REAL ? "Real" : "Integer";
+}
+
+static int is_time(const Instance *instance, uint32_t reference)
+{
+    return reference == MODEL_VARIABLE_COUNT && instance->fmi_prefix[3] == '3';
+}
+
+/* 1 when ``reference`` names a variable of ``type`` that may be got (``setting`` 0) or set now;
+ * else Error, with the reason logged. FMI 3.0's independent variable time is a Real to get only. */
+static int accessible(Instance *instance, const char *function, uint32_t reference, VariableType type, int setting)
+{
+    const VariableInfo *v;
+    const char *problem = NULL;
+    char number[24];
+    snprintf(number, sizeof number, "%lu", (unsigned long)reference);
+    if (is_time(instance, reference)) {
+        if (type == VAR_REAL && !setting) {
+            return 1;
+        }
+        instance_fail(instance, instance->fmi_prefix, function, ": value reference ", number,
+                      " is the independent variable time, a Real that cannot be set", (const char *)NULL);
+        return 0;
+    }
+    if (reference >= MODEL_VARIABLE_COUNT) {
+        instance_fail(instance, instance->fmi_prefix, function, ": value reference ", number, " is unknown",
+                      (const char *)NULL);
+        return 0;
+    }
+    v = &model_variables[reference];
+    if (v->type != type) {
+        instance_fail(instance, instance->fmi_prefix, function, ": variable ", v->name, " (value reference ", number,
+                      ") is of type ", type_name(v->type), ", not ", type_name(type), (const char *)NULL);
+        return 0;
+    }
+    if (setting && v->causality == CAUSALITY_OUTPUT) {
+        problem = ") is an output and cannot be set";
+    } else if (setting && instance->mode == MODE_STEP && v->causality == CAUSALITY_PARAMETER && !v->tunable) {
+        problem = ") is a fixed parameter and cannot be changed after initialisation";
+    }
+    if (problem != NULL) {
+        instance_fail(instance, instance->fmi_prefix, function, ": variable ", v->name, " (value reference ", number,
+                      problem, (const char *)NULL);
+        return 0;
+    }
+    return 1;
+}
+
+#define SETTABLE_MODES (MODE_BIT(MODE_INSTANTIATED) | MODE_BIT(MODE_INITIALIZATION) | MODE_BIT(MODE_STEP))
+
+/* 1 when the call may get or set these ``n`` references now (checked before any value moves). */
+static int all_accessible(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                          const void *values, VariableType type, int setting)
+{
+    size_t i;
+    if (!instance_allows(instance, setting ? SETTABLE_MODES : ANY_MODE, function)) {
+        return 0;
+    }
+    if (n > 0 && (vr == NULL || values == NULL)) {
+        instance_fail(instance, instance->fmi_prefix, function, ": null array of value references or values",
+                      (const char *)NULL);
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        if (!accessible(instance, function, vr[i], type, setting)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+Status instance_set_real(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                         const double value[])
+{
+    size_t i;
+    if (!all_accessible(instance, function, vr, n, value, VAR_REAL, 1)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        instance->data.real_value[vr[i]] = value[i];
+    }
+    return STATUS_OK;
+}
+
+Status instance_set_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                            const int32_t value[])
+{
+    size_t i;
+    if (!all_accessible(instance, function, vr, n, value, VAR_INTEGER, 1)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        instance->data.int_value[vr[i]] = value[i];
+    }
+    return STATUS_OK;
+}
+
+Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[])
+{
+    size_t i;
+    if (!all_accessible(instance, function, vr, n, value, VAR_REAL, 0)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        value[i] = is_time(instance, vr[i]) ? instance->data.time : instance->data.real_value[vr[i]];
+    }
+    return STATUS_OK;
+}
+
+Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[])
+{
+    size_t i;
+    if (!all_accessible(instance, function, vr, n, value, VAR_INTEGER, 0)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        value[i] = instance->data.int_value[vr[i]];
+    }
+    return STATUS_OK;
+}
+
+Status instance_no_variables_of(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                                const char *type, int setting)
+{
+    char number[24];
+    if (!all_accessible(instance, function, vr, 0, NULL, VAR_REAL, setting)) {
+        return STATUS_ERROR;
+    }
+    if (n == 0) {
+        return STATUS_OK;
+    }
+    if (vr == NULL) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": null array of value references",
+                             (const char *)NULL);
+    }
+    snprintf(number, sizeof number, "%lu", (unsigned long)vr[0]);
+    if (vr[0] < MODEL_VARIABLE_COUNT) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": variable ", model_variables[vr[0]].name,
+                             " (value reference ", number, ") is of type ", type_name(model_variables[vr[0]].type),
+                             ", not ", type, (const char *)NULL);
+    }
+    return instance_fail(instance, instance->fmi_prefix, function, ": value reference ", number,
+                         " is not a variable of type ", type, (const char *)NULL);
+}
+
+static const char *const LOG_CATEGORIES[] = {"logStatusWarning", "logStatusDiscard", "logStatusError",
+                                             "logStatusFatal", "logAll"};
+
+Status instance_set_debug_logging(Instance *instance, const char *function, size_t n, const char *const categories[])
+{
+    size_t i, j;
+    if (n > 0 && categories == NULL) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": null array of categories",
+                             (const char *)NULL);
+    }
+    for (i = 0; i < n; i++) {
+        int known = 0;
+        for (j = 0; j < sizeof LOG_CATEGORIES / sizeof LOG_CATEGORIES[0]; j++) {
+            known = known || (categories[i] != NULL && strcmp(categories[i], LOG_CATEGORIES[j]) == 0);
+        }
+        if (!known) {
+            return instance_fail(instance, instance->fmi_prefix, function, ": unknown log category '",
+                                 categories[i] ? categories[i] : "(null)", "'", (const char *)NULL);
+        }
+    }
+    return STATUS_OK;
+}
+
+Status instance_unsupported(Instance *instance, const char *function)
+{
+    return instance_fail(instance, instance->fmi_prefix, function,
+                         " is not supported by this co-simulation FMU", (const char *)NULL);
+}
+
+/* ---- FMU state ---------------------------------------------------------------------------- */
+
+#define STATE_TAG 0x4452564C53544154ull /* marks a live StoredState */
+#define STATE_FORMAT 1u
+static const char STATE_MAGIC[8] = {'D', 'R', 'V', 'L', 'S', 'T', 'A', 'T'};
+
+struct StoredState {
+    uint64_t tag;
+    Mode mode;
+    double start_time;
+    ModelData data;
+};
+
+static const StoredState *live_state(Instance *instance, const char *function, const void *state)
+{
+    const StoredState *stored = state;
+    if (stored == NULL || stored->tag != STATE_TAG) {
+        instance_fail(instance, instance->fmi_prefix, function, ": not an FMU state of this FMU (or already freed)",
+                      (const char *)NULL);
+        return NULL;
+    }
+    return stored;
+}
+
+/* Where a state goes: the live state the host hands back to be overwritten (the standard allows
+ * it), or a new one; NULL (Error logged) if neither. */
+static StoredState *state_slot(Instance *instance, const char *function, void *given)
+{
+    StoredState *slot;
+    if (given != NULL) {
+        return live_state(instance, function, given) != NULL ? given : NULL;
+    }
+    slot = calloc(1, sizeof *slot);
+    if (slot == NULL) {
+        instance_fail(instance, instance->fmi_prefix, function, ": out of memory", (const char *)NULL);
+    }
+    return slot;
+}
+
+Status state_get(Instance *instance, const char *function, void **state)
+{
+    StoredState *stored;
+    if (!instance_allows(instance, ANY_MODE & ~MODE_BIT(MODE_ERROR), function)) {
+        return STATUS_ERROR;
+    }
+    if (state == NULL) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": null state pointer", (const char *)NULL);
+    }
+    stored = state_slot(instance, function, *state);
+    if (stored == NULL) {
+        return STATUS_ERROR;
+    }
+    stored->tag = STATE_TAG;
+    stored->mode = instance->mode;
+    stored->start_time = instance->start_time;
+    stored->data = instance->data;
+    *state = stored;
+    return STATUS_OK;
+}
+
+Status state_set(Instance *instance, const char *function, const void *state)
+{
+    const StoredState *stored = live_state(instance, function, state);
+    if (stored == NULL) {
+        return STATUS_ERROR;
+    }
+    instance->mode = stored->mode;
+    instance->start_time = stored->start_time;
+    instance->data = stored->data;
+    return STATUS_OK;
+}
+
+Status state_free(Instance *instance, const char *function, void **state)
+{
+    StoredState *stored;
+    if (state == NULL || *state == NULL) {
+        return STATUS_OK;
+    }
+    if (live_state(instance, function, *state) == NULL) {
+        return STATUS_ERROR;
+    }
+    stored = *state;
+    stored->tag = 0;
+    free(stored);
+    *state = NULL;
+    return STATUS_OK;
+}
+
+/* Serialized layout: magic, format, byte-order mark, token length and token, variable and slot
+ * counts, mode, start time, time, initialized, Real values, Integer values, internal slots,
+ * then an FNV-1a checksum of everything before it. */
+static size_t token_length(void)
+{
+    return strlen(MODEL_TOKEN);
+}
+
+size_t state_serialized_size(void)
+{
+    return sizeof STATE_MAGIC + 5 * sizeof(uint32_t) + token_length() + 2 * sizeof(int32_t) + 2 * sizeof(double) +
+           MODEL_VARIABLE_COUNT * (sizeof(double) + sizeof(int32_t)) + FMU_INTERNAL_SLOTS * sizeof(double) +
+           sizeof(uint64_t);
+}
+
+static uint64_t checksum(const char *bytes, size_t size)
+{
+    uint64_t hash = 14695981039346656037ull;
+    size_t i;
+    for (i = 0; i < size; i++) {
+        hash = (hash ^ (unsigned char)bytes[i]) * 1099511628211ull;
+    }
+    return hash;
+}
+
+typedef struct {
+    char *bytes;
+    const char *read;
+    size_t at;
+} Cursor;
+
+static void put(Cursor *cursor, const void *value, size_t size)
+{
+    memcpy(cursor->bytes + cursor->at, value, size);
+    cursor->at += size;
+}
+
+static void take(Cursor *cursor, void *value, size_t size)
+{
+    memcpy(value, cursor->read + cursor->at, size);
+    cursor->at += size;
+}
+
+static void header(uint32_t words[4])
+{
+    words[0] = STATE_FORMAT;
+    words[1] = 0x01020304u; /* byte order */
+    words[2] = (uint32_t)token_length();
+    words[3] = MODEL_VARIABLE_COUNT;
+}
+
+Status state_serialize(Instance *instance, const char *function, const void *state, char *bytes, size_t size)
+{
+    const StoredState *stored = live_state(instance, function, state);
+    Cursor cursor = {NULL, NULL, 0};
+    uint32_t words[4], slots = FMU_INTERNAL_SLOTS;
+    int32_t mode, initialized;
+    uint64_t sum;
+    if (stored == NULL) {
+        return STATUS_ERROR;
+    }
+    if (bytes == NULL || size < state_serialized_size()) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": the buffer is smaller than the state size",
+                             (const char *)NULL);
+    }
+    cursor.bytes = bytes;
+    header(words);
+    mode = (int32_t)stored->mode;
+    initialized = stored->data.initialized;
+    put(&cursor, STATE_MAGIC, sizeof STATE_MAGIC);
+    put(&cursor, words, sizeof words);
+    put(&cursor, MODEL_TOKEN, token_length());
+    put(&cursor, &slots, sizeof slots);
+    put(&cursor, &mode, sizeof mode);
+    put(&cursor, &initialized, sizeof initialized);
+    put(&cursor, &stored->start_time, sizeof(double));
+    put(&cursor, &stored->data.time, sizeof(double));
+    put(&cursor, stored->data.real_value, sizeof stored->data.real_value);
+    put(&cursor, stored->data.int_value, sizeof stored->data.int_value);
+    put(&cursor, stored->data.internal, sizeof stored->data.internal);
+    sum = checksum(bytes, cursor.at);
+    put(&cursor, &sum, sizeof sum);
+    return STATUS_OK;
+}
+
+static Status refuse_bytes(Instance *instance, const char *function, const char *why)
+{
+    return instance_fail(instance, instance->fmi_prefix, function, ": refused: ", why, (const char *)NULL);
+}
+
+Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state)
+{
+    Cursor cursor = {NULL, NULL, 0};
+    uint32_t words[4], expected[4], slots;
+    int32_t mode, initialized;
+    uint64_t sum;
+    StoredState decoded, *target;
+    if (state == NULL || (bytes == NULL && size > 0)) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": null argument", (const char *)NULL);
+    }
+    header(expected);
+    cursor.read = bytes;
+    if (size < sizeof STATE_MAGIC + sizeof words || memcmp(bytes, STATE_MAGIC, sizeof STATE_MAGIC) != 0) {
+        return refuse_bytes(instance, function, "the bytes are not a serialized FMU state of these native FMUs");
+    }
+    cursor.at = sizeof STATE_MAGIC;
+    take(&cursor, words, sizeof words);
+    if (words[0] != expected[0] || words[1] != expected[1]) {
+        return refuse_bytes(instance, function, "the state was written by another format version or platform");
+    }
+    if (words[2] != expected[2] || words[3] != expected[3] || size != state_serialized_size() ||
+        memcmp(bytes + cursor.at, MODEL_TOKEN, token_length()) != 0) {
+        return refuse_bytes(instance, function,
+                            "the state belongs to another model or build (instantiation token differs)");
+    }
+    memcpy(&sum, bytes + size - sizeof sum, sizeof sum);
+    if (checksum(bytes, size - sizeof sum) != sum) {
+        return refuse_bytes(instance, function, "the state is corrupt (checksum mismatch)");
+    }
+    cursor.at += token_length();
+    memset(&decoded, 0, sizeof decoded);
+    take(&cursor, &slots, sizeof slots);
+    take(&cursor, &mode, sizeof mode);
+    take(&cursor, &initialized, sizeof initialized);
+    if (slots != FMU_INTERNAL_SLOTS || mode < MODE_INSTANTIATED || mode > MODE_TERMINATED || initialized < 0 ||
+        initialized > 1) {
+        return refuse_bytes(instance, function, "the state holds impossible values");
+    }
+    take(&cursor, &decoded.start_time, sizeof(double));
+    take(&cursor, &decoded.data.time, sizeof(double));
+    take(&cursor, decoded.data.real_value, sizeof decoded.data.real_value);
+    take(&cursor, decoded.data.int_value, sizeof decoded.data.int_value);
+    take(&cursor, decoded.data.internal, sizeof decoded.data.internal);
+    decoded.mode = (Mode)mode;
+    decoded.data.initialized = initialized;
+    decoded.tag = STATE_TAG;
+    target = state_slot(instance, function, *state);
+    if (target == NULL) {
+        return STATUS_ERROR;
+    }
+    *target = decoded;
+    *state = target;
+    return STATUS_OK;
+}
+
+/* ---- instances ------------------------------------------------------------------------------ */
+
+Instance *instance_new(const char *name, const char *token, const char *fmi_prefix, Emit emit,
+                       void (*host_logger)(void), void *host_environment)
+{
+    Instance *instance = calloc(1, sizeof *instance);
+    size_t length;
+    if (instance == NULL) {
+        return NULL;
+    }
+    if (name == NULL) {
+        name = "";
+    }
+    length = strlen(name);
+    instance->name = malloc(length + 1);
+    if (instance->name == NULL) {
+        free(instance);
+        return NULL;
+    }
+    memcpy(instance->name, name, length + 1);
+    instance->emit = emit;
+    instance->host_logger = host_logger;
+    instance->host_environment = host_environment;
+    instance->fmi_prefix = fmi_prefix;
+    if (token == NULL || strcmp(token, MODEL_TOKEN) != 0) {
+        instance_log(instance, STATUS_ERROR, fmi_prefix, "Instantiate: the token '", token ? token : "(null)",
+                     "' is not this FMU's (", MODEL_NAME, ": '", MODEL_TOKEN, "')", (const char *)NULL);
+        instance_free(instance);
+        return NULL;
+    }
+    instance_reset(instance);
+    return instance;
+}
+
+void instance_free(Instance *instance)
+{
+    if (instance != NULL) {
+        free(instance->name);
+        free(instance);
+    }
+}

@@ -1,0 +1,146 @@
+/* Shared core of the native co-simulation FMUs (FMI 2.0 and FMI 3.0): one instance, no global state.
+ *
+ * The FMI layers (fmi2_functions.c, fmi3_functions.c) translate the standard's calls into the
+ * functions below; a model file (one per model) supplies the physics through the model_* hooks;
+ * the generated model_variables.c supplies the variable table and the range checks' messages.
+ * The step logic mirrors driveline/model.py (SteppedModel): a refused step leaves the model
+ * exactly as it was and reports the same reasons, word for word.
+ */
+#ifndef FMU_INSTANCE_H
+#define FMU_INSTANCE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "model_variables.h"
+
+/* Marks a parameter the standard's signature has and this implementation does not need. */
+#if defined(__GNUC__) || defined(__clang__)
+#define UNUSED __attribute__((unused))
+#else
+#define UNUSED
+#endif
+
+#define FMU_PI 3.14159265358979323846
+#define FMU_MESSAGE_SIZE 400
+#define FMU_MAX_MESSAGES 48
+#define FMU_INTERNAL_SLOTS 4
+
+typedef enum { VAR_REAL, VAR_INTEGER } VariableType;
+typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT } Causality;
+
+/* A message cut into the text before and after the offending value. */
+typedef struct {
+    const char *before;
+    const char *after;
+} MessageParts;
+
+/* One variable of the model's spec; its value reference is its index in model_variables[]. */
+typedef struct {
+    const char *name;
+    VariableType type;
+    Causality causality;
+    int tunable;  /* a parameter the host may change after initialisation */
+    double start; /* start value (an Integer's as a double: exact for int32) */
+    int has_min, has_max;
+    double min, max;
+    MessageParts not_finite, below_min, above_max; /* the range checks' messages */
+} VariableInfo;
+
+extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
+
+/* Everything a step may change: the FMU state. Values are indexed by value reference;
+ * an Integer is held in int_value, a Real in real_value. */
+typedef struct {
+    double real_value[MODEL_VARIABLE_COUNT];
+    int32_t int_value[MODEL_VARIABLE_COUNT];
+    double internal[FMU_INTERNAL_SLOTS]; /* model-specific internal state */
+    double time;
+    int initialized;
+} ModelData;
+
+typedef struct {
+    int count;
+    char text[FMU_MAX_MESSAGES][FMU_MESSAGE_SIZE];
+} Messages;
+
+typedef enum { MODE_INSTANTIATED, MODE_INITIALIZATION, MODE_STEP, MODE_TERMINATED, MODE_ERROR } Mode;
+
+typedef enum { STATUS_OK = 0, STATUS_DISCARD = 2, STATUS_ERROR = 3 } Status;
+
+typedef struct Instance Instance;
+/* Hands one message to the host's logger of the instance's FMI version (as data, never a format). */
+typedef void (*Emit)(const Instance *instance, Status status, const char *category, const char *message);
+
+struct Instance {
+    char *name;
+    Emit emit;
+    void (*host_logger)(void); /* the FMI version's logger callback */
+    void *host_environment;
+    const char *fmi_prefix;   /* "fmi2" or "fmi3", for misuse messages */
+    Mode mode;
+    double start_time;
+    ModelData data;
+    Messages messages;
+};
+
+/* ---- hooks every model file defines (see driveline/<model>/model.py) ---------------- */
+void model_reset_internal(ModelData *data);
+/* Physics at the start time / over one step; NULL, or the arithmetic failure as Python names it
+ * ("ZeroDivisionError: float division by zero"). */
+const char *model_start(ModelData *data, double start_time);
+const char *model_advance(ModelData *data, double current_time, double step_size);
+void model_extra_parameter_errors(const ModelData *data, Messages *out);
+void model_extra_input_errors(const ModelData *data, Messages *out);
+
+/* ---- helpers for model files ---------------------------------------------------------- */
+void messages_add(Messages *out, const char *first, ...);
+/* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
+void python_float_repr(double value, char *out, size_t size);
+/* Python's format(value, '.6g'). */
+void python_g6(double value, char *out, size_t size);
+/* math.degrees of CPython. */
+double degrees(double radians);
+/* SteppedModel.angle_bound_errors: input ``name`` against [lower, upper] (lower NULL: none). */
+void angle_bound_errors(const ModelData *data, Messages *out, int variable, int upper, int lower, const char *note);
+
+/* ---- life cycle (used by the FMI layers) -------------------------------------------- */
+void instance_reset(Instance *instance);
+void instance_log(Instance *instance, Status status, const char *first, ...);
+void instance_log_messages(Instance *instance, Status status);
+/* Error unless the instance is in one of the modes of ``allowed`` (a bit mask of 1 << mode). */
+int instance_allows(Instance *instance, unsigned allowed, const char *function);
+Status instance_exit_initialization(Instance *instance);
+Status instance_do_step(Instance *instance, double current_time, double step_size);
+Status instance_set_real(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                         const double value[]);
+Status instance_set_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                            const int32_t value[]);
+Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[]);
+Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[]);
+Status instance_fail(Instance *instance, const char *first, ...);
+/* Get or set of a type the model has no variable of: OK for none, else Error naming the reference. */
+Status instance_no_variables_of(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                                const char *type, int setting);
+/* Checks the categories; messages (all of status Error) are logged whether debug logging is on or not. */
+Status instance_set_debug_logging(Instance *instance, const char *function, size_t n, const char *const categories[]);
+/* A function of an interface type or capability these FMUs do not offer. */
+Status instance_unsupported(Instance *instance, const char *function);
+
+#define MODE_BIT(mode) (1u << (mode))
+#define ANY_MODE 0x1Fu
+
+/* ---- FMU state ------------------------------------------------------------------------ */
+typedef struct StoredState StoredState;
+Status state_get(Instance *instance, const char *function, void **state);
+Status state_set(Instance *instance, const char *function, const void *state);
+Status state_free(Instance *instance, const char *function, void **state);
+size_t state_serialized_size(void);
+Status state_serialize(Instance *instance, const char *function, const void *state, char *bytes, size_t size);
+Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state);
+
+Instance *instance_new(const char *name, const char *token, const char *fmi_prefix, Emit emit,
+                       void (*host_logger)(void), void *host_environment);
+void instance_free(Instance *instance);
+
+#endif

@@ -1,0 +1,47 @@
+/* SpeedSource: shaft speed ramp plus sine, exact in time (port of driveline/source/model.py). */
+#include <math.h>
+
+#include "fmu_instance.h"
+
+#define VALUE(name) (data->real_value[V_##name])
+
+void model_reset_internal(ModelData *data)
+{
+    (void)data;
+}
+
+/* omega(t) = omega_start + ramp_rate t + a sin(w t), alpha = d(omega)/dt, phi its exact integral. */
+static const char *evaluate(ModelData *data, double t)
+{
+    double w = 2.0 * FMU_PI * VALUE(sine_frequency), a = VALUE(sine_amplitude);
+    if (isinf(w * t)) {
+        return "ValueError: math domain error"; /* what Python's math.sin says of an infinite angle */
+    }
+    VALUE(omega) = VALUE(omega_start) + VALUE(ramp_rate) * t + a * sin(w * t);
+    VALUE(alpha) = VALUE(ramp_rate) + a * w * cos(w * t);
+    VALUE(phi) = VALUE(phi_start) + VALUE(omega_start) * t + 0.5 * VALUE(ramp_rate) * t * t +
+                 (w > 0.0 ? a * (1.0 - cos(w * t)) / w : 0.0);
+    return NULL;
+}
+
+const char *model_start(ModelData *data, double start_time)
+{
+    return evaluate(data, start_time);
+}
+
+const char *model_advance(ModelData *data, double current_time, double step_size)
+{
+    return evaluate(data, current_time + step_size);
+}
+
+void model_extra_parameter_errors(const ModelData *data, Messages *out)
+{
+    (void)data;
+    (void)out;
+}
+
+void model_extra_input_errors(const ModelData *data, Messages *out)
+{
+    (void)data;
+    (void)out;
+}

@@ -1,0 +1,113 @@
+/* UniversalReducer: few-teeth-difference planetary gear through an RCRCR mechanism, seed 004
+ * (Gu, Chen 2016; port of driveline/reducer/). phi_out = phi_in / i (eq 17) at any alpha; the
+ * loads are the seed's quasi-static relations (eqs 18-21) and the third strength theory at C.
+ */
+#include <math.h>
+#include <stdio.h>
+
+#include "fmu_instance.h"
+
+#define VALUE(name) (data->real_value[V_##name])
+#define INTEGER(name) (data->int_value[V_##name])
+
+void model_reset_internal(ModelData *data)
+{
+    (void)data;
+}
+
+typedef struct {
+    double M_E, M_C1, M_B, M_C; /* eqs 19-21 */
+    double sigma, tau, sigma_eq;
+} Loads;
+
+/* Eqs 18-21 for input torque M_in, then the stresses of the solid shaft at C (bent by M_C,
+ * twisted by M_C1): sigma = M/W, tau = T/(2W), sigma_eq = sqrt(sigma^2 + 4 tau^2), W = pi r^3/4. */
+static void connecting_shaft(const ModelData *data, double M_in, double i, double cube, Loads *loads)
+{
+    double half = 0.5 * VALUE(alpha), M_out = i * M_in, F_B = M_in / VALUE(e);
+    double F_t = 2.0 * M_out / (VALUE(module) * INTEGER(z1)), shared, section_modulus;
+    loads->M_E = 2.0 * F_B * VALUE(L1) * sin(half);
+    loads->M_C1 = F_t * 0.5 * VALUE(module) * INTEGER(z2);
+    shared = loads->M_E / (2.0 * sin(half));
+    loads->M_B = loads->M_C1 / sin(VALUE(alpha)) + shared;
+    loads->M_C = loads->M_C1 * cos(VALUE(alpha)) / sin(VALUE(alpha)) + shared;
+    section_modulus = 0.25 * FMU_PI * cube;
+    loads->sigma = loads->M_C / section_modulus;
+    loads->tau = loads->M_C1 / (2.0 * section_modulus);
+    loads->sigma_eq = sqrt(loads->sigma * loads->sigma + 4.0 * (loads->tau * loads->tau));
+}
+
+static const char *evaluate(ModelData *data)
+{
+    double i = (double)INTEGER(z1) / (double)(INTEGER(z1) - INTEGER(z2)); /* eqs 4, 17 */
+    double half = 0.5 * VALUE(alpha), cube = pow(VALUE(r_shaft), 3.0);
+    Loads loads, unit;
+    if (isinf(cube)) {
+        return "OverflowError: (34, 'Numerical result out of range')"; /* Python's float ** says so */
+    }
+    VALUE(speed_ratio) = 1.0 / i;
+    VALUE(phi_out) = VALUE(phi_in) / i;
+    VALUE(omega_out) = VALUE(omega_in) / i;
+    VALUE(T_in) = VALUE(T_load) / i;                                        /* eq 18, lossless */
+    VALUE(s_b) = VALUE(e) * cos(half) / sin(half) * sin(VALUE(phi_in)); /* eq 15 */
+    connecting_shaft(data, VALUE(T_in), i, cube, &loads);
+    VALUE(M_E) = loads.M_E;
+    VALUE(M_C1) = loads.M_C1;
+    VALUE(M_B) = loads.M_B;
+    VALUE(M_C) = loads.M_C;
+    VALUE(sigma_bend) = loads.sigma;
+    VALUE(tau_torsion) = loads.tau;
+    VALUE(sigma_eq) = loads.sigma_eq;
+    VALUE(utilisation) = loads.sigma_eq / VALUE(sigma_allow);
+    connecting_shaft(data, 1.0, i, cube, &unit);
+    if (unit.sigma_eq == 0.0) {
+        return "ZeroDivisionError: float division by zero";
+    }
+    VALUE(T_in_allow) = VALUE(sigma_allow) / unit.sigma_eq;
+    return NULL;
+}
+
+const char *model_start(ModelData *data, double start_time)
+{
+    (void)start_time;
+    VALUE(phi_in) = VALUE(phi_in_start);
+    return evaluate(data);
+}
+
+const char *model_advance(ModelData *data, double current_time, double step_size)
+{
+    (void)current_time;
+    VALUE(phi_in) = VALUE(phi_in) + VALUE(omega_in) * step_size;
+    return evaluate(data);
+}
+
+void model_extra_parameter_errors(const ModelData *data, Messages *out)
+{
+    static const int positive[] = {V_module, V_e, V_r_shaft, V_sigma_allow, V_alpha_min};
+    char first[40], second[40];
+    size_t k;
+    if (!(INTEGER(z1) > INTEGER(z2))) {
+        snprintf(first, sizeof first, "%ld", (long)INTEGER(z1));
+        snprintf(second, sizeof second, "%ld", (long)INTEGER(z2));
+        messages_add(out, "parameter z1 = ", first, " must exceed z2 = ", second, " (i = z1 / (z1 - z2))",
+                     (const char *)NULL);
+    }
+    for (k = 0; k < sizeof positive / sizeof positive[0]; k++) {
+        if (!(data->real_value[positive[k]] > 0.0)) {
+            python_float_repr(data->real_value[positive[k]], first, sizeof first);
+            messages_add(out, "parameter ", model_variables[positive[k]].name, " = ", first, " must be positive",
+                         (const char *)NULL);
+        }
+    }
+    if (!(VALUE(alpha_min) <= VALUE(alpha_max) && VALUE(alpha_max) < FMU_PI)) {
+        python_g6(degrees(VALUE(alpha_min)), first, sizeof first);
+        python_g6(degrees(VALUE(alpha_max)), second, sizeof second);
+        messages_add(out, "parameters alpha_min = ", first, " deg and alpha_max = ", second,
+                     " deg must satisfy alpha_min <= alpha_max < 180 deg", (const char *)NULL);
+    }
+}
+
+void model_extra_input_errors(const ModelData *data, Messages *out)
+{
+    angle_bound_errors(data, out, V_alpha, V_alpha_max, V_alpha_min, " (eq 21 is singular at 0 and 180 deg)");
+}

@@ -1,0 +1,333 @@
+"""The native (C) FMUs against their Python twins, through fmpy, both FMI versions: a clean and
+identical description, a binary needing only libc and libm, the carried sources, equal outputs, the
+same refusals word for word, and misuse answered with Error (never Fatal, never a crash)."""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.validation import validate_fmu
+from hypothesis import given, settings
+
+import test_cardan_reducer_fmu as reducer_and_cardan
+import test_fmu_behaviour as behaviour
+import test_fmus_common as common
+from driveline.catalog import MODELS
+from fmu_harness import interop
+from fmu_harness.build import native
+from fmu_harness.runner import FmuInstance, StepRefused
+from fmu_harness.scenario import scenario
+from test_fmu_properties import Run, _runs, run_alongside_the_core
+
+NATIVE = native.native_models()
+VERSIONS = ("2", "3")
+# Both sides evaluate the same formulas in float64, but numpy's and libm's sin, cos, atan2 may
+# differ in the last bit: outputs must agree within this fraction of each signal's largest magnitude.
+TOLERANCE = 1e-12
+
+
+def _native(native_dir: Path, name: str, fmi: str) -> Path:
+    return native.fmu_path(native_dir, name, fmi)
+
+
+def _deviation(reference: np.ndarray, other: np.ndarray) -> float:
+    """Largest difference of any output, relative to that output's largest magnitude."""
+    return max(float(np.abs(reference[n] - other[n]).max() / (np.abs(reference[n]).max() or 1.0))
+               for n in reference.dtype.names)
+
+
+def _standard_run(path: Path, name: str, **open_options) -> np.ndarray:
+    case = scenario(MODELS[name].spec)
+    with FmuInstance(path, **open_options) as fmu:
+        fmu.initialize(case.input_values(0.0))
+        return fmu.run(case.stop_time, case.step_size, case.signals())
+
+
+def test_the_models_without_a_c_port_are_skipped(native_dir):
+    assert NATIVE == [name for name in ("CardanJoint", "UniversalReducer", "SpeedSource") if name in MODELS]
+    built = {path.relative_to(native_dir).as_posix() for path in native_dir.rglob("*.fmu")}
+    assert built == {f"{native.SUBDIR[fmi]}/{name}.fmu" for name in NATIVE for fmi in VERSIONS}
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_passes_fmpy_validate_and_fmutool_check(native_dir, name, fmi):
+    path = _native(native_dir, name, fmi)
+    assert validate_fmu(str(path)) == []
+    assert interop._fmutool_check(path) == interop.Outcome("pass")
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_binary_needs_only_libc_and_libm_and_exports_only_fmi(native_dir, tmp_path, name, fmi):
+    with zipfile.ZipFile(_native(native_dir, name, fmi)) as archive:
+        binaries = [member for member in archive.namelist() if member.startswith("binaries/")]
+        assert len(binaries) == 1
+        library = tmp_path / Path(binaries[0]).name
+        library.write_bytes(archive.read(binaries[0]))
+    dynamic = subprocess.run(["readelf", "-d", str(library)], capture_output=True, text=True, check=True).stdout
+    needed = {line.split("[")[1].rstrip("]") for line in dynamic.splitlines() if "(NEEDED)" in line}
+    assert needed == {"libc.so.6", "libm.so.6"}
+    symbols = subprocess.run(["nm", "-D", "--defined-only", str(library)], capture_output=True, text=True,
+                             check=True).stdout.split()[2::3]
+    assert symbols and all(symbol.startswith(f"fmi{fmi}") for symbol in symbols)
+
+
+def _fields(item: object) -> dict:
+    return {slot: getattr(item, slot) for slot in type(item).__slots__ if slot != "__weakref__"} if item else {}
+
+
+def _value(text: str | None) -> float | None:
+    """A start, min or max as written: "0" and "0.0" are one value, and pythonfmu writes starts
+    with 16 significant digits where the native description has the spec's repr (17 at most)."""
+    return None if text is None else float(f"{float(text):.15g}")
+
+
+def _described(path: Path) -> dict:
+    """Everything a host reads from a model description, except token and generator."""
+    d = read_model_description(str(path))
+    fields = ("name", "valueReference", "causality", "variability", "description", "type", "unit", "displayUnit",
+              "min", "max", "start", "initial")
+    return {
+        "model": (d.modelName, d.description, d.fmiVersion, d.coSimulation.modelIdentifier),
+        "variables": [tuple(_value(getattr(v, f)) if f in ("start", "min", "max") else getattr(v, f) for f in fields)
+                      for v in d.modelVariables],
+        "units": [(u.name, _fields(u.baseUnit), [(x.name, x.factor, x.offset) for x in u.displayUnits])
+                  for u in d.unitDefinitions],
+        "experiment": _fields(d.defaultExperiment),
+        "outputs": [v.variable.name for v in d.outputs],
+        "initial_unknowns": [v.variable.name for v in d.initialUnknowns],
+        "capabilities": {k: getattr(d.coSimulation, k) for k in (
+            "canHandleVariableCommunicationStepSize", "canGetAndSetFMUstate", "canSerializeFMUstate")},
+    }
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_description_is_the_python_fmus(native_dir, fmu_path, name, fmi):
+    python, native = (_described(path) for path in (fmu_path(name, fmi), _native(native_dir, name, fmi)))
+    assert native == python
+    with zipfile.ZipFile(_native(native_dir, name, fmi)) as archive:
+        description = archive.read("modelDescription.xml").decode()
+    for category in ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll"):
+        assert f'name="{category}"' in description
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_standard_scenario_matches_the_python_fmu(native_dir, fmu_path, name, fmi):
+    assert _deviation(_standard_run(fmu_path(name, fmi), name), _standard_run(_native(native_dir, name, fmi), name)) <= TOLERANCE
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="rebuilding from the carried sources needs cmake")
+def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, fmi):
+    """What a Windows or macOS user does: fmpy's build_platform_binary (CMake) from the FMU's
+    sources alone; the rebuilt binary gives the shipped one's results bit for bit."""
+    from fmpy.build import build_platform_binary
+
+    name = "CardanJoint"
+    unzipdir = Path(extract(str(_native(native_dir, name, fmi)), unzipdir=str(tmp_path / "fmu")))
+    shutil.rmtree(unzipdir / "binaries")
+    (tmp_path / "build").mkdir()
+    build_platform_binary(unzipdir, build_dir=tmp_path / "build")
+    rebuilt = _standard_run(_native(native_dir, name, fmi), name, unzipdir=str(unzipdir))
+    assert rebuilt.tobytes() == _standard_run(_native(native_dir, name, fmi), name).tobytes()
+
+
+# -- refusals: the Python FMUs' tests, run on the native FMUs ----------------------------------------
+
+
+def _native_only(cases: list[tuple]) -> list[tuple]:
+    return [case for case in cases if case[0] in NATIVE]
+
+
+@pytest.mark.parametrize("name, variable", _native_only(common.INPUTS))
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf])
+def test_non_finite_input_is_refused_and_the_run_goes_on(native_dir, name, variable, value):
+    common.test_non_finite_input_is_refused_and_the_run_goes_on(native_dir / "native", name, variable, value)
+
+
+@pytest.mark.parametrize("name, variable", _native_only(common.PARAMETERS))
+def test_non_finite_parameter_is_refused(native_dir, name, variable):
+    common.test_non_finite_parameter_is_refused(native_dir / "native", name, variable)
+
+
+@pytest.mark.parametrize("name", NATIVE)
+@pytest.mark.parametrize("step", [0.0, -1e-3, math.inf])
+def test_bad_step_size_is_refused(native_dir, name, step):
+    common.test_bad_step_size_is_refused(native_dir / "native", name, step)
+
+
+@pytest.mark.parametrize("values, fragment", [({"z1": 29}, "z1"), ({"z2": 0}, "z2"), ({"module": 0.0}, "module")])
+def test_reducer_refuses_bad_gearing(native_dir, values, fragment):
+    reducer_and_cardan.test_reducer_refuses_bad_gearing(native_dir / "native", values, fragment)
+
+
+def test_cardan_refuses_beta_above_its_guard(native_dir):
+    reducer_and_cardan.test_cardan_refuses_beta_above_its_guard(native_dir / "native")
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@pytest.mark.parametrize("name", NATIVE)
+def test_random_runs_match_the_core_and_refuse_alike(native_dir, name, fmi):
+    """The property test of the Python FMUs (random parameters, inputs and step sizes, bad ones
+    included) on the native FMU: a step is refused exactly when the Python core refuses it, with
+    the same reasons word for word; accepted steps agree within TOLERANCE of each output's largest
+    magnitude over the run."""
+    unzipdir = extract(str(_native(native_dir, name, fmi)))
+
+    @settings(max_examples=60, deadline=None)
+    @given(run=_runs(name))
+    def check(run: Run) -> None:
+        with FmuInstance(_native(native_dir, name, fmi), unzipdir=unzipdir) as fmu:
+            native_rows, core_rows = run_alongside_the_core(fmu, MODELS[name], run)
+        if core_rows:
+            reference, native = np.array(core_rows, dtype=float), np.array(native_rows, dtype=float)
+            scale = np.abs(reference).max(axis=0)
+            assert np.all(np.abs(native - reference) <= TOLERANCE * scale), (native - reference) / scale
+
+    try:
+        check()
+    finally:
+        shutil.rmtree(unzipdir, ignore_errors=True)
+
+
+# -- misuse: Error with a reason, never Fatal, never a crash --------------------------------------------
+
+
+def _error(call, *args) -> int:
+    with pytest.raises(FMICallException) as failed:
+        call(*args)
+    return failed.value.status
+
+
+def test_misuse_returns_error_with_a_reason(native_dir, fmi):
+    path = _native(native_dir, "CardanJoint", fmi)
+    fmi3 = fmi == "3"
+    cases = {
+        "unknown value reference": lambda f: (f.getFloat64 if fmi3 else f.getReal)([999]),
+        "wrong type": lambda f: (f.getInt32 if fmi3 else f.getInteger)([0]),
+        "string on a Real": lambda f: f.setString([0], ["x"]),
+        "set an output": lambda f: (f.setFloat64 if fmi3 else f.setReal)([6], [1.0]),
+        "step before initialisation": lambda f: f.doStep(0.0, 1e-3),
+    }
+    for case, call in cases.items():
+        with FmuInstance(path) as fmu:
+            assert _error(call, fmu.fmu) == 3, case  # fmi2Error / fmi3Error
+            assert fmu.log and fmu.log[-1].status == "Error" and fmu.log[-1].category == "logStatusError", case
+            # after an Error the instance takes reset and, from there, a whole run again
+            fmu.reset()
+            fmu.initialize()
+            fmu.step(1e-3)
+    with FmuInstance(path) as fmu:
+        fmu.initialize()
+        fixed = fmu.variables["beta_max"].valueReference
+        assert _error((fmu.fmu.setFloat64 if fmi3 else fmu.fmu.setReal), [fixed], [0.5]) == 3
+        assert "fixed" in fmu.log[-1].message
+    with FmuInstance(path) as fmu:
+        fmu.initialize()
+        fmu.step(1e-3)
+        fmu.fmu.terminate()
+        assert _error(fmu.fmu.doStep, 1e-3, 1e-3) == 3
+    with FmuInstance(path) as fmu:
+        fmu.initialize()
+        assert _error(fmu.fmu.doStep, math.nan, 1e-3) == 3
+        assert "not finite" in fmu.log[-1].message
+
+
+def test_a_wrong_token_is_refused_at_instantiation(native_dir, tmp_path, fmi):
+    path = _native(native_dir, "SpeedSource", fmi)
+    unzipdir = extract(str(path), unzipdir=str(tmp_path))
+    description = read_model_description(str(path))
+    if fmi == "3":
+        description.instantiationToken = "{wrong}"
+    else:
+        description.guid = "{wrong}"
+    from fmpy.simulation import instantiate_fmu
+
+    logged = []
+
+    def logger(*args: object) -> None:  # fmpy's logger proxy is process-global: always pass one
+        logged.append(args[-1])
+
+    with pytest.raises(Exception, match="nstantiat"):
+        instantiate_fmu(unzipdir, description, "CoSimulation", logger=logger)
+    assert any(b"is not this FMU's" in message for message in logged)
+
+
+def test_a_discarded_step_is_retryable_and_terminated_stays_false(native_dir, fmi):
+    with FmuInstance(_native(native_dir, "CardanJoint", fmi)) as fmu:
+        fmu.initialize()
+        fmu.set({"beta": math.nan})
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1e-3)
+        assert refused.value.status == "Discard"
+        if fmi == "2":
+            assert fmu.fmu.getBooleanStatus(3) is False  # fmi2Terminated
+            assert fmu.fmu.getRealStatus(2) == 0.0  # fmi2LastSuccessfulTime
+        fmu.set({"beta": 0.3})
+        fmu.step(1e-3)
+        assert fmu.get(["phi_in"])[0] == pytest.approx(MODELS["CardanJoint"].spec["omega_in"].start * 1e-3, rel=1e-15)
+
+
+def test_fmi3_honours_the_start_time(native_dir):
+    """Outputs at initialisation and the independent variable are those at the start time."""
+    core = MODELS["SpeedSource"]()
+    assert core.initialize(0.75) == []
+    with FmuInstance(_native(native_dir, "SpeedSource", "3")) as fmu:
+        fmu.initialize(start_time=0.75)
+        assert fmu.get(["omega", "phi", "alpha", "time"]) == [core.omega, core.phi, core.alpha, 0.75]
+        fmu.step(0.25)
+        core.step(0.75, 0.25)
+        assert fmu.get(["omega", "time"]) == [core.omega, 1.0]
+
+
+def test_state_bytes_of_another_model_or_corrupt_are_refused(native_dir, fmi):
+    with FmuInstance(_native(native_dir, "SpeedSource", fmi)) as other:
+        other.initialize()
+        foreign = other.serialize_state(other.get_state())
+    # one instance at a time: fmpy's FMI 2.0 logger proxy serves the last instance created
+    with FmuInstance(_native(native_dir, "CardanJoint", fmi)) as fmu:
+        fmu.initialize()
+        fmu.step(1e-3)
+        serialized = fmu.serialize_state(fmu.get_state())
+        corrupt = bytearray(serialized)
+        corrupt[len(corrupt) // 2] ^= 0x10
+        for data, reason in ((foreign, "another model"), (bytes(corrupt), "corrupt"), (serialized[:-1], "another model"),
+                             (b"\x80\x04garbage", "not a serialized FMU state")):
+            assert _error(fmu.deserialize_state, data) == 3
+            assert reason in fmu.log[-1].message
+            fmu.reset()
+
+
+# -- what every importer relies on: the Python FMUs' tests, run on the native FMUs -----------------------
+
+
+@pytest.fixture(scope="module")
+def open_native(native_dir):
+    return lambda name, version="2", instance_name="instance": FmuInstance(_native(native_dir, name, version),
+                                                                           instance_name)
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_native_fmi2_and_fmi3_give_identical_outputs(open_native, name):
+    behaviour.test_fmi2_and_fmi3_give_identical_outputs(name, open_native)
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_state_round_trips_and_continues_bit_identically(open_native, name, fmi):
+    behaviour.test_state_round_trips_and_continues_bit_identically(name, fmi, open_native)
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_instances_are_independent(open_native, name, fmi):
+    behaviour.test_instances_are_independent(name, fmi, open_native)
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_reset_returns_to_the_start_values(open_native, name, fmi):
+    behaviour.test_reset_returns_to_the_start_values(name, fmi, open_native)
