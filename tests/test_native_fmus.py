@@ -110,8 +110,9 @@ def _described(path: Path) -> dict:
 
 @pytest.mark.parametrize("name", NATIVE)
 def test_description_is_the_python_fmus(native_dir, fmu_path, name, fmi):
-    python, native = (_described(path) for path in (fmu_path(name, fmi), _native(native_dir, name, fmi)))
-    assert native == python
+    python_description, native_description = (_described(path) for path in (fmu_path(name, fmi),
+                                                                             _native(native_dir, name, fmi)))
+    assert native_description == python_description
     with zipfile.ZipFile(_native(native_dir, name, fmi)) as archive:
         description = archive.read("modelDescription.xml").decode()
     for category in ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll"):
@@ -186,9 +187,9 @@ def test_random_runs_match_the_core_and_refuse_alike(native_dir, name, fmi):
         with FmuInstance(_native(native_dir, name, fmi), unzipdir=unzipdir) as fmu:
             native_rows, core_rows = run_alongside_the_core(fmu, MODELS[name], run)
         if core_rows:
-            reference, native = np.array(core_rows, dtype=float), np.array(native_rows, dtype=float)
+            reference, values = np.array(core_rows, dtype=float), np.array(native_rows, dtype=float)
             scale = np.abs(reference).max(axis=0)
-            assert np.all(np.abs(native - reference) <= TOLERANCE * scale), (native - reference) / scale
+            assert np.all(np.abs(values - reference) <= TOLERANCE * scale), (values - reference) / scale
 
     try:
         check()

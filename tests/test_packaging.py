@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from fmu_harness import cli
-from fmu_harness.build import FMI_VERSIONS, fmu_path
+from fmu_harness.build import FMI_VERSIONS, fmu_path, native
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -102,5 +102,7 @@ def test_build_command_builds_one_model(tmp_path):
                           "--no-references", "SpeedSource"], capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert run.returncode == 0, run.stderr[-2000:]
     built = fmu_path(tmp_path, "SpeedSource")
-    assert run.stdout.split() == [str(built)] and sorted(tmp_path.rglob("*.fmu")) == [built]
+    native_built = native.fmu_path(tmp_path, "SpeedSource")  # the model has a C port too
+    assert run.stdout.split() == [str(built), str(native_built)]
+    assert sorted(tmp_path.rglob("*.fmu")) == sorted([built, native_built])
     assert "driveline/source/model.py" in members(built)
