@@ -1,0 +1,52 @@
+/* No-physics twin of a native model, the floor of the native FMUs for the step-cost benchmark.
+ *
+ * Built with the model's generated variable table, so it has the same variables, range checks
+ * and FMI traffic; every Real output takes the first Real input's value (the time if there is
+ * none), as the Python twins of benchmarks/minimal_models.py do.
+ */
+#include "fmu_instance.h"
+
+void model_reset_internal(ModelData *data)
+{
+    (void)data;
+}
+
+static const char *copy_first_input(ModelData *data, double time)
+{
+    double value = time;
+    int i, found = 0;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (!found && model_variables[i].causality == CAUSALITY_INPUT && model_variables[i].type == VAR_REAL) {
+            value = data->real_value[i];
+            found = 1;
+        }
+    }
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (model_variables[i].causality == CAUSALITY_OUTPUT && model_variables[i].type == VAR_REAL) {
+            data->real_value[i] = value;
+        }
+    }
+    return NULL;
+}
+
+const char *model_start(ModelData *data, double start_time)
+{
+    return copy_first_input(data, start_time);
+}
+
+const char *model_advance(ModelData *data, double current_time, double step_size)
+{
+    return copy_first_input(data, current_time + step_size);
+}
+
+void model_extra_parameter_errors(const ModelData *data, Messages *out)
+{
+    (void)data;
+    (void)out;
+}
+
+void model_extra_input_errors(const ModelData *data, Messages *out)
+{
+    (void)data;
+    (void)out;
+}

@@ -1,0 +1,84 @@
+"""Per-step cost of the native FMUs, through fmpy and from a C host, against their Python twins
+and a no-physics native twin built the same way.
+
+``python -m benchmarks.native_step_cost``: for each model with a C port and each FMI version,
+builds the native FMU, its no-physics twin (``benchmarks/native_minimal.c`` with the model's
+generated variable table: same variables, range checks and FMI traffic) and the Python FMU. Through
+fmpy's low-level API each is stepped as in :mod:`benchmarks.step_cost` (one batched set of the Real
+inputs, doStep, one batched get of the Real outputs; best of alternating rounds). From C,
+``benchmarks/native_step_timer.c`` (compiled here) loads the shared library with dlopen and times
+the same three calls per step, best of its rounds.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import tempfile
+from pathlib import Path
+
+from fmpy import extract, read_model_description
+
+from benchmarks.step_cost import Stepper, compare
+from benchmarks.timing import machine
+from driveline.catalog import MODELS
+from fmu_harness.build import build, native
+
+HERE = Path(__file__).resolve().parent
+C_STEPS, C_ROUNDS = 200_000, 7
+
+
+def compile_timer(folder: Path) -> Path:
+    executable = folder / "native_step_timer"
+    subprocess.run([native.compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2",
+                    "-I", str(native.fmi_headers()), str(HERE / "native_step_timer.c"), "-o", str(executable),
+                    "-ldl"], check=True)
+    return executable
+
+
+def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path) -> float:
+    """Nanoseconds per step of ``fmu`` from the C timer."""
+    unzipdir = Path(extract(str(fmu), unzipdir=str(work)))
+    description = read_model_description(str(fmu))
+    token = description.instantiationToken if fmi == "3" else description.guid
+    real = ("Real", "Float64")
+    inputs = [v.valueReference for v in description.modelVariables if v.causality == "input" and v.type in real]
+    outputs = [v.valueReference for v in description.modelVariables if v.causality == "output" and v.type in real]
+    library = next((unzipdir / "binaries").rglob("*.so"))
+    done = subprocess.run([str(timer), str(library), fmi, token, description.defaultExperiment.stepSize,
+                           str(C_STEPS), str(C_ROUNDS), " ".join(map(str, inputs)), " ".join(map(str, outputs))],
+                          check=True, capture_output=True, text=True)
+    return float(done.stdout)
+
+
+def fmpy_cost(fmu: Path, inputs: list[str]) -> float:
+    stepper = Stepper(fmu, {}, inputs)
+    try:
+        return min(stepper.round() for _ in range(3))
+    finally:
+        stepper.instance.close()
+
+
+def main() -> None:
+    print(f"Per-step cost (set inputs, doStep, get outputs); {machine()}")
+    print("| FMU | FMI | native via fmpy us | no-physics twin via fmpy us | ratio | Python FMU via fmpy us "
+          "| native from C ns | no-physics twin from C ns |")
+    print("|---|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as folder:
+        dest = Path(folder)
+        timer = compile_timer(dest)
+        for fmi in ("2", "3"):
+            for name in native.native_models():
+                inputs = [v.name for v in MODELS[name].spec.of("input")]
+                fmu = native.build(name, dest, fmi)
+                twin = native.build(name, dest / "twin", fmi, HERE / "native_minimal.c")
+                python_fmu = build(name, dest / "python", fmi)
+                ours, floor = compare(fmu, twin, {}, inputs)
+                python = fmpy_cost(python_fmu, inputs)
+                c_ours = c_host_cost(timer, fmu, fmi, dest / f"c_{name}_{fmi}")
+                c_floor = c_host_cost(timer, twin, fmi, dest / f"c_twin_{name}_{fmi}")
+                print(f"| {name} | {fmi}.0 | {ours:.2f} | {floor:.2f} | {ours / floor:.2f} | {python:.1f} "
+                      f"| {c_ours:.0f} | {c_floor:.0f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
