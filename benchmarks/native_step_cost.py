@@ -5,9 +5,9 @@ and a no-physics native twin built the same way.
 builds the native FMU, its no-physics twin (``benchmarks/native_minimal.c`` with the model's
 generated variable table: same variables, range checks and FMI traffic) and the Python FMU. Through
 fmpy's low-level API each is stepped as in :mod:`benchmarks.step_cost` (one batched set of the Real
-inputs, doStep, one batched get of the Real outputs; best of alternating rounds). From C,
+inputs, doStep, one batched get of the Real outputs; CPU time, best of alternating rounds). From C,
 ``benchmarks/native_step_timer.c`` (compiled here) loads the shared library with dlopen and times
-the same three calls per step, best of its rounds.
+the same three calls per step (CPU time, best of its rounds).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from benchmarks.step_cost import Stepper, compare
+from benchmarks.step_cost import ROUNDS, Stepper
 from benchmarks.timing import machine
 from driveline.catalog import MODELS
 from fmu_harness.build import build, native
@@ -50,12 +50,15 @@ def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path) -> float:
     return float(done.stdout)
 
 
-def fmpy_cost(fmu: Path, inputs: list[str]) -> float:
-    stepper = Stepper(fmu, {}, inputs)
+def fmpy_costs(fmus: list[Path], inputs: list[str]) -> list[float]:
+    """Microseconds per step of each FMU through fmpy, best of rounds that alternate between them."""
+    steppers = [Stepper(fmu, {}, inputs) for fmu in fmus]
     try:
-        return min(stepper.round() for _ in range(3))
+        rounds = [[stepper.round() for stepper in steppers] for _ in range(ROUNDS)]
     finally:
-        stepper.instance.close()
+        for stepper in steppers:
+            stepper.instance.close()
+    return [min(column) for column in zip(*rounds)]
 
 
 def main() -> None:
@@ -72,8 +75,7 @@ def main() -> None:
                 fmu = native.build(name, dest, fmi)
                 twin = native.build(name, dest / "twin", fmi, HERE / "native_minimal.c")
                 python_fmu = build(name, dest / "python", fmi)
-                ours, floor = compare(fmu, twin, {}, inputs)
-                python = fmpy_cost(python_fmu, inputs)
+                ours, floor, python = fmpy_costs([fmu, twin, python_fmu], inputs)
                 c_ours = c_host_cost(timer, fmu, fmi, dest / f"c_{name}_{fmi}")
                 c_floor = c_host_cost(timer, twin, fmi, dest / f"c_twin_{name}_{fmi}")
                 print(f"| {name} | {fmi}.0 | {ours:.2f} | {floor:.2f} | {ours / floor:.2f} | {python:.1f} "
