@@ -6,11 +6,6 @@
  */
 #include "fmu_instance.h"
 
-void model_reset_internal(ModelData *data)
-{
-    (void)data;
-}
-
 static const char *copy_first_input(ModelData *data, double time)
 {
     double value = time;
@@ -29,24 +24,4 @@ static const char *copy_first_input(ModelData *data, double time)
     return NULL;
 }
 
-const char *model_start(ModelData *data, double start_time)
-{
-    return copy_first_input(data, start_time);
-}
-
-const char *model_advance(ModelData *data, double current_time, double step_size)
-{
-    return copy_first_input(data, current_time + step_size);
-}
-
-void model_extra_parameter_errors(const ModelData *data, Messages *out)
-{
-    (void)data;
-    (void)out;
-}
-
-void model_extra_input_errors(const ModelData *data, Messages *out)
-{
-    (void)data;
-    (void)out;
-}
+const ModelHooks model_hooks = {NULL, copy_first_input, NULL, NULL, NULL, NULL};

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from benchmarks.step_cost import ROUNDS, Stepper
+from benchmarks.step_cost import Stepper, best_alternating
 from benchmarks.timing import machine
 from driveline.catalog import MODELS
 from fmu_harness.build import build, native
@@ -50,17 +50,6 @@ def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path) -> float:
     return float(done.stdout)
 
 
-def fmpy_costs(fmus: list[Path], inputs: list[str]) -> list[float]:
-    """Microseconds per step of each FMU through fmpy, best of rounds that alternate between them."""
-    steppers = [Stepper(fmu, {}, inputs) for fmu in fmus]
-    try:
-        rounds = [[stepper.round() for stepper in steppers] for _ in range(ROUNDS)]
-    finally:
-        for stepper in steppers:
-            stepper.instance.close()
-    return [min(column) for column in zip(*rounds)]
-
-
 def main() -> None:
     print(f"Per-step cost (set inputs, doStep, get outputs); {machine()}")
     print("| FMU | FMI | native via fmpy us | no-physics twin via fmpy us | ratio | Python FMU via fmpy us "
@@ -75,7 +64,7 @@ def main() -> None:
                 fmu = native.build(name, dest, fmi)
                 twin = native.build(name, dest / "twin", fmi, HERE / "native_minimal.c")
                 python_fmu = build(name, dest / "python", fmi)
-                ours, floor, python = fmpy_costs([fmu, twin, python_fmu], inputs)
+                ours, floor, python = best_alternating([Stepper(path, {}, inputs) for path in (fmu, twin, python_fmu)])
                 c_ours = c_host_cost(timer, fmu, fmi, dest / f"c_{name}_{fmi}")
                 c_floor = c_host_cost(timer, twin, fmi, dest / f"c_twin_{name}_{fmi}")
                 print(f"| {name} | {fmi}.0 | {ours:.2f} | {floor:.2f} | {ours / floor:.2f} | {python:.1f} "

@@ -85,12 +85,16 @@ def compare(fmu: Path, twin: Path, start_values: dict[str, float], inputs: list[
     """Best round of each of: the FMU in the batched fmpy loop, the minimal twin in the same loop,
     the FMU through the harness with constant inputs and with inputs as functions of time; their
     rounds alternate so that all see the same load."""
-    steppers = [
+    return best_alternating([
         Stepper(fmu, start_values, inputs),
         Stepper(twin, start_values, inputs),
         HarnessStepper(fmu, start_values, inputs, varying=False),
         HarnessStepper(fmu, start_values, inputs, varying=True),
-    ]
+    ])
+
+
+def best_alternating(steppers: list[Stepper | HarnessStepper]) -> list[float]:
+    """Each stepper's best of ``ROUNDS`` rounds, the rounds alternating between them; closes them."""
     try:
         rounds = [[stepper.round() for stepper in steppers] for _ in range(ROUNDS)]
     finally:

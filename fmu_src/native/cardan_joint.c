@@ -13,7 +13,7 @@
 #define SAMPLE_TIME (data->internal[1])  /* time of that evaluation [s] */
 #define HAS_SAMPLE (data->internal[2])   /* 1 once there was an evaluation */
 
-void model_reset_internal(ModelData *data)
+static void reset_internal(ModelData *data)
 {
     OMEGA_SAMPLE = 0.0;
     SAMPLE_TIME = 0.0;
@@ -45,21 +45,21 @@ static void evaluate(ModelData *data, double input_time)
     VALUE(speed_fluctuation) = tan(beta) * sin(beta); /* (C5) */
 }
 
-const char *model_start(ModelData *data, double start_time)
+static const char *start(ModelData *data, double start_time)
 {
     VALUE(phi_in) = VALUE(phi_in_start);
     evaluate(data, start_time);
     return NULL;
 }
 
-const char *model_advance(ModelData *data, double current_time, double step_size)
+static const char *advance(ModelData *data, double current_time, double step_size)
 {
     VALUE(phi_in) = VALUE(phi_in) + VALUE(omega_in) * step_size;
     evaluate(data, current_time);
     return NULL;
 }
 
-void model_extra_parameter_errors(const ModelData *data, Messages *out)
+static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
     char shown[40];
     if (!(VALUE(beta_max) < 0.5 * FMU_PI)) {
@@ -68,7 +68,9 @@ void model_extra_parameter_errors(const ModelData *data, Messages *out)
     }
 }
 
-void model_extra_input_errors(const ModelData *data, Messages *out)
+static void extra_input_errors(const ModelData *data, Messages *out)
 {
     angle_bound_errors(data, out, V_beta, V_beta_max, -1, "");
 }
+
+const ModelHooks model_hooks = {reset_internal, NULL, start, advance, extra_parameter_errors, extra_input_errors};

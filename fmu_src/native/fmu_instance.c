@@ -185,8 +185,8 @@ static void parameter_errors(const ModelData *data, Messages *out)
 {
     int before = out->count;
     range_errors(data, CAUSALITY_PARAMETER, out);
-    if (out->count == before) {
-        model_extra_parameter_errors(data, out);
+    if (out->count == before && model_hooks.extra_parameter_errors != NULL) {
+        model_hooks.extra_parameter_errors(data, out);
     }
 }
 
@@ -194,8 +194,8 @@ static void input_errors(const ModelData *data, Messages *out)
 {
     int before = out->count;
     range_errors(data, CAUSALITY_INPUT, out);
-    if (out->count == before) {
-        model_extra_input_errors(data, out);
+    if (out->count == before && model_hooks.extra_input_errors != NULL) {
+        model_hooks.extra_input_errors(data, out);
     }
 }
 
@@ -280,18 +280,30 @@ static void output_errors(const ModelData *data, Messages *out, const char **fai
 
 typedef enum { ACTION_START, ACTION_ADVANCE } Action;
 
-static void undoable(Instance *instance, Action action, double time, double step_size, const char *what)
+/* Runs the action; if it fails arithmetically or leaves a non-finite output, undoes it and says why
+ * ("the start values ..." or "the step from t = ... s ...", formatted only then). */
+static void undoable(Instance *instance, Action action, double time, double step_size)
 {
     ModelData snapshot = instance->data;
     Messages *out = &instance->messages;
     int before = out->count;
-    const char *failure =
-        action == ACTION_START ? model_start(&instance->data, time) : model_advance(&instance->data, time, step_size);
+    char shown[40];
+    const char *failure;
+    if (model_hooks.at_time != NULL) {
+        failure = model_hooks.at_time(&instance->data, action == ACTION_START ? time : time + step_size);
+    } else if (action == ACTION_START) {
+        failure = model_hooks.start(&instance->data, time);
+    } else {
+        failure = model_hooks.advance(&instance->data, time, step_size);
+    }
     if (failure == NULL) {
         output_errors(&instance->data, out, &failure);
     }
-    if (failure != NULL) {
-        messages_add(out, what, " could not be computed (", failure, ")", (const char *)NULL);
+    if (failure != NULL && action == ACTION_START) {
+        messages_add(out, "the start values could not be computed (", failure, ")", (const char *)NULL);
+    } else if (failure != NULL) {
+        python_float_repr(time, shown, sizeof shown);
+        messages_add(out, "the step from t = ", shown, " s could not be computed (", failure, ")", (const char *)NULL);
     }
     if (out->count != before) {
         instance->data = snapshot;
@@ -307,14 +319,14 @@ static void initialize(Instance *instance, double start_time)
         return;
     }
     instance->data.time = start_time;
-    undoable(instance, ACTION_START, start_time, 0.0, "the start values");
+    undoable(instance, ACTION_START, start_time, 0.0);
     instance->data.initialized = out->count == 0;
 }
 
 static void step(Instance *instance, double current_time, double step_size)
 {
     Messages *out = &instance->messages;
-    char shown[40], what[80];
+    char shown[40];
     if (!instance->data.initialized) {
         initialize(instance, current_time);
         if (out->count) {
@@ -331,9 +343,7 @@ static void step(Instance *instance, double current_time, double step_size)
     if (out->count) {
         return;
     }
-    python_float_repr(current_time, shown, sizeof shown);
-    snprintf(what, sizeof what, "the step from t = %s s", shown);
-    undoable(instance, ACTION_ADVANCE, current_time, step_size, what);
+    undoable(instance, ACTION_ADVANCE, current_time, step_size);
     if (out->count == 0) {
         instance->data.time = current_time + step_size;
     }
@@ -403,7 +413,9 @@ void instance_reset(Instance *instance)
         instance->data.real_value[i] = model_variables[i].start;
         instance->data.int_value[i] = (int32_t)model_variables[i].start;
     }
-    model_reset_internal(&instance->data);
+    if (model_hooks.reset_internal != NULL) {
+        model_hooks.reset_internal(&instance->data);
+    }
     instance->start_time = 0.0;
     instance->mode = MODE_INSTANTIATED;
 }
@@ -450,40 +462,27 @@ static int is_time(const Instance *instance, uint32_t reference)
  * else Error, with the reason logged. FMI 3.0's independent variable time is a Real to get only. */
 static int accessible(Instance *instance, const char *function, uint32_t reference, VariableType type, int setting)
 {
-    const VariableInfo *v;
+    const VariableInfo *v = reference < MODEL_VARIABLE_COUNT ? &model_variables[reference] : NULL;
     const char *problem = NULL;
     char number[24];
-    snprintf(number, sizeof number, "%lu", (unsigned long)reference);
     if (is_time(instance, reference)) {
-        if (type == VAR_REAL && !setting) {
-            return 1;
-        }
-        instance_fail(instance, instance->fmi_prefix, function, ": value reference ", number,
-                      " is the independent variable time, a Real that cannot be set", (const char *)NULL);
-        return 0;
-    }
-    if (reference >= MODEL_VARIABLE_COUNT) {
-        instance_fail(instance, instance->fmi_prefix, function, ": value reference ", number, " is unknown",
-                      (const char *)NULL);
-        return 0;
-    }
-    v = &model_variables[reference];
-    if (v->type != type) {
-        instance_fail(instance, instance->fmi_prefix, function, ": variable ", v->name, " (value reference ", number,
-                      ") is of type ", type_name(v->type), ", not ", type_name(type), (const char *)NULL);
-        return 0;
-    }
-    if (setting && v->causality == CAUSALITY_OUTPUT) {
-        problem = ") is an output and cannot be set";
+        problem = type == VAR_REAL && !setting ? NULL : " is the independent variable time, a Real that cannot be set";
+    } else if (v == NULL) {
+        problem = " is unknown";
+    } else if (v->type != type) {
+        problem = type == VAR_REAL ? " is not of type Real" : " is not of type Integer";
+    } else if (setting && v->causality == CAUSALITY_OUTPUT) {
+        problem = " is an output and cannot be set";
     } else if (setting && instance->mode == MODE_STEP && v->causality == CAUSALITY_PARAMETER && !v->tunable) {
-        problem = ") is a fixed parameter and cannot be changed after initialisation";
+        problem = " is a fixed parameter and cannot be changed after initialisation";
     }
-    if (problem != NULL) {
-        instance_fail(instance, instance->fmi_prefix, function, ": variable ", v->name, " (value reference ", number,
-                      problem, (const char *)NULL);
-        return 0;
+    if (problem == NULL) {
+        return 1;
     }
-    return 1;
+    snprintf(number, sizeof number, "%lu", (unsigned long)reference); /* formatted for a failure only */
+    instance_fail(instance, instance->fmi_prefix, function, ": value reference ", number,
+                  v != NULL ? " (" : "", v != NULL ? v->name : "", v != NULL ? ")" : "", problem, (const char *)NULL);
+    return 0;
 }
 
 #define SETTABLE_MODES (MODE_BIT(MODE_INSTANTIATED) | MODE_BIT(MODE_INITIALIZATION) | MODE_BIT(MODE_STEP))

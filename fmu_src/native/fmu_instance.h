@@ -84,14 +84,21 @@ struct Instance {
     Messages messages;
 };
 
-/* ---- hooks every model file defines (see driveline/<model>/model.py) ---------------- */
-void model_reset_internal(ModelData *data);
-/* Physics at the start time / over one step; NULL, or the arithmetic failure as Python names it
- * ("ZeroDivisionError: float division by zero"). */
-const char *model_start(ModelData *data, double start_time);
-const char *model_advance(ModelData *data, double current_time, double step_size);
-void model_extra_parameter_errors(const ModelData *data, Messages *out);
-void model_extra_input_errors(const ModelData *data, Messages *out);
+/* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
+ * The physics returns NULL, or the arithmetic failure as Python names it ("ZeroDivisionError:
+ * float division by zero"). A model whose outputs are functions of time alone gives ``at_time``
+ * (start: at the start time, step: at its end); the others give ``start`` and ``advance``.
+ * A NULL ``reset_internal`` or ``extra_*_errors`` means none. */
+typedef struct {
+    void (*reset_internal)(ModelData *data);
+    const char *(*at_time)(ModelData *data, double time);
+    const char *(*start)(ModelData *data, double start_time);
+    const char *(*advance)(ModelData *data, double current_time, double step_size);
+    void (*extra_parameter_errors)(const ModelData *data, Messages *out);
+    void (*extra_input_errors)(const ModelData *data, Messages *out);
+} ModelHooks;
+
+extern const ModelHooks model_hooks;
 
 /* ---- helpers for model files ---------------------------------------------------------- */
 void messages_add(Messages *out, const char *first, ...);

@@ -5,11 +5,6 @@
 
 #define VALUE(name) (data->real_value[V_##name])
 
-void model_reset_internal(ModelData *data)
-{
-    (void)data;
-}
-
 /* omega(t) = omega_start + ramp_rate t + a sin(w t), alpha = d(omega)/dt, phi its exact integral. */
 static const char *evaluate(ModelData *data, double t)
 {
@@ -24,24 +19,4 @@ static const char *evaluate(ModelData *data, double t)
     return NULL;
 }
 
-const char *model_start(ModelData *data, double start_time)
-{
-    return evaluate(data, start_time);
-}
-
-const char *model_advance(ModelData *data, double current_time, double step_size)
-{
-    return evaluate(data, current_time + step_size);
-}
-
-void model_extra_parameter_errors(const ModelData *data, Messages *out)
-{
-    (void)data;
-    (void)out;
-}
-
-void model_extra_input_errors(const ModelData *data, Messages *out)
-{
-    (void)data;
-    (void)out;
-}
+const ModelHooks model_hooks = {NULL, evaluate, NULL, NULL, NULL, NULL};

@@ -10,11 +10,6 @@
 #define VALUE(name) (data->real_value[V_##name])
 #define INTEGER(name) (data->int_value[V_##name])
 
-void model_reset_internal(ModelData *data)
-{
-    (void)data;
-}
-
 typedef struct {
     double M_E, M_C1, M_B, M_C; /* eqs 19-21 */
     double sigma, tau, sigma_eq;
@@ -67,21 +62,21 @@ static const char *evaluate(ModelData *data)
     return NULL;
 }
 
-const char *model_start(ModelData *data, double start_time)
+static const char *start(ModelData *data, double start_time)
 {
     (void)start_time;
     VALUE(phi_in) = VALUE(phi_in_start);
     return evaluate(data);
 }
 
-const char *model_advance(ModelData *data, double current_time, double step_size)
+static const char *advance(ModelData *data, double current_time, double step_size)
 {
     (void)current_time;
     VALUE(phi_in) = VALUE(phi_in) + VALUE(omega_in) * step_size;
     return evaluate(data);
 }
 
-void model_extra_parameter_errors(const ModelData *data, Messages *out)
+static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
     static const int positive[] = {V_module, V_e, V_r_shaft, V_sigma_allow, V_alpha_min};
     char first[40], second[40];
@@ -107,7 +102,9 @@ void model_extra_parameter_errors(const ModelData *data, Messages *out)
     }
 }
 
-void model_extra_input_errors(const ModelData *data, Messages *out)
+static void extra_input_errors(const ModelData *data, Messages *out)
 {
     angle_bound_errors(data, out, V_alpha, V_alpha_max, V_alpha_min, " (eq 21 is singular at 0 and 180 deg)");
 }
+
+const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, extra_input_errors};
