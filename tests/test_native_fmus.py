@@ -187,6 +187,37 @@ def test_cardan_refuses_beta_above_its_guard(native_dir):
     reducer_and_cardan.test_cardan_refuses_beta_above_its_guard(native_dir / "native")
 
 
+DECLARED_RULES = [  # every kind of declared bound and relation the native models have, broken once
+    ("CardanJoint", {"beta": math.radians(46.0)}),
+    ("CardanJoint", {"beta_max": 0.5 * math.pi}),
+    ("CardanJoint", {"beta_max": -0.1, "beta": 2.0}),
+    ("UniversalReducer", {"z1": 29}),
+    ("UniversalReducer", {"z2": 0}),
+    ("UniversalReducer", {"module": 0.0}),
+    ("UniversalReducer", {"e": -1e-3, "r_shaft": -0.0}),
+    ("UniversalReducer", {"alpha_min": 2.0, "alpha_max": 1.9}),
+    ("UniversalReducer", {"alpha_max": math.pi}),
+    ("UniversalReducer", {"alpha": 1.5}),
+    ("UniversalReducer", {"alpha": 3.0}),
+    ("SpeedSource", {"sine_amplitude": -1.0, "sine_frequency": math.inf}),
+]
+
+
+@pytest.mark.parametrize("name, values", [case for case in DECLARED_RULES if case[0] in NATIVE])
+def test_declared_bounds_and_relations_refuse_word_for_word(native_dir, name, values, fmi):
+    """The checks generated from the spec give the Python core's messages exactly."""
+    core = MODELS[name]()
+    for variable, value in values.items():
+        setattr(core, variable, value)
+    errors = core.step(0.0, 1e-3)
+    assert errors
+    with FmuInstance(_native(native_dir, name, fmi)) as fmu:
+        fmu.initialize(values)
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1e-3)
+    assert refused.value.messages == errors
+
+
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
 @pytest.mark.parametrize("name", NATIVE)
 def test_random_runs_match_the_core_and_refuse_alike(native_dir, name, fmi):

@@ -37,7 +37,7 @@ import fmu_src
 from driveline import __version__
 from driveline.catalog import MODELS
 from driveline.model import SteppedModel
-from driveline.variables import ModelSpec, Variable
+from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
 from .model_description import complete_fmi2, complete_fmi3
 
@@ -49,7 +49,6 @@ SUBDIR = {"2": "native", "3": "native/fmi3"}
 CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-fPIC", "-O2", "-fvisibility=hidden")
 TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
-_MARK = "\x00VALUE\x00"
 
 
 def snake_case(name: str) -> str:
@@ -78,27 +77,61 @@ def fmi_headers() -> Path:
 
 # -- the variable table in C --------------------------------------------------------------------
 
+# A checked value enters a message through Python's repr() or, in a display unit, through
+# format(factor * value + offset, ".6g"); these marks stand for either, so the wording can be cut
+# from the Python checks themselves and the C side fills the values in the same way.
+_SLOTS = {("value", "repr"): "SLOT_VALUE_REPR", ("value", "g6"): "SLOT_VALUE_DISPLAY",
+          ("bound", "repr"): "SLOT_BOUND_REPR", ("bound", "g6"): "SLOT_BOUND_DISPLAY"}
+_MARK = re.compile("\x00(value|bound):(repr|g6)\x00")
+
 
 class _Marked(float):
-    """A float whose repr is a mark: probes where a check puts the value in its message."""
+    """A float that keeps its mark through the arithmetic of a display unit and prints as it."""
+
+    role = "value"
 
     def __repr__(self) -> str:
-        return _MARK
+        return f"\x00{self.role}:repr\x00"
+
+    def __format__(self, spec: str) -> str:
+        return f"\x00{self.role}:g6\x00"
+
+    def _same(self, other: object) -> _Marked:
+        return self
+
+    __add__ = __radd__ = __mul__ = __rmul__ = __sub__ = __rsub__ = _same
 
 
 class _MarkedInt(int):
+    role = "value"
+
     def __repr__(self) -> str:
-        return _MARK
+        return f"\x00{self.role}:repr\x00"
 
 
-def _message_parts(variable: Variable, value: float) -> tuple[str, str]:
-    """The range check's message for ``value``, split around the value."""
-    marked = _MarkedInt(value) if variable.type == "Integer" else _Marked(value)
-    message = SteppedModel._range_error(SimpleNamespace(**{variable.name: marked}), variable)
-    if message is None or message.count(_MARK) != 1:
-        raise ValueError(f"{variable.name}: the range check gave no message for {value!r}")
-    before, after = message.split(_MARK)
-    return before, after
+def _marked(variable: Variable, value: float, role: str = "value") -> float:
+    marked = _MarkedInt(int(value)) if variable.type == "Integer" else _Marked(value)
+    marked.role = role
+    return marked
+
+
+def _template(message: str | None) -> str:
+    """A C message template (``{text, slot}`` pieces) from a message with marked values."""
+    if message is None:
+        raise ValueError("the probed check gave no message")
+    pieces, rest = [], message
+    while (found := _MARK.search(rest)) is not None:
+        pieces.append(f"{{{_c_string(rest[:found.start()])}, {_SLOTS[found.group(1), found.group(2)]}}}")
+        rest = rest[found.end():]
+    pieces.append(f"{{{_c_string(rest)}, SLOT_END}}")
+    return "{{" + ", ".join(pieces) + "}}"
+
+
+_NO_MESSAGE = '{{{"", SLOT_END}}}'
+
+
+def _range_message(variable: Variable, value: float) -> str:
+    return _template(SteppedModel._range_error(SimpleNamespace(**{variable.name: _marked(variable, value)}), variable))
 
 
 def _c_string(text: str) -> str:
@@ -112,20 +145,58 @@ def _c_double(value: float) -> str:
     return repr(float(value)) if math.isfinite(value) else ("HUGE_VAL" if value > 0 else "-HUGE_VAL")
 
 
+def _display(variable: Variable) -> tuple[float, float]:
+    """Factor and offset of the variable's display unit (1, 0 without one)."""
+    if variable.display_unit is None:
+        return 1.0, 0.0
+    display = next(d for d in UNITS[variable.unit].display_units if d.name == variable.display_unit)
+    return display.factor, display.offset
+
+
 def _table_entry(variable: Variable) -> str:
     if variable.type not in ("Real", "Integer"):
         raise ValueError(f"{variable.name}: the native FMUs hold Real and Integer variables only")
-    step = (lambda x, d: x + d) if variable.type == "Integer" else (lambda x, d: math.nextafter(x, d * math.inf))
-    not_finite = _message_parts(variable, math.nan) if variable.type == "Real" else ("", "")
-    below = _message_parts(variable, step(variable.min, -1)) if variable.min is not None else ("", "")
-    above = _message_parts(variable, step(variable.max, 1)) if variable.max is not None else ("", "")
-    parts = ", ".join("{" + ", ".join(_c_string(p) for p in pair) + "}" for pair in (not_finite, below, above))
+    below = (lambda x: x - 1) if variable.type == "Integer" else (lambda x: math.nextafter(x, -math.inf))
+    above = (lambda x: x + 1) if variable.type == "Integer" else (lambda x: math.nextafter(x, math.inf))
+    has_min, has_max = variable.min is not None, variable.max is not None
+    minimum = maximum = _NO_MESSAGE
+    if has_min:
+        minimum = _range_message(variable, variable.min if variable.min_exclusive else below(variable.min))
+    if has_max:
+        maximum = _range_message(variable, variable.max if variable.max_exclusive else above(variable.max))
+    messages = [_range_message(variable, math.nan) if variable.type == "Real" else _NO_MESSAGE, minimum, maximum]
+    factor, offset = _display(variable)
     return (
         f"    {{{_c_string(variable.name)}, VAR_{variable.type.upper()}, CAUSALITY_{variable.causality.upper()}, "
-        f"{int(variable.effective_variability == 'tunable')}, {_c_double(float(variable.start))}, "
-        f"{int(variable.min is not None)}, {int(variable.max is not None)}, "
-        f"{_c_double(variable.min if variable.min is not None else 0.0)}, "
-        f"{_c_double(variable.max if variable.max is not None else 0.0)}, {parts}}},"
+        f"{int(variable.effective_variability == 'tunable')}, {_c_double(float(variable.start))},\n"
+        f"     {int(has_min)}, {int(has_max)}, {int(variable.min_exclusive)}, {int(variable.max_exclusive)}, "
+        f"{_c_double(variable.min if has_min else 0.0)}, {_c_double(variable.max if has_max else 0.0)}, "
+        f"{_c_double(factor)}, {_c_double(offset)},\n     " + ",\n     ".join(messages) + "},"
+    )
+
+
+_OPERATORS = {"<": "OP_LT", "<=": "OP_LE", ">": "OP_GT", ">=": "OP_GE"}
+
+
+def _relation_entry(spec: ModelSpec, relation: Relation) -> str:
+    """One declared relation, its message cut from SteppedModel._relation_error on a violation."""
+    left = spec[relation.lhs]
+    right_variable = spec[relation.rhs] if isinstance(relation.rhs, str) else None
+    violating = 1.0 if relation.op in ("<", "<=") else -1.0  # against a (marked) bound of 0
+    values = {left.name: _marked(left, violating)}
+    if right_variable is not None:
+        values[right_variable.name] = _marked(right_variable, 0.0, "bound")
+    probe = SimpleNamespace(spec=spec, **values)
+    message = SteppedModel._relation_error(probe, relation)
+    if right_variable is None:  # a constant bound is part of the text
+        message = SteppedModel._relation_error(SimpleNamespace(spec=spec, **{left.name: values[left.name]}), relation)
+    integer_bound = right_variable is not None and right_variable.type == "Integer" and relation.bound(1) == 1
+    rhs_index = spec.variables.index(right_variable) if right_variable is not None else -1
+    constant = relation.rhs if right_variable is None else 0.0
+    return (
+        f"    {{V_{left.name}, {_OPERATORS[relation.op]}, {rhs_index}, {_c_double(constant)}, "
+        f"{_c_double(relation.scale)}, {_c_double(relation.offset)}, {int(integer_bound)}, "
+        f"{int(spec.involves_input(relation))},\n     {_template(message)}}},"
     )
 
 
@@ -139,6 +210,7 @@ def variable_table(spec: ModelSpec, token: str) -> dict[str, str]:
 #define MODEL_NAME {_c_string(spec.name)}
 #define MODEL_TOKEN {_c_string(token)}
 #define MODEL_VARIABLE_COUNT {len(spec.variables)}
+#define MODEL_RELATION_COUNT {len(spec.relations)}
 
 /* value references */
 enum {{
@@ -148,13 +220,21 @@ enum {{
 #endif
 """
     entries = "\n".join(_table_entry(v) for v in spec.variables)
-    source = f"""/* Variable table and range-check messages of {spec.name}, generated from its spec: do not edit. */
+    relations = "\n".join(_relation_entry(spec, r) for r in spec.relations)
+    source = f"""/* Variable table, declared bounds and relations of {spec.name} with their messages, generated
+ * from its spec: do not edit. */
 #include <math.h>
 
 #include "fmu_instance.h"
 
 const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 {entries}
+}};
+"""
+    if spec.relations:
+        source += f"""
+const RelationInfo model_relations[MODEL_RELATION_COUNT] = {{
+{relations}
 }};
 """
     return {"model_variables.h": header, "model_variables.c": source}

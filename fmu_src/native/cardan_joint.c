@@ -59,18 +59,4 @@ static const char *advance(ModelData *data, double current_time, double step_siz
     return NULL;
 }
 
-static void extra_parameter_errors(const ModelData *data, Messages *out)
-{
-    char shown[40];
-    if (!(VALUE(beta_max) < 0.5 * FMU_PI)) {
-        python_g6(degrees(VALUE(beta_max)), shown, sizeof shown);
-        messages_add(out, "parameter beta_max = ", shown, " deg must be below 90 deg", (const char *)NULL);
-    }
-}
-
-static void extra_input_errors(const ModelData *data, Messages *out)
-{
-    angle_bound_errors(data, out, V_beta, V_beta_max, -1, "");
-}
-
-const ModelHooks model_hooks = {reset_internal, NULL, start, advance, extra_parameter_errors, extra_input_errors};
+const ModelHooks model_hooks = {reset_internal, NULL, start, advance, NULL, NULL};

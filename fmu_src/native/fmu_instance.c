@@ -110,7 +110,8 @@ void python_float_repr(double value, char *out, size_t size)
     snprintf(out, size, "%s", text);
 }
 
-void python_g6(double value, char *out, size_t size)
+/* Python's format(value, '.6g') (glibc would print a negative NaN as "-nan"). */
+static void python_g6(double value, char *out, size_t size)
 {
     if (isnan(value)) {
         snprintf(out, size, "nan");
@@ -119,72 +120,102 @@ void python_g6(double value, char *out, size_t size)
     }
 }
 
-double degrees(double radians)
+/* A number as a message shows it: an Integer's digits, a Real's repr(), or in the display unit. */
+static void show(double value, int integer, int display, const VariableInfo *v, char *out, size_t size)
 {
-    return radians * (180.0 / FMU_PI);
+    if (display) {
+        python_g6(v->display_factor * value + v->display_offset, out, size);
+    } else if (integer) {
+        snprintf(out, size, "%ld", (long)value);
+    } else {
+        python_float_repr(value, out, size);
+    }
 }
 
-static void repr_of(const ModelData *data, int variable, char *out, size_t size)
+/* Fills a generated template with ``value`` (of variable ``v``) and ``bound``. */
+static void add_message(Messages *out, const MessageTemplate *message, const VariableInfo *v, double value,
+                        double bound, int integer_bound)
 {
-    if (model_variables[variable].type == VAR_INTEGER) {
-        snprintf(out, size, "%ld", (long)data->int_value[variable]);
-    } else {
-        python_float_repr(data->real_value[variable], out, size);
+    char text[FMU_MESSAGE_SIZE] = "", shown[40];
+    int i;
+    for (i = 0; i < 3; i++) {
+        const MessagePiece *piece = &message->pieces[i];
+        strncat(text, piece->text, sizeof text - strlen(text) - 1);
+        if (piece->slot == SLOT_END) {
+            break;
+        }
+        if (piece->slot == SLOT_VALUE_REPR || piece->slot == SLOT_VALUE_DISPLAY) {
+            show(value, v->type == VAR_INTEGER, piece->slot == SLOT_VALUE_DISPLAY, v, shown, sizeof shown);
+        } else {
+            show(bound, integer_bound, piece->slot == SLOT_BOUND_DISPLAY, v, shown, sizeof shown);
+        }
+        strncat(text, shown, sizeof text - strlen(text) - 1);
     }
+    messages_add(out, text, (const char *)NULL);
 }
 
-void angle_bound_errors(const ModelData *data, Messages *out, int variable, int upper, int lower, const char *note)
+static double value_of(const ModelData *data, int variable)
 {
-    double value = data->real_value[variable], high = data->real_value[upper];
-    double low = lower >= 0 ? data->real_value[lower] : -HUGE_VAL;
-    char shown[40], low_deg[40], high_deg[40];
-    if (low <= value && value <= high) {
-        return;
-    }
-    python_g6(degrees(value), shown, sizeof shown);
-    python_g6(degrees(high), high_deg, sizeof high_deg);
-    if (lower >= 0) {
-        python_g6(degrees(low), low_deg, sizeof low_deg);
-        messages_add(out, "input ", model_variables[variable].name, " = ", shown, " deg is outside [",
-                     model_variables[lower].name, ", ", model_variables[upper].name, "] = [", low_deg, ", ", high_deg,
-                     "] deg", note, (const char *)NULL);
-    } else {
-        messages_add(out, "input ", model_variables[variable].name, " = ", shown, " deg is above ",
-                     model_variables[upper].name, " = ", high_deg, " deg", note, (const char *)NULL);
-    }
+    return model_variables[variable].type == VAR_INTEGER ? (double)data->int_value[variable]
+                                                         : data->real_value[variable];
 }
 
 /* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
 
+/* SteppedModel._range_error for every variable of ``causality``: finite, then the declared bounds. */
 static void range_errors(const ModelData *data, Causality causality, Messages *out)
 {
     int i;
-    char shown[40];
     for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
         const VariableInfo *v = &model_variables[i];
-        const MessageParts *parts = NULL;
-        double value = v->type == VAR_REAL ? data->real_value[i] : (double)data->int_value[i];
+        const MessageTemplate *message = NULL;
+        double value = value_of(data, i);
         if (v->causality != causality) {
             continue;
         }
         if (v->type == VAR_REAL && !isfinite(value)) {
-            parts = &v->not_finite;
-        } else if (v->has_min && value < v->min) {
-            parts = &v->below_min;
-        } else if (v->has_max && value > v->max) {
-            parts = &v->above_max;
+            message = &v->not_finite;
+        } else if (v->has_min && (v->min_exclusive ? !(value > v->min) : value < v->min)) {
+            message = &v->outside_min;
+        } else if (v->has_max && (v->max_exclusive ? !(value < v->max) : value > v->max)) {
+            message = &v->outside_max;
         }
-        if (parts != NULL) {
-            repr_of(data, i, shown, sizeof shown);
-            messages_add(out, parts->before, shown, parts->after, (const char *)NULL);
+        if (message != NULL) {
+            add_message(out, message, v, value, 0.0, 0);
         }
     }
+}
+
+/* SteppedModel._relation_error for every declared relation checked with the inputs (``inputs``)
+ * or with the parameters. */
+static void relation_errors(const ModelData *data, int inputs, Messages *out)
+{
+#if MODEL_RELATION_COUNT > 0
+    int i;
+    for (i = 0; i < MODEL_RELATION_COUNT; i++) {
+        const RelationInfo *r = &model_relations[i];
+        double left = value_of(data, r->lhs), right = r->rhs >= 0 ? value_of(data, r->rhs) : r->constant;
+        double bound = r->scale == 1.0 && r->offset == 0.0 ? right : r->scale * right + r->offset;
+        int holds = r->op == OP_LT ? left < bound : r->op == OP_LE ? left <= bound : r->op == OP_GT ? left > bound
+                                                                                                     : left >= bound;
+        if (r->involves_input == inputs && !holds) {
+            add_message(out, &r->message, &model_variables[r->lhs], left, bound, r->integer_bound);
+        }
+    }
+#else
+    (void)data;
+    (void)inputs;
+    (void)out;
+#endif
 }
 
 static void parameter_errors(const ModelData *data, Messages *out)
 {
     int before = out->count;
     range_errors(data, CAUSALITY_PARAMETER, out);
+    if (out->count == before) {
+        relation_errors(data, 0, out);
+    }
     if (out->count == before && model_hooks.extra_parameter_errors != NULL) {
         model_hooks.extra_parameter_errors(data, out);
     }
@@ -194,6 +225,9 @@ static void input_errors(const ModelData *data, Messages *out)
 {
     int before = out->count;
     range_errors(data, CAUSALITY_INPUT, out);
+    if (out->count == before) {
+        relation_errors(data, 1, out);
+    }
     if (out->count == before && model_hooks.extra_input_errors != NULL) {
         model_hooks.extra_input_errors(data, out);
     }

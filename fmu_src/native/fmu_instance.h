@@ -29,11 +29,18 @@
 typedef enum { VAR_REAL, VAR_INTEGER } VariableType;
 typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT } Causality;
 
-/* A message cut into the text before and after the offending value. */
+/* A refusal message: text, then the checked value or the bound it broke (as Python's repr(), or
+ * in the display unit with format '.6g'), up to two values; generated from the Python checks. */
+typedef enum { SLOT_END, SLOT_VALUE_REPR, SLOT_VALUE_DISPLAY, SLOT_BOUND_REPR, SLOT_BOUND_DISPLAY } Slot;
+
 typedef struct {
-    const char *before;
-    const char *after;
-} MessageParts;
+    const char *text;
+    Slot slot;
+} MessagePiece;
+
+typedef struct {
+    MessagePiece pieces[3];
+} MessageTemplate;
 
 /* One variable of the model's spec; its value reference is its index in model_variables[]. */
 typedef struct {
@@ -42,12 +49,29 @@ typedef struct {
     Causality causality;
     int tunable;  /* a parameter the host may change after initialisation */
     double start; /* start value (an Integer's as a double: exact for int32) */
-    int has_min, has_max;
+    int has_min, has_max, min_exclusive, max_exclusive;
     double min, max;
-    MessageParts not_finite, below_min, above_max; /* the range checks' messages */
+    double display_factor, display_offset; /* display unit (1, 0 without one) */
+    MessageTemplate not_finite, outside_min, outside_max;
 } VariableInfo;
 
+typedef enum { OP_LT, OP_LE, OP_GT, OP_GE } Operator;
+
+/* A declared relation ``lhs op scale * rhs + offset`` (rhs: a variable, or ``constant`` if -1). */
+typedef struct {
+    int lhs;
+    Operator op;
+    int rhs;
+    double constant, scale, offset;
+    int integer_bound; /* the bound is the Integer rhs itself */
+    int involves_input; /* checked with the inputs, else with the parameters */
+    MessageTemplate message;
+} RelationInfo;
+
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
+#if MODEL_RELATION_COUNT > 0
+extern const RelationInfo model_relations[MODEL_RELATION_COUNT];
+#endif
 
 /* Everything a step may change: the FMU state. Values are indexed by value reference;
  * an Integer is held in int_value, a Real in real_value. */
@@ -104,12 +128,6 @@ extern const ModelHooks model_hooks;
 void messages_add(Messages *out, const char *first, ...);
 /* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
 void python_float_repr(double value, char *out, size_t size);
-/* Python's format(value, '.6g'). */
-void python_g6(double value, char *out, size_t size);
-/* math.degrees of CPython. */
-double degrees(double radians);
-/* SteppedModel.angle_bound_errors: input ``name`` against [lower, upper] (lower NULL: none). */
-void angle_bound_errors(const ModelData *data, Messages *out, int variable, int upper, int lower, const char *note);
 
 /* ---- life cycle (used by the FMI layers) -------------------------------------------- */
 void instance_reset(Instance *instance);

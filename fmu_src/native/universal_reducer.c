@@ -3,7 +3,6 @@
  * loads are the seed's quasi-static relations (eqs 18-21) and the third strength theory at C.
  */
 #include <math.h>
-#include <stdio.h>
 
 #include "fmu_instance.h"
 
@@ -76,35 +75,4 @@ static const char *advance(ModelData *data, double current_time, double step_siz
     return evaluate(data);
 }
 
-static void extra_parameter_errors(const ModelData *data, Messages *out)
-{
-    static const int positive[] = {V_module, V_e, V_r_shaft, V_sigma_allow, V_alpha_min};
-    char first[40], second[40];
-    size_t k;
-    if (!(INTEGER(z1) > INTEGER(z2))) {
-        snprintf(first, sizeof first, "%ld", (long)INTEGER(z1));
-        snprintf(second, sizeof second, "%ld", (long)INTEGER(z2));
-        messages_add(out, "parameter z1 = ", first, " must exceed z2 = ", second, " (i = z1 / (z1 - z2))",
-                     (const char *)NULL);
-    }
-    for (k = 0; k < sizeof positive / sizeof positive[0]; k++) {
-        if (!(data->real_value[positive[k]] > 0.0)) {
-            python_float_repr(data->real_value[positive[k]], first, sizeof first);
-            messages_add(out, "parameter ", model_variables[positive[k]].name, " = ", first, " must be positive",
-                         (const char *)NULL);
-        }
-    }
-    if (!(VALUE(alpha_min) <= VALUE(alpha_max) && VALUE(alpha_max) < FMU_PI)) {
-        python_g6(degrees(VALUE(alpha_min)), first, sizeof first);
-        python_g6(degrees(VALUE(alpha_max)), second, sizeof second);
-        messages_add(out, "parameters alpha_min = ", first, " deg and alpha_max = ", second,
-                     " deg must satisfy alpha_min <= alpha_max < 180 deg", (const char *)NULL);
-    }
-}
-
-static void extra_input_errors(const ModelData *data, Messages *out)
-{
-    angle_bound_errors(data, out, V_alpha, V_alpha_max, V_alpha_min, " (eq 21 is singular at 0 and 180 deg)");
-}
-
-const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, extra_input_errors};
+const ModelHooks model_hooks = {NULL, NULL, start, advance, NULL, NULL};
