@@ -183,8 +183,47 @@ class SteppedModel(ABC):
         self.__dict__.clear()
         self.__dict__.update(copy.deepcopy(state))
 
+    #: Internal attributes that the next step rebuilds from the parameters; never saved.
+    derived_state: ClassVar[tuple[str, ...]] = ()
+
+    def saved_values(self, state: dict[str, Any]) -> dict[str, Any]:
+        """What of ``state`` (from :meth:`get_state`) a serialised state keeps: plain values only."""
+        return {name: value for name, value in state.items() if name not in self.derived_state}
+
+    def state_from_saved(self, values: dict[str, Any]) -> dict[str, Any]:
+        """A state for :meth:`set_state` from untrusted :meth:`saved_values`; ValueError naming what does
+        not fit. Parameters are validated again at the next step, inputs at every step."""
+        fresh = type(self)().__dict__
+        expected = set(fresh) - set(self.derived_state)
+        if set(values) != expected:
+            odd = sorted(set(values) ^ expected)
+            raise ValueError(f"the saved state does not hold the values of {self.spec.name} (differs in {odd[:5]})")
+        state = dict(values)
+        for variable in self.spec.variables:
+            state[variable.name] = _saved_value(variable.name, values[variable.name], _SAVED_TYPES[variable.type])
+        state["time"] = _saved_value("time", values["time"], _SAVED_TYPES["Real"])
+        _saved_value("_initialized", values["_initialized"], (bool,))
+        state.update(self.internal_from_saved(state))
+        for name in self.derived_state:
+            state[name] = fresh[name]
+        state["_valid_parameters"] = None
+        return state
+
+    def internal_from_saved(self, state: dict[str, Any]) -> dict[str, Any]:
+        """Hook: internal values of a saved state rebuilt as the model holds them (ValueError if odd)."""
+        return {}
+
     def outputs(self) -> dict[str, Any]:
         return {v.name: getattr(self, v.name) for v in self.spec.of("output")}
+
+
+_SAVED_TYPES: dict[str, tuple[type, ...]] = {"Real": (float, int), "Integer": (int,), "Boolean": (bool,), "String": (str,)}
+
+
+def _saved_value(name: str, value: Any, kinds: tuple[type, ...]) -> Any:
+    if isinstance(value, bool) != (bool in kinds) or not isinstance(value, kinds):
+        raise ValueError(f"the saved value of {name} is a {type(value).__name__}, not a {kinds[0].__name__}")
+    return float(value) if kinds[0] is float else value
 
 
 class DrivenShaftModel(SteppedModel):

@@ -2,7 +2,9 @@
 
 Shipped inside every FMI 2.0 FMU next to the model's modules and ``model_adapter``. A
 refused step returns False, which pythonfmu reports as fmi2Discard; the reasons go to the
-FMI logger with status fmi2Error (category ``logStatusError``).
+FMI logger with status fmi2Error (category ``logStatusError``). pythonfmu has no fmi2Error
+outside an exception (which it turns into fmi2Fatal), so misuse is refused with fmi2Discard
+too (``model_adapter``).
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Intege
 from pythonfmu.default_experiment import DefaultExperiment
 from pythonfmu.enums import Fmi2Status
 
-from .model_adapter import ModelAdapter
+from .model_adapter import ModelAdapter, StepOutcome
 
 # pythonfmu 0.7's native loader re-executes the FMU script on every fmi2Instantiate and
 # then releases one reference to the script module's globals that it never owned. A
@@ -37,3 +39,11 @@ class ModelSlave(ModelAdapter, Fmi2Slave):
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         _PINNED_GLOBALS.append(sys.modules[cls.__module__].__dict__)
+
+    def wire_text(self, message: str) -> str:
+        """pythonfmu passes the text to the FMI 2.0 logger as its printf format: '%' must be '%%'."""
+        return message.replace("%", "%%")
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        """True: fmi2OK; False: fmi2Discard (a refused step, or misuse, reasons logged)."""
+        return self.step_outcome(current_time, step_size) is StepOutcome.OK

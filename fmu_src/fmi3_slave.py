@@ -1,18 +1,18 @@
 """Generic FMI 3.0 co-simulation adapter (pythonfmu3) around a :class:`SteppedModel`.
 
-Shipped inside every FMI 3.0 FMU next to the model's modules and ``model_adapter``. FMI
-3.0 wants an independent variable: ``time``, after the spec's variables. A refused step
-returns ``Fmi3StepResult(status=discard)``: pythonfmu3's native ``fmi3DoStep`` returns that
-status, **fmi3Discard**, with ``lastSuccessfulTime`` = ``currentCommunicationPoint`` and
-``terminateSimulation`` false, so the host may retry the step. The reasons go to the FMI
-logger with status fmi3Error (category ``logStatusError``); pythonfmu3 forwards them whether
-or not logging was switched on.
+Shipped inside every FMI 3.0 FMU next to the model's modules and ``model_adapter``. FMI 3.0
+wants an independent variable: ``time``, after the spec's variables. A refused step returns
+``Fmi3StepResult(status=discard)``: pythonfmu3's native ``fmi3DoStep`` returns that status,
+**fmi3Discard**, with ``lastSuccessfulTime`` = ``currentCommunicationPoint`` and
+``terminateSimulation`` false, so the host may retry the step; misuse and the error state
+return **fmi3Error**. The reasons go to the FMI logger with status fmi3Error (category
+``logStatusError``); pythonfmu3 forwards them whether or not logging was switched on.
 
 pythonfmu3 0.3.4 drops the ``startTime`` of ``fmi3EnterInitializationMode`` (the Python
-slave never sees it). The model is initialised at t = 0 and, if the first
-``fmi3DoStep`` starts elsewhere, initialised again at that time before the step.
-pythonfmu3's loader imports the FMU script once per process, so it has no counterpart of
-pythonfmu 0.7's globals-reference defect (tested with many instances in one process).
+slave never sees it). The model is initialised at t = 0 and, if the first ``fmi3DoStep``
+starts elsewhere, initialised again at that time before the step. pythonfmu3's loader
+imports the FMU script once per process, so it has no counterpart of pythonfmu 0.7's
+globals-reference defect (tested with many instances in one process).
 """
 
 from __future__ import annotations
@@ -22,7 +22,10 @@ from typing import Any
 from pythonfmu3 import Boolean, Fmi3Causality, Fmi3Slave, Fmi3Status, Fmi3StepResult, Fmi3Variability, Float64, Int32, String
 from pythonfmu3.default_experiment import DefaultExperiment
 
-from .model_adapter import ModelAdapter
+from driveline.variables import Variable
+from .model_adapter import ModelAdapter, Phase, StepOutcome
+
+_STATUS = {StepOutcome.OK: Fmi3Status.ok, StepOutcome.DISCARD: Fmi3Status.discard, StepOutcome.ERROR: Fmi3Status.error}
 
 
 class ModelSlave(ModelAdapter, Fmi3Slave):
@@ -37,13 +40,14 @@ class ModelSlave(ModelAdapter, Fmi3Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
-        self.register_variable(
-            Float64("time", causality=Fmi3Causality.independent, variability=Fmi3Variability.continuous,
-                    description="Simulation time", getter=lambda: self.model.time)
-        )
+        time = Float64("time", causality=Fmi3Causality.independent, variability=Fmi3Variability.continuous,
+                       description="Simulation time", getter=lambda: self.model.time)
+        self.register_variable(time)
+        self._spec_of_reference[time.value_reference] = Variable("time", "independent", 0.0, "Simulation time")
 
     def do_step(self, current_time: float, step_size: float) -> Fmi3StepResult:
-        if not self.stepped and current_time != self.start_time:
+        first_step_elsewhere = not self.stepped and current_time != self.start_time
+        if first_step_elsewhere and self.phase is Phase.STEPPING and self.fault is None and current_time - current_time == 0.0:
             self.start_time = current_time
-            self.exit_initialization_mode()
-        return Fmi3StepResult(Fmi3Status.ok if super().do_step(current_time, step_size) else Fmi3Status.discard)
+            self.initialize_model()
+        return Fmi3StepResult(status=_STATUS[self.step_outcome(current_time, step_size)])

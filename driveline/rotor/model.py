@@ -76,6 +76,7 @@ class CriticalSpeedsModel(SteppedModel):
     """The ``CriticalSpeeds`` co-simulation model."""
 
     spec = SPEC
+    derived_state = ("_analysis", "_analysed_for")
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None

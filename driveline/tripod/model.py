@@ -16,6 +16,16 @@ class TripodCouplingModel(DrivenShaftModel):
     def reset_internal_state(self) -> None:
         self._solution: Solution | None = None  # warm start of the exact solver
 
+    def internal_from_saved(self, state: dict) -> dict:
+        """The warm start of a saved state: five floats, or none."""
+        saved = state["_solution"]
+        if saved is None:
+            return {}
+        if not (isinstance(saved, tuple) and len(saved) == len(Solution._fields)
+                and all(isinstance(value, float) for value in saved)):
+            raise ValueError(f"the saved warm start of the solver is not {len(Solution._fields)} floats")
+        return {"_solution": Solution(*saved)}
+
     def extra_parameter_errors(self) -> list[str]:
         if self.mu > 0.0 and self.kinematics != EXACT:
             return [f"friction mu = {self.mu!r} needs the exact kinematics (kinematics = {EXACT})"]
