@@ -205,7 +205,9 @@ class SteppedModel(ABC):
         _saved_value("_initialized", values["_initialized"], (bool,))
         state.update(self.internal_from_saved(state))
         for name in self.derived_state:
-            state[name] = fresh[name]
+            state.pop(name, None)
+            if name in fresh:
+                state[name] = fresh[name]
         state["_valid_parameters"] = None
         return state
 

@@ -33,13 +33,20 @@ File layout (SI units; all tables except ``segments`` optional)::
                                  # segment there (masses and bearings too)
     # bending_stiffness = 0.0    # N m/rad; > 0 makes it a rotational spring
 
-Every problem raises :class:`ValueError` naming the table, entry and key.
+Every problem raises :class:`ValueError` naming the table, entry and key. A description is
+read only from a regular file of at most :data:`MAX_FILE_BYTES` (a FIFO, a device or a
+directory is refused without reading from it), nests at most :data:`MAX_NESTING` brackets
+deep and has at most :data:`MAX_SEGMENTS` segments and :data:`MAX_POINT_ELEMENTS` masses,
+bearings and hinges each: bounds on the work and memory a description can demand.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import re
+import stat
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -50,6 +57,15 @@ from .driveline import Driveline
 from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, ShaftSegment
 
 __all__ = ["example_path", "load_driveline", "loads_driveline", "one_piece_shaft"]
+
+#: A description of the largest driveline accepted is a few kilobytes.
+MAX_FILE_BYTES = 64 * 1024
+#: Brackets open at once (arrays, inline tables, table headers count one level each).
+MAX_NESTING = 16
+#: Segments of one description; the analysis cost grows with their number.
+MAX_SEGMENTS = 100
+#: Masses, bearings and hinges of one description, each.
+MAX_POINT_ELEMENTS = 2 * (MAX_SEGMENTS + 1)
 
 _TOP_KEYS = {"name", "left_end", "right_end", "materials", "segments", "masses", "bearings", "hinges"}
 _MATERIAL_KEYS = {"youngs_modulus", "density"}
@@ -99,6 +115,24 @@ def _table_list(data: dict[str, Any], key: str) -> list[dict[str, Any]]:
     if not isinstance(items, list) or not all(isinstance(t, dict) for t in items):
         raise ValueError(f"{key} must be an array of tables ([[{key}]])")
     return items
+
+
+def _counted(data: dict[str, Any], key: str, limit: int) -> list[dict[str, Any]]:
+    items = _table_list(data, key)
+    if len(items) > limit:
+        raise ValueError(f"{len(items)} [[{key}]] tables are more than the {limit} accepted")
+    return items
+
+
+def _nesting_errors(text: str, source: str) -> None:
+    """Refuse text whose brackets nest deeper than MAX_NESTING (brackets inside strings count
+    too: a conservative bound that keeps the TOML parser's recursion shallow)."""
+    depth = deepest = 0
+    for match in re.finditer(r"[\[{\]}]", text):
+        depth = depth + 1 if match.group() in "[{" else max(depth - 1, 0)
+        deepest = max(deepest, depth)
+        if deepest > MAX_NESTING:
+            raise ValueError(f"{source}: brackets nest deeper than {MAX_NESTING} levels")
 
 
 def _materials(data: dict[str, Any]) -> dict[str, tuple[float, float]]:
@@ -264,6 +298,7 @@ def _hinge(i: int, t: dict[str, Any], node: int, n_nodes: int) -> Hinge:
 
 def loads_driveline(text: str, source: str = "<string>") -> Driveline:
     """Build a :class:`Driveline` from TOML text (see the module docstring for the layout)."""
+    _nesting_errors(text, source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -280,11 +315,11 @@ def loads_driveline(text: str, source: str = "<string>") -> Driveline:
             raise ValueError(f"{key} = {v!r} is not one of: {', '.join(allowed)}")
         ends.append(EndCondition(v))
     mats = _materials(data)
-    seg_tables = _table_list(data, "segments")
+    seg_tables = _counted(data, "segments", MAX_SEGMENTS)
     if not seg_tables:
         raise ValueError(f"{source}: at least one [[segments]] table is required")
     segments = [_segment(i, t, mats) for i, t in enumerate(seg_tables)]
-    tables = {kind: _table_list(data, kind) for kind in ("masses", "bearings", "hinges")}
+    tables = {kind: _counted(data, kind, MAX_POINT_ELEMENTS) for kind in ("masses", "bearings", "hinges")}
     stations = {kind: [_station(f"{kind}[{i}]", t, len(segments) + 1) for i, t in enumerate(items)]
                 for kind, items in tables.items()}
     segments, nodes = _cut(segments, stations)
@@ -301,9 +336,13 @@ def load_driveline(path: str | Path) -> Driveline:
     Messages name the file by its absolute path."""
     p = Path(path).absolute()
     try:
-        text = p.read_text(encoding="utf-8")
+        raw = _read_regular_file(p)
     except OSError as exc:
         raise ValueError(f"cannot read driveline file {str(p)!r}: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"driveline file {str(p)!r} is not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     try:
         return loads_driveline(text, str(p))
     except ValueError as exc:
@@ -311,8 +350,26 @@ def load_driveline(path: str | Path) -> Driveline:
         raise ValueError(message if message.startswith(str(p)) else f"{p}: {message}") from None
 
 
+def _read_regular_file(path: Path) -> bytes:
+    """The bytes of ``path``, opened without blocking; only a regular file of at most MAX_FILE_BYTES."""
+    descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+    try:
+        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+            raise ValueError(f"driveline file {str(path)!r} is not a regular file")
+        data = b""
+        while len(data) <= MAX_FILE_BYTES and (chunk := os.read(descriptor, MAX_FILE_BYTES + 1 - len(data))):
+            data += chunk
+    finally:
+        os.close(descriptor)
+    if len(data) > MAX_FILE_BYTES:
+        raise ValueError(f"driveline file {str(path)!r} is larger than {MAX_FILE_BYTES} bytes")
+    return data
+
+
 def example_path(name: str = "two_piece_propshaft") -> Path:
     """Path of a shipped example description (``data/<name>.toml``)."""
+    if not re.fullmatch(r"\w{1,64}", name, re.ASCII):
+        raise ValueError(f"no shipped example named {name[:80]!r} (names are letters, digits and '_')")
     p = Path(str(resources.files(__package__).joinpath("data", f"{name}.toml")))
     if not p.is_file():
         raise ValueError(f"no shipped example named {name!r}")
