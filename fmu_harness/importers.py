@@ -30,7 +30,7 @@ class Session:
 
     set: Callable[[Mapping[str, float]], None]
     get: Callable[[Iterable[str]], list[float]]
-    step: Callable[[], None]
+    step: Callable[[], object]  # libcosim: whether the step was taken; Ecos: the new time
     resources: ExitStack = field(default_factory=ExitStack)
 
     def close(self) -> None:
@@ -134,10 +134,12 @@ def cosim_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp:
             else:
                 execution.real_initial_value(index, reference, float(value))
 
-    def step() -> None:
+    def step() -> bool:
+        """True when libcosim took the step (False: an FMU refused it)."""
         nonlocal started
-        execution.step()
+        taken = execution.step()
         started = True
+        return taken
 
     def get_values(names: Iterable[str]) -> list[float]:
         return [observer.last_real_values(references[name][0], [references[name][1]])[0] for name in names]

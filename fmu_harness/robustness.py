@@ -1,0 +1,280 @@
+"""Robustness suite: hostile inputs and misuse of the FMUs, each case in a process of its own with a
+time limit, through fmpy (FMI 2.0 and 3.0) and, for a subset, libcosim and Ecos.
+
+Usage: ``python -m fmu_harness.robustness [--models models] [--slow] [--workers 2]`` after
+building the FMUs. Prints per class of case: cases, crashes (the host process died), hangs (it
+did not end within the time limit), wrong statuses and wrong outputs (outputs wrong with status
+OK), and the cases whose defined outcome departs from the standard because of the Python
+wrappers (docs/robustness.md). The procedures are in :mod:`fmu_harness.robustness_probe`.
+
+The FMUs are data: :func:`cases` takes a function ``(model name, FMI version) -> FMU path``, so
+another build of the same models runs the same suite with one more call.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import json
+import math
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterable
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+from driveline.catalog import MODELS
+
+from .robustness_probe import VERDICT
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Seconds a case may take; every case needs a few seconds at most (a host process start included).
+TIME_LIMIT = 60.0
+NON_FINITE = (math.nan, math.inf, -math.inf)
+FmuPath = Callable[[str, str], Path]
+
+#: Departures from the standard that the wrappers force (docs/robustness.md).
+STATUS_OK_LOGGED = "pythonfmu/pythonfmu3 return OK (the error is logged, later steps refused)"
+NO_GUID_CHECK = "pythonfmu/pythonfmu3 do not pass the GUID / instantiation token to Python"
+NO_START_TIME = "pythonfmu3 does not pass startTime to Python"
+FMI2_DISCARD = "pythonfmu has no fmi2Error without fmi2Fatal: misuse returns fmi2Discard"
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run: ``procedure(*arguments)`` of :mod:`.robustness_probe` in a fresh process."""
+
+    kind: str
+    name: str
+    procedure: str
+    arguments: tuple
+    fmi: str
+    limited: str = ""
+
+
+@dataclass(frozen=True)
+class Result:
+    case: Case
+    verdict: str  # ok, crash, hang, wrong status, wrong output
+    detail: str
+    seconds: float
+
+
+def _variables(model: str, causality: str) -> list[str]:
+    return [v.name for v in MODELS[model].spec.of(causality) if v.type == "Real"]
+
+
+def _non_finite(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
+    """Every Real input of every model and two parameters of each, one non-finite value each;
+    when slow, every Real parameter too and all three values."""
+    found, index = [], 0
+    for model in MODELS:
+        for causality, procedure in (("input", "bad_input"), ("parameter", "bad_parameter")):
+            names = _variables(model, causality)
+            for name in names if slow or causality == "input" else names[:2]:
+                values = NON_FINITE if slow else (NON_FINITE[index % 3],)
+                index += 1
+                found += [Case("non-finite values", f"{model}.{name} = {v}", procedure,
+                               (str(fmu_path(model, fmi)), name, v), fmi) for v in values]
+    return found
+
+
+def _out_of_range(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
+    """Bounded Real parameters and inputs just beyond their bounds: all when slow, else one per model."""
+    found = []
+    for model, cls in MODELS.items():
+        of_model = []
+        for v in cls.spec.variables:
+            if v.type != "Real" or v.causality not in ("input", "parameter"):
+                continue
+            procedure = "bad_input" if v.causality == "input" else "bad_parameter"
+            for beyond in ([v.min - 1.0] if v.min is not None else []) + ([v.max + 1.0] if v.max is not None else []):
+                of_model.append(Case("out-of-range values", f"{model}.{v.name} = {beyond:g}", procedure,
+                                     (str(fmu_path(model, fmi)), v.name, beyond), fmi))
+        found += of_model if slow else of_model[:1]
+    return found
+
+
+def _step_sizes(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
+    sizes = (0.0, -1e-3, 5e-324, 1e-300, 1e300, math.nan, math.inf, -math.inf)
+    return [Case("step sizes", f"{model} h = {h!r}", "step_size", (str(fmu_path(model, fmi)), h), fmi)
+            for model in (MODELS if slow else ("SpeedSource",)) for h in sizes]
+
+
+MISUSE = ("step before initialisation", "step in initialisation mode", "step after terminate",
+          "set after terminate", "nan time", "-inf time", "unknown value reference", "string on a real",
+          "set an output", "fixed parameter after initialisation", "enter initialisation twice", "wrong guid")
+
+
+def _misuse(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    found = []
+    for kind in MISUSE:
+        model = "TripodCoupling" if kind == "fixed parameter after initialisation" else "CardanJoint"
+        limited = {"wrong guid": NO_GUID_CHECK}.get(kind, "")
+        if kind in ("set after terminate", "unknown value reference", "string on a real", "set an output",
+                    "fixed parameter after initialisation", "enter initialisation twice"):
+            limited = STATUS_OK_LOGGED
+        elif fmi == "2" and kind != "wrong guid":
+            limited = FMI2_DISCARD
+        found.append(Case("call sequence misuse", kind, "misuse", (str(fmu_path(model, fmi)), kind), fmi, limited))
+    return found
+
+
+STATE_KINDS = ("round trip", "pickle running a command", "truncated", "one bit flipped", "empty", "another model's state")
+
+
+def _states(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    return [Case("state round trips and corrupt state", kind, "state",
+                 (str(fmu_path("CardanJoint", fmi)), kind, str(fmu_path("SpeedSource", fmi))), fmi,
+                 "" if kind == "round trip" else STATUS_OK_LOGGED)
+            for kind in STATE_KINDS]
+
+
+def _instances(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
+    return [Case("instances and threads", f"{model}, {'threads' if threads else 'interleaved'}", "instances",
+                 (str(fmu_path(model, fmi)), threads), fmi)
+            for model in (("CardanJoint", "TripodCoupling") if slow else ("CardanJoint",)) for threads in (False, True)]
+
+
+#: (layout value, file to prepare under the FMU's folder, fragment of the expected message)
+LAYOUTS = (
+    ("%s%s%s%s%s%s.toml", "", "%s%s%s%s%s%s.toml"),
+    ("%x%x%x%x%n.toml", "", "%x%x%x%x%n.toml"),
+    ("fifo.toml", "fifo", "not a regular file"),
+    ("zero.toml", "dev zero", "not a regular file"),
+    ("folder.toml", "directory", "not a regular file"),
+    ("segments.toml", "many segments", "[[segments]] tables are more than the 100 accepted"),
+    ("nested.toml", "deep nesting", "brackets nest deeper than 16 levels"),
+    ("large.toml", "large file", "is larger than 65536 bytes"),
+    ("missing.toml", "", "No such file or directory"),
+    ("../../../etc/passwd", "", "no shipped example named"),
+    ("x" * 300 + ".toml", "", "File name too long"),
+)
+
+
+def _layouts(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    path = str(fmu_path("CriticalSpeeds", fmi))
+    found = [Case("hostile layout values", f"layout {value[:24]!r}", "layout", (path, value, fragment, prepare), fmi)
+             for value, prepare, fragment in LAYOUTS]
+    found.append(Case("hostile layout values", "layout of 10^5 characters", "long_string",
+                      (path, "layout", 100000), fmi, STATUS_OK_LOGGED))
+    return found
+
+
+#: (parameter, value, fragment of the expected message): work, memory and resolution limits
+LIMITS = (
+    ("orders", "99999999999999999999", "is not an integer from 1 to 100"),
+    ("orders", ",".join(["1"] * 1000), "more than 16 orders"),
+    ("L_shaft", 100.0, "more than the 250 accepted"),
+    ("L_shaft", 1e6, "more than the 250 accepted"),
+    ("density", 1e308, "more than the 250 accepted"),
+    ("E", 1e-300, "more than the 250 accepted"),
+    ("E", 1e180, "finite-element check"),
+    ("omega_max", 1e300, "more than the 250 accepted"),
+)
+
+
+def _limits(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    path = str(fmu_path("CriticalSpeeds", fmi))
+    return [Case("work, memory and resolution limits", f"{name} = {str(value)[:24]}", "parameter_limit",
+                 (path, name, value, fragment), fmi) for name, value, fragment in LIMITS]
+
+
+def _start_time(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    return [Case("outputs at a start time other than 0", "SpeedSource at t0 = 1 s", "start_time",
+                 (str(fmu_path("SpeedSource", fmi)), 1.0), fmi, NO_START_TIME if fmi == "3" else "")]
+
+
+def _engines(fmu_path: FmuPath) -> list[Case]:
+    found = []
+    for engine, package, versions in (("libcosim", "libcosimpy", ("2",)), ("Ecos", "ecospy", ("2", "3"))):
+        if importlib.util.find_spec(package) is None:
+            continue
+        for fmi in versions:
+            for model, name in (("CardanJoint", "omega_in"), ("TripodCoupling", "beta")):
+                found.append(Case(f"refused steps in {engine}", f"{model}.{name} = nan", "engine_refusal",
+                                  (str(fmu_path(model, fmi)), engine, name, math.nan), fmi,
+                                  "Ecos ignores fmi2Discard/fmi3Discard" if engine == "Ecos" else ""))
+    return found
+
+
+def _soak(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    return [Case("soak", "100,000 bad/good alternations", "soak", (str(fmu_path("CardanJoint", fmi)), "omega_in", 100000), fmi)]
+
+
+def cases(fmu_path: FmuPath, slow: bool = False, versions: Iterable[str] = ("2", "3")) -> list[Case]:
+    """The suite for the FMUs ``fmu_path(model, fmi)``; ``slow`` adds every variable, value, model
+    and step size of the sampled classes, and the soak."""
+    found = []
+    for fmi in versions:
+        found += (_non_finite(fmu_path, fmi, slow) + _out_of_range(fmu_path, fmi, slow)
+                  + _step_sizes(fmu_path, fmi, slow) + _misuse(fmu_path, fmi) + _states(fmu_path, fmi)
+                  + _instances(fmu_path, fmi, slow)
+                  + _layouts(fmu_path, fmi) + _limits(fmu_path, fmi) + _start_time(fmu_path, fmi))
+        if slow:
+            found += _soak(fmu_path, fmi)
+    return found + _engines(fmu_path)
+
+
+def run(case: Case, time_limit: float = TIME_LIMIT) -> Result:
+    """Run ``case`` in a new Python process and classify what happened."""
+    command = [sys.executable, "-m", "fmu_harness.robustness_probe",
+               json.dumps({"procedure": case.procedure, "arguments": list(case.arguments)})]
+    started = time.perf_counter()
+    try:
+        done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, errors="replace", timeout=time_limit)
+    except subprocess.TimeoutExpired:
+        return Result(case, "hang", f"no end within {time_limit:.0f} s", time.perf_counter() - started)
+    seconds = time.perf_counter() - started
+    lines = [line for line in done.stdout.splitlines() if line.startswith(VERDICT)]
+    if not lines:
+        return Result(case, "crash", f"exit code {done.returncode}: {done.stderr.strip()[-300:]}", seconds)
+    verdict = json.loads(lines[-1][len(VERDICT):])
+    return Result(case, verdict["result"], verdict.get("detail", ""), seconds)
+
+
+def run_all(suite: list[Case], workers: int = 2, time_limit: float = TIME_LIMIT) -> list[Result]:
+    with ThreadPoolExecutor(workers) as pool:
+        return list(pool.map(lambda case: run(case, time_limit), suite))
+
+
+COLUMNS = ("crash", "hang", "wrong status", "wrong output")
+
+
+def table(results: list[Result]) -> str:
+    """Markdown table per class (FMI versions and hosts together)."""
+    kinds = list(dict.fromkeys(result.case.kind for result in results))
+    lines = ["| class | cases | crashes | hangs | wrong statuses | wrong outputs | wrapper-limited |",
+             "|---|---|---|---|---|---|---|"]
+    for kind in kinds + ["all"]:
+        rows = [r for r in results if kind in ("all", r.case.kind)]
+        counts = [sum(r.verdict == column for r in rows) for column in COLUMNS]
+        limited = sum(bool(r.case.limited) for r in rows)
+        lines.append(f"| {kind} | {len(rows)} | " + " | ".join(map(str, counts)) + f" | {limited} |")
+    return "\n".join(lines)
+
+
+def failures(results: list[Result]) -> list[Result]:
+    return [result for result in results if result.verdict != "ok"]
+
+
+def main(argv: list[str] | None = None) -> None:
+    from .build import fmu_path
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--models", type=Path, default=ROOT / "models", help="folder of the built FMUs")
+    parser.add_argument("--slow", action="store_true", help="every non-finite value and the soak")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args(argv)
+    started = time.perf_counter()
+    results = run_all(cases(lambda model, fmi: fmu_path(args.models, model, fmi), args.slow), args.workers)
+    print(table(results))
+    for result in failures(results):
+        print(f"- {result.verdict}: FMI {result.case.fmi} {result.case.kind} / {result.case.name}: {result.detail}")
+    print(f"{len(results)} runs in {time.perf_counter() - started:.0f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,451 @@
+"""One robustness case, run in a process of its own: ``python -m fmu_harness.robustness_probe CASE_JSON``.
+
+The case names a procedure of this module and its arguments; the procedure drives the FMU
+through raw FMI calls (fmpy, or the libcosim/Ecos engines) and raises :class:`Wrong` when a
+status or an output is not the defined one. The last line printed is the verdict as JSON;
+a process that dies before printing it crashed, one that does not end in time hung.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import pickle
+import sys
+import threading
+from pathlib import Path
+from typing import Any
+
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.simulation import instantiate_fmu
+
+VERDICT = "robustness verdict: "
+STATUS_NAMES = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
+_FMI3_NAMES = {"getReal": "getFloat64", "setReal": "setFloat64", "getInteger": "getInt32", "setInteger": "setInt32",
+               "getFMUstate": "getFMUState", "setFMUstate": "setFMUState", "freeFMUstate": "freeFMUState",
+               "serializeFMUstate": "serializeFMUState", "deSerializeFMUstate": "deserializeFMUState"}
+
+
+class Wrong(Exception):
+    """A status or output other than the defined one; ``kind`` is "status" or "output"."""
+
+    def __init__(self, kind: str, detail: str):
+        super().__init__(detail)
+        self.kind = kind
+
+
+class Probe:
+    """One instance of the FMU at ``path`` with logging on; calls return their FMI status name."""
+
+    def __init__(self, path: str, name: str = "probe", guid: str | None = None, unzipdir: str | None = None):
+        self.description = read_model_description(path)
+        if guid is not None:
+            self.description.guid = self.description.instantiationToken = guid
+        self.unzipdir = unzipdir or extract(path)
+        self.fmi3 = self.description.fmiVersion.startswith("3")
+        self.log: list[tuple[str, str]] = []
+        self.variables = {v.name: v for v in self.description.modelVariables}
+        self.fmu = instantiate_fmu(self.unzipdir, self.description, "CoSimulation", debug_logging=True, logger=self._on_log)
+        self.time = 0.0
+
+    def _on_log(self, *args: Any) -> None:
+        status, _, message = args[-3:]
+        text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
+        self.log.append((STATUS_NAMES[status] if 0 <= status < len(STATUS_NAMES) else str(status), text))
+
+    # -- raw calls ---------------------------------------------------------------
+    def call(self, name: str, *args: Any) -> tuple[str, Any]:
+        """``(status name, result)`` of FMI call ``name`` (FMI 2.0 spelling, mapped for 3.0)."""
+        function = getattr(self.fmu, _FMI3_NAMES.get(name, name) if self.fmi3 else name)
+        try:
+            return "OK", function(*args)
+        except FMICallException as error:
+            return STATUS_NAMES[error.status], None
+
+    def status(self, name: str, *args: Any) -> str:
+        return self.call(name, *args)[0]
+
+    def reference(self, name: str) -> int:
+        return self.variables[name].valueReference
+
+    def set(self, name: str, value: Any) -> str:
+        kind = self.variables[name].type
+        setter = {"Real": "setReal", "Float64": "setReal", "Integer": "setInteger", "Int32": "setInteger",
+                  "Boolean": "setBoolean", "String": "setString"}[kind]
+        return self.status(setter, [self.reference(name)], [value])
+
+    def get(self, names: list[str]) -> list[float]:
+        return [self.call("getReal", [self.reference(name)])[1][0] for name in names]
+
+    def outputs(self) -> list[str]:
+        return [v.name for v in self.description.modelVariables
+                if v.causality == "output" and v.type in ("Real", "Float64")]
+
+    def enter(self, start_time: float = 0.0) -> str:
+        if self.fmi3:
+            return self.status("enterInitializationMode", None, start_time)
+        self.status("setupExperiment", None, start_time)
+        return self.status("enterInitializationMode")
+
+    def initialize(self, values: dict[str, Any] | None = None, start_time: float = 0.0) -> str:
+        self.time = start_time
+        self.enter(start_time)
+        for name, value in (values or {}).items():
+            self.set(name, value)
+        return self.status("exitInitializationMode")
+
+    def step(self, step_size: float, time: float | None = None) -> str:
+        status = self.status("doStep", self.time if time is None else time, step_size)
+        if status == "OK":
+            self.time += step_size
+        return status
+
+    def errors_logged(self) -> list[str]:
+        return [text for status, text in self.log if status == "Error"]
+
+    def close(self) -> None:
+        self.fmu.freeInstance()
+
+
+def expect(observed: str, *allowed: str, what: str = "") -> None:
+    if observed not in allowed:
+        raise Wrong("status", f"{what or 'call'} returned {observed}, expected {' or '.join(allowed)}")
+
+
+def refused(probe: Probe) -> str:
+    """Status of a refused misuse: fmi3Error; fmi2Discard (pythonfmu has no fmi2Error without Fatal)."""
+    return "Error" if probe.fmi3 else "Discard"
+
+
+def _finite_outputs(probe: Probe) -> None:
+    values = probe.get(probe.outputs())
+    if not all(math.isfinite(v) for v in values):
+        raise Wrong("output", f"non-finite outputs with status OK: {values}")
+
+
+# -- procedures: (path, *arguments) -> None, raising Wrong ----------------------------
+def bad_input(path: str, name: str, value: float) -> None:
+    """A bad input refuses the step (Discard), keeps the outputs; the corrected input steps on."""
+    probe = Probe(path)
+    expect(probe.initialize(), "OK", what="exitInitializationMode")
+    expect(probe.step(1e-3), "OK", what="first doStep")
+    good, before = probe.get([name])[0], probe.get(probe.outputs())
+    probe.set(name, value)
+    expect(probe.step(1e-3), "Discard", what=f"doStep with {name} = {value!r}")
+    if not any(name in text for text in probe.errors_logged()):
+        raise Wrong("status", f"the refusal does not name {name}: {probe.errors_logged()}")
+    after = probe.get(probe.outputs())
+    if [repr(v) for v in after] != [repr(v) for v in before]:
+        raise Wrong("output", f"a refused step changed the outputs: {before} -> {after}")
+    probe.set(name, good)
+    expect(probe.step(1e-3), "OK", what="doStep after correcting the input")
+    _finite_outputs(probe)
+    probe.close()
+
+
+def bad_parameter(path: str, name: str, value: Any) -> None:
+    """A bad start value of a parameter is logged at initialisation and refuses every step."""
+    probe = Probe(path)
+    expect(probe.initialize({name: value}), "OK", what="exitInitializationMode")
+    expect(probe.step(1e-3), "Discard", what=f"doStep with {name} = {value!r}")
+    if not any(name in text for text in probe.errors_logged()):
+        raise Wrong("status", f"the refusal does not name {name}: {probe.errors_logged()[:2]}")
+    probe.close()
+
+
+def step_size(path: str, size: float) -> None:
+    """Non-positive or non-finite sizes are refused; a tiny or huge one is taken or refused, never
+    with non-finite outputs."""
+    probe = Probe(path)
+    probe.initialize()
+    status = probe.step(size)
+    if math.isfinite(size) and size > 0.0:
+        expect(status, "OK", "Discard", what=f"doStep({size!r})")
+        if status == "OK":
+            _finite_outputs(probe)
+    else:
+        expect(status, "Discard", what=f"doStep({size!r})")
+    expect(probe.step(1e-3), "OK", what="a good step after it")
+    probe.close()
+
+
+def misuse(path: str, kind: str) -> None:
+    """Calls out of the life-cycle order or with wrong references: the defined outcome is the
+    status of the call, an Error logged, and (error state) every later step refused."""
+    probe = Probe(path, guid="{00000000-0000-0000-0000-000000000000}" if kind == "wrong guid" else None)
+    first_input = next((v.name for v in probe.description.modelVariables if v.causality == "input"), None)
+    fixed = next((v.name for v in probe.description.modelVariables if v.causality == "parameter"
+                  and v.variability == "fixed" and v.type in ("Real", "Float64")), None)
+    output = probe.outputs()[0]
+    if kind == "step before initialisation":
+        expect(probe.step(1e-3), refused(probe), what="doStep before initialisation")
+        return probe.close()
+    if kind == "step in initialisation mode":
+        probe.enter()
+        expect(probe.step(1e-3), refused(probe), what="doStep in initialisation mode")
+        return probe.close()
+    if kind == "wrong guid":
+        expect(probe.initialize(), "OK")
+        expect(probe.step(1e-3), "OK", what="doStep (pythonfmu does not check the GUID)")
+        return probe.close()
+    probe.initialize()
+    expect(probe.step(1e-3), "OK", what="first doStep")
+    if kind in ("step after terminate", "set after terminate"):
+        expect(probe.status("terminate"), "OK", what="terminate")
+        if kind == "set after terminate" and first_input:
+            expect(probe.set(first_input, 1.0), "OK", what="set after terminate (logged)")
+            if not probe.errors_logged():
+                raise Wrong("status", "setting after terminate logged no error")
+    elif kind in ("nan time", "-inf time"):
+        time = math.nan if kind == "nan time" else -math.inf
+        expect(probe.step(1e-3, time), refused(probe), what=f"doStep at t = {time}")
+    else:
+        call = {
+            "unknown value reference": lambda: probe.call("getReal", [987654])[0],
+            "string on a real": lambda: probe.status("setString", [probe.reference(output if not first_input else first_input)], ["x"]),
+            "set an output": lambda: probe.status("setReal", [probe.reference(output)], [1.0]),
+            "fixed parameter after initialisation": lambda: probe.set(fixed, 0.5) if fixed else "OK",
+            "enter initialisation twice": lambda: probe.enter(),
+        }[kind]
+        expect(call(), "OK", what=f"{kind} (logged; the wrappers have no other non-fatal status)")
+        if kind == "fixed parameter after initialisation" and not fixed:
+            return probe.close()
+        if not probe.errors_logged():
+            raise Wrong("status", f"{kind}: no error logged")
+    expect(probe.step(1e-3), refused(probe), what=f"doStep after {kind}")
+    probe.close()
+
+
+def _state_bytes(probe: Probe) -> bytes:
+    state = probe.call("getFMUstate")[1]
+    data = bytes(probe.call("serializeFMUstate", state)[1])
+    probe.call("freeFMUstate", state)
+    return data
+
+
+class _RunsCommand:
+    def __init__(self, marker: str):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (os.system, (f"touch {self.marker}",))
+
+
+def state(path: str, kind: str, other_path: str = "") -> None:
+    """A serialised state restores exactly; anything else is refused at setFMUstate (Error logged,
+    later steps refused) and never run."""
+    other_state = b""
+    if kind == "another model's state":  # first: fmpy's FMI 2.0 logger serves the last instance created
+        other = Probe(other_path, "other")
+        other.initialize()
+        other_state = _state_bytes(other)
+        other.close()
+    probe = Probe(path)
+    probe.initialize()
+    for _ in range(3):
+        expect(probe.step(1e-3), "OK")
+    good = _state_bytes(probe)
+    marker = Path(probe.unzipdir) / "state_code_ran"
+    data = {
+        "round trip": good,
+        "pickle running a command": pickle.dumps(_RunsCommand(str(marker))),
+        "truncated": good[: len(good) // 2],
+        "one bit flipped": good[:50] + bytes([good[50] ^ 4]) + good[51:],
+        "empty": b"",
+        "another model's state": other_state,
+    }[kind]
+    time, reference = probe.time, None
+    if kind == "round trip":
+        reference = [probe.step(1e-3) and probe.get(probe.outputs()) for _ in range(3)]
+        probe.time = time
+    status, restored = probe.call("deSerializeFMUstate", data)
+    expect(status, "OK", what="deserialising (refusal is reported when the state is set)")
+    expect(probe.status("setFMUstate", restored), "OK", what="setFMUstate")
+    if marker.exists():
+        raise Wrong("output", "deserialising ran a command")
+    if kind == "round trip":
+        again = [probe.step(1e-3) and probe.get(probe.outputs()) for _ in range(3)]
+        if again != reference:
+            raise Wrong("output", "the restored state continued differently")
+        return probe.close()
+    if not any("refused" in text for text in probe.errors_logged()):
+        raise Wrong("status", f"{kind}: no refusal logged")
+    expect(probe.step(1e-3), refused(probe), what="doStep after a refused state")
+    probe.close()
+
+
+def layout(path: str, value: str, fragment: str, prepare: str = "") -> None:
+    """A hostile ``layout`` is refused (Discard) with a message holding ``fragment``, quickly; the
+    message reaches the logger verbatim (no printf conversion of host text)."""
+    folder = Path(extract(path))
+    target = folder / value if prepare else Path(value)
+    if prepare == "fifo":
+        os.mkfifo(target)
+    elif prepare == "dev zero":
+        target.symlink_to("/dev/zero")
+    elif prepare == "directory":
+        target.mkdir()
+    elif prepare in ("many segments", "large file"):
+        target.write_text("[[segments]]\nlength = 0.1\nouter_diameter = 0.05\nyoungs_modulus = 2.1e11\n"
+                          "density = 7850.0\n" * (101 if prepare == "many segments" else 10000))
+    elif prepare == "deep nesting":
+        target.write_text("x = " + "[" * 1000 + "]" * 1000)
+    probe = Probe(path, unzipdir=str(folder))
+    expect(probe.initialize({"layout": str(target) if prepare else value}), "OK")
+    expect(probe.step(1e-3), "Discard", what=f"doStep with layout {value[:40]!r}")
+    if not any(fragment in text for text in probe.errors_logged()):
+        raise Wrong("status", f"no message with {fragment!r}: {[t[:120] for t in probe.errors_logged()]}")
+    probe.close()
+
+
+def parameter_limit(path: str, name: str, value: Any, fragment: str) -> None:
+    """A parameter beyond what the analysis can do in bounded time or resolve is refused quickly."""
+    probe = Probe(path)
+    expect(probe.initialize({name: value}), "OK")
+    expect(probe.step(1e-3), "Discard", what=f"doStep with {name} = {value!r}")
+    if not any(fragment in text for text in probe.errors_logged()):
+        raise Wrong("status", f"no message with {fragment!r}: {[t[:120] for t in probe.errors_logged()]}")
+    probe.close()
+
+
+def long_string(path: str, name: str, length: int) -> None:
+    """A string longer than the adapter accepts is refused at the set (error state)."""
+    probe = Probe(path)
+    probe.initialize()
+    expect(probe.set(name, "1," * (length // 2)), "OK", what="setString (logged)")
+    expect(probe.step(1e-3), refused(probe), what="doStep after the refused string")
+    probe.close()
+
+
+def start_time(path: str, start: float) -> None:
+    """Outputs of a time-dependent model read right after initialisation at ``start``: those at
+    ``start`` (FMI 2.0); in FMI 3.0, where pythonfmu3 withholds the start time, those at t = 0
+    until the first step, which starts at ``start`` correctly (docs/robustness.md)."""
+    def initial_outputs(name: str, at: float) -> tuple[list[float], list[float]]:
+        probe = Probe(path, name)
+        probe.initialize(start_time=at)
+        initial = probe.get(probe.outputs())
+        expect(probe.step(0.0 + 1e-3), "OK")
+        stepped = probe.get(probe.outputs())
+        probe.close()
+        return initial, stepped
+
+    (initial, stepped), (at_zero, _) = initial_outputs("probe", start), initial_outputs("fresh", 0.0)
+    fmi3 = read_model_description(path).fmiVersion.startswith("3")
+    if (initial == at_zero) != fmi3:
+        raise Wrong("output", f"outputs after initialisation at t = {start}: {initial} (at t = 0: {at_zero})")
+    reference = Probe(path, "reference")
+    reference.initialize(start_time=start - 1e-3)
+    expect(reference.step(1e-3), "OK")
+    expect(reference.step(1e-3), "OK")
+    if max(abs(a - b) for a, b in zip(reference.get(reference.outputs()), stepped)) > 1e-9 * max(map(abs, stepped)):
+        raise Wrong("output", "the first step from a start time other than 0 differs from a run through it")
+    reference.close()
+
+
+def instances(path: str, threads: bool) -> None:
+    """Two instances stepped interleaved (or in two threads) give what each gives alone."""
+    def run(probe: Probe, results: list, omega: float | None) -> None:
+        probe.initialize()
+        rows = []
+        for _ in range(20):
+            if omega is not None and probe.outputs():
+                first_input = next((v.name for v in probe.description.modelVariables if v.causality == "input"), None)
+                if first_input:
+                    probe.set(first_input, omega)
+            expect(probe.step(1e-3), "OK")
+            rows.append(probe.get(probe.outputs()))
+        results.append(rows)
+
+    alone: list = []
+    for omega in (None, 1.0):
+        probe = Probe(path, f"alone{omega}")
+        run(probe, alone, omega)
+        probe.close()
+    together: list[list] = [[], []]
+    pair = [Probe(path, "a"), Probe(path, "b")]
+    if threads:
+        workers = [threading.Thread(target=run, args=(p, r, o)) for p, r, o in zip(pair, together, (None, 1.0))]
+        for worker in workers:
+            worker.start()
+        for worker in workers:
+            worker.join()
+        together = [r[0] for r in together]
+    else:
+        for probe in pair:
+            probe.initialize()
+        first_input = next((v.name for v in pair[1].description.modelVariables if v.causality == "input"), None)
+        rows: list[list] = [[], []]
+        for _ in range(20):
+            for index, probe in enumerate(pair):
+                if index == 1 and first_input:
+                    probe.set(first_input, 1.0)
+                expect(probe.step(1e-3), "OK")
+                rows[index].append(probe.get(probe.outputs()))
+        together = rows
+    for probe in pair:
+        probe.close()
+    if together != alone:
+        raise Wrong("output", "interleaved instances differ from instances alone")
+
+
+def engine_refusal(path: str, engine: str, name: str, value: float) -> None:
+    """In libcosim or Ecos, a step the FMU refuses leaves its outputs as they were and the host
+    running; libcosim reports the step as not taken (Ecos advances its time regardless)."""
+    from . import importers
+
+    session = (importers.cosim_session if engine == "libcosim" else importers.ecos_session)(1e-3, {"m": Path(path)})
+    outputs = [f"m.{v.name}" for v in read_model_description(path).modelVariables
+               if v.causality == "output" and v.type in ("Real", "Float64")]
+    session.step()
+    before = session.get(outputs)
+    session.set({f"m.{name}": value})
+    taken = session.step()
+    after = session.get(outputs)
+    session.close()
+    if engine == "libcosim" and taken is not False:
+        raise Wrong("status", f"libcosim reported the refused step as taken ({taken!r})")
+    if [repr(v) for v in after] != [repr(v) for v in before]:
+        raise Wrong("output", f"the refused step changed the outputs: {before} -> {after}")
+
+
+def soak(path: str, name: str, alternations: int) -> None:
+    """Bad and good values alternated many times: every bad step refused, every good one taken,
+    and resident memory bounded (pythonfmu leaks each distinct log text once)."""
+    import resource
+
+    probe = Probe(path)
+    probe.initialize()
+    good = probe.get([name])[0]
+    baseline = None
+    for index in range(alternations):
+        probe.set(name, math.nan)
+        expect(probe.step(1e-3), "Discard", what=f"bad step {index}")
+        probe.set(name, good)
+        expect(probe.step(1e-3), "OK", what=f"good step {index}")
+        probe.log.clear()
+        if index == alternations // 10:
+            baseline = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    growth = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - (baseline or 0)
+    if growth > 8 * 1024:  # kB: 8 MB over 90 % of the run
+        raise Wrong("output", f"resident memory grew by {growth} kB")
+    probe.close()
+
+
+def main(argv: list[str] | None = None) -> None:
+    case = json.loads((argv or sys.argv[1:])[0])
+    try:
+        globals()[case["procedure"]](*case["arguments"])
+        verdict = {"result": "ok"}
+    except Wrong as wrong:
+        verdict = {"result": f"wrong {wrong.kind}", "detail": str(wrong)}
+    except Exception as error:  # noqa: BLE001 - the host saw an exception from an FMI call
+        verdict = {"result": "wrong status", "detail": f"{type(error).__name__}: {error}"}
+    print(VERDICT + json.dumps(verdict), flush=True)
+    os._exit(0)  # skip interpreter teardown: an FMU's embedded objects are not ours to finalise
+
+
+if __name__ == "__main__":
+    main()
