@@ -276,22 +276,30 @@ def state(path: str, kind: str, other_path: str = "") -> None:
     probe.close()
 
 
+SEGMENT_TABLE = "[[segments]]\nlength = 0.1\nouter_diameter = 0.05\nyoungs_modulus = 2.1e11\ndensity = 7850.0\n"
+
+
+def hostile_file(target: Path, kind: str) -> None:
+    """Create a hostile layout file of ``kind`` at ``target``."""
+    if kind == "fifo":
+        os.mkfifo(target)
+    elif kind == "dev zero":
+        target.symlink_to("/dev/zero")
+    elif kind == "directory":
+        target.mkdir()
+    elif kind == "deep nesting":
+        target.write_text("x = " + "[" * 1000 + "]" * 1000)
+    else:
+        target.write_text(SEGMENT_TABLE * {"many segments": 101, "large file": 10000}[kind])
+
+
 def layout(path: str, value: str, fragment: str, prepare: str = "") -> None:
     """A hostile ``layout`` is refused (Discard) with a message holding ``fragment``, quickly; the
     message reaches the logger verbatim (no printf conversion of host text)."""
     folder = Path(extract(path))
     target = folder / value if prepare else Path(value)
-    if prepare == "fifo":
-        os.mkfifo(target)
-    elif prepare == "dev zero":
-        target.symlink_to("/dev/zero")
-    elif prepare == "directory":
-        target.mkdir()
-    elif prepare in ("many segments", "large file"):
-        target.write_text("[[segments]]\nlength = 0.1\nouter_diameter = 0.05\nyoungs_modulus = 2.1e11\n"
-                          "density = 7850.0\n" * (101 if prepare == "many segments" else 10000))
-    elif prepare == "deep nesting":
-        target.write_text("x = " + "[" * 1000 + "]" * 1000)
+    if prepare:
+        hostile_file(target, prepare)
     probe = Probe(path, unzipdir=str(folder))
     expect(probe.initialize({"layout": str(target) if prepare else value}), "OK")
     expect(probe.step(1e-3), "Discard", what=f"doStep with layout {value[:40]!r}")

@@ -3,15 +3,12 @@ every analysis: each refused quickly with a message naming what was exceeded."""
 
 from __future__ import annotations
 
-import os
-
 import pytest
 
 from driveline.rotor import load_driveline, loads_driveline
 from driveline.rotor.loader import MAX_FILE_BYTES, MAX_NESTING, MAX_SEGMENTS
 from driveline.rotor.model import MAX_ORDER, MAX_ORDERS, CriticalSpeedsModel, parse_orders
-
-SEGMENT = "[[segments]]\nlength = 0.1\nouter_diameter = 0.05\nyoungs_modulus = 2.1e11\ndensity = 7850.0\n"
+from fmu_harness.robustness_probe import SEGMENT_TABLE, hostile_file
 
 
 def _refusal(**parameters) -> list[str]:
@@ -60,7 +57,7 @@ def test_the_default_and_a_ten_metre_tube_pass_the_checks():
 
 def test_segment_count_is_bounded():
     with pytest.raises(ValueError, match=f"more than the {MAX_SEGMENTS} accepted"):
-        loads_driveline(SEGMENT * (MAX_SEGMENTS + 1))
+        loads_driveline(SEGMENT_TABLE * (MAX_SEGMENTS + 1))
 
 
 def test_deep_nesting_is_refused_before_parsing():
@@ -69,21 +66,22 @@ def test_deep_nesting_is_refused_before_parsing():
             loads_driveline(text)
 
 
-@pytest.mark.parametrize("kind", ["fifo", "dev_zero", "directory", "large", "binary"])
-def test_only_small_regular_files_are_read(tmp_path, kind):
+@pytest.mark.parametrize("kind, fragment", [
+    ("fifo", "not a regular file"), ("dev zero", "not a regular file"), ("directory", "not a regular file"),
+    ("large file", f"larger than {MAX_FILE_BYTES} bytes"), ("many segments", f"more than the {MAX_SEGMENTS} accepted"),
+    ("deep nesting", f"nest deeper than {MAX_NESTING}"),
+])
+def test_only_small_regular_files_are_read(tmp_path, kind, fragment):
     path = tmp_path / "layout.toml"
-    if kind == "fifo":
-        os.mkfifo(path)
-    elif kind == "dev_zero":
-        path.symlink_to("/dev/zero")
-    elif kind == "directory":
-        path.mkdir()
-    elif kind == "large":
-        path.write_text("# " + "x" * MAX_FILE_BYTES + "\n" + SEGMENT)
-    else:
-        path.write_bytes(b"\xff\xfe" + SEGMENT.encode())
-    fragment = {"large": f"larger than {MAX_FILE_BYTES} bytes", "binary": "not UTF-8"}.get(kind, "not a regular file")
+    hostile_file(path, kind)
     with pytest.raises(ValueError, match=fragment):
+        load_driveline(path)
+
+
+def test_a_file_that_is_not_utf8_is_refused(tmp_path):
+    path = tmp_path / "layout.toml"
+    path.write_bytes(b"\xff\xfe" + SEGMENT_TABLE.encode())
+    with pytest.raises(ValueError, match="not UTF-8"):
         load_driveline(path)
 
 
