@@ -17,8 +17,10 @@ import argparse
 import importlib.util
 import json
 import math
+import resource
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
@@ -27,6 +29,7 @@ from pathlib import Path
 
 from driveline.catalog import MODELS
 
+from .failing_model import FAILURES, FailingModel, build_failing_fmus
 from .robustness_probe import VERDICT
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -200,6 +203,24 @@ def _engines(fmu_path: FmuPath) -> list[Case]:
     return found
 
 
+def _model_failures(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    """Only where ``fmu_path`` has an FMU of :class:`.failing_model.FailingModel`."""
+    path = fmu_path(FailingModel.spec.name, fmi)
+    if not Path(path).exists():
+        return []
+    return [Case("model failures outside its checks", name, "model_failure", (str(path), failure, name), fmi,
+                 "" if name == "OverflowError" or fmi == "3" else FMI2_DISCARD)
+            for failure, name in FAILURES.items()]
+
+
+def with_failing_model(fmu_path: FmuPath, folder: Path) -> FmuPath:
+    """``fmu_path`` plus the failing model's FMUs, built into ``folder``."""
+    from .build import fmu_path as built_path
+
+    build_failing_fmus(folder)
+    return lambda model, fmi: built_path(folder, model, fmi) if model == FailingModel.spec.name else fmu_path(model, fmi)
+
+
 def _soak(fmu_path: FmuPath, fmi: str) -> list[Case]:
     return [Case("soak", "100,000 bad/good alternations", "soak", (str(fmu_path("CardanJoint", fmi)), "omega_in", 100000), fmi)]
 
@@ -212,7 +233,8 @@ def cases(fmu_path: FmuPath, slow: bool = False, versions: Iterable[str] = ("2",
         found += (_non_finite(fmu_path, fmi, slow) + _out_of_range(fmu_path, fmi, slow)
                   + _step_sizes(fmu_path, fmi, slow) + _misuse(fmu_path, fmi) + _states(fmu_path, fmi)
                   + _instances(fmu_path, fmi, slow)
-                  + _layouts(fmu_path, fmi) + _limits(fmu_path, fmi) + _start_time(fmu_path, fmi))
+                  + _layouts(fmu_path, fmi) + _limits(fmu_path, fmi) + _start_time(fmu_path, fmi)
+                  + _model_failures(fmu_path, fmi))
         if slow:
             found += _soak(fmu_path, fmi)
     return found + _engines(fmu_path)
@@ -268,12 +290,22 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--slow", action="store_true", help="every non-finite value and the soak")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
-    started = time.perf_counter()
-    results = run_all(cases(lambda model, fmi: fmu_path(args.models, model, fmi), args.slow), args.workers)
+    started, cpu = time.perf_counter(), _children_cpu()
+    with tempfile.TemporaryDirectory() as failing:
+        paths = with_failing_model(lambda model, fmi: fmu_path(args.models, model, fmi), Path(failing))
+        results = run_all(cases(paths, args.slow), args.workers)
     print(table(results))
     for result in failures(results):
         print(f"- {result.verdict}: FMI {result.case.fmi} {result.case.kind} / {result.case.name}: {result.detail}")
-    print(f"{len(results)} runs in {time.perf_counter() - started:.0f} s")
+    print(f"{len(results)} runs in {time.perf_counter() - started:.0f} s wall clock, "
+          f"{_children_cpu() - cpu:.0f} s CPU of the host processes")
+
+
+def _children_cpu() -> float:
+    """CPU seconds of the ended child processes (the wall clock of an idle machine is about this
+    divided by the workers)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 if __name__ == "__main__":

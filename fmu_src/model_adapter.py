@@ -35,6 +35,8 @@ _PLACEHOLDER = {"Real": float("nan"), "Integer": 0, "Boolean": False, "String": 
 #: Distinct log texts kept for reuse: the wrappers leak one reference to every message text
 #: they forward, so a repeated refusal reuses its text instead of leaking a new copy.
 _LOG_TEXTS_KEPT = 1024
+#: One category object for every message (the wrappers would build, and leak, a new one each time).
+_ERROR_CATEGORY = "logStatusError"
 
 
 class Phase(Enum):
@@ -136,7 +138,7 @@ class ModelAdapter:
     def _report(self, errors: list[str]) -> bool:
         """Log every reason with the error status; True when there was none."""
         for message in errors:
-            self.log(self.log_text(message), self.error_status)
+            self.log(self.log_text(message), self.error_status, _ERROR_CATEGORY)
         return not errors
 
     def _fail(self, call: str, reason: str) -> None:

@@ -13,11 +13,15 @@ from fmu_harness import build, robustness
 
 CLASSES = {"non-finite values", "out-of-range values", "step sizes", "call sequence misuse",
            "state round trips and corrupt state", "instances and threads", "hostile layout values",
-           "work, memory and resolution limits", "outputs at a start time other than 0"}
+           "work, memory and resolution limits", "outputs at a start time other than 0",
+           "model failures outside its checks"}
 
 
-def _paths(fmu_dir: Path) -> robustness.FmuPath:
-    return lambda model, fmi: build.fmu_path(fmu_dir, model, fmi)
+@pytest.fixture(scope="module")
+def paths(fmu_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> robustness.FmuPath:
+    """The catalog's FMUs, and those of the failing model in a folder of their own."""
+    return robustness.with_failing_model(lambda model, fmi: build.fmu_path(fmu_dir, model, fmi),
+                                         tmp_path_factory.mktemp("failing"))
 
 
 def _report(results: list[robustness.Result]) -> str:
@@ -26,8 +30,8 @@ def _report(results: list[robustness.Result]) -> str:
 
 
 @pytest.fixture(scope="module")
-def results(fmu_dir: Path) -> list[robustness.Result]:
-    return robustness.run_all(robustness.cases(_paths(fmu_dir)))
+def results(paths: robustness.FmuPath) -> list[robustness.Result]:
+    return robustness.run_all(robustness.cases(paths))
 
 
 def test_no_case_crashes_hangs_or_gets_a_wrong_status_or_output(results):
@@ -40,10 +44,10 @@ def test_the_suite_covers_every_class_in_both_fmi_versions(results):
 
 
 @pytest.mark.slow
-def test_every_variable_value_and_model_and_a_long_soak(fmu_dir: Path, results):
+def test_every_variable_value_and_model_and_a_long_soak(paths: robustness.FmuPath, results):
     """The cases the default run samples, and 100,000 bad/good alternations per FMI version with
     resident memory bounded."""
     sampled = {(r.case.fmi, r.case.kind, r.case.name) for r in results}
-    rest = [c for c in robustness.cases(_paths(fmu_dir), slow=True) if (c.fmi, c.kind, c.name) not in sampled]
+    rest = [c for c in robustness.cases(paths, slow=True) if (c.fmi, c.kind, c.name) not in sampled]
     slow_results = robustness.run_all(rest, time_limit=600.0)
     assert not robustness.failures(slow_results), _report(slow_results)
