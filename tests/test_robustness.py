@@ -49,5 +49,5 @@ def test_every_variable_value_and_model_and_a_long_soak(paths: robustness.FmuPat
     resident memory bounded."""
     sampled = {(r.case.fmi, r.case.kind, r.case.name) for r in results}
     rest = [c for c in robustness.cases(paths, slow=True) if (c.fmi, c.kind, c.name) not in sampled]
-    slow_results = robustness.run_all(rest, time_limit=600.0)
+    slow_results = robustness.run_all(rest)
     assert not robustness.failures(slow_results), _report(slow_results)
