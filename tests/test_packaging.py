@@ -96,6 +96,7 @@ def test_every_command_has_help(command, capsys):
     assert usage.startswith(f"usage: driveline-fmus {command or ''}".rstrip())
 
 
+@pytest.mark.fmu
 def test_build_command_builds_one_model(tmp_path):
     """The console script's build, in a process of its own as a user runs it."""
     run = subprocess.run([sys.executable, "-m", "fmu_harness.cli", "build", "--dest", str(tmp_path), "--fmi", "2",
@@ -106,3 +107,23 @@ def test_build_command_builds_one_model(tmp_path):
     assert run.stdout.split() == [str(built), str(native_built)]
     assert sorted(tmp_path.rglob("*.fmu")) == sorted([built, native_built])
     assert "driveline/source/model.py" in members(built)
+
+
+def collected(*options: str) -> set[str]:
+    run = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", *options,
+                          "tests/test_packaging.py", "tests/test_validity.py"],
+                         capture_output=True, text=True, timeout=300, cwd=ROOT)
+    return {line.split("::")[1].split("[")[0] for line in run.stdout.splitlines() if "::" in line}
+
+
+def test_markers_follow_what_the_tests_use():
+    """Assigned in conftest.py: a built FMU makes an ``fmu`` test, none a ``core`` one; ``--fmi 2``
+    drops the FMI 3.0 variants."""
+    fmu, core = collected("-m", "fmu"), collected("-m", "core")
+    assert {"test_each_fmu_ships_the_modules_its_model_imports", "test_build_command_builds_one_model"} <= fmu
+    assert {"test_every_command_has_help", "test_a_declared_rule_refuses_with_its_message"} <= core
+    assert not fmu & core and "test_markers_follow_what_the_tests_use" in core
+    assert "test_different_fmus_alive_at_once_in_one_host" in collected("-m", "slow")
+    run = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "--fmi", "2",
+                          "tests/test_packaging.py"], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert "[2]" in run.stdout and "[3]" not in run.stdout
