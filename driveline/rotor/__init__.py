@@ -19,7 +19,7 @@ from .driveline import (
     OrderResonance,
     WhirlFrequencies,
 )
-from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, PointElement, ShaftSegment
+from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, PointElement, ShaftSegment, Unbalance
 from .loader import example_path, load_driveline, loads_driveline, one_piece_shaft
 from .transfer import ModeShape
 
@@ -34,6 +34,7 @@ __all__ = [
     "OrderResonance",
     "PointElement",
     "ShaftSegment",
+    "Unbalance",
     "WhirlFrequencies",
     "example_path",
     "load_driveline",

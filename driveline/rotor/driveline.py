@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import transfer
-from .elements import Bearing, ConcentratedMass, EndCondition, PointElement, ShaftSegment
+from .elements import Bearing, ConcentratedMass, EndCondition, PointElement, ShaftSegment, Unbalance
 from .roots import RootSearchReport, find_roots
 
 FloatArray = NDArray[np.float64]
@@ -93,7 +93,8 @@ class Driveline:
     ``right`` are the end conditions; bearings are point elements and may sit at
     any node, including the ends (then use ``free`` ends, as the seed's Fig. 2).
     ``joints`` holds further point elements (:class:`Hinge`, ...), applied at their
-    node after its masses and bearings; a hinge must sit at an inner node.
+    node after its masses and bearings; a hinge must sit at an inner node. ``unbalances``
+    excite the forced response (:mod:`driveline.rotor.damped`) and leave the whirl alone.
     """
 
     segments: Sequence[ShaftSegment]
@@ -103,6 +104,7 @@ class Driveline:
     right: EndCondition | str = EndCondition.FREE
     name: str = ""
     joints: Sequence[PointElement] = ()
+    unbalances: Sequence[Unbalance] = ()
     _chain: transfer.Chain = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -135,6 +137,12 @@ class Driveline:
         object.__setattr__(self, "masses", masses)
         object.__setattr__(self, "bearings", bearings)
         object.__setattr__(self, "joints", joints)
+        unbalances = _as_tuple(self.unbalances, Unbalance, "unbalances")
+        length = math.fsum(s.length for s in segs)
+        for i, it in enumerate(unbalances):
+            if it.position > length:
+                raise ValueError(f"unbalances[{i}].position = {it.position!r} m lies beyond the right end ({length!r} m)")
+        object.__setattr__(self, "unbalances", unbalances)
         object.__setattr__(self, "left", ends[0])
         object.__setattr__(self, "right", ends[1])
         object.__setattr__(self, "_chain", transfer.Chain.build(segs, self.point_elements, ends[0], ends[1]))
@@ -143,6 +151,11 @@ class Driveline:
     def point_elements(self) -> tuple[PointElement, ...]:
         """Every point element, in the order applied at a node: masses, bearings, joints."""
         return (*self.masses, *self.bearings, *self.joints)
+
+    @property
+    def length(self) -> float:
+        """Overall length [m]."""
+        return math.fsum(s.length for s in self.segments)
 
     @property
     def is_isotropic(self) -> bool:

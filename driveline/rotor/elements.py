@@ -51,6 +51,7 @@ __all__ = [
     "Hinge",
     "PointElement",
     "ShaftSegment",
+    "Unbalance",
 ]
 
 
@@ -553,24 +554,45 @@ class ConcentratedMass(PointElement):
 
 @dataclass(frozen=True)
 class Bearing(PointElement):
-    """Linear elastic bearing at station ``node``; ``kxx`` [N/m], ``kyy`` (default ``kxx``).
+    """Linear bearing at station ``node``: stiffness ``kxx`` [N/m], ``kyy`` (default ``kxx``) and
+    damping ``cxx`` [N s/m], ``cyy`` (default ``cxx``), optionally cross-coupled (``kxy``, ``kyx``,
+    ``cxy``, ``cyx``). The force on the shaft is ``-(K [x, y] + C [x', y'])``.
 
-    Isotropic point matrix (seed Eq. 27): ``V+ = V- - k U``. With ``kxx != kyy`` the
-    forward and backward whirl components couple::
+    In the complex coordinate ``u = x + i y`` that force is ``-(k_a u + k_b conj(u)) - (c_a u' +
+    c_b conj(u'))`` with :attr:`stiffness_components` ``k_a = (kxx + kyy)/2 + i (kyx - kxy)/2``,
+    ``k_b = (kxx - kyy)/2 + i (kyx + kxy)/2`` (the same for ``c``). On a forward component ``a``
+    and the conjugate backward component ``conj(b)`` of a whirl at ``w`` the point matrix is::
 
-        V_a -= kbar U_a + dk U_b,   V_b -= dk U_a + kbar U_b,
-        kbar = (kxx + kyy)/2,       dk = (kxx - kyy)/2.
+        V_a -= (k_a + i w c_a) U_a + (k_b + i w c_b) U_b',
+        V_b' -= (conj(k_b) + i w conj(c_b)) U_a + (conj(k_a) + i w conj(c_a)) U_b'
+
+    (:meth:`damped_transfer_matrix_pair`, ``b' = conj(b)``). The undamped transfer matrices (seed
+    Eq. 27: ``V+ = V- - k U``; ``k_b = dk = (kxx - kyy)/2`` couples the components) take no
+    damping, which only the damped analyses (:mod:`driveline.rotor.damped`) see, and no
+    cross-coupled stiffness.
     """
 
     node: int
     kxx: float
     kyy: float | None = None
+    cxx: float = 0.0
+    cyy: float | None = None
+    kxy: float = 0.0
+    kyx: float = 0.0
+    cxy: float = 0.0
+    cyx: float = 0.0
 
     def __post_init__(self) -> None:
         _node(self.node)
         _non_negative("kxx", self.kxx)
         if self.kyy is not None:
             _non_negative("kyy", self.kyy)
+        _non_negative("cxx", self.cxx)
+        if self.cyy is not None:
+            _non_negative("cyy", self.cyy)
+        for name in ("kxy", "kyx", "cxy", "cyx"):
+            if not math.isfinite(float(getattr(self, name))):
+                raise ValueError(f"{name} must be a finite number, got {getattr(self, name)!r}")
 
     @property
     def k_yy(self) -> float:
@@ -578,14 +600,35 @@ class Bearing(PointElement):
         return self.kxx if self.kyy is None else float(self.kyy)
 
     @property
+    def c_yy(self) -> float:
+        """Damping in y [N s/m]."""
+        return self.cxx if self.cyy is None else float(self.cyy)
+
+    @property
     def isotropic(self) -> bool:
         return self.kyy is None or float(self.kyy) == float(self.kxx)
+
+    @property
+    def stiffness_components(self) -> tuple[complex, complex]:
+        """``(k_a, k_b)``: the stiffness acting on ``u`` and on ``conj(u)``."""
+        return _components(self.kxx, self.k_yy, self.kxy, self.kyx)
+
+    @property
+    def damping_components(self) -> tuple[complex, complex]:
+        """``(c_a, c_b)``: the damping acting on ``u'`` and on ``conj(u')``."""
+        return _components(self.cxx, self.c_yy, self.cxy, self.cyx)
+
+    def _undamped_stiffness(self) -> float:
+        if self.kxy != 0.0 or self.kyx != 0.0:
+            raise ValueError("cross-coupled bearing stiffness (kxy, kyx) enters the damped analyses only, "
+                             "not the undamped transfer matrices")
+        return 0.5 * (self.kxx + self.k_yy)
 
     def transfer_matrix(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
         """Point matrix of one whirl component, with the mean stiffness ``kbar``."""
         w_arr, _ = _broadcast(w, spin)
         P = _identity(w_arr.shape)
-        P[..., 3, 0] = -0.5 * (self.kxx + self.k_yy)
+        P[..., 3, 0] = -self._undamped_stiffness()
         return P
 
     def transfer_matrix_pair(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
@@ -595,10 +638,27 @@ class Bearing(PointElement):
         P[..., 7, 0] = -dk
         return P
 
+    def damped_transfer_matrix_pair(self, w: ArrayLike) -> NDArray[np.complex128]:
+        """Complex point matrix on ``[s_a, conj(s_b)]`` at the (complex) whirl frequency ``w``, shape (n, 8, 8)."""
+        w_arr = np.atleast_1d(np.asarray(w, dtype=complex))
+        (ka, kb), (ca, cb) = self.stiffness_components, self.damping_components
+        P = np.broadcast_to(np.eye(8, dtype=complex), w_arr.shape + (8, 8)).copy()
+        P[..., 3, 0] = -(ka + 1j * w_arr * ca)
+        P[..., 3, 4] = -(kb + 1j * w_arr * cb)
+        P[..., 7, 0] = -(np.conj(kb) + 1j * w_arr * np.conj(cb))
+        P[..., 7, 4] = -(np.conj(ka) + 1j * w_arr * np.conj(ca))
+        return P
+
     def fe_matrices(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The undamped stiffness ``kxx`` (the damped assembly takes the components instead)."""
         if not self.isotropic:
             raise ValueError("the finite-element check covers isotropic bearings only")
-        return np.diag([float(self.kxx), 0.0]), np.zeros((2, 2)), np.zeros((2, 2))
+        return np.diag([self._undamped_stiffness(), 0.0]), np.zeros((2, 2)), np.zeros((2, 2))
+
+
+def _components(xx: float, yy: float, xy: float, yx: float) -> tuple[complex, complex]:
+    """Coefficients of ``u`` and ``conj(u)`` of the complex force ``f_x + i f_y`` of ``[[xx, xy], [yx, yy]] [x, y]``."""
+    return complex(0.5 * (xx + yy), 0.5 * (yx - xy)), complex(0.5 * (xx - yy), 0.5 * (yx + xy))
 
 
 @dataclass(frozen=True)
@@ -668,3 +728,20 @@ class Hinge(PointElement):
             Y_after[:, row, cols - r:] += R[:, :r, i]
         sign = np.sign(np.linalg.det(Q)) * (-1.0) ** (r * (cols - r))
         return Y_after, T, sign
+
+
+@dataclass(frozen=True)
+class Unbalance:
+    """Unbalance ``amount`` = mass x eccentricity [kg m] at ``position`` [m from the left end], at the
+    angle ``phase`` [rad] from the x axis at time 0: the rotating force ``amount Omega^2 exp(i (Omega t +
+    phase))`` on the shaft."""
+
+    position: float
+    amount: float
+    phase: float = 0.0
+
+    def __post_init__(self) -> None:
+        _non_negative("position", self.position)
+        _non_negative("amount", self.amount)
+        if not math.isfinite(float(self.phase)):
+            raise ValueError(f"phase must be a finite angle in rad, got {self.phase!r}")

@@ -386,16 +386,20 @@ def one_piece_shaft(
     Jp_joint: float,
     Jd_joint: float,
     k_bearing: float,
+    c_bearing: float = 0.0,
+    shear: bool = False,
 ) -> Driveline:
     """One-piece tube propshaft: a joint mass and an isotropic bearing at each end.
 
     SI units: lengths [m], ``E`` [Pa], ``density`` [kg/m3], ``m_joint`` [kg],
-    ``Jp_joint``/``Jd_joint`` [kg m2], ``k_bearing`` [N/m]; free ends (the bearings
-    carry the shaft, as in the seed's Fig. 2). Errors name the offending parameter.
+    ``Jp_joint``/``Jd_joint`` [kg m2], ``k_bearing`` [N/m], ``c_bearing`` [N s/m]; free ends
+    (the bearings carry the shaft, as in the seed's Fig. 2); a Timoshenko tube if ``shear``
+    (else Rayleigh). Errors name the offending parameter.
     """
     vals = {
         "L_shaft": L_shaft, "D_outer": D_outer, "D_inner": D_inner, "E": E, "density": density,
         "m_joint": m_joint, "Jp_joint": Jp_joint, "Jd_joint": Jd_joint, "k_bearing": k_bearing,
+        "c_bearing": c_bearing,
     }
     for k, v in vals.items():
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):
@@ -403,12 +407,12 @@ def one_piece_shaft(
     for k in ("L_shaft", "D_outer", "E", "density", "k_bearing"):
         if vals[k] <= 0.0:
             raise ValueError(f"{k} must be > 0, got {vals[k]!r}")
-    for k in ("D_inner", "m_joint", "Jp_joint", "Jd_joint"):
+    for k in ("D_inner", "m_joint", "Jp_joint", "Jd_joint", "c_bearing"):
         if vals[k] < 0.0:
             raise ValueError(f"{k} must be >= 0, got {vals[k]!r}")
     if D_inner >= D_outer:
         raise ValueError(f"D_inner ({D_inner!r}) must be smaller than D_outer ({D_outer!r})")
-    seg = ShaftSegment(float(L_shaft), float(D_outer), float(D_inner), float(E), float(density))
+    seg = ShaftSegment(float(L_shaft), float(D_outer), float(D_inner), float(E), float(density), shear=bool(shear))
     masses = [ConcentratedMass(n, float(m_joint), float(Jp_joint), float(Jd_joint)) for n in (0, 1)]
-    bearings = [Bearing(n, float(k_bearing)) for n in (0, 1)]
+    bearings = [Bearing(n, float(k_bearing), cxx=float(c_bearing)) for n in (0, 1)]
     return Driveline([seg], masses, bearings, EndCondition.FREE, EndCondition.FREE, "one-piece propshaft")

@@ -1,0 +1,232 @@
+"""Damped whirl and unbalance response of a driveline, by finite elements.
+
+The model is that of :func:`fem.assemble_damped` in the complex whirl coordinate ``u = x + i y``::
+
+    M u'' + (C - i Omega G) u' + C_b conj(u') + K u + K_b conj(u) = f.
+
+A bearing with ``kxx != kyy`` or cross-coupling (``K_b``, ``C_b`` non-zero) couples ``u`` and
+``conj(u)``; taking ``p = u`` and ``q = conj(u)`` as independent unknowns doubles the system::
+
+    M2 x'' + (C2 + Omega Gv) x' + K2 x = f2,   x = [p, q],
+    K2 = [[K, K_b], [conj(K_b), conj(K)]],  C2 likewise,  Gv = diag(-i G, i G),  M2 = diag(M, M).
+
+With axisymmetric bearings ``q`` decouples (it is the conjugate of ``p``) and only ``p`` is kept.
+
+* **Damped whirl**: the eigenvalues ``lam = -sigma + i w_d`` of ``x = X exp(lam t)``. A mode is
+  reported once, with ``w_d >= 0``; its forward share is ``sum |p_U|^2 / sum (|p_U|^2 + |q_U|^2)``
+  over the translations (the backward circle of ``u`` is ``conj(q)``). Damping ratio
+  ``zeta = sigma / |lam|``, logarithmic decrement ``2 pi sigma / w_d``.
+* **Unbalance response**: an unbalance ``U exp(i phi)`` at spin ``Omega`` is the force
+  ``U Omega^2 exp(i (Omega t + phi))``; with ``x = X exp(i Omega t)``::
+
+      (K2 + i Omega (C2 + Omega Gv) - Omega^2 M2) X = Omega^2 [F, 0],
+
+  and ``u = A exp(i Omega t) + B exp(-i Omega t)`` with ``A = X_p``, ``B = conj(X_q)``: the
+  orbit is an ellipse with major semi-axis ``|A| + |B|`` and minor semi-axis ``||A| - |B||``.
+  A bearing transmits ``F_a = (k_a + i Omega c_a) A + (k_b + i Omega c_b) conj(B)`` forward and
+  ``conj(F_q)``, ``F_q = (conj(k_b) + i Omega conj(c_b)) A + (conj(k_a) + i Omega conj(c_a)) conj(B)``,
+  backward: major semi-axis ``|F_a| + |F_q|``.
+
+Forces and displacements between beam nodes use the cubic Hermite shape functions. The
+beam elements converge as ``h**4`` (Rayleigh) or ``h**2`` (Timoshenko).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import fem
+from .driveline import Driveline
+from .elements import Unbalance
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+
+#: Spins solved at once by :meth:`DampedRotor.unbalance_response` (bounds the memory of the stacked systems).
+SOLVE_BATCH = 64
+
+
+@dataclass(frozen=True)
+class DampedMode:
+    """One damped whirl mode: ``eigenvalue = -sigma + i w_d`` (``w_d >= 0``) and the share of its
+    forward circular component in ``sum |U|^2`` (1 forward whirl, 0 backward)."""
+
+    eigenvalue: complex
+    forward_share: float
+
+    @property
+    def frequency(self) -> float:
+        """Damped whirl frequency ``w_d`` [rad/s]."""
+        return self.eigenvalue.imag
+
+    @property
+    def damping_ratio(self) -> float:
+        """``zeta = sigma / |lam|`` (negative: the mode grows)."""
+        return -self.eigenvalue.real / abs(self.eigenvalue)
+
+    @property
+    def log_decrement(self) -> float:
+        """Logarithmic decrement ``2 pi sigma / w_d`` per whirl period."""
+        return -2.0 * np.pi * self.eigenvalue.real / self.eigenvalue.imag
+
+    @property
+    def whirl(self) -> Literal["forward", "backward"]:
+        """The dominant whirl sense."""
+        return "forward" if self.forward_share >= 0.5 else "backward"
+
+
+@dataclass(frozen=True)
+class UnbalanceResponse:
+    """Synchronous response ``u = A exp(i Omega t) + B exp(-i Omega t)`` at ``positions`` [m] for
+    each of ``spins`` [rad/s]: ``forward`` = ``A``, ``backward`` = ``B`` [m], arrays (spins,
+    positions); ``bearing_forces`` [N] (spins, bearings), the major semi-axis of each bearing's
+    force orbit (0 for a bearing on a pinned or clamped end)."""
+
+    spins: FloatArray
+    positions: FloatArray
+    forward: ComplexArray
+    backward: ComplexArray
+    bearing_forces: FloatArray
+
+    @property
+    def major(self) -> FloatArray:
+        """Major semi-axis of the orbit ``|A| + |B|`` [m]: the largest displacement."""
+        return np.abs(self.forward) + np.abs(self.backward)
+
+    @property
+    def minor(self) -> FloatArray:
+        """Minor semi-axis ``||A| - |B||`` [m]."""
+        return np.abs(np.abs(self.forward) - np.abs(self.backward))
+
+
+def _hermite(xi: FloatArray, h: FloatArray) -> FloatArray:
+    """Cubic Hermite shape functions on ``[U1, psi1, U2, psi2]`` at ``xi`` in [0, 1], shape (n, 4)."""
+    x2, x3 = xi * xi, xi**3
+    return np.stack([1 - 3 * x2 + 2 * x3, h * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, h * (x3 - x2)], axis=-1)
+
+
+class DampedRotor:
+    """Finite-element model of ``driveline`` (``elements_per_segment`` beam elements per segment)
+    with the bearings' damping and anisotropy: damped modes and unbalance response."""
+
+    def __init__(self, driveline: Driveline, elements_per_segment: int = 40) -> None:
+        self.driveline = driveline
+        fe = fem.assemble_damped(driveline, elements_per_segment)
+        self._fe = fe
+        self.doubled = bool(np.any(fe.K_b) or np.any(fe.C_b))
+        n = fe.M.shape[0]
+        if self.doubled:
+            self.K = np.block([[fe.K, fe.K_b], [fe.K_b.conj(), fe.K.conj()]])
+            self.C = np.block([[fe.C, fe.C_b], [fe.C_b.conj(), fe.C.conj()]])
+            zero = np.zeros((n, n))
+            self.M = np.block([[fe.M, zero], [zero, fe.M]])
+            self.G = np.block([[-1j * fe.G, zero], [zero, 1j * fe.G]])
+        else:
+            self.K, self.C, self.M, self.G = fe.K, fe.C, fe.M, -1j * fe.G
+        self._n = n
+        mesh = fe.mesh
+        rows = fe.index[np.unique(mesh.elements[:, [0, 2]])]
+        self._translations = rows[rows >= 0]
+        self._bearing_rows = np.array([fe.index[mesh.node_u[b.node]] for b in driveline.bearings], dtype=int)
+
+    # -- building blocks -------------------------------------------------------
+    def _shape_rows(self, positions: ArrayLike) -> ComplexArray:
+        """Rows (positions, n) interpolating ``u`` from the ``p`` unknowns (Hermite shape functions)."""
+        z = np.atleast_1d(np.asarray(positions, dtype=float))
+        length = self.driveline.length
+        if np.any(~np.isfinite(z)) or np.any(z < 0.0) or np.any(z > length * (1 + 1e-12)):
+            raise ValueError(f"positions must lie on the shaft, 0 to {length!r} m, got {z.tolist()!r}")
+        mesh = self._fe.mesh
+        e = np.clip(np.searchsorted(mesh.z, z, side="right") - 1, 0, len(mesh.elements) - 1)
+        h = mesh.z[e + 1] - mesh.z[e]
+        shape = _hermite(np.clip((z - mesh.z[e]) / h, 0.0, 1.0), h)
+        rows = np.zeros((z.size, self._n), dtype=complex)
+        for k in range(4):
+            target = self._fe.index[mesh.elements[e, k]]
+            hit = target >= 0
+            np.add.at(rows, (np.flatnonzero(hit), target[hit]), shape[hit, k])
+        return rows
+
+    def load(self, unbalances: Sequence[Unbalance]) -> ComplexArray:
+        """Load vector ``[F, 0]`` of the unbalances per unit ``Omega^2`` (consistent nodal loads)."""
+        rows = self._shape_rows([u.position for u in unbalances]) if unbalances else np.zeros((0, self._n))
+        phasors = np.array([u.amount * np.exp(1j * u.phase) for u in unbalances], dtype=complex)
+        force = phasors @ rows
+        return np.concatenate([force, np.zeros(self._n)]) if self.doubled else force
+
+    def dynamic_stiffness(self, spins: FloatArray) -> ComplexArray:
+        """``K2 + i Omega (C2 + Omega Gv) - Omega^2 M2`` for each of ``spins``, shape (spins, N, N)."""
+        s = np.asarray(spins, dtype=float)[:, None, None]
+        return self.K + 1j * s * self.C + 1j * s * s * self.G - s * s * self.M
+
+    def components(self, solution: ComplexArray, rows: ComplexArray) -> tuple[ComplexArray, ComplexArray]:
+        """``(A, B)`` at the positions of ``rows`` from solutions (spins, N): forward and backward circles."""
+        forward = solution[:, : self._n] @ rows.T
+        backward = (solution[:, self._n:] @ rows.T).conj() if self.doubled else np.zeros_like(forward)
+        return forward, backward
+
+    def bearing_forces(self, spins: FloatArray, solution: ComplexArray) -> FloatArray:
+        """Major semi-axis of each bearing's force orbit [N], shape (spins, bearings)."""
+        out = np.zeros((len(spins), len(self._bearing_rows)))
+        w = np.asarray(spins, dtype=float)
+        for j, (bearing, row) in enumerate(zip(self.driveline.bearings, self._bearing_rows)):
+            if row < 0:
+                continue
+            (ka, kb), (ca, cb) = bearing.stiffness_components, bearing.damping_components
+            a = solution[:, row]
+            q = solution[:, self._n + row] if self.doubled else np.zeros_like(a)
+            fa = (ka + 1j * w * ca) * a + (kb + 1j * w * cb) * q
+            fq = (np.conj(kb) + 1j * w * np.conj(cb)) * a + (np.conj(ka) + 1j * w * np.conj(ca)) * q
+            out[:, j] = np.abs(fa) + np.abs(fq)
+        return out
+
+    # -- results -----------------------------------------------------------------
+    def modes(self, spin: float = 0.0, n: int | None = None) -> list[DampedMode]:
+        """Damped whirl modes at ``spin`` [rad/s], ascending in damped frequency (the first ``n``)."""
+        size = self.M.shape[0]
+        inverse_mass = np.linalg.inv(self.M)
+        first_order = np.zeros((2 * size, 2 * size), dtype=complex)
+        first_order[:size, size:] = np.eye(size)
+        first_order[size:, :size] = -inverse_mass @ self.K
+        first_order[size:, size:] = -inverse_mass @ (self.C + spin * self.G)
+        lam, vectors = np.linalg.eig(first_order)
+        tol = 1e-9 * np.max(np.abs(lam))
+        t = self._translations
+        out = []
+        for value, vector in zip(lam, vectors.T):
+            if abs(value.imag) <= tol:  # overdamped or static: no whirl
+                continue
+            if self.doubled:
+                if value.imag < 0.0:  # the conjugate of a mode kept at +w_d
+                    continue
+                fwd = float(np.sum(np.abs(vector[t]) ** 2))
+                bwd = float(np.sum(np.abs(vector[self._n + t]) ** 2))
+                out.append(DampedMode(complex(value), fwd / (fwd + bwd)))
+            else:  # u = p exp(lam t): Im lam < 0 whirls backward
+                out.append(DampedMode(complex(value.real, abs(value.imag)), 1.0 if value.imag > 0 else 0.0))
+        out.sort(key=lambda mode: mode.frequency)
+        return out if n is None else out[:n]
+
+    def unbalance_response(
+        self, spins: ArrayLike, unbalances: Sequence[Unbalance] | None = None, positions: ArrayLike | None = None
+    ) -> UnbalanceResponse:
+        """Synchronous response to ``unbalances`` (default: the driveline's) at ``positions`` [m]
+        (default: its nodes) for every speed of ``spins`` [rad/s]."""
+        spin_arr = np.atleast_1d(np.asarray(spins, dtype=float))
+        if positions is None:
+            positions = np.concatenate([[0.0], np.cumsum([s.length for s in self.driveline.segments])])
+        z = np.atleast_1d(np.asarray(positions, dtype=float))
+        rows = self._shape_rows(z)
+        load = self.load(self.driveline.unbalances if unbalances is None else unbalances)
+        solution = np.empty((spin_arr.size, load.size), dtype=complex)
+        for start in range(0, spin_arr.size, SOLVE_BATCH):
+            batch = spin_arr[start: start + SOLVE_BATCH]
+            rhs = (batch * batch)[:, None] * load
+            solution[start: start + batch.size] = np.linalg.solve(self.dynamic_stiffness(batch), rhs[..., None])[..., 0]
+        forward, backward = self.components(solution, rows)
+        return UnbalanceResponse(spin_arr, z, forward, backward, self.bearing_forces(spin_arr, solution))
