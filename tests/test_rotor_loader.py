@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from driveline.rotor import (
+    Bearing,
     Driveline,
     EndCondition,
     Hinge,
@@ -13,6 +14,7 @@ from driveline.rotor import (
     load_driveline,
     loads_driveline,
     one_piece_shaft,
+    Unbalance,
 )
 
 GOOD = """
@@ -251,11 +253,52 @@ def test_cutting_a_bare_segment_changes_nothing():
     ("[[hinges]]\nnode = 1\nbending_stiffness = -1.0\n", "hinges[0].bending_stiffness"),
     ("[[hinges]]\nnode = 1\nstiff = 1.0\n", "unknown key 'stiff'"),
     ("[[hinges]]\nbending_stiffness = 1.0\n", "hinges[0]: give exactly one of 'node' or 'position'"),
+    ("[[bearings]]\nnode = 0\nstiffness = 1e7\ndamping = -1.0\n", "bearings[2].damping must be >= 0"),
+    ("[[bearings]]\nnode = 0\nstiffness = 1e7\ndamping = 1.0\ncyy = 2.0\n",
+     "bearings[2]: give either 'damping' or 'cxx'/'cyy', not both"),
+    ("[[bearings]]\nnode = 0\nstiffness = 1e7\ncyy = 2.0\n", "bearings[2]: 'cyy' needs 'cxx'"),
+    ("[[bearings]]\nnode = 0\nstiffness = 1e7\ncxx = 'x'\n", "bearings[2].cxx must be a number"),
+    ("[[bearings]]\nnode = 0\nstiffness = 1e7\nkxy = inf\n", "bearings[2].kxy must be finite"),
+    ("[[unbalances]]\nposition = 1.5\namount = 1e-4\n", "unbalances[0].position = 1.5 m lies beyond the right end"),
+    ("[[unbalances]]\nnode = 3\namount = 1e-4\n", "unbalances[0].node = 3 is out of range"),
+    ("[[unbalances]]\nnode = 1\n", "unbalances[0]: missing key 'amount'"),
+    ("[[unbalances]]\nnode = 1\namount = -1e-4\n", "unbalances[0].amount must be >= 0"),
+    ("[[unbalances]]\nnode = 1\namount = 1e-4\nphase = 'up'\n", "unbalances[0].phase must be a number"),
+    ("[[unbalances]]\nnode = 1\nmass = 1e-4\n", "unbalances[0]: unknown key 'mass'"),
 ])
 def test_bad_point_tables_are_refused(table, fragment):
     with pytest.raises(ValueError) as refused:
         loads_driveline(SHAFT + table)
     assert fragment in str(refused.value)
+
+
+def test_damping_and_unbalance_tables_load():
+    d = loads_driveline(SHAFT + """
+[[bearings]]
+node = 0
+stiffness = 1e7
+damping = 300.0
+
+[[bearings]]
+position = 0.4
+kxx = 1e7
+kyy = 2e6
+cxx = 100.0
+cyy = 50.0
+kxy = -1e5
+cyx = 20.0
+
+[[unbalances]]
+node = 1
+amount = 2e-4
+phase = -0.5
+
+[[unbalances]]
+position = 0.3
+amount = 1e-4
+""")
+    assert d.bearings[2:] == (Bearing(0, 1e7, None, 300.0), Bearing(1, 1e7, 2e6, 100.0, 50.0, kxy=-1e5, cyx=20.0))
+    assert d.unbalances == (Unbalance(0.6, 2e-4, -0.5), Unbalance(0.3, 1e-4))  # node 1 of the file: 0.6 m
 
 
 def test_hinge_table_loads():

@@ -16,7 +16,8 @@ File layout (SI units; all tables except ``segments`` optional)::
     wall_thickness = 0.00165     # m   (or inner_diameter / inner_radius; default solid)
     material = "steel"           # or youngs_modulus and density in the segment
     # rotary_inertia = true, gyroscopic = true
-    # shear = false, poisson_ratio = 0.3  (Timoshenko beam, Cowper's shear coefficient)
+    # shear = true, poisson_ratio = 0.3  (Timoshenko beam, Cowper's shear coefficient;
+    #                                     shear = false: Rayleigh beam)
 
     [[masses]]
     node = 0
@@ -27,6 +28,13 @@ File layout (SI units; all tables except ``segments`` optional)::
     [[bearings]]
     node = 0
     stiffness = 1.0e7            # N/m, isotropic; or kxx and kyy
+    # damping = 500.0            # N s/m, isotropic; or cxx and cyy (default: undamped)
+    # kxy = 0.0, kyx = 0.0, cxy = 0.0, cyx = 0.0   cross-coupling (damped analyses only)
+
+    [[unbalances]]               # excitation of the unbalance response
+    position = 0.7               # m from the left end (or node)
+    amount = 1.0e-4              # kg m (mass x eccentricity)
+    # phase = 0.0                # rad
 
     [[hinges]]                   # moment-free joint at an inner node (universal, tripod)
     position = 0.8               # m from the left end, instead of a node: the loader cuts the
@@ -37,12 +45,13 @@ Every problem raises :class:`ValueError` naming the table, entry and key. A desc
 read only from a regular file of at most :data:`MAX_FILE_BYTES` (a FIFO, a device or a
 directory is refused without reading from it), nests at most :data:`MAX_NESTING` brackets
 deep and has at most :data:`MAX_SEGMENTS` segments and :data:`MAX_POINT_ELEMENTS` masses,
-bearings and hinges each: bounds on the work and memory a description can demand.
+bearings, hinges and unbalances each: bounds on the work and memory a description can demand.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import os
 import re
@@ -54,7 +63,7 @@ from typing import Any
 import tomllib
 
 from .driveline import Driveline
-from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, ShaftSegment
+from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, ShaftSegment, Unbalance
 
 __all__ = ["example_path", "load_driveline", "loads_driveline", "one_piece_shaft"]
 
@@ -64,10 +73,10 @@ MAX_FILE_BYTES = 64 * 1024
 MAX_NESTING = 16
 #: Segments of one description; the analysis cost grows with their number.
 MAX_SEGMENTS = 100
-#: Masses, bearings and hinges of one description, each.
+#: Masses, bearings, hinges and unbalances of one description, each.
 MAX_POINT_ELEMENTS = 2 * (MAX_SEGMENTS + 1)
 
-_TOP_KEYS = {"name", "left_end", "right_end", "materials", "segments", "masses", "bearings", "hinges"}
+_TOP_KEYS = {"name", "left_end", "right_end", "materials", "segments", "masses", "bearings", "hinges", "unbalances"}
 _MATERIAL_KEYS = {"youngs_modulus", "density"}
 _SEGMENT_KEYS = {
     "length", "outer_diameter", "outer_radius", "inner_diameter", "inner_radius",
@@ -75,7 +84,10 @@ _SEGMENT_KEYS = {
     "gyroscopic", "shear", "poisson_ratio", "label",
 }
 _MASS_KEYS = {"node", "position", "mass", "polar_inertia", "diametral_inertia", "label"}
-_BEARING_KEYS = {"node", "position", "stiffness", "kxx", "kyy", "label"}
+_BEARING_KEYS = {"node", "position", "stiffness", "kxx", "kyy", "damping", "cxx", "cyy",
+                 "kxy", "kyx", "cxy", "cyx", "label"}
+_CROSS_KEYS = ("kxy", "kyx", "cxy", "cyx")
+_UNBALANCE_KEYS = {"node", "position", "amount", "phase", "label"}
 _HINGE_KEYS = {"node", "position", "bending_stiffness", "label"}
 
 
@@ -85,7 +97,7 @@ def _unknown(where: str, table: dict[str, Any], allowed: set[str]) -> None:
         raise ValueError(f"{where}: unknown key {extra[0]!r} (allowed: {', '.join(sorted(allowed))})")
 
 
-def _number(where: str, key: str, value: Any, *, positive: bool = False) -> float:
+def _number(where: str, key: str, value: Any, *, positive: bool = False, signed: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{where}.{key} must be a number, got {value!r}")
     v = float(value)
@@ -93,7 +105,7 @@ def _number(where: str, key: str, value: Any, *, positive: bool = False) -> floa
         raise ValueError(f"{where}.{key} must be finite, got {value!r}")
     if positive and v <= 0.0:
         raise ValueError(f"{where}.{key} must be > 0, got {value!r}")
-    if v < 0.0:
+    if v < 0.0 and not signed:
         raise ValueError(f"{where}.{key} must be >= 0, got {value!r}")
     return v
 
@@ -273,18 +285,42 @@ def _mass(i: int, t: dict[str, Any], node: int) -> ConcentratedMass:
     )
 
 
+def _pair(where: str, t: dict[str, Any], key: str, xx: str, yy: str, positive: bool) -> tuple[float, float | None]:
+    """``(xx, yy)`` of a bearing from the isotropic ``key`` or from ``xx`` [+ ``yy``]."""
+    if key in t:
+        if xx in t or yy in t:
+            raise ValueError(f"{where}: give either {key!r} or {xx!r}/{yy!r}, not both")
+        return _number(where, key, t[key], positive=positive), None
+    if xx not in t:
+        if positive:
+            raise ValueError(f"{where}: missing key {key!r} (or {xx!r})")
+        if yy in t:
+            raise ValueError(f"{where}: {yy!r} needs {xx!r}")
+        return 0.0, None
+    return (_number(where, xx, t[xx], positive=positive),
+            _number(where, yy, t[yy], positive=positive) if yy in t else None)
+
+
 def _bearing(i: int, t: dict[str, Any], node: int) -> Bearing:
     where = f"bearings[{i}]"
     _unknown(where, t, _BEARING_KEYS)
-    if "stiffness" in t:
-        if "kxx" in t or "kyy" in t:
-            raise ValueError(f"{where}: give either 'stiffness' or 'kxx'/'kyy', not both")
-        return Bearing(node, _number(where, "stiffness", t["stiffness"], positive=True))
-    if "kxx" not in t:
-        raise ValueError(f"{where}: missing key 'stiffness' (or 'kxx')")
-    kxx = _number(where, "kxx", t["kxx"], positive=True)
-    kyy = _number(where, "kyy", t["kyy"], positive=True) if "kyy" in t else None
-    return Bearing(node, kxx, kyy)
+    kxx, kyy = _pair(where, t, "stiffness", "kxx", "kyy", positive=True)
+    cxx, cyy = _pair(where, t, "damping", "cxx", "cyy", positive=False)
+    cross = {k: _number(where, k, t[k], signed=True) for k in _CROSS_KEYS if k in t}
+    return Bearing(node, kxx, kyy, cxx, cyy, **cross)
+
+
+def _unbalance(i: int, t: dict[str, Any], ends: list[float]) -> Unbalance:
+    where = f"unbalances[{i}]"
+    _unknown(where, t, _UNBALANCE_KEYS)
+    how, value = _station(where, t, len(ends))
+    position = ends[int(value)] if how == "node" else value
+    if position > ends[-1] + NODE_SNAP:
+        raise ValueError(f"{where}.position = {value!r} m lies beyond the right end ({ends[-1]!r} m)")
+    if "amount" not in t:
+        raise ValueError(f"{where}: missing key 'amount'")
+    return Unbalance(min(position, ends[-1]), _number(where, "amount", t["amount"]),
+                     _number(where, "phase", t.get("phase", 0.0), signed=True))
 
 
 def _hinge(i: int, t: dict[str, Any], node: int, n_nodes: int) -> Hinge:
@@ -307,18 +343,21 @@ def loads_driveline(text: str, source: str = "<string>") -> Driveline:
     name = data.get("name", "")
     if not isinstance(name, str):
         raise ValueError(f"{source}: name must be a string, got {name!r}")
-    ends = []
+    conditions = []
     for key in ("left_end", "right_end"):
         v = data.get(key, "free")
         allowed = [e.value for e in EndCondition]
         if v not in allowed:
             raise ValueError(f"{key} = {v!r} is not one of: {', '.join(allowed)}")
-        ends.append(EndCondition(v))
+        conditions.append(EndCondition(v))
+    left, right = conditions
     mats = _materials(data)
     seg_tables = _counted(data, "segments", MAX_SEGMENTS)
     if not seg_tables:
         raise ValueError(f"{source}: at least one [[segments]] table is required")
     segments = [_segment(i, t, mats) for i, t in enumerate(seg_tables)]
+    ends = [0.0, *itertools.accumulate(seg.length for seg in segments)]
+    unbalances = [_unbalance(i, t, ends) for i, t in enumerate(_counted(data, "unbalances", MAX_POINT_ELEMENTS))]
     tables = {kind: _counted(data, kind, MAX_POINT_ELEMENTS) for kind in ("masses", "bearings", "hinges")}
     stations = {kind: [_station(f"{kind}[{i}]", t, len(segments) + 1) for i, t in enumerate(items)]
                 for kind, items in tables.items()}
@@ -327,7 +366,7 @@ def loads_driveline(text: str, source: str = "<string>") -> Driveline:
     bearings = [_bearing(i, t, node) for i, (t, node) in enumerate(zip(tables["bearings"], nodes["bearings"]))]
     hinges = [_hinge(i, t, node, len(segments) + 1)
               for i, (t, node) in enumerate(zip(tables["hinges"], nodes["hinges"]))]
-    return Driveline(segments, masses, bearings, ends[0], ends[1], name, hinges)
+    return Driveline(segments, masses, bearings, left, right, name, hinges, unbalances)
 
 
 def load_driveline(path: str | Path) -> Driveline:
