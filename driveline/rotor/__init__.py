@@ -15,6 +15,7 @@ Typical use::
 
 from .driveline import (
     CampbellDiagram,
+    CriticalSpeed,
     Driveline,
     OrderResonance,
     WhirlFrequencies,
@@ -27,6 +28,7 @@ __all__ = [
     "Bearing",
     "CampbellDiagram",
     "ConcentratedMass",
+    "CriticalSpeed",
     "Driveline",
     "EndCondition",
     "Hinge",

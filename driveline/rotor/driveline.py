@@ -50,6 +50,24 @@ class CampbellDiagram:
     backward: FloatArray
 
 
+#: Forward share of ``sum |U|^2`` from which unbalance counts as exciting a synchronous mode.
+EXCITED_SHARE = 0.01
+
+
+@dataclass(frozen=True)
+class CriticalSpeed:
+    """A critical speed [rad/s] and the share of its mode's forward circular component in
+    ``sum |U|^2`` (1 forward whirl; anisotropic supports give nearly planar modes near 0.5)."""
+
+    spin: float
+    forward_share: float
+
+    @property
+    def whirl(self) -> Whirl:
+        """The dominant whirl sense of the mode."""
+        return "forward" if self.forward_share >= 0.5 else "backward"
+
+
 @dataclass(frozen=True)
 class OrderResonance:
     """Spin speed at which ``order * spin`` equals a whirl frequency of the given sense."""
@@ -327,13 +345,34 @@ class Driveline:
     ) -> FloatArray:
         """Critical speeds [rad/s]: spin speeds with a synchronous whirl frequency.
 
-        ``whirl="forward"`` (default) solves ``f(Omega, Omega) = 0`` directly;
-        ``"backward"`` solves ``f(-Omega, Omega) = 0``. First ``n`` or all up to ``spin_max``.
-        Fewer than ``n`` are returned if no more exist below ``limit`` (a Rayleigh
-        shaft has finitely many forward critical speeds).
+        ``whirl="forward"`` (default): the speeds unbalance excites, :meth:`unbalance_critical_speeds`
+        (isotropic supports: the roots of ``f(Omega, Omega) = 0``). ``"backward"`` solves
+        ``f(-Omega, Omega) = 0`` (anisotropic: the synchronous roots classified backward). First ``n``
+        or all up to ``spin_max``. Fewer than ``n`` are returned if no more exist below ``limit``
+        (a Rayleigh shaft has finitely many forward critical speeds).
         """
+        if whirl == "forward":
+            return np.array([c.spin for c in self.unbalance_critical_speeds(n, spin_max, limit)])
         res = self.order_resonances((1,), (whirl,), n, spin_max, limit)
         return np.array([r.spin for r in res])
+
+    def unbalance_critical_speeds(
+        self, n: int | None = 3, spin_max: float | None = None, limit: float = SEARCH_LIMIT
+    ) -> list[CriticalSpeed]:
+        """The synchronous roots (whirl = spin) whose mode unbalance excites, ascending.
+
+        Unbalance is a forward rotating force: it excites a mode through the mode's forward
+        circular component. Isotropic supports: the forward roots (backward modes have none).
+        Anisotropic supports: every synchronous root whose forward share of ``sum |U|^2`` is at
+        least :data:`EXCITED_SHARE`, among the ``2 (n + 1)`` lowest (fewer than ``n`` are returned
+        when nearly pure backward modes crowd them out).
+        """
+        if self.is_isotropic:
+            return [CriticalSpeed(r.spin, 1.0) for r in self.order_resonances((1,), ("forward",), n, spin_max, limit)]
+        found = self.order_resonances((1,), ("forward", "backward"), None if n is None else n + 1, spin_max, limit)
+        shares = [(r.spin, self.mode_shape(r.spin, r.spin, 4).forward_fraction) for r in found]
+        excited = [CriticalSpeed(spin, share) for spin, share in sorted(shares) if share >= EXCITED_SHARE]
+        return excited if n is None else excited[:n]
 
     def nearest_order_resonance(
         self,
