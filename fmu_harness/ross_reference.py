@@ -10,7 +10,7 @@ import contextlib
 import os
 import sys
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -52,9 +52,10 @@ ELEMENTS_PER_METRE = 24
 ROSS_RTOL = 1e-8
 
 
-def ross_rotor(d: Driveline):
-    """The same rotor in ROSS: Timoshenko elements (Cowper's coefficient) where our segment has
-    ``shear``, Rayleigh ones elsewhere; undamped bearings."""
+def ross_rotor(d: Driveline) -> tuple[Any, list[int]]:
+    """The same rotor in ROSS, and the ROSS node of each of our nodes: Timoshenko elements
+    (Cowper's coefficient) where our segment has ``shear``, Rayleigh ones elsewhere; bearings
+    with their stiffness, damping and cross-coupling."""
     rs = _ross()
     mat = rs.Material(name="steel_test", rho=RHO, E=E, Poisson=0.3)
     shaft, node_of_station = [], [0]
@@ -74,8 +75,12 @@ def ross_rotor(d: Driveline):
         rs.DiskElement(n=node_of_station[m.node], m=m.mass, Id=m.diametral_inertia, Ip=m.polar_inertia)
         for m in d.masses
     ]
-    bearings = [rs.BearingElement(n=node_of_station[b.node], kxx=b.kxx, cxx=0.0) for b in d.bearings]
-    return rs.Rotor(shaft, disk_elements=disks, bearing_elements=bearings)
+    bearings = [
+        rs.BearingElement(n=node_of_station[b.node], kxx=b.kxx, kyy=b.k_yy, kxy=b.kxy, kyx=b.kyx,
+                          cxx=b.cxx, cyy=b.c_yy, cxy=b.cxy, cyx=b.cyx)
+        for b in d.bearings
+    ]
+    return rs.Rotor(shaft, disk_elements=disks, bearing_elements=bearings), node_of_station
 
 
 def _forward_fraction(vec: np.ndarray) -> tuple[float, float]:
@@ -94,7 +99,7 @@ def _forward_fraction(vec: np.ndarray) -> tuple[float, float]:
 
 def ross_forward_critical_speeds(d: Driveline, n: int = 3) -> np.ndarray:
     """First ``n`` forward lateral critical speeds from ``run_critical_speed``, filtered."""
-    rotor = ross_rotor(d)
+    rotor, _ = ross_rotor(d)
     num_modes = 4 * n  # n backward/forward pairs, each a complex-conjugate pair
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -111,3 +116,32 @@ def ross_forward_critical_speeds(d: Driveline, n: int = 3) -> np.ndarray:
     if out.size < n:
         raise ArithmeticError(f"ROSS returned only {out.size} forward lateral critical speeds")
     return out[:n]
+
+
+def ross_unbalance_response(d: Driveline, node: int, amount: float, phase: float, probe: int
+                            ) -> Callable[[np.ndarray], np.ndarray]:
+    """Major semi-axis [m] of the orbit at our node ``probe`` from ROSS's ``run_unbalance_response``
+    for an unbalance ``amount`` [kg m] at ``phase`` [rad] on our node ``node``, as a function of the
+    speeds (the ROSS rotor is built once)."""
+    rotor, node_of_station = ross_rotor(d)
+    dof = rotor.number_dof * node_of_station[probe]
+
+    def major(spins: np.ndarray) -> np.ndarray:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            response = rotor.run_unbalance_response(node_of_station[node], amount, phase,
+                                                    frequency=np.atleast_1d(np.asarray(spins, dtype=float)))
+        x, y = response.forced_resp[dof], response.forced_resp[dof + 1]
+        # x + i y = A exp(i W t) + B exp(-i W t), A = (X + i Y)/2, B = conj(X - i Y)/2
+        return 0.5 * (np.abs(x + 1j * y) + np.abs(x - 1j * y))
+
+    return major
+
+
+def ross_damped_modes(d: Driveline, spin: float, num_modes: int = 24) -> tuple[np.ndarray, np.ndarray]:
+    """Damped natural frequencies ``wd`` [rad/s] and logarithmic decrements of ROSS's ``run_modal``."""
+    rotor, _ = ross_rotor(d)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        modal = rotor.run_modal(spin, num_modes=num_modes)
+    return np.asarray(modal.wd), np.asarray(modal.log_dec)

@@ -68,3 +68,18 @@ def damped_transfer_chain(driveline, w: complex, spin: float, force: tuple[int, 
         return minor, []
     coefficients = np.append(np.linalg.solve(minor, -basis[[2, 3, 6, 7], 4]), 1.0)
     return minor, [s @ coefficients for s in states]
+
+
+def response_peaks(rotor, spins: np.ndarray, position: float) -> tuple[np.ndarray, np.ndarray]:
+    """Speeds and values of the local maxima of the orbit's major semi-axis at ``position`` for the
+    driveline's unbalances (``rotor``: a ``DampedRotor``), found on ``spins`` and refined to 1e-9."""
+    from scipy.optimize import minimize_scalar
+
+    major = rotor.unbalance_response(spins, positions=[position]).major[:, 0]
+    inner = np.flatnonzero((major[1:-1] > major[:-2]) & (major[1:-1] >= major[2:])) + 1
+
+    def negative(spin: float) -> float:
+        return -rotor.unbalance_response([spin], positions=[position]).major[0, 0]
+
+    found = [minimize_scalar(negative, bracket=tuple(spins[i - 1: i + 2]), tol=1e-9) for i in inner]
+    return np.array([f.x for f in found]), -np.array([f.fun for f in found])

@@ -7,12 +7,12 @@ import dataclasses
 
 import numpy as np
 import pytest
-from scipy.optimize import minimize_scalar, newton
+from scipy.optimize import newton
 
 from driveline.rotor import Bearing, Driveline, Unbalance, one_piece_shaft
 from driveline.rotor.damped import DampedRotor
 
-from rotor_checks import damped_transfer_chain
+from rotor_checks import damped_transfer_chain, response_peaks
 
 TUBE = dict(L_shaft=1.4, D_outer=0.0762, D_inner=0.0729, E=2.1e11, density=7850.0,
             m_joint=2.5, Jp_joint=0.004, Jd_joint=0.002, k_bearing=1e7)
@@ -88,18 +88,6 @@ def test_unbalance_response_matches_the_transfer_chain(bearings):
             assert fe.bearing_forces[i, j] == pytest.approx(abs(fa) + abs(fq), rel=1e-7)
 
 
-def response_peaks(d: Driveline, spins: np.ndarray, position: float) -> np.ndarray:
-    """Speeds of the local maxima of the orbit's major semi-axis at ``position``, refined to 1e-9."""
-    rotor = DampedRotor(d, 40)
-    major = rotor.unbalance_response(spins, positions=[position]).major[:, 0]
-    inner = np.flatnonzero((major[1:-1] > major[:-2]) & (major[1:-1] >= major[2:])) + 1
-
-    def negative(spin: float) -> float:
-        return -rotor.unbalance_response([spin], positions=[position]).major[0, 0]
-
-    return np.array([minimize_scalar(negative, bracket=tuple(spins[i - 1: i + 2]), tol=1e-9).x for i in inner])
-
-
 @pytest.mark.parametrize("kyy", [2e6, None], ids=["anisotropic", "isotropic"])
 def test_critical_speeds_are_the_peaks_of_the_lightly_damped_response(kyy):
     """Rotor (b) on kxx = 1e7 N/m bearings, light damping (5 N s/m), unbalance off-centre: the
@@ -109,7 +97,7 @@ def test_critical_speeds_are_the_peaks_of_the_lightly_damped_response(kyy):
     bearings = [Bearing(n, 1e7, kyy, cxx=5.0) for n in (0, 1)]
     d = dataclasses.replace(tube(bearings), unbalances=[Unbalance(0.5, 1e-4)])
     critical = d.critical_speeds(4, spin_max=1200.0)
-    peaks = response_peaks(d, np.arange(300.0, 1200.0, 1.0), 0.3)
+    peaks, _ = response_peaks(DampedRotor(d, 40), np.arange(300.0, 1200.0, 1.0), 0.3)
     np.testing.assert_allclose(peaks, critical, rtol=5e-5)
     if kyy:
         assert critical[0] == pytest.approx(528.1222, abs=1e-4)
