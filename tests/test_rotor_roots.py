@@ -24,6 +24,8 @@ from driveline.rotor import (
 )
 from driveline.rotor.roots import find_roots
 
+from rotor_checks import rayleigh
+
 #: FE elements per segment.
 N_EL = 40
 #: Agreement of each matched frequency. The FE error grows as (mode number / N_EL)^4:
@@ -44,11 +46,11 @@ def _fe_in_range(d: Driveline, spin: float, n: int) -> tuple[np.ndarray, np.ndar
 
 
 def _two_piece() -> Driveline:
-    return load_driveline(example_path())
+    return rayleigh(load_driveline(example_path()))
 
 
 def _tube() -> Driveline:
-    return one_piece_shaft(1.4, 0.0762, 0.0729, 2.1e11, 7850.0, 2.5, 0.004, 0.002, 1e7)
+    return one_piece_shaft(1.4, 0.0762, 0.0729, 2.1e11, 7850.0, 2.5, 0.004, 0.002, 1e7, shear=False)
 
 
 def _soft_heavy() -> Driveline:

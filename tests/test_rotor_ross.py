@@ -56,20 +56,17 @@ def uniform_shaft() -> Driveline:
 
 
 def tube_propshaft() -> Driveline:
-    """(b) one-piece tube: OD 76.2 mm, wall 1.65 mm, 1.4 m, 2.5 kg joints, 1e7 N/m bearings."""
-    return one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7)
+    """(b) one-piece tube: OD 76.2 mm, wall 1.65 mm, 1.4 m, 2.5 kg joints, 1e7 N/m bearings; Rayleigh beam."""
+    return one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7, shear=False)
 
 
 def tube_propshaft_shear() -> Driveline:
-    """(b) with a Timoshenko tube (Cowper's shear coefficient, nu = 0.3), as ROSS with shear on."""
-    d = tube_propshaft()
-    seg = d.segments[0]
-    return Driveline([ShaftSegment(seg.length, seg.outer_diameter, seg.inner_diameter, E, RHO, shear=True)],
-                     d.masses, d.bearings)
+    """(b) with a Timoshenko tube (Cowper's shear coefficient, nu = 0.3; the default), as ROSS with shear on."""
+    return one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7)
 
 
 def two_piece_propshaft() -> Driveline:
-    """(c) the shipped two-piece example with a centre bearing."""
+    """(c) the shipped two-piece example with a centre bearing (Timoshenko tubes, the layout default)."""
     return load_driveline(example_path("two_piece_propshaft"))
 
 

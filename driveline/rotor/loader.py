@@ -213,7 +213,7 @@ def _segment(i: int, t: dict[str, Any], mats: dict[str, tuple[float, float]]) ->
     for key, v in (("youngs_modulus", E), ("density", rho)):
         if v is None:
             raise ValueError(f"{where}: missing key {key!r} (or a 'material')")
-    flags = {k: _flag(where, k, t[k]) for k in ("rotary_inertia", "gyroscopic", "shear") if k in t}
+    flags = {"shear": True} | {k: _flag(where, k, t[k]) for k in ("rotary_inertia", "gyroscopic", "shear") if k in t}
     if "poisson_ratio" in t:
         nu = t["poisson_ratio"]
         if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1.0 < nu < 0.5:
@@ -426,14 +426,14 @@ def one_piece_shaft(
     Jd_joint: float,
     k_bearing: float,
     c_bearing: float = 0.0,
-    shear: bool = False,
+    shear: bool = True,
 ) -> Driveline:
     """One-piece tube propshaft: a joint mass and an isotropic bearing at each end.
 
     SI units: lengths [m], ``E`` [Pa], ``density`` [kg/m3], ``m_joint`` [kg],
     ``Jp_joint``/``Jd_joint`` [kg m2], ``k_bearing`` [N/m], ``c_bearing`` [N s/m]; free ends
-    (the bearings carry the shaft, as in the seed's Fig. 2); a Timoshenko tube if ``shear``
-    (else Rayleigh). Errors name the offending parameter.
+    (the bearings carry the shaft, as in the seed's Fig. 2); a Timoshenko tube unless ``shear``
+    is false (Rayleigh). Errors name the offending parameter.
     """
     vals = {
         "L_shaft": L_shaft, "D_outer": D_outer, "D_inner": D_inner, "E": E, "density": density,
