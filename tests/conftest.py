@@ -42,6 +42,7 @@ SLOW = (
     "tests/test_coupling_comparison.py::test_two_cardan_joints_cancel_when_phased_and_double_when_not",
     "tests/test_critical_speeds_model.py::test_analysis_runs_only_when_the_structure_changes",
     "tests/test_critical_speeds_model.py::test_fmu_follows_a_speed_ramp_and_refuses_overspeed",
+    "tests/test_critical_speeds_model.py::test_shear_parameter_selects_the_beam_theory",
     "tests/test_critical_speeds_model.py::test_shipped_layout_by_name",
     "tests/test_host_environment.py",
     "tests/test_packaging.py::test_different_fmus_alive_at_once_in_one_host",

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
-import math
+import dataclasses
 
 import numpy as np
 import pytest
 
-from driveline.rotor import example_path, load_driveline, one_piece_shaft
+from driveline.rotor import Unbalance, example_path, load_driveline, one_piece_shaft
+from driveline.rotor.damped import DampedRotor
+from driveline.rotor.driveline import EXCITED_SHARE
 from driveline.rotor.model import CriticalSpeedsModel
+from driveline.rotor.unbalance_outputs import DAMPED_MODES, DAMPING_POINTS, FE_ELEMENTS
 from fmu_harness.runner import FmuInstance, StepRefused, simulate
 
 import model_checks
@@ -85,6 +88,10 @@ def test_shipped_layout_by_name():
         ({"orders": "1,two"}, "'two'"),
         ({"layout": "missing.toml"}, "missing.toml"),
         ({"omega_max": 0.0}, "omega_max"),
+        ({"c_bearing": -1.0}, "c_bearing"),
+        ({"unbalance_position": 1.5}, "unbalance_position"),
+        ({"response_position": -0.1}, "response_position"),
+        ({"unbalance": -1e-4}, "unbalance"),
     ],
 )
 def test_non_physical_structure_is_refused_with_the_value_named(values, fragment):
@@ -141,3 +148,51 @@ def test_layout_path_any_case_relative_to_the_working_directory(tmp_path, monkey
     broken.layout = "missing.toml"
     errors = broken.initialize(0.0)
     assert errors and str(tmp_path / "missing.toml") in errors[0]  # the full path
+
+
+def test_unbalance_outputs_match_the_damped_model():
+    model = model_checks.started(CriticalSpeedsModel, c_bearing=800.0, unbalance=2e-4, unbalance_position=0.3,
+                                 response_position=0.6)
+    d = dataclasses.replace(one_piece_shaft(**ROTOR_B, c_bearing=800.0), unbalances=[Unbalance(0.42, 2e-4)])
+    rotor = DampedRotor(d, FE_ELEMENTS)
+    speeds = np.linspace(0.0, 1500.0, DAMPING_POINTS)
+    for speed in (*speeds, 123.4, 655.0, 1234.5):
+        model.omega = speed
+        assert model.step(0.0, 0.01) == []
+        response = rotor.unbalance_response([speed], positions=[0.84])
+        assert model.unbalance_response == pytest.approx(response.major[0, 0], rel=1e-12, abs=0.0)
+        assert model.bearing_force_max == pytest.approx(np.max(response.bearing_forces), rel=1e-12, abs=0.0)
+        if speed in speeds:  # on a knot of the table: exact
+            excited = [m for m in rotor.modes(speed, 4 * DAMPED_MODES) if m.forward_share >= EXCITED_SHARE]
+            nearest = min(excited[:DAMPED_MODES], key=lambda m: abs(m.frequency - speed))
+            assert model.damping_ratio == pytest.approx(nearest.damping_ratio, rel=1e-9)
+
+
+def test_fmu_unbalance_response_peaks_at_the_first_critical_speed(fmu_path, fmi):
+    # A ramp through the first critical speed of the (Timoshenko) tube, 655.23 rad/s: the response
+    # peaks there (FE_ELEMENTS elements: the peak lies 1.1e-4 above the exact root, measured), and
+    # the damping ratio read there is the first forward mode's (2.5e-3 at 800 N s/m; the table's
+    # splines are within 1e-4 of it).
+    result = simulate(fmu_path("CriticalSpeeds", fmi), 1.0, 0.001, inputs={"omega": lambda t: 640.0 + 30.0 * t},
+                      start_values={"c_bearing": 800.0})
+    critical = result["omega_crit_1"][-1]
+    peak = int(np.argmax(result["unbalance_response"]))
+    speed_at_peak = 640.0 + 30.0 * (result["time"][peak] - 0.001)
+    assert speed_at_peak == pytest.approx(critical, rel=3e-4)
+    assert result["bearing_force_max"][peak] == np.max(result["bearing_force_max"])
+    d = one_piece_shaft(**ROTOR_B, c_bearing=800.0)
+    rotor = DampedRotor(d, FE_ELEMENTS)
+    first = min(rotor.modes(speed_at_peak, 4), key=lambda m: abs(m.frequency - speed_at_peak))
+    assert first.whirl == "forward"
+    assert result["damping_ratio"][peak] == pytest.approx(first.damping_ratio, rel=1e-4)
+    expected = rotor.unbalance_response([speed_at_peak], [Unbalance(0.7, 1e-4)], [0.7])
+    assert result["unbalance_response"][peak] == pytest.approx(expected.major[0, 0], rel=1e-9)
+
+
+def test_shear_parameter_selects_the_beam_theory(fmu_path, fmi):
+    rayleigh = simulate(fmu_path("CriticalSpeeds", fmi), 0.01, 0.01, start_values={"shear": False})
+    timoshenko = simulate(fmu_path("CriticalSpeeds", fmi), 0.01, 0.01)
+    assert rayleigh["omega_crit_1"][-1] == pytest.approx(one_piece_shaft(**ROTOR_B, shear=False).critical_speeds(1)[0],
+                                                         rel=1e-12)
+    assert timoshenko["omega_crit_1"][-1] == pytest.approx(one_piece_shaft(**ROTOR_B).critical_speeds(1)[0], rel=1e-12)
+    assert timoshenko["omega_crit_1"][-1] / rayleigh["omega_crit_1"][-1] - 1 == pytest.approx(-0.0078, abs=1e-4)

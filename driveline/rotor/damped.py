@@ -53,6 +53,8 @@ ComplexArray = NDArray[np.complex128]
 
 #: Eigenvalues computed beyond ``2 n`` for the first ``n`` modes (room for overdamped ones).
 EXTRA_EIGENVALUES = 6
+#: Largest first-order system solved densely for the first modes (above: shift-invert Arnoldi).
+DENSE_SIZE = 160
 #: Shift of the Arnoldi iteration [1/s]: off zero, where a free rotor has its rigid-body modes.
 SHIFT = -1.0
 
@@ -156,9 +158,12 @@ class DampedRotor:
         rows = fe.index[np.unique(mesh.elements[:, [0, 2]])]
         self._translations = rows[rows >= 0]
         self._bearing_rows = np.array([fe.index[mesh.node_u[b.node]] for b in driveline.bearings], dtype=int)
+        self._bearing_coefficients = np.array(
+            [[*b.stiffness_components, *b.damping_components] for b in driveline.bearings], dtype=complex
+        ).reshape(-1, 4).T
 
     # -- building blocks -------------------------------------------------------
-    def _shape_rows(self, positions: ArrayLike) -> ComplexArray:
+    def shape_rows(self, positions: ArrayLike) -> ComplexArray:
         """Rows (positions, n) interpolating ``u`` from the ``p`` unknowns (Hermite shape functions)."""
         z = np.atleast_1d(np.asarray(positions, dtype=float))
         length = self.driveline.length
@@ -177,7 +182,7 @@ class DampedRotor:
 
     def load(self, unbalances: Sequence[Unbalance]) -> ComplexArray:
         """Load vector ``[F, 0]`` of the unbalances per unit ``Omega^2`` (consistent nodal loads)."""
-        rows = self._shape_rows([u.position for u in unbalances]) if unbalances else np.zeros((0, self._n))
+        rows = self.shape_rows([u.position for u in unbalances]) if unbalances else np.zeros((0, self._n))
         phasors = np.array([u.amount * np.exp(1j * u.phase) for u in unbalances], dtype=complex)
         force = phasors @ rows
         return np.concatenate([force, np.zeros(self._n)]) if self.doubled else force
@@ -202,27 +207,24 @@ class DampedRotor:
 
     def bearing_forces(self, spins: FloatArray, solution: ComplexArray) -> FloatArray:
         """Major semi-axis of each bearing's force orbit [N], shape (spins, bearings)."""
-        out = np.zeros((len(spins), len(self._bearing_rows)))
-        w = np.asarray(spins, dtype=float)
-        for j, (bearing, row) in enumerate(zip(self.driveline.bearings, self._bearing_rows)):
-            if row < 0:
-                continue
-            (ka, kb), (ca, cb) = bearing.stiffness_components, bearing.damping_components
-            a = solution[:, row]
-            q = solution[:, self._n + row] if self.doubled else np.zeros_like(a)
-            fa = (ka + 1j * w * ca) * a + (kb + 1j * w * cb) * q
-            fq = (np.conj(kb) + 1j * w * np.conj(cb)) * a + (np.conj(ka) + 1j * w * np.conj(ca)) * q
-            out[:, j] = np.abs(fa) + np.abs(fq)
-        return out
+        rows, held = np.maximum(self._bearing_rows, 0), self._bearing_rows >= 0
+        ka, kb, ca, cb = self._bearing_coefficients
+        w = 1j * np.asarray(spins, dtype=float)[:, None]
+        a = solution[:, rows]
+        q = solution[:, self._n + rows] if self.doubled else np.zeros_like(a)
+        fa = (ka + w * ca) * a + (kb + w * cb) * q
+        fq = (kb.conj() + w * cb.conj()) * a + (ka.conj() + w * ca.conj()) * q
+        return np.where(held, np.abs(fa) + np.abs(fq), 0.0)
 
     # -- results -----------------------------------------------------------------
     def modes(self, spin: float = 0.0, n: int | None = None) -> list[DampedMode]:
         """Damped whirl modes at ``spin`` [rad/s], ascending in damped frequency (the first ``n``).
 
         Eigenvalues of ``A y = lam B y``, ``y = [x, x'/s]``, ``A = [[0, s I], [-K2/s, -(C2 + Omega Gv)]]``,
-        ``B = diag(I, M2)`` (``s`` balances stiffness and mass): all of them (dense) or, for ``n``, the ``2 n + EXTRA_EIGENVALUES`` nearest
-        to zero by shift-invert Arnoldi on a sparse factorisation (conjugates and overdamped ones
-        are among them and dropped).
+        ``B = diag(I, M2)`` (``s`` balances stiffness and mass): all of them (dense, also for a system
+        of at most DENSE_SIZE) or, for ``n``, the ``2 n + EXTRA_EIGENVALUES`` nearest to zero by
+        shift-invert Arnoldi on a sparse factorisation (conjugates and overdamped ones are among
+        them and dropped).
         """
         size = self.M.shape[0]
         eye = sparse.identity(size, format="csc")
@@ -231,7 +233,7 @@ class DampedRotor:
                                                sparse.csc_matrix(-(self.C + spin * self.G))]], format="csc")
         b = sparse.block_diag([eye, sparse.csc_matrix(self.M)], format="csc")
         count = None if n is None else 2 * n + EXTRA_EIGENVALUES
-        if count is None or count >= 2 * size - 2:
+        if count is None or 2 * size <= DENSE_SIZE:
             lam, vectors = eig(a.toarray(), b.toarray())
         else:
             factor = splu((a - SHIFT * b).astype(complex).tocsc())
@@ -264,7 +266,7 @@ class DampedRotor:
         if positions is None:
             positions = np.concatenate([[0.0], np.cumsum([s.length for s in self.driveline.segments])])
         z = np.atleast_1d(np.asarray(positions, dtype=float))
-        rows = self._shape_rows(z)
+        rows = self.shape_rows(z)
         load = self.load(self.driveline.unbalances if unbalances is None else unbalances)
         solution = np.array([self.solve(spin, load) for spin in spin_arr]).reshape(spin_arr.size, load.size)
         forward, backward = self.components(solution, rows)

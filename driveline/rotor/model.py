@@ -19,9 +19,10 @@ from scipy.linalg import eigh
 from ..model import SteppedModel
 from . import fem
 from .driveline import SEARCH_LIMIT, Driveline, OrderResonance
-from .elements import Bearing
+from .elements import Bearing, Unbalance
 from .loader import example_path, load_driveline, one_piece_shaft
 from .spec import SPEC
+from .unbalance_outputs import UnbalanceOutputs
 
 #: Orders watched at most, and the highest order (joints excite low orders: 1, 2, 3, 6).
 MAX_ORDERS = 16
@@ -34,7 +35,9 @@ FE_ELEMENTS = 4
 PLAUSIBLE_DEVIATION = 0.02
 CAMPBELL_POINTS = 41  # spline knots over [0, omega_max]; measured interpolation error <= 1e-12 relative
 WHIRL_MODES = 2
-SHAFT_PARAMETERS = ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", "Jp_joint", "Jd_joint", "k_bearing")
+SHAFT_PARAMETERS = ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", "Jp_joint", "Jd_joint", "k_bearing",
+                    "c_bearing", "shear")
+UNBALANCE_PARAMETERS = ("unbalance", "unbalance_position", "response_position")
 
 
 @dataclass(frozen=True)
@@ -128,14 +131,16 @@ class CriticalSpeedsModel(SteppedModel):
     """The ``CriticalSpeeds`` co-simulation model."""
 
     spec = SPEC
-    derived_state = ("_analysis", "_analysed_for", "_resonance_speeds")
+    derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_unbalance")
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None
         self._analysed_for: tuple | None = None
+        self._unbalance: UnbalanceOutputs | None = None
 
     def _structure(self) -> tuple:
-        return (self.layout, self.orders, self.omega_max, *(getattr(self, n) for n in SHAFT_PARAMETERS))
+        return (self.layout, self.orders, self.omega_max,
+                *(getattr(self, n) for n in SHAFT_PARAMETERS + UNBALANCE_PARAMETERS))
 
     def extra_parameter_errors(self) -> list[str]:
         """Build and analyse the driveline (only when the structure changed): its errors are the checks."""
@@ -154,6 +159,9 @@ class CriticalSpeedsModel(SteppedModel):
             reason = implausibility(driveline, analysis)
             if reason is not None:
                 raise ValueError(reason)
+            unbalances = driveline.unbalances if self.layout else (
+                Unbalance(self.unbalance_position * driveline.length, self.unbalance),)
+            self._unbalance = UnbalanceOutputs.build(driveline, unbalances, self.response_position, self.omega_max)
             self._analysis = analysis
             self._resonance_speeds = analysis.resonance_speeds
         except (ValueError, ArithmeticError) as error:  # e.g. a diameter of 1e300 overflows
@@ -186,3 +194,4 @@ class CriticalSpeedsModel(SteppedModel):
         self.resonance_margin = float(margins[closest])
         self.resonance_count = int(np.count_nonzero(np.abs(margins) < self.band))
         self.resonance_warning = self.resonance_count > 0
+        self.unbalance_response, self.bearing_force_max, self.damping_ratio = self._unbalance.evaluate(speed)

@@ -10,8 +10,9 @@ SPEC = ModelSpec(
     name="CriticalSpeeds",
     description=(
         "Bending critical speeds of a driveline shaft by the transfer matrix method (Hruby, Nahlik "
-        "2021; exact Rayleigh-beam segments with gyroscopic coupling): critical speeds, whirl "
-        "frequencies at the current speed, and the nearest order resonance of the couplings."
+        "2021; exact Timoshenko- or Rayleigh-beam segments with gyroscopic coupling): critical speeds, "
+        "whirl frequencies at the current speed, the nearest order resonance of the couplings, and the "
+        "unbalance response with bearing damping (finite elements)."
     ),
     variables=(
         Variable("L_shaft", "parameter", 1.4, f"{STRUCTURE}: tube length", "m", "mm",
@@ -32,6 +33,19 @@ SPEC = ModelSpec(
                  "kg.m2", min=0.0, variability="tunable"),
         Variable("k_bearing", "parameter", 1e7, f"{STRUCTURE}: stiffness of the bearing at each end", "N/m",
                  min=0.0, min_exclusive=True, variability="tunable"),
+        Variable("c_bearing", "parameter", 500.0, f"{STRUCTURE}: damping of the bearing at each end (the "
+                 "unbalance response and damping_ratio; the critical speeds are those of the undamped shaft)",
+                 "N.s/m", min=0.0, variability="tunable"),
+        Variable("shear", "parameter", True, f"{STRUCTURE}: shear deformation of the tube (Timoshenko beam, "
+                 "Cowper's coefficient); false: Rayleigh beam", type="Boolean", variability="tunable"),
+        Variable("unbalance", "parameter", 1e-4, "Unbalance of the one-piece tube (mass x eccentricity; a "
+                 "layout brings its own [[unbalances]])", "kg.m", "g.mm", min=0.0, variability="tunable"),
+        Variable("unbalance_position", "parameter", 0.5,
+                 "Axial position of the unbalance on the one-piece tube, as a fraction of its length", "1",
+                 min=0.0, max=1.0, variability="tunable"),
+        Variable("response_position", "parameter", 0.5,
+                 "Axial position of unbalance_response, as a fraction of the driveline's length", "1",
+                 min=0.0, max=1.0, variability="tunable"),
         Variable("layout", "parameter", "",
                  "Driveline description (TOML) replacing the one-piece tube above: a file path ending in "
                  "'.toml' (any case; a relative path is relative to the importing process's working "
@@ -49,14 +63,14 @@ SPEC = ModelSpec(
                  min=0.0, min_exclusive=True, variability="tunable"),
         Variable("omega", "input", 300.0, "Current shaft speed (sign ignored)", "rad/s", "rpm"),
         Variable("omega_crit_1", "output", 0.0,
-                 "First forward bending critical speed (1e5 rad/s when none lies below that search limit)",
+                 "First bending critical speed: synchronous whirl that unbalance excites (1e5 rad/s when none "
+                 "lies below that search limit)", "rad/s", "rpm"),
+        Variable("omega_crit_2", "output", 0.0, "Second bending critical speed (1e5 rad/s if missing)",
                  "rad/s", "rpm"),
-        Variable("omega_crit_2", "output", 0.0, "Second forward bending critical speed (1e5 rad/s if missing)",
-                 "rad/s", "rpm"),
-        Variable("omega_crit_3", "output", 0.0, "Third forward bending critical speed (1e5 rad/s if missing)",
+        Variable("omega_crit_3", "output", 0.0, "Third bending critical speed (1e5 rad/s if missing)",
                  "rad/s", "rpm"),
         Variable("critical_speed_count", "output", 0,
-                 "Number of forward critical speeds found below 1e5 rad/s, at most 3 (a short, stiff shaft has "
+                 "Number of critical speeds found below 1e5 rad/s, at most 3 (a short, stiff shaft has "
                  "fewer)", type="Integer"),
         Variable("whirl_forward_1", "output", 0.0, "First forward whirl frequency at the current speed",
                  "rad/s", "rpm"),
@@ -79,6 +93,13 @@ SPEC = ModelSpec(
                  "Number of order resonances (all watched orders, both whirl directions) within the band",
                  type="Integer"),
         Variable("resonance_warning", "output", False, "True when resonance_count > 0", type="Boolean"),
+        Variable("unbalance_response", "output", 0.0,
+                 "Unbalance response at response_position and the current speed: major semi-axis of the orbit",
+                 "m", "mm"),
+        Variable("bearing_force_max", "output", 0.0,
+                 "Largest force a bearing transmits at the current speed (major semi-axis of its force orbit)", "N"),
+        Variable("damping_ratio", "output", 0.0,
+                 "Damping ratio of the unbalance-excited whirl mode whose damped frequency is nearest |omega|", "1"),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-2),
     relations=(
