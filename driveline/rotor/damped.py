@@ -40,7 +40,6 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import sparse
-from scipy.linalg import eig
 from scipy.linalg.lapack import zgbsv
 from scipy.sparse.linalg import LinearOperator, eigs, splu
 
@@ -233,27 +232,27 @@ class DampedRotor:
                                                sparse.csc_matrix(-(self.C + spin * self.G))]], format="csc")
         b = sparse.block_diag([eye, sparse.csc_matrix(self.M)], format="csc")
         count = None if n is None else 2 * n + EXTRA_EIGENVALUES
-        if count is None or 2 * size <= DENSE_SIZE:
-            lam, vectors = eig(a.toarray(), b.toarray())
+        if count is None or 2 * size <= DENSE_SIZE:  # B^-1 A: only the mass block is inverted
+            dense = a.toarray()
+            dense[size:] = np.linalg.solve(self.M, dense[size:])
+            # an axisymmetric model needs no eigenvectors: the sign of Im lam is the whirl sense
+            lam, vectors = np.linalg.eig(dense) if self.doubled else (np.linalg.eigvals(dense), None)
         else:
             factor = splu((a - SHIFT * b).astype(complex).tocsc())
             operator = LinearOperator(a.shape, matvec=lambda v: factor.solve(b @ v), dtype=complex)
-            nu, vectors = eigs(operator, k=count, which="LM")
+            nu, vectors = eigs(operator, k=count, which="LM") if self.doubled else (
+                eigs(operator, k=count, which="LM", return_eigenvectors=False), None)
             lam = SHIFT + 1.0 / nu
-        tol = 1e-9 * np.max(np.abs(lam))
-        t = self._translations
-        out = []
-        for value, vector in zip(lam, vectors.T):
-            if not np.isfinite(value) or abs(value.imag) <= tol:  # overdamped or static: no whirl
-                continue
-            if self.doubled:
-                if value.imag < 0.0:  # the conjugate of a mode kept at +w_d
-                    continue
+        whirling = np.isfinite(lam) & (np.abs(lam.imag) > 1e-9 * np.max(np.abs(lam)))  # not overdamped or static
+        if not self.doubled:  # u = p exp(lam t): Im lam < 0 whirls backward
+            out = [DampedMode(complex(v.real, abs(v.imag)), float(v.imag > 0)) for v in lam[whirling]]
+        else:  # each mode also appears conjugated, at -w_d
+            t = self._translations
+            out = []
+            for value, vector in zip(lam[whirling & (lam.imag > 0)], vectors.T[whirling & (lam.imag > 0)]):
                 fwd = float(np.sum(np.abs(vector[t]) ** 2))
                 bwd = float(np.sum(np.abs(vector[self._n + t]) ** 2))
                 out.append(DampedMode(complex(value), fwd / (fwd + bwd)))
-            else:  # u = p exp(lam t): Im lam < 0 whirls backward
-                out.append(DampedMode(complex(value.real, abs(value.imag)), 1.0 if value.imag > 0 else 0.0))
         out.sort(key=lambda mode: mode.frequency)
         return out if n is None else out[:n]
 
