@@ -12,18 +12,23 @@ from __future__ import annotations
 import numpy as np
 
 from benchmarks.timing import best_of, machine
-from driveline.rotor import one_piece_shaft
+from driveline.rotor import Driveline, one_piece_shaft
 from fmu_harness.ross_reference import E, RHO, ross_forward_critical_speeds
 
 AGREEMENT = 5e-3
 
 
+def tube() -> Driveline:
+    """The tube propshaft with a Rayleigh tube (as measured in docs/benchmarks.md)."""
+    return one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7, shear=False)
+
+
 def ours() -> np.ndarray:
-    return one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7).critical_speeds(3)
+    return tube().critical_speeds(3)
 
 
 def ross() -> np.ndarray:
-    return ross_forward_critical_speeds(one_piece_shaft(1.4, 0.0762, 0.0762 - 2 * 0.00165, E, RHO, 2.5, 0.004, 0.002, 1e7))
+    return ross_forward_critical_speeds(tube())
 
 
 def main() -> None:
