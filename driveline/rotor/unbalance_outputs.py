@@ -57,7 +57,7 @@ class UnbalanceOutputs:
     def evaluate(self, speed: float) -> tuple[float, float, float]:
         """Major semi-axis of the orbit at the chosen position [m], the largest bearing force [N]
         and the damping ratio of the tabulated mode nearest ``speed`` [rad/s] (an undamped
-        resonance hit exactly reads as an infinite response)."""
+        resonance hit exactly gives an infinite response, which the model refuses)."""
         table = self.modes(speed)
         zeta = float(table[DAMPED_MODES + int(np.argmin(np.abs(table[:DAMPED_MODES] - speed)))])
         if speed == 0.0:
