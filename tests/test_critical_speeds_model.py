@@ -196,3 +196,16 @@ def test_shear_parameter_selects_the_beam_theory(fmu_path, fmi):
                                                          rel=1e-12)
     assert timoshenko["omega_crit_1"][-1] == pytest.approx(one_piece_shaft(**ROTOR_B).critical_speeds(1)[0], rel=1e-12)
     assert timoshenko["omega_crit_1"][-1] / rayleigh["omega_crit_1"][-1] - 1 == pytest.approx(-0.0078, abs=1e-4)
+
+
+def test_a_layout_brings_its_own_unbalance_and_damping(tmp_path):
+    text = example_path("two_piece_propshaft").read_text().replace("stiffness = 1.0e6", "stiffness = 1.0e6\ndamping = 300.0")
+    layout = tmp_path / "unbalanced.toml"
+    layout.write_text(text + "\n[[unbalances]]\nposition = 0.35\namount = 5e-5\nphase = 1.0\n")
+    model = model_checks.started(CriticalSpeedsModel, layout=str(layout), unbalance=1.0, response_position=0.25)
+    d = load_driveline(layout)
+    expected = DampedRotor(d, FE_ELEMENTS).unbalance_response([300.0], positions=[0.25 * d.length])
+    assert model.unbalance_response == pytest.approx(expected.major[0, 0], rel=1e-12)  # the FMU's unbalance is not used
+    assert model.bearing_force_max == pytest.approx(np.max(expected.bearing_forces), rel=1e-12)
+    plain = model_checks.started(CriticalSpeedsModel, layout="two_piece_propshaft")
+    assert plain.unbalance_response == 0.0 and plain.bearing_force_max == 0.0  # no [[unbalances]]
