@@ -136,8 +136,10 @@ def _misuse(fmu_path: FmuPath, fmi: str) -> list[Case]:
     found = []
     for kind in MISUSE:
         model = "TripodCoupling" if kind == "fixed parameter after initialisation" else "CardanJoint"
-        departures = (NO_GUID_CHECK,) if kind == "wrong guid" else _refusing(
-            fmi, *((STATUS_OK_LOGGED,) if kind in LOGGED_WITH_OK else ()))
+        if kind == "wrong guid":
+            departures = (NO_GUID_CHECK,)
+        else:
+            departures = _refusing(fmi, STATUS_OK_LOGGED) if kind in LOGGED_WITH_OK else _refusing(fmi)
         found.append(Case("call sequence misuse", kind, "misuse", (str(fmu_path(model, fmi)), kind), fmi, departures))
     return found
 

@@ -4,8 +4,8 @@ The case names a procedure of this module, its arguments and the departures from
 its outcome is checked with (none for the native FMUs; the wrappers' for the Python FMUs,
 docs/robustness.md); the procedure drives the FMU through raw FMI calls (fmpy, or the
 libcosim/Ecos engines) and raises :class:`Wrong` when a status or an output is not the defined
-one. The last line printed is the verdict as JSON;
-a process that dies before printing it crashed, one that does not end in time hung.
+one. The last line printed is the verdict as JSON; a process that dies before printing it
+crashed, one that does not end in time hung.
 """
 
 from __future__ import annotations
