@@ -72,8 +72,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined UNU
     if (!instance_allows(instance, MODE_BIT(MODE_INSTANTIATED), "SetupExperiment")) {
         return fmi2Error;
     }
-    instance->start_time = startTime;
-    return fmi2OK;
+    return (fmi2Status)instance_set_start_time(instance, "SetupExperiment", startTime);
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c)

@@ -107,11 +107,10 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefi
                                        fmi3Float64 stopTime UNUSED)
 {
     INSTANCE(c, fmi3Error)
-    if (!instance_allows(instance, MODE_BIT(MODE_INSTANTIATED), "EnterInitializationMode")) {
+    if (!instance_allows(instance, MODE_BIT(MODE_INSTANTIATED), "EnterInitializationMode") ||
+        instance_set_start_time(instance, "EnterInitializationMode", startTime) != STATUS_OK) {
         return fmi3Error;
     }
-    instance->start_time = startTime;
-    instance->data.time = startTime;
     instance->mode = MODE_INITIALIZATION;
     return fmi3OK;
 }

@@ -454,6 +454,19 @@ void instance_reset(Instance *instance)
     instance->mode = MODE_INSTANTIATED;
 }
 
+Status instance_set_start_time(Instance *instance, const char *function, double start_time)
+{
+    char shown[40];
+    if (!isfinite(start_time)) {
+        python_float_repr(start_time, shown, sizeof shown);
+        return instance_fail(instance, instance->fmi_prefix, function, ": startTime = ", shown, " is not finite",
+                             (const char *)NULL);
+    }
+    instance->start_time = start_time;
+    instance->data.time = start_time;
+    return STATUS_OK;
+}
+
 Status instance_exit_initialization(Instance *instance)
 {
     instance->messages.count = 0;

@@ -131,6 +131,8 @@ void python_float_repr(double value, char *out, size_t size);
 
 /* ---- life cycle (used by the FMI layers) -------------------------------------------- */
 void instance_reset(Instance *instance);
+/* Sets the start time of the experiment; Error if it is not finite. */
+Status instance_set_start_time(Instance *instance, const char *function, double start_time);
 void instance_log(Instance *instance, Status status, const char *first, ...);
 void instance_log_messages(Instance *instance, Status status);
 /* Error unless the instance is in one of the modes of ``allowed`` (a bit mask of 1 << mode). */
