@@ -119,12 +119,13 @@ def _step_sizes(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
 
 MISUSE = ("step before initialisation", "step in initialisation mode", "step after terminate",
           "set after terminate", "nan time", "-inf time", "unknown value reference", "string on a real",
-          "set an output", "fixed parameter after initialisation", "enter initialisation twice", "wrong guid")
+          "set an output", "fixed parameter after initialisation", "enter initialisation twice", "wrong guid",
+          "nan start time")
 
 
 #: Misuse the wrappers log and answer with OK instead of Error.
 LOGGED_WITH_OK = ("set after terminate", "unknown value reference", "string on a real", "set an output",
-                  "fixed parameter after initialisation", "enter initialisation twice")
+                  "fixed parameter after initialisation", "enter initialisation twice", "nan start time")
 
 
 def _refusing(fmi: str, *departures: str) -> tuple[str, ...]:
@@ -138,6 +139,8 @@ def _misuse(fmu_path: FmuPath, fmi: str) -> list[Case]:
         model = "TripodCoupling" if kind == "fixed parameter after initialisation" else "CardanJoint"
         if kind == "wrong guid":
             departures = (NO_GUID_CHECK,)
+        elif kind == "nan start time" and fmi == "3":
+            departures = (NO_START_TIME,)
         else:
             departures = _refusing(fmi, STATUS_OK_LOGGED) if kind in LOGGED_WITH_OK else _refusing(fmi)
         found.append(Case("call sequence misuse", kind, "misuse", (str(fmu_path(model, fmi)), kind), fmi, departures))

@@ -227,6 +227,17 @@ def misuse(path: str, kind: str) -> None:
         probe.enter()
         expect(probe.step(1e-3), probe.refusal(), what="doStep in initialisation mode")
         return probe.close()
+    if kind == "nan start time" and probe.departs(NO_START_TIME):  # pythonfmu3 never sees it
+        expect(probe.initialize(), "OK")
+        expect(probe.step(1e-3), "OK", what="doStep (pythonfmu3 does not pass the start time)")
+        return probe.close()
+    if kind == "nan start time":
+        expect(probe.enter(math.nan), probe.misuse_status(), what="initialisation at t = nan")
+        if not probe.errors_logged():
+            raise Wrong("status", "a start time of nan logged no error")
+        probe.status("exitInitializationMode")
+        expect(probe.step(1e-3), probe.refusal(), what="doStep after a start time of nan")
+        return probe.close()
     if kind == "wrong guid":
         expect(probe.initialize(), "OK")
         expect(probe.step(1e-3), "OK", what="doStep (pythonfmu does not check the GUID)")
