@@ -160,6 +160,14 @@ static double value_of(const ModelData *data, int variable)
                                                          : data->real_value[variable];
 }
 
+#if MODEL_EXTRA_MESSAGE_COUNT > 0
+void messages_add_extra(Messages *out, const ModelData *data, int message)
+{
+    const ExtraMessage *extra = &model_extra_messages[message];
+    add_message(out, &extra->message, &model_variables[extra->variable], value_of(data, extra->variable), 0.0, 0);
+}
+#endif
+
 /* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
 
 /* SteppedModel._range_error for every variable of ``causality``: finite, then the declared bounds. */
@@ -648,7 +656,7 @@ Status instance_unsupported(Instance *instance, const char *function)
 /* ---- FMU state ---------------------------------------------------------------------------- */
 
 #define STATE_TAG 0x4452564C53544154ull /* marks a live StoredState */
-#define STATE_FORMAT 1u
+#define STATE_FORMAT 2u
 static const char STATE_MAGIC[8] = {'D', 'R', 'V', 'L', 'S', 'T', 'A', 'T'};
 
 struct StoredState {

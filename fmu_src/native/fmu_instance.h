@@ -24,7 +24,7 @@
 #define FMU_PI 3.14159265358979323846
 #define FMU_MESSAGE_SIZE 400
 #define FMU_MAX_MESSAGES 48
-#define FMU_INTERNAL_SLOTS 4
+#define FMU_INTERNAL_SLOTS 6
 
 typedef enum { VAR_REAL, VAR_INTEGER } VariableType;
 typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT } Causality;
@@ -68,9 +68,19 @@ typedef struct {
     MessageTemplate message;
 } RelationInfo;
 
+/* A message of one of the model's own checks (SteppedModel.extra_parameter_errors), cut from the
+ * Python check run on its declared probe; it shows the value of ``variable``. */
+typedef struct {
+    int variable;
+    MessageTemplate message;
+} ExtraMessage;
+
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
 #if MODEL_RELATION_COUNT > 0
 extern const RelationInfo model_relations[MODEL_RELATION_COUNT];
+#endif
+#if MODEL_EXTRA_MESSAGE_COUNT > 0
+extern const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT];
 #endif
 
 /* Everything a step may change: the FMU state. Values are indexed by value reference;
@@ -126,6 +136,10 @@ extern const ModelHooks model_hooks;
 
 /* ---- helpers for model files ---------------------------------------------------------- */
 void messages_add(Messages *out, const char *first, ...);
+#if MODEL_EXTRA_MESSAGE_COUNT > 0
+/* Adds generated message ``message`` (a MESSAGE_* of model_variables.h) with its variable's value. */
+void messages_add_extra(Messages *out, const ModelData *data, int message);
+#endif
 /* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
 void python_float_repr(double value, char *out, size_t size);
 
