@@ -656,7 +656,7 @@ Status instance_unsupported(Instance *instance, const char *function)
 /* ---- FMU state ---------------------------------------------------------------------------- */
 
 #define STATE_TAG 0x4452564C53544154ull /* marks a live StoredState */
-#define STATE_FORMAT 2u
+#define STATE_FORMAT 2u /* 2: six internal slots (1 had four) */
 static const char STATE_MAGIC[8] = {'D', 'R', 'V', 'L', 'S', 'T', 'A', 'T'};
 
 struct StoredState {

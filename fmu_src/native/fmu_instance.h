@@ -24,6 +24,8 @@
 #define FMU_PI 3.14159265358979323846
 #define FMU_MESSAGE_SIZE 400
 #define FMU_MAX_MESSAGES 48
+/* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
+ * five-number warm start); a new count needs a new STATE_FORMAT (fmu_instance.c). */
 #define FMU_INTERNAL_SLOTS 6
 
 typedef enum { VAR_REAL, VAR_INTEGER } VariableType;
