@@ -233,6 +233,7 @@ DECLARED_RULES = [  # every kind of declared bound and relation the native model
     ("TripodCoupling", {"beta_max": 1.1, "kinematics": 2}),
     ("TripodCoupling", {"beta": math.radians(50.0)}),
     ("TripodCoupling", {"mu": 0.05}),  # the model's own check: friction needs the exact kinematics
+    ("TripodCoupling", {"mu": 2.0**-24}),  # repr 5.960464477539063e-08: not printf's nearest 16 digits
 ]
 
 
@@ -260,6 +261,9 @@ ARITHMETIC_FAILURES = [  # where the Python core fails arithmetically, the C por
     ("TripodCoupling", {"kinematics": 1, "r": 0.6999, "beta": 1.0, "beta_max": 1.04}),
     ("TripodCoupling", {"kinematics": 1, "omega_in": 1e200}),
     ("TripodCoupling", {"omega_in": 1e300}),
+    ("TripodCoupling", {"T_load": 1e307}),
+    ("TripodCoupling", {"T_load": 1e307, "kinematics": 1}),
+    ("TripodCoupling", {"T_load": 1e306}),
 ]
 
 

@@ -105,11 +105,12 @@ static StarCentre star_centre(Guard *guard, double x, double y, const double tur
 
 /* Newton's method on "star centre = tripod centre" for the axis (x, y), from the warm start
  * ``solution`` (when ``warm``) or the small-r/l orbit; ``solution`` is overwritten with the new one.
- * Gives phi_out and d(phi_out)/d(phi_in) by the implicit function theorem. */
-static void plane_solve(Guard *guard, double phi_in, double beta, double r, double l, int warm, double solution[5],
-                        double *phi_out, double *ratio)
+ * Gives phi_out and d(phi_out)/d(phi_in) by the implicit function theorem. ``cb``, ``sb``: cos and
+ * sin of beta (libm gives the same bits for the same argument, so each is computed once). */
+static void plane_solve(Guard *guard, double phi_in, double cb, double sb, double r, double l, int warm,
+                        double solution[5], double *phi_out, double *ratio)
 {
-    double cb = cos(beta), sb = sin(beta), x, y, turn3[2], jxx = 0.0, jyx = 0.0, jxy = 0.0, jyy = 0.0;
+    double x, y, turn3[2], jxx = 0.0, jyx = 0.0, jxy = 0.0, jyy = 0.0;
     double det = 0.0, dx = 0.0, dy = 0.0, gradient_x, gradient_y, twist, dx_dphi, dy_dphi;
     StarCentre f = {0.0, 0.0, 0.0, 0.0, 0.0}, fx = f, fy = f;
     int i;
@@ -171,7 +172,7 @@ typedef struct {
 } Reactions;
 
 typedef struct {
-    double phi_in, beta, omega, omega_dot, T_load, r, l, m, friction, slip_speed;
+    double phi_in, cb, sb, omega, omega_dot, T_load, r, l, m, friction, slip_speed; /* cb, sb: cos, sin of beta */
 } Load;
 
 /* One arm of the exact balance: groove point g, ball height bz, arm vector e = b - P,
@@ -253,7 +254,7 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
 {
     const double half_root_3 = 0.5 * sqrt(3.0), r = load->r, l = load->l, m = load->m;
     const double omega = load->omega, omega_dot = load->omega_dot;
-    double cb = cos(load->beta), sb = sin(load->beta), zn = root(guard, 1.0 - x * x - y * y);
+    double cb = load->cb, sb = load->sb, zn = root(guard, 1.0 - x * x - y * y);
     double k = divide(guard, 1.0, 1.0 + zn);
     /* twist-free frame (E1, E2, U) of the output shaft, nominal output frame -> input frame (eq 2) */
     double e1x = 1.0 - x * x * k, e1y = -x * y * k, e2x = -x * y * k, e2y = 1.0 - y * y * k;
@@ -391,8 +392,7 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
 static void leading_order_reactions(Guard *guard, const Load *load, double ratio, double pin, Reactions *out)
 {
     double m = load->m, r = load->r, l = load->l, omega_dot = load->omega_dot, T = load->T_load;
-    double cb = cos(load->beta), tb = divide(guard, sin(load->beta), cb);
-    double half = divide(guard, sin(load->beta), 1.0 + cb);
+    double cb = load->cb, tb = divide(guard, load->sb, cb), half = divide(guard, load->sb, 1.0 + cb);
     double A = divide(guard, 1.5 * m * r * r * tb, cb * cb), omega2 = load->omega * load->omega;
     double ry_in = divide(guard, -(T * half + A * omega_dot * cb), l);
     int j;
@@ -420,9 +420,10 @@ static const char *evaluate(ModelData *data)
     Load load;
     Reactions forces;
     double phi_in = VALUE(phi_in), beta = VALUE(beta), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
-    double cos_beta = cos(beta), rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin, output_power, total;
+    double cos_beta = cos(beta), sin_beta = sin(beta), rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin, output_power, total;
     load.phi_in = phi_in;
-    load.beta = beta;
+    load.cb = cos_beta;
+    load.sb = sin_beta;
     load.omega = VALUE(omega_in);
     load.omega_dot = VALUE(alpha_in);
     load.T_load = T_load;
@@ -434,7 +435,7 @@ static const char *evaluate(ModelData *data)
     rho = divide(&guard, r * (1.0 - cos_beta), 2.0 * cos_beta); /* orbit radius of the tripod centre */
     pin = divide(&guard, T_load, 3.0 * (r + rho));              /* eq 24 with the corrected eq 21 */
     if (INTEGER(kinematics) == EXACT) {
-        plane_solve(&guard, phi_in, beta, r, l, HAS_SOLUTION != 0.0, SOLUTION, &phi_out, &ratio);
+        plane_solve(&guard, phi_in, cos_beta, sin_beta, r, l, HAS_SOLUTION != 0.0, SOLUTION, &phi_out, &ratio);
         if (guard.failure != NULL) {
             return guard.failure;
         }
@@ -486,7 +487,7 @@ static const char *evaluate(ModelData *data)
         /* eqs 20, 30, 33, 34 as printed, with the seed's phi */
         double omega_squared = VALUE(omega_in) * VALUE(omega_in), tan_beta = tan(beta);
         double phi = phi_in + PAPER_PHASE, cos_3phi = cosine(&guard, 3.0 * phi);
-        double a_sum = -6.0 * omega_squared * rho * sin(beta) * cos_3phi, m = VALUE(m_plunger);
+        double a_sum = -6.0 * omega_squared * rho * sin_beta * cos_3phi, m = VALUE(m_plunger);
         VALUE(a_plunger_sum) = a_sum;                                                        /* eq 20 */
         VALUE(Rz_out) = -6.0 * m * rho * omega_squared * tan_beta * cos_3phi;               /* eq 30 */
         VALUE(Rx_in) = tan_beta * m * a_sum;                                                 /* eq 33 */
