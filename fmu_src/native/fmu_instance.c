@@ -477,7 +477,7 @@ int instance_allows(Instance *instance, unsigned allowed, const char *function)
 
 /* ---- life cycle ------------------------------------------------------------------------------ */
 
-void instance_reset(Instance *instance)
+Status instance_reset(Instance *instance)
 {
     int i;
     memset(&instance->data, 0, sizeof instance->data);
@@ -490,14 +490,27 @@ void instance_reset(Instance *instance)
     }
     instance->start_time = 0.0;
     instance->mode = MODE_INSTANTIATED;
+    return STATUS_OK;
 }
 
 Status instance_exit_initialization(Instance *instance)
 {
+    if (!instance_allows(instance, MODE_BIT(MODE_INITIALIZATION), "ExitInitializationMode")) {
+        return STATUS_ERROR;
+    }
     instance->messages.count = 0;
     initialize(instance, instance->start_time);
     instance_log_messages(instance, STATUS_ERROR); /* as the Python FMUs: logged, and OK */
     instance->mode = MODE_STEP;
+    return STATUS_OK;
+}
+
+Status instance_terminate(Instance *instance)
+{
+    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "Terminate")) {
+        return STATUS_ERROR;
+    }
+    instance->mode = MODE_TERMINATED;
     return STATUS_OK;
 }
 
@@ -779,11 +792,20 @@ static size_t token_length(void)
     return strlen(MODEL_TOKEN);
 }
 
-size_t state_serialized_size(void)
+static size_t state_serialized_size(void)
 {
     return sizeof STATE_MAGIC + 5 * sizeof(uint32_t) + token_length() + 2 * sizeof(int32_t) + 2 * sizeof(double) +
            MODEL_VARIABLE_COUNT * (sizeof(double) + sizeof(int32_t)) + FMU_INTERNAL_SLOTS * sizeof(double) +
            sizeof(uint64_t);
+}
+
+Status state_size(Instance *instance, const char *function, size_t *size)
+{
+    if (size == NULL) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": null size pointer", (const char *)NULL);
+    }
+    *size = state_serialized_size();
+    return STATUS_OK;
 }
 
 static uint64_t checksum(const char *bytes, size_t size)

@@ -136,6 +136,22 @@ typedef struct {
 
 extern const ModelHooks model_hooks;
 
+/* ``start`` and ``advance`` of a model driven by an input shaft (DrivenShaftModel in
+ * driveline/model.py): phi_in starts at phi_in_start and integrates the held omega_in exactly;
+ * ``evaluate(data, input_time)`` gives the outputs at the current phi_in, input_time being the
+ * communication point at which the host set the inputs. */
+#define DRIVEN_SHAFT_HOOKS(evaluate)                                                                            \
+    static const char *start(ModelData *data, double start_time)                                                \
+    {                                                                                                           \
+        data->real_value[V_phi_in] = data->real_value[V_phi_in_start];                                          \
+        return evaluate(data, start_time);                                                                      \
+    }                                                                                                           \
+    static const char *advance(ModelData *data, double current_time, double step_size)                          \
+    {                                                                                                           \
+        data->real_value[V_phi_in] = data->real_value[V_phi_in] + data->real_value[V_omega_in] * step_size;     \
+        return evaluate(data, current_time);                                                                    \
+    }
+
 /* ---- helpers for model files ---------------------------------------------------------- */
 void messages_add(Messages *out, const char *first, ...);
 #if MODEL_EXTRA_MESSAGE_COUNT > 0
@@ -146,12 +162,13 @@ void messages_add_extra(Messages *out, const ModelData *data, int message);
 void python_float_repr(double value, char *out, size_t size);
 
 /* ---- life cycle (used by the FMI layers) -------------------------------------------- */
-void instance_reset(Instance *instance);
+Status instance_reset(Instance *instance);
 void instance_log(Instance *instance, Status status, const char *first, ...);
 void instance_log_messages(Instance *instance, Status status);
 /* Error unless the instance is in one of the modes of ``allowed`` (a bit mask of 1 << mode). */
 int instance_allows(Instance *instance, unsigned allowed, const char *function);
 Status instance_exit_initialization(Instance *instance);
+Status instance_terminate(Instance *instance);
 Status instance_do_step(Instance *instance, double current_time, double step_size);
 Status instance_set_real(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                          const double value[]);
@@ -169,6 +186,39 @@ Status instance_set_debug_logging(Instance *instance, const char *function, size
 Status instance_unsupported(Instance *instance, const char *function);
 
 #define MODE_BIT(mode) (1u << (mode))
+
+/* The instance behind an FMI handle ``c``; a NULL handle gets ``result`` (there is no logger to tell). */
+#define INSTANCE(c, result)                                                                                     \
+    Instance *instance = (Instance *)(c);                                                                      \
+    if (instance == NULL) {                                                                                     \
+        return result;                                                                                          \
+    }
+
+/* A whole FMI function body: ``expression`` (of ``instance``, the instance behind handle ``c``) as
+ * the status of FMI version ``version`` (fmi2 or fmi3); a NULL handle gets the version's Error. */
+#define ON_INSTANCE(version, expression)                                                                        \
+    {                                                                                                           \
+        INSTANCE(c, version##Error)                                                                             \
+        return (version##Status)(expression);                                                                  \
+    }
+
+/* The six FMU state functions of FMI ``version`` (fmi2 or fmi3) over state_*: ``Handle`` is the
+ * version's instance type, ``State`` and ``Deserialize`` its spellings of "FMUstate" and "Deserialize". */
+#define FMU_STATE_FUNCTIONS(version, Handle, State, Deserialize)                                               \
+    version##Status version##Get##State(Handle c, version##State *state)                                       \
+    ON_INSTANCE(version, state_get(instance, "Get" #State, state))                                             \
+    version##Status version##Set##State(Handle c, version##State state)                                        \
+    ON_INSTANCE(version, state_set(instance, "Set" #State, state))                                             \
+    version##Status version##Free##State(Handle c, version##State *state)                                      \
+    ON_INSTANCE(version, state_free(instance, "Free" #State, state))                                           \
+    version##Status version##Serialized##State##Size(Handle c, version##State state UNUSED, size_t *size)      \
+    ON_INSTANCE(version, state_size(instance, "Serialized" #State "Size", size))                               \
+    version##Status version##Serialize##State(Handle c, version##State state, version##Byte bytes[],           \
+                                              size_t size)                                                     \
+    ON_INSTANCE(version, state_serialize(instance, "Serialize" #State, state, (char *)bytes, size))            \
+    version##Status version##Deserialize##State(Handle c, const version##Byte bytes[], size_t size,            \
+                                                version##State *state)                                         \
+    ON_INSTANCE(version, state_deserialize(instance, #Deserialize #State, (const char *)bytes, size, state))
 #define ANY_MODE 0x1Fu
 
 /* ---- FMU state ------------------------------------------------------------------------ */
@@ -176,7 +226,7 @@ typedef struct StoredState StoredState;
 Status state_get(Instance *instance, const char *function, void **state);
 Status state_set(Instance *instance, const char *function, const void *state);
 Status state_free(Instance *instance, const char *function, void **state);
-size_t state_serialized_size(void);
+Status state_size(Instance *instance, const char *function, size_t *size);
 Status state_serialize(Instance *instance, const char *function, const void *state, char *bytes, size_t size);
 Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state);
 

@@ -414,13 +414,14 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
 
 /* ---- outputs (outputs.coupling_outputs) ------------------------------------------------------ */
 
-static const char *evaluate(ModelData *data)
+static const char *evaluate(ModelData *data, double input_time UNUSED)
 {
     Guard guard = {NULL};
     Load load;
     Reactions forces;
     double phi_in = VALUE(phi_in), beta = VALUE(beta), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
-    double cos_beta = cos(beta), sin_beta = sin(beta), rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin, output_power, total;
+    double cos_beta = cos(beta), sin_beta = sin(beta), rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin;
+    double output_power, total;
     load.phi_in = phi_in;
     load.cb = cos_beta;
     load.sb = sin_beta;
@@ -497,20 +498,9 @@ static const char *evaluate(ModelData *data)
     return guard.failure;
 }
 
-static const char *start(ModelData *data, double start_time)
-{
-    (void)start_time;
-    HAS_SOLUTION = 0.0;
-    VALUE(phi_in) = VALUE(phi_in_start);
-    return evaluate(data);
-}
-
-static const char *advance(ModelData *data, double current_time, double step_size)
-{
-    (void)current_time;
-    VALUE(phi_in) = VALUE(phi_in) + VALUE(omega_in) * step_size;
-    return evaluate(data);
-}
+/* The warm start is empty at the start, as TripodCouplingModel.start leaves it: reset clears it
+ * and a refused start is undone. */
+DRIVEN_SHAFT_HOOKS(evaluate)
 
 /* TripodCouplingModel.extra_parameter_errors: friction needs the exact kinematics. */
 static void extra_parameter_errors(const ModelData *data, Messages *out)

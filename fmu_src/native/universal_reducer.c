@@ -31,7 +31,7 @@ static void connecting_shaft(const ModelData *data, double M_in, double i, doubl
     loads->sigma_eq = sqrt(loads->sigma * loads->sigma + 4.0 * (loads->tau * loads->tau));
 }
 
-static const char *evaluate(ModelData *data)
+static const char *evaluate(ModelData *data, double input_time UNUSED)
 {
     double i = (double)INTEGER(z1) / (double)(INTEGER(z1) - INTEGER(z2)); /* eqs 4, 17 */
     double half = 0.5 * VALUE(alpha), cube = pow(VALUE(r_shaft), 3.0);
@@ -61,18 +61,6 @@ static const char *evaluate(ModelData *data)
     return NULL;
 }
 
-static const char *start(ModelData *data, double start_time)
-{
-    (void)start_time;
-    VALUE(phi_in) = VALUE(phi_in_start);
-    return evaluate(data);
-}
-
-static const char *advance(ModelData *data, double current_time, double step_size)
-{
-    (void)current_time;
-    VALUE(phi_in) = VALUE(phi_in) + VALUE(omega_in) * step_size;
-    return evaluate(data);
-}
+DRIVEN_SHAFT_HOOKS(evaluate)
 
 const ModelHooks model_hooks = {NULL, NULL, start, advance, NULL, NULL};
