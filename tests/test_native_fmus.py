@@ -167,6 +167,29 @@ def test_runs_in_libcosim_and_ecos(native_dir, name, fmi, importer):
     assert result.status == ("pass" if f"{fmi}.0" in importer.versions else "unsupported"), result
 
 
+@pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")
+def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
+    """A state stored half way through an exact run with friction, restored from its bytes into an
+    instance whose solver was warm-started elsewhere, continues bit for bit."""
+    path, parameters = _native(native_dir, "TripodCoupling", fmi), {"kinematics": 1, "mu": 0.05}
+    case = scenario(MODELS["TripodCoupling"].spec)
+    with FmuInstance(path) as fmu:
+        fmu.initialize({**parameters, **case.input_values(0.0)})
+        fmu.run(case.stop_time / 2, case.step_size, case.signals())
+        middle, state = fmu.time, fmu.get_state()
+        serialized = fmu.serialize_state(state)
+        fmu.free_state(state)
+        reference = fmu.run(case.stop_time, case.step_size, case.signals())
+    with FmuInstance(path) as other:
+        other.initialize({**parameters, "beta": 0.2, "phi_in_start": 1.0})
+        other.run(case.stop_time / 3, case.step_size)
+        restored = other.deserialize_state(serialized)
+        other.set_state(restored)
+        other.free_state(restored)
+        other.time = middle
+        assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
+
+
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="rebuilding from the carried sources needs cmake")
 @pytest.mark.parametrize("name", NATIVE)
 def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, name, fmi):

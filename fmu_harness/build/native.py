@@ -5,7 +5,8 @@ others are skipped. For each native model and FMI version this module
 
 * generates ``model_variables.h``/``.c`` from the spec: the variable table (value reference =
   position in the spec, as in the Python FMUs) and the range checks' messages, cut from
-  :meth:`driveline.model.SteppedModel._range_error` itself so the wording exists once;
+  :meth:`driveline.model.SteppedModel._range_error` itself so the wording exists once, and the
+  messages of the model's own checks, cut from them run on the model's ``extra_parameter_probes``;
 * generates the model description with the Python FMUs' own completion
   (:mod:`model_description`: units, display units, min/max, descriptions, model structure), so a
   host can swap one FMU for the other, plus the sources the FMU carries (FMI 2.0 ``SourceFiles``,

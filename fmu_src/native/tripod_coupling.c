@@ -36,6 +36,8 @@ typedef struct {
     const char *failure;
 } Guard;
 
+/* Python's float division, math.sqrt, math.cos, math.sin and math.asin: where those raise, the
+ * first failure is kept and the evaluation goes on with 0 (its results are then discarded). */
 static double refuse(Guard *guard, const char *why)
 {
     if (guard->failure == NULL) {
