@@ -186,6 +186,7 @@ Status instance_set_debug_logging(Instance *instance, const char *function, size
 Status instance_unsupported(Instance *instance, const char *function);
 
 #define MODE_BIT(mode) (1u << (mode))
+#define ANY_MODE 0x1Fu
 
 /* The instance behind an FMI handle ``c``; a NULL handle gets ``result`` (there is no logger to tell). */
 #define INSTANCE(c, result)                                                                                     \
@@ -202,8 +203,18 @@ Status instance_unsupported(Instance *instance, const char *function);
         return (version##Status)(expression);                                                                  \
     }
 
+/* ---- FMU state ------------------------------------------------------------------------ */
+typedef struct StoredState StoredState;
+Status state_get(Instance *instance, const char *function, void **state);
+Status state_set(Instance *instance, const char *function, const void *state);
+Status state_free(Instance *instance, const char *function, void **state);
+Status state_size(Instance *instance, const char *function, size_t *size);
+Status state_serialize(Instance *instance, const char *function, const void *state, char *bytes, size_t size);
+Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state);
+
 /* The six FMU state functions of FMI ``version`` (fmi2 or fmi3) over state_*: ``Handle`` is the
- * version's instance type, ``State`` and ``Deserialize`` its spellings of "FMUstate" and "Deserialize". */
+ * version's instance type, ``State`` and ``Deserialize`` its spellings of those words (FMI 2.0:
+ * FMUstate, DeSerialize; FMI 3.0: FMUState, Deserialize). */
 #define FMU_STATE_FUNCTIONS(version, Handle, State, Deserialize)                                               \
     version##Status version##Get##State(Handle c, version##State *state)                                       \
     ON_INSTANCE(version, state_get(instance, "Get" #State, state))                                             \
@@ -219,16 +230,6 @@ Status instance_unsupported(Instance *instance, const char *function);
     version##Status version##Deserialize##State(Handle c, const version##Byte bytes[], size_t size,            \
                                                 version##State *state)                                         \
     ON_INSTANCE(version, state_deserialize(instance, #Deserialize #State, (const char *)bytes, size, state))
-#define ANY_MODE 0x1Fu
-
-/* ---- FMU state ------------------------------------------------------------------------ */
-typedef struct StoredState StoredState;
-Status state_get(Instance *instance, const char *function, void **state);
-Status state_set(Instance *instance, const char *function, const void *state);
-Status state_free(Instance *instance, const char *function, void **state);
-Status state_size(Instance *instance, const char *function, size_t *size);
-Status state_serialize(Instance *instance, const char *function, const void *state, char *bytes, size_t size);
-Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state);
 
 Instance *instance_new(const char *name, const char *token, const char *fmi_prefix, Emit emit,
                        void (*host_logger)(void), void *host_environment);
