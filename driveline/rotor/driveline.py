@@ -167,17 +167,18 @@ class Driveline:
         return transfer.mode_shape(self._chain, w, spin, points_per_segment)
 
     # -- grids and searches ----------------------------------------------------
-    def _grid(self, x_max: float, ratio: float) -> FloatArray:
+    def _grid(self, x_max: float, ratio: float, coarse: bool = False) -> FloatArray:
         """Search grid on ``(0, x_max]`` for the frequency ``ratio * x``.
 
         Uniform in the bare-shaft phase ``theta = kappa sqrt(|ratio| x)``. The shaft
         alone has one root per pi of ``theta``; each translational or rotational
         degree of freedom of a concentrated mass can add one root anywhere, and the
         8x8 (anisotropic) determinant holds both whirl senses. The grid has
-        ``POINTS_PER_ROOT`` points per expected root on that count, plus a
-        logarithmic lead-in for heavy masses on soft bearings near zero.
+        ``POINTS_PER_ROOT`` points per expected root on that count (``coarse``: per
+        bare-shaft root only), plus a logarithmic lead-in for heavy masses on soft
+        bearings near zero.
         """
-        extra = sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
+        extra = 0 if coarse else sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
         per_pi = POINTS_PER_ROOT * (1 + extra) * (1 if self.is_isotropic else 2)
         kappa = self._kappa * math.sqrt(abs(ratio))
         theta_max = kappa * math.sqrt(x_max)
@@ -189,17 +190,19 @@ class Driveline:
         lead = np.geomspace(x[0] * 1e-4, x[0], 9)[:-1]
         return np.concatenate([lead, x])
 
-    def _line_roots(self, lines: FloatArray, n: int | None, x_max: float | None, limit: float) -> list[FloatArray]:
+    def _line_roots(
+        self, lines: FloatArray, n: int | None, x_max: float | None, limit: float, coarse: bool = False
+    ) -> list[FloatArray]:
         """Roots ``x > 0`` of ``f(w, spin)`` along every line ``(w, spin) = (w_k x, s_k x + o_k)``, one
-        batch search: all up to ``x_max``, or the first ``n`` below ``limit``.
+        batch search: all up to ``x_max`` (on ``coarse`` grids if asked), or the first ``n`` below ``limit``.
 
         ``lines`` is (m, 3) with rows ``(w_k, s_k, o_k)``; each line's grid follows its ``|w_k|``.
         A line short of ``n`` roots is searched again over a 4x wider range, until ``limit``.
         """
-        w_k, s_k, o_k = lines.T
+        w_k, s_k, o_k = np.asarray(lines, dtype=float).T
         ratios = np.abs(w_k)
         if x_max is not None:
-            grids = [self._grid(x_max, r) for r in ratios]
+            grids = [self._grid(x_max, r, coarse) for r in ratios]
             return find_roots_batch(lambda x, k: self.determinant(w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
         if n is None or isinstance(n, bool) or not float(n).is_integer() or n < 1:
             raise ValueError(f"n must be a positive integer (or give an upper limit), got {n!r}")
