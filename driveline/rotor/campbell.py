@@ -67,15 +67,17 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
         knots = sp
         found = _roots_over_speeds(driveline, knots, x_hi, None)
         for round_ in range(REFINEMENTS + 1):
-            branches = [_follow(driveline, knots, sign, roots, n_modes) for sign, roots in zip((1.0, -1.0), found)]
+            branches = [_follow(knots, roots, slopes, n_modes)
+                        for roots, slopes in zip(found, _slopes(driveline, knots, found))]
             if round_ == REFINEMENTS or knots.size > MAX_KNOTS:
                 break
             coarse = np.flatnonzero(_spline_error(driveline, knots, branches) > SPLINE_RTOL)
             if not coarse.size:
                 break
-            middles = 0.5 * (knots[coarse] + knots[coarse + 1])
-            added = _roots_over_speeds(driveline, middles, x_hi, (found, coarse))
-            knots = np.insert(knots, coarse + 1, middles)
+            counts = np.array([[r.size for r in sense] for sense in found]).T  # (speeds, senses)
+            added = _roots_over_speeds(driveline, 0.5 * (knots[coarse] + knots[coarse + 1]), x_hi,
+                                       np.stack([counts[coarse], counts[coarse + 1]], axis=1))
+            knots = np.insert(knots, coarse + 1, 0.5 * (knots[coarse] + knots[coarse + 1]))
             found = [_insert(old, coarse + 1, new) for old, new in zip(found, added)]
         enough = min(r.size for roots in found for r in roots) >= n_modes
         if x_hi >= SEARCH_LIMIT or (enough and not any(np.isnan(b).any() for b in branches)):
@@ -84,6 +86,7 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
 
 
 def _insert(roots: list[FloatArray], at: NDArray[np.intp], new: list[FloatArray]) -> list[FloatArray]:
+    """``roots`` with ``new[k]`` inserted before index ``at[k]`` (of the original list), for every ``k``."""
     out = list(roots)
     for position, r in sorted(zip(at, new), key=lambda item: -item[0]):
         out.insert(position, r)
@@ -91,67 +94,73 @@ def _insert(roots: list[FloatArray], at: NDArray[np.intp], new: list[FloatArray]
 
 
 def _roots_over_speeds(
-    driveline: Driveline, spins: FloatArray, x_hi: float, between: tuple[list[list[FloatArray]], NDArray[np.intp]] | None
+    driveline: Driveline, spins: FloatArray, x_hi: float, neighbours: NDArray[np.intp] | None
 ) -> list[list[FloatArray]]:
     """Forward and backward whirl frequencies up to ``x_hi`` at every speed (see the module docstring).
 
-    The coarse counts are checked against the full grid at the first speed, or, for speeds
-    ``between`` known ones (their roots, and the index of the speed below each new one),
-    against those neighbours.
+    Searched on bare-shaft grids; a new set of speeds (``neighbours`` None) is checked
+    against the full grid at its first speed, speeds inserted between known ones against
+    the counts (forward, backward) at the known speed below and above each,
+    ``neighbours`` (k, 2, 2). A failed check searches every speed on the full grid.
     """
     lines = np.array([(sign, 0.0, spin) for spin in spins for sign in (1.0, -1.0)])
-    found = driveline._line_roots(lines, None, x_hi, SEARCH_LIMIT, coarse=True)
-    counts = np.array([r.size for r in found]).reshape(-1, 2)
-    if between is None:
-        first = driveline._line_roots(lines[:2], None, x_hi, SEARCH_LIMIT)
-        reference = [(np.array([first[0].size, first[1].size]), 0)]
+    reference = lines[:2] if neighbours is None else lines[:0]
+    coarse = np.arange(len(lines) + len(reference)) < len(lines)
+    found = driveline._line_roots(np.vstack([lines, reference]), None, x_hi, SEARCH_LIMIT, coarse)
+    counts = np.array([r.size for r in found[: len(lines)]]).reshape(-1, 2)
+    if neighbours is None:
+        full_count = [r.size for r in found[len(lines):]]
+        failed = np.any(counts[0] != full_count) or np.any(np.abs(np.diff(counts, axis=0)) > 1)
     else:
-        known, below = between
-        sizes = np.array([[r.size for r in sense] for sense in known]).T
-        reference = [(sizes[below], 1), (sizes[below + 1], 1)]
-    steps = [np.abs(counts[:1] - ref[:1] if between is None else counts - ref) > allowed for ref, allowed in reference]
-    if np.any(np.abs(np.diff(counts, axis=0)) > 1) or any(np.any(step) for step in steps):
+        failed = np.any(np.abs(counts[:, None, :] - neighbours) > 1)
+    if failed:
         found = driveline._line_roots(lines, None, x_hi, SEARCH_LIMIT)
-    return [found[0::2], found[1::2]]
+    return [found[0 : len(lines) : 2], found[1 : len(lines) : 2]]
+
+
+def _slopes(driveline: Driveline, spins: FloatArray, found: list[list[FloatArray]]) -> list[list[FloatArray]]:
+    """Slopes ``dw/dOmega = -f_Omega / f_w`` (central differences, one evaluation) of the forward and
+    backward whirl frequencies ``found`` at ``spins``; 0 where undefined (a double root)."""
+    sizes = [r.size for sense in found for r in sense]
+    w = np.concatenate([r for sense in found for r in sense])
+    spin = np.repeat(np.tile(spins, 2), sizes)
+    sign = np.repeat([1.0, -1.0], [sum(r.size for r in sense) for sense in found])
+    h = SLOPE_STEP * w
+    f = driveline.determinant(np.concatenate([sign * (w + h), sign * (w - h), sign * w, sign * w]),
+                              np.concatenate([spin, spin, spin + h, spin - h])).reshape(4, -1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = -(f[2] - f[3]) / (f[0] - f[1])
+    parts = np.split(np.where(np.isfinite(slope), slope, 0.0), np.cumsum(sizes)[:-1])
+    return [parts[: spins.size], parts[spins.size :]]
 
 
 def _spline_error(driveline: Driveline, knots: FloatArray, branches: list[FloatArray]) -> FloatArray:
     """Relative error of the branches' cubic splines at the middle of every knot interval (largest of
     all branches), estimated by one Newton step ``f / f_w`` on the determinant there."""
     middles = 0.5 * (knots[:-1] + knots[1:])
-    error = np.zeros(middles.size)
-    for sign, table in zip((1.0, -1.0), branches):
-        w = CubicSpline(knots, table)(middles)
-        spin = np.broadcast_to(middles[:, None], w.shape)
-        h = SLOPE_STEP * w
-        f = driveline.determinant(sign * np.stack([w, w + h, w - h]), np.stack([spin] * 3))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            step = np.abs(f[0] * 2.0 * h / (f[1] - f[2])) / w
-        error = np.fmax(error, np.nanmax(np.where(np.isfinite(step), step, np.nan), axis=1, initial=0.0))
-    return error
-
-
-def _follow(driveline: Driveline, spins: FloatArray, sign: float, roots: list[FloatArray], n_modes: int) -> FloatArray:
-    """Columns of the branches through ``roots`` (ascending per speed) of the whirl sense ``sign``.
-
-    From speed ``i`` to ``i + 1`` every root moves on by its slope ``dw/dOmega = -f_Omega / f_w``
-    (central differences); the predicted positions, in their order, take the roots found
-    at ``i + 1`` in theirs, so branches that cross between two speeds keep their identity.
-    A root crossing the search limit ends or starts a branch. Only branches among the
-    first ``n_modes`` at some speed are returned.
-    """
-    w = np.concatenate(roots)
-    spin = np.repeat(spins, [r.size for r in roots])
+    w = np.hstack([CubicSpline(knots, table)(middles) for table in branches])
+    sign = np.repeat([1.0, -1.0], [table.shape[1] for table in branches])
+    spin = np.broadcast_to(middles[:, None], w.shape)
     h = SLOPE_STEP * w
-    f = driveline.determinant(sign * np.concatenate([w + h, w - h, w, w]),
-                              np.concatenate([spin, spin, spin + h, spin - h])).reshape(4, -1)
+    f = driveline.determinant(sign * np.stack([w, w + h, w - h]), np.stack([spin] * 3))
     with np.errstate(divide="ignore", invalid="ignore"):
-        slope = -(f[2] - f[3]) / (f[0] - f[1])
-    slope = np.split(np.where(np.isfinite(slope), slope, 0.0), np.cumsum([r.size for r in roots])[:-1])
+        step = np.abs(f[0] * 2.0 * h / (f[1] - f[2])) / w
+    return np.nanmax(np.where(np.isfinite(step), step, np.nan), axis=1, initial=0.0)
+
+
+def _follow(spins: FloatArray, roots: list[FloatArray], slopes: list[FloatArray], n_modes: int) -> FloatArray:
+    """Columns of the branches through ``roots`` (ascending per speed) of one whirl sense.
+
+    From speed ``i`` to ``i + 1`` every root moves on by its slope; the predicted
+    positions, in their order, take the roots found at ``i + 1`` in theirs, so branches
+    that cross between two speeds keep their identity. A root crossing the search limit
+    ends or starts a branch. Only branches among the first ``n_modes`` at some speed are
+    returned.
+    """
     branch = [np.arange(roots[0].size)]
     count = roots[0].size
     for i in range(spins.size - 1):
-        predicted = roots[i] + slope[i] * (spins[i + 1] - spins[i])
+        predicted = roots[i] + slopes[i] * (spins[i + 1] - spins[i])
         kept = min(roots[i].size, roots[i + 1].size)
         ids = np.concatenate([branch[i][np.argsort(predicted, kind="stable")[:kept]],
                               np.arange(count, count + roots[i + 1].size - kept)])
@@ -167,22 +176,22 @@ def _follow(driveline: Driveline, spins: FloatArray, sign: float, roots: list[Fl
 class WhirlTable:
     """The first ``n_modes`` forward and backward whirl frequencies at any speed of the branches' range.
 
-    Each branch is a cubic spline over the speed (a missing value reads as ``missing``);
-    a call sorts the branches of each sense at the speed asked and returns
-    ``(forward_1..n, backward_1..n)``, ``missing`` where a sense has fewer branches.
+    Each branch is a cubic spline over the speed (a missing value reads as ``missing``, and
+    a sense with fewer than ``n_modes`` branches gets constant ones at ``missing``); a call
+    sorts the branches of each sense at the speed asked and returns ``(forward_1..n, backward_1..n)``.
     """
 
     def __init__(self, branches: WhirlBranches, n_modes: int, missing: float) -> None:
-        columns = np.hstack([branches.forward, branches.backward])
+        senses = []
+        for table in (branches.forward, branches.backward):
+            short = max(n_modes - table.shape[1], 0)
+            senses.append(np.hstack([table, np.full((table.shape[0], short), missing)]))
+        columns = np.hstack(senses)
         self._spline = CubicSpline(branches.spins, np.where(np.isnan(columns), missing, columns))
-        self._forward = branches.forward.shape[1]
+        self._forward = senses[0].shape[1]
         self._n = n_modes
-        self._missing = missing
 
     def __call__(self, speed: float) -> FloatArray:
         values = self._spline(speed)
-        out = []
-        for part in (values[: self._forward], values[self._forward:]):
-            first = np.sort(part)[: self._n]
-            out.append(np.pad(first, (0, self._n - first.size), constant_values=self._missing))
-        return np.concatenate(out)
+        k, n = self._forward, self._n
+        return np.concatenate((np.sort(values[:k])[:n], np.sort(values[k:])[:n]))

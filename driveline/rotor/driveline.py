@@ -191,10 +191,11 @@ class Driveline:
         return np.concatenate([lead, x])
 
     def _line_roots(
-        self, lines: FloatArray, n: int | None, x_max: float | None, limit: float, coarse: bool = False
+        self, lines: FloatArray, n: int | None, x_max: float | None, limit: float, coarse: ArrayLike = False
     ) -> list[FloatArray]:
         """Roots ``x > 0`` of ``f(w, spin)`` along every line ``(w, spin) = (w_k x, s_k x + o_k)``, one
-        batch search: all up to ``x_max`` (on ``coarse`` grids if asked), or the first ``n`` below ``limit``.
+        batch search: all up to ``x_max`` (on ``coarse`` grids where asked, per line), or the first
+        ``n`` below ``limit``.
 
         ``lines`` is (m, 3) with rows ``(w_k, s_k, o_k)``; each line's grid follows its ``|w_k|``.
         A line short of ``n`` roots is searched again over a 4x wider range, until ``limit``.
@@ -202,7 +203,9 @@ class Driveline:
         w_k, s_k, o_k = np.asarray(lines, dtype=float).T
         ratios = np.abs(w_k)
         if x_max is not None:
-            grids = [self._grid(x_max, r, coarse) for r in ratios]
+            kinds = list(zip(ratios, np.broadcast_to(coarse, ratios.shape)))
+            grid = {kind: self._grid(x_max, *kind) for kind in set(kinds)}
+            grids = [grid[kind] for kind in kinds]
             return find_roots_batch(lambda x, k: self.determinant(w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
         if n is None or isinstance(n, bool) or not float(n).is_integer() or n < 1:
             raise ValueError(f"n must be a positive integer (or give an upper limit), got {n!r}")

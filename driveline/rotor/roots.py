@@ -68,7 +68,7 @@ def find_roots(
     f: VecFunc,
     grid: FloatArray,
     xtol: float = 1e-12,
-    rtol: float = 1e-13,
+    rtol: float = 4.0 * np.finfo(float).eps,
     max_roots: int | None = None,
 ) -> RootSearchReport:
     """Roots of ``f`` inside ``[grid[0], grid[-1]]``, ascending, double roots twice.
@@ -83,7 +83,9 @@ def find_roots(
     return RootSearchReport(roots, rep.evaluations, rep.rejected_poles, rep.dips_examined, rep.double_roots)
 
 
-def find_roots_batch(f: BatchFunc, grids: Sequence[FloatArray], xtol: float = 1e-12, rtol: float = 1e-13) -> BatchReport:
+def find_roots_batch(
+    f: BatchFunc, grids: Sequence[FloatArray], xtol: float = 1e-12, rtol: float = 4.0 * np.finfo(float).eps
+) -> BatchReport:
     """Roots of the functions ``f(., k)`` inside ``[grids[k][0], grids[k][-1]]``, all searched together.
 
     Each grid must be strictly increasing and resolve its function's oscillation. A
