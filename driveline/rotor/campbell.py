@@ -71,14 +71,14 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
                         for roots, slopes in zip(found, _slopes(driveline, knots, found))]
             if round_ == REFINEMENTS or knots.size > MAX_KNOTS:
                 break
-            coarse = np.flatnonzero(_spline_error(driveline, knots, branches) > SPLINE_RTOL)
-            if not coarse.size:
+            rough = np.flatnonzero(_spline_error(driveline, knots, branches) > SPLINE_RTOL)
+            if not rough.size:
                 break
+            middles = 0.5 * (knots[rough] + knots[rough + 1])
             counts = np.array([[r.size for r in sense] for sense in found]).T  # (speeds, senses)
-            added = _roots_over_speeds(driveline, 0.5 * (knots[coarse] + knots[coarse + 1]), x_hi,
-                                       np.stack([counts[coarse], counts[coarse + 1]], axis=1))
-            knots = np.insert(knots, coarse + 1, 0.5 * (knots[coarse] + knots[coarse + 1]))
-            found = [_insert(old, coarse + 1, new) for old, new in zip(found, added)]
+            added = _roots_over_speeds(driveline, middles, x_hi, np.stack([counts[rough], counts[rough + 1]], axis=1))
+            knots = np.insert(knots, rough + 1, middles)
+            found = [_insert(old, rough + 1, new) for old, new in zip(found, added)]
         enough = min(r.size for roots in found for r in roots) >= n_modes
         if x_hi >= SEARCH_LIMIT or (enough and not any(np.isnan(b).any() for b in branches)):
             return WhirlBranches(knots, *branches)

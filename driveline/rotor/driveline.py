@@ -178,7 +178,8 @@ class Driveline:
         bare-shaft root only), plus a logarithmic lead-in for heavy masses on soft
         bearings near zero.
         """
-        extra = 0 if coarse else sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
+        extra = sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
+        extra = 0 if coarse else extra
         per_pi = POINTS_PER_ROOT * (1 + extra) * (1 if self.is_isotropic else 2)
         kappa = self._kappa * math.sqrt(abs(ratio))
         theta_max = kappa * math.sqrt(x_max)
@@ -200,13 +201,12 @@ class Driveline:
         ``lines`` is (m, 3) with rows ``(w_k, s_k, o_k)``; each line's grid follows its ``|w_k|``.
         A line short of ``n`` roots is searched again over a 4x wider range, until ``limit``.
         """
-        w_k, s_k, o_k = np.asarray(lines, dtype=float).T
-        ratios = np.abs(w_k)
+        lines = np.asarray(lines, dtype=float)
+        ratios = np.abs(lines[:, 0])
         if x_max is not None:
             kinds = list(zip(ratios, np.broadcast_to(coarse, ratios.shape)))
             grid = {kind: self._grid(x_max, *kind) for kind in set(kinds)}
-            grids = [grid[kind] for kind in kinds]
-            return find_roots_batch(lambda x, k: self.determinant(w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
+            return self._batch(lines, [grid[kind] for kind in kinds])
         if n is None or isinstance(n, bool) or not float(n).is_integer() or n < 1:
             raise ValueError(f"n must be a positive integer (or give an upper limit), got {n!r}")
         limit = _speed("limit", limit, positive=True)
@@ -214,9 +214,7 @@ class Driveline:
         out: list[FloatArray] = [np.empty(0)] * len(lines)
         todo = np.arange(len(lines))
         while todo.size:
-            grids = [self._grid(x_hi[j], ratios[j]) for j in todo]
-            w_t, s_t, o_t = w_k[todo], s_k[todo], o_k[todo]
-            found = find_roots_batch(lambda x, k: self.determinant(w_t[k] * x, s_t[k] * x + o_t[k]), grids).roots
+            found = self._batch(lines[todo], [self._grid(x_hi[j], ratios[j]) for j in todo])
             short = []
             for j, roots in zip(todo, found):
                 out[j] = roots[:n]
@@ -225,6 +223,11 @@ class Driveline:
             todo = np.array(short, dtype=np.intp)
             x_hi[todo] = np.minimum(4.0 * x_hi[todo], limit)
         return out
+
+    def _batch(self, lines: FloatArray, grids: list[FloatArray]) -> list[FloatArray]:
+        """Roots of the determinant along ``lines`` (rows ``(w_k, s_k, o_k)``) on their ``grids``, one batch."""
+        w_k, s_k, o_k = lines.T
+        return find_roots_batch(lambda x, k: self.determinant(w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
 
     @staticmethod
     def _take(roots: FloatArray, n: int | None) -> FloatArray:
