@@ -35,6 +35,8 @@ SLOPE_STEP = 1e-6
 SPLINE_RTOL = 1e-12
 REFINEMENTS = 4
 MAX_KNOTS = 400
+#: An estimated spline error within this multiple of the estimate's own round-off is no error.
+NOISE = 10.0
 
 
 @dataclass(frozen=True)
@@ -136,16 +138,21 @@ def _slopes(driveline: Driveline, spins: FloatArray, found: list[list[FloatArray
 
 def _spline_error(driveline: Driveline, knots: FloatArray, branches: list[FloatArray]) -> FloatArray:
     """Relative error of the branches' cubic splines at the middle of every knot interval (largest of
-    all branches), estimated by one Newton step ``f / f_w`` on the determinant there."""
-    middles = 0.5 * (knots[:-1] + knots[1:])
-    w = np.hstack([CubicSpline(knots, table)(middles) for table in branches])
+    all branches), estimated by one Newton step ``f / f_w`` on the determinant there. The same step
+    at the interval's ends, where the splines hold the roots, is the round-off of the estimate:
+    an error within ``NOISE`` times that counts as zero."""
+    at = np.concatenate([0.5 * (knots[:-1] + knots[1:]), knots])
+    w = np.hstack([CubicSpline(knots, table)(at) for table in branches])
     sign = np.repeat([1.0, -1.0], [table.shape[1] for table in branches])
-    spin = np.broadcast_to(middles[:, None], w.shape)
+    spin = np.broadcast_to(at[:, None], w.shape)
     h = SLOPE_STEP * w
     f = driveline.determinant(sign * np.stack([w, w + h, w - h]), np.stack([spin] * 3))
     with np.errstate(divide="ignore", invalid="ignore"):
         step = np.abs(f[0] * 2.0 * h / (f[1] - f[2])) / w
-    return np.nanmax(np.where(np.isfinite(step), step, np.nan), axis=1, initial=0.0)
+    step = np.where(np.isfinite(step), step, 0.0)
+    middle, end = step[: knots.size - 1], step[knots.size - 1:]
+    noise = NOISE * np.maximum(end[:-1], end[1:])
+    return np.max(np.where(middle > noise, middle, 0.0), axis=1, initial=0.0)
 
 
 def _follow(spins: FloatArray, roots: list[FloatArray], slopes: list[FloatArray], n_modes: int) -> FloatArray:
