@@ -1,14 +1,18 @@
 """Robustness suite: hostile inputs and misuse of the FMUs, each case in a process of its own with a
 time limit, through fmpy (FMI 2.0 and 3.0) and, for a subset, libcosim and Ecos.
 
-Usage: ``python -m fmu_harness.robustness [--models models] [--slow] [--workers 2]`` after
-building the FMUs. Prints per class of case: cases, crashes (the host process died), hangs (it
-did not end within the time limit), wrong statuses and wrong outputs (outputs wrong with status
-OK), and the cases whose defined outcome departs from the standard because of the Python
-wrappers (docs/robustness.md). The procedures are in :mod:`fmu_harness.robustness_probe`.
+Usage: ``python -m fmu_harness.robustness [--models models] [--family python|native] [--slow]
+[--workers 2]`` after building the FMUs (``python build_fmu.py``). Prints per family of FMUs
+(the Python FMUs, the native ones; both unless ``--family`` names one) and class of case: cases,
+crashes (the host process died), hangs (it did not end within the time limit), wrong statuses
+and wrong outputs (outputs wrong with status OK), the cases whose defined outcome is a
+documented departure from the standard (the Python wrappers', or a host's; docs/robustness.md)
+and the cases skipped because an FMU they need was not built (a model without a C port has no
+native FMU). The procedures are in :mod:`fmu_harness.robustness_probe`.
 
-The FMUs are data: :func:`cases` takes a function ``(model name, FMI version) -> FMU path``, so
-another build of the same models runs the same suite with one more call.
+The cases are described once: :func:`cases` takes a function ``(model name, FMI version) -> FMU
+path`` and the family, which decides the defined outcomes (the native FMUs have none of the
+wrappers' departures), so another build of the same models runs the same suite with one more call.
 """
 
 from __future__ import annotations
@@ -24,13 +28,14 @@ import tempfile
 import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from driveline.catalog import MODELS
 
 from .failing_model import FAILURES, FailingModel, build_failing_fmus
-from .robustness_probe import VERDICT
+from .robustness_probe import (DISTINCT_TEXTS_LEAK, ECOS_IGNORES_DISCARD, FMI2_DISCARD, NO_GUID_CHECK,
+                                NO_START_TIME, STATUS_OK_LOGGED, VERDICT, WRAPPER_DEPARTURES)
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Seconds a case may take; every case needs a few seconds at most (a host process start included).
@@ -39,31 +44,34 @@ TIME_LIMIT = 60.0
 SOAK_TIME_LIMIT = 600.0
 NON_FINITE = (math.nan, math.inf, -math.inf)
 FmuPath = Callable[[str, str], Path]
-
-#: Departures from the standard that the wrappers force (docs/robustness.md).
-STATUS_OK_LOGGED = "pythonfmu/pythonfmu3 return OK (the error is logged, later steps refused)"
-NO_GUID_CHECK = "pythonfmu/pythonfmu3 do not pass the GUID / instantiation token to Python"
-NO_START_TIME = "pythonfmu3 does not pass startTime to Python"
-FMI2_DISCARD = "pythonfmu has no fmi2Error without fmi2Fatal: misuse returns fmi2Discard"
+#: The Python FMUs (pythonfmu, pythonfmu3) and the native (C) ones.
+FAMILIES = ("python", "native")
 
 
 @dataclass(frozen=True)
 class Case:
-    """One run: ``procedure(*arguments)`` of :mod:`.robustness_probe` in a fresh process."""
+    """One run: ``procedure(*arguments)`` of :mod:`.robustness_probe` in a fresh process, its
+    outcome checked with ``departures`` from the standard (none: the standard's outcome)."""
 
     kind: str
     name: str
     procedure: str
     arguments: tuple
     fmi: str
-    limited: str = ""
+    departures: tuple[str, ...] = ()
     time_limit: float = TIME_LIMIT
+    family: str = "python"
+
+    @property
+    def fmus(self) -> list[Path]:
+        """The FMUs the case loads (its arguments that name one)."""
+        return [Path(a) for a in self.arguments if isinstance(a, str) and a.endswith(".fmu")]
 
 
 @dataclass(frozen=True)
 class Result:
     case: Case
-    verdict: str  # ok, crash, hang, wrong status, wrong output
+    verdict: str  # ok, crash, hang, wrong status, wrong output, skipped
     detail: str
     seconds: float
 
@@ -111,20 +119,31 @@ def _step_sizes(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
 
 MISUSE = ("step before initialisation", "step in initialisation mode", "step after terminate",
           "set after terminate", "nan time", "-inf time", "unknown value reference", "string on a real",
-          "set an output", "fixed parameter after initialisation", "enter initialisation twice", "wrong guid")
+          "set an output", "fixed parameter after initialisation", "enter initialisation twice", "wrong guid",
+          "nan start time")
+
+
+#: Misuse the wrappers log and answer with OK instead of Error.
+LOGGED_WITH_OK = ("set after terminate", "unknown value reference", "string on a real", "set an output",
+                  "fixed parameter after initialisation", "enter initialisation twice", "nan start time")
+
+
+def _refusing(fmi: str, *departures: str) -> tuple[str, ...]:
+    """``departures`` of a case whose later steps are refused: with fmi2Discard for fmi2Error in FMI 2.0."""
+    return departures + ((FMI2_DISCARD,) if fmi == "2" else ())
 
 
 def _misuse(fmu_path: FmuPath, fmi: str) -> list[Case]:
     found = []
     for kind in MISUSE:
         model = "TripodCoupling" if kind == "fixed parameter after initialisation" else "CardanJoint"
-        limited = {"wrong guid": NO_GUID_CHECK}.get(kind, "")
-        if kind in ("set after terminate", "unknown value reference", "string on a real", "set an output",
-                    "fixed parameter after initialisation", "enter initialisation twice"):
-            limited = STATUS_OK_LOGGED
-        elif fmi == "2" and kind != "wrong guid":
-            limited = FMI2_DISCARD
-        found.append(Case("call sequence misuse", kind, "misuse", (str(fmu_path(model, fmi)), kind), fmi, limited))
+        if kind == "wrong guid":
+            departures = (NO_GUID_CHECK,)
+        elif kind == "nan start time" and fmi == "3":
+            departures = (NO_START_TIME,)
+        else:
+            departures = _refusing(fmi, STATUS_OK_LOGGED) if kind in LOGGED_WITH_OK else _refusing(fmi)
+        found.append(Case("call sequence misuse", kind, "misuse", (str(fmu_path(model, fmi)), kind), fmi, departures))
     return found
 
 
@@ -134,7 +153,7 @@ STATE_KINDS = ("round trip", "pickle running a command", "truncated", "one bit f
 def _states(fmu_path: FmuPath, fmi: str) -> list[Case]:
     return [Case("state round trips and corrupt state", kind, "state",
                  (str(fmu_path("CardanJoint", fmi)), kind, str(fmu_path("SpeedSource", fmi))), fmi,
-                 "" if kind == "round trip" else STATUS_OK_LOGGED)
+                 () if kind == "round trip" else _refusing(fmi, STATUS_OK_LOGGED))
             for kind in STATE_KINDS]
 
 
@@ -165,7 +184,7 @@ def _layouts(fmu_path: FmuPath, fmi: str) -> list[Case]:
     found = [Case("hostile layout values", f"layout {value[:24]!r}", "layout", (path, value, fragment, prepare), fmi)
              for value, prepare, fragment in LAYOUTS]
     found.append(Case("hostile layout values", "layout of 10^5 characters", "long_string",
-                      (path, "layout", 100000), fmi, STATUS_OK_LOGGED))
+                      (path, "layout", 100000), fmi, _refusing(fmi, STATUS_OK_LOGGED)))
     return found
 
 
@@ -190,7 +209,7 @@ def _limits(fmu_path: FmuPath, fmi: str) -> list[Case]:
 
 def _start_time(fmu_path: FmuPath, fmi: str) -> list[Case]:
     return [Case("outputs at a start time other than 0", "SpeedSource at t0 = 1 s", "start_time",
-                 (str(fmu_path("SpeedSource", fmi)), 1.0), fmi, NO_START_TIME if fmi == "3" else "")]
+                 (str(fmu_path("SpeedSource", fmi)), 1.0), fmi, (NO_START_TIME,) if fmi == "3" else ())]
 
 
 def _engines(fmu_path: FmuPath) -> list[Case]:
@@ -202,17 +221,15 @@ def _engines(fmu_path: FmuPath) -> list[Case]:
             for model, name in (("CardanJoint", "omega_in"), ("TripodCoupling", "beta")):
                 found.append(Case(f"refused steps in {engine}", f"{model}.{name} = nan", "engine_refusal",
                                   (str(fmu_path(model, fmi)), engine, name, math.nan), fmi,
-                                  "Ecos ignores fmi2Discard/fmi3Discard" if engine == "Ecos" else ""))
+                                  (ECOS_IGNORES_DISCARD,) if engine == "Ecos" else ()))
     return found
 
 
 def _model_failures(fmu_path: FmuPath, fmi: str) -> list[Case]:
-    """Only where ``fmu_path`` has an FMU of :class:`.failing_model.FailingModel`."""
+    """The FMUs of :class:`.failing_model.FailingModel` (skipped where ``fmu_path`` has none)."""
     path = fmu_path(FailingModel.spec.name, fmi)
-    if not Path(path).exists():
-        return []
     return [Case("model failures outside its checks", name, "model_failure", (str(path), failure, name), fmi,
-                 "" if name == "OverflowError" or fmi == "3" else FMI2_DISCARD)
+                 () if name == "OverflowError" else _refusing(fmi))
             for failure, name in FAILURES.items()]
 
 
@@ -225,30 +242,42 @@ def with_failing_model(fmu_path: FmuPath, folder: Path) -> FmuPath:
 
 
 def _soak(fmu_path: FmuPath, fmi: str) -> list[Case]:
-    return [Case("soak", "100,000 bad/good alternations", "soak", (str(fmu_path("CardanJoint", fmi)), "omega_in", 100000),
-                 fmi, time_limit=SOAK_TIME_LIMIT)]
+    return [Case("soak", "100,000 bad/good alternations", "soak", (str(fmu_path("CardanJoint", fmi)), "beta", 100000),
+                 fmi, (DISTINCT_TEXTS_LEAK,), time_limit=SOAK_TIME_LIMIT)]
 
 
-def cases(fmu_path: FmuPath, slow: bool = False, versions: Iterable[str] = ("2", "3")) -> list[Case]:
-    """The suite for the FMUs ``fmu_path(model, fmi)``; ``slow`` adds every variable, value, model
-    and step size of the sampled classes, and the soak."""
+def cases(fmu_path: FmuPath, slow: bool = False, versions: Iterable[str] = ("2", "3"),
+          family: str = "python") -> list[Case]:
+    """The suite for the FMUs ``fmu_path(model, fmi)`` of ``family``; ``slow`` adds every variable,
+    value, model and step size of the sampled classes, and the soak. A native case is checked with
+    the standard's outcome where the Python one departs from it because of the wrappers; the
+    failing model is a Python model, so its cases are the Python family's only."""
     found = []
     for fmi in versions:
         found += (_non_finite(fmu_path, fmi, slow) + _out_of_range(fmu_path, fmi, slow)
                   + _step_sizes(fmu_path, fmi, slow) + _misuse(fmu_path, fmi) + _states(fmu_path, fmi)
                   + _instances(fmu_path, fmi, slow)
                   + _layouts(fmu_path, fmi) + _limits(fmu_path, fmi) + _start_time(fmu_path, fmi)
-                  + _model_failures(fmu_path, fmi))
+                  + (_model_failures(fmu_path, fmi) if family == "python" else []))
         if slow:
             found += _soak(fmu_path, fmi)
-    return found + _engines(fmu_path)
+    found += _engines(fmu_path)
+    if family == "python":
+        return found
+    return [replace(case, family=family, departures=tuple(d for d in case.departures if d not in WRAPPER_DEPARTURES))
+            for case in found]
 
 
 def run(case: Case) -> Result:
-    """Run ``case`` in a new Python process and classify what happened."""
+    """Run ``case`` in a new Python process and classify what happened; a case whose FMUs were not
+    built is skipped."""
+    missing = [fmu.stem for fmu in case.fmus if not fmu.exists()]
+    if missing:
+        return Result(case, "skipped", f"no {case.family} FMU of {', '.join(missing)}", 0.0)
     time_limit = case.time_limit
     command = [sys.executable, "-m", "fmu_harness.robustness_probe",
-               json.dumps({"procedure": case.procedure, "arguments": list(case.arguments)})]
+               json.dumps({"procedure": case.procedure, "arguments": list(case.arguments),
+                           "departures": list(case.departures)})]
     started = time.perf_counter()
     try:
         done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, errors="replace", timeout=time_limit)
@@ -271,37 +300,57 @@ COLUMNS = ("crash", "hang", "wrong status", "wrong output")
 
 
 def table(results: list[Result]) -> str:
-    """Markdown table per class (FMI versions and hosts together)."""
+    """Markdown table per class (FMI versions and hosts together): the cases run, by outcome, those
+    checked with a departure from the standard, and those skipped."""
     kinds = list(dict.fromkeys(result.case.kind for result in results))
-    lines = ["| class | cases | crashes | hangs | wrong statuses | wrong outputs | wrapper-limited |",
-             "|---|---|---|---|---|---|---|"]
+    lines = ["| class | cases | crashes | hangs | wrong statuses | wrong outputs | limited | skipped |",
+             "|---|---|---|---|---|---|---|---|"]
     for kind in kinds + ["all"]:
         rows = [r for r in results if kind in ("all", r.case.kind)]
-        counts = [sum(r.verdict == column for r in rows) for column in COLUMNS]
-        limited = sum(bool(r.case.limited) for r in rows)
-        lines.append(f"| {kind} | {len(rows)} | " + " | ".join(map(str, counts)) + f" | {limited} |")
+        ran = [r for r in rows if r.verdict != "skipped"]
+        counts = [sum(r.verdict == column for r in ran) for column in COLUMNS]
+        limited = sum(bool(r.case.departures) for r in ran)
+        lines.append(f"| {kind} | {len(ran)} | " + " | ".join(map(str, counts))
+                     + f" | {limited} | {len(rows) - len(ran)} |")
     return "\n".join(lines)
 
 
 def failures(results: list[Result]) -> list[Result]:
-    return [result for result in results if result.verdict != "ok"]
+    return [result for result in results if result.verdict not in ("ok", "skipped")]
+
+
+def skipped(results: list[Result]) -> str:
+    """Why cases were skipped, e.g. "12 cases: no native FMU of TripodCoupling" ("" if none)."""
+    reasons = [r.detail for r in results if r.verdict == "skipped"]
+    return "; ".join(f"{reasons.count(reason)} cases: {reason}" for reason in dict.fromkeys(reasons))
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .build import fmu_path
+    from .build import fmu_path, native
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--models", type=Path, default=ROOT / "models", help="folder of the built FMUs")
+    parser.add_argument("--models", type=Path, default=ROOT / "models",
+                        help="folder of the built FMUs (the native ones in its native/)")
+    parser.add_argument("--family", action="append", choices=FAMILIES,
+                        help="the FMUs to test (repeat for both; default: both)")
     parser.add_argument("--slow", action="store_true", help="every non-finite value and the soak")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
+    families = args.family or list(FAMILIES)
     started, cpu = time.perf_counter(), _children_cpu()
     with tempfile.TemporaryDirectory() as failing:
-        paths = with_failing_model(lambda model, fmi: fmu_path(args.models, model, fmi), Path(failing))
-        results = run_all(cases(paths, args.slow), args.workers)
-    print(table(results))
+        paths = {"python": with_failing_model(lambda model, fmi: fmu_path(args.models, model, fmi), Path(failing)),
+                 "native": lambda model, fmi: native.fmu_path(args.models, model, fmi)}
+        results = run_all([case for family in families for case in cases(paths[family], args.slow, family=family)],
+                          args.workers)
+    for family in families:
+        of_family = [r for r in results if r.case.family == family]
+        print(f"{family} FMUs\n{table(of_family)}")
+        if skipped(of_family):
+            print(f"skipped: {skipped(of_family)}")
     for result in failures(results):
-        print(f"- {result.verdict}: FMI {result.case.fmi} {result.case.kind} / {result.case.name}: {result.detail}")
+        print(f"- {result.verdict}: {result.case.family} FMI {result.case.fmi} {result.case.kind} / "
+              f"{result.case.name}: {result.detail}")
     print(f"{len(results)} runs in {time.perf_counter() - started:.0f} s wall clock, "
           f"{_children_cpu() - cpu:.0f} s CPU of the host processes")
 

@@ -1,7 +1,9 @@
 """The robustness suite (fmu_harness.robustness): every hostile input and misuse of issue 14's
 classes, each in its own host process with a time limit, through fmpy (FMI 2.0 and 3.0) and a
-subset in libcosim and Ecos. Every column of the table must stay at zero; a departure that the
-Python wrappers force is a defined outcome, checked as documented in docs/robustness.md."""
+subset in libcosim and Ecos, on the Python FMUs and on the native ones. Every column of the table
+must stay at zero; a departure that the Python wrappers force is a defined outcome of the Python
+FMUs, checked as documented in docs/robustness.md, and the native FMUs must give the standard's
+outcome instead. Cases of a model without a C port are skipped for the native FMUs, and only they."""
 
 from __future__ import annotations
 
@@ -9,17 +11,30 @@ from pathlib import Path
 
 import pytest
 
+from driveline.catalog import MODELS
 from fmu_harness import build, robustness
+from fmu_harness.build import native
+from fmu_harness.failing_model import FailingModel
 
 CLASSES = {"non-finite values", "out-of-range values", "step sizes", "call sequence misuse",
            "state round trips and corrupt state", "instances and threads", "hostile layout values",
            "work, memory and resolution limits", "outputs at a start time other than 0",
            "model failures outside its checks"}
+#: Classes of CriticalSpeeds alone (no C port yet) and of the Python failing model.
+NOT_NATIVE = {"hostile layout values", "work, memory and resolution limits", "model failures outside its checks"}
+
+
+@pytest.fixture(scope="module", params=robustness.FAMILIES)
+def family(request: pytest.FixtureRequest) -> str:
+    return request.param
 
 
 @pytest.fixture(scope="module")
-def paths(fmu_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> robustness.FmuPath:
-    """The catalog's FMUs, and those of the failing model in a folder of their own."""
+def paths(family: str, fmu_dir: Path, native_dir: Path, tmp_path_factory: pytest.TempPathFactory
+          ) -> robustness.FmuPath:
+    """The native FMUs, or the catalog's Python FMUs and those of the failing model in a folder of their own."""
+    if family == "native":
+        return lambda model, fmi: native.fmu_path(native_dir, model, fmi)
     return robustness.with_failing_model(lambda model, fmi: build.fmu_path(fmu_dir, model, fmi),
                                          tmp_path_factory.mktemp("failing"))
 
@@ -30,24 +45,31 @@ def _report(results: list[robustness.Result]) -> str:
 
 
 @pytest.fixture(scope="module")
-def results(paths: robustness.FmuPath) -> list[robustness.Result]:
-    return robustness.run_all(robustness.cases(paths))
+def results(paths: robustness.FmuPath, family: str) -> list[robustness.Result]:
+    return robustness.run_all(robustness.cases(paths, family=family))
 
 
 def test_no_case_crashes_hangs_or_gets_a_wrong_status_or_output(results):
     assert not robustness.failures(results), _report(results)
 
 
-def test_the_suite_covers_every_class_in_both_fmi_versions(results):
+def test_the_suite_covers_every_class_in_both_fmi_versions(results, family):
+    expected = CLASSES - NOT_NATIVE if family == "native" else CLASSES
     for fmi in ("2", "3"):
-        assert {r.case.kind for r in results if r.case.fmi == fmi} >= CLASSES
+        assert {r.case.kind for r in results if r.case.fmi == fmi and r.verdict != "skipped"} >= expected
+
+
+def test_only_cases_of_models_without_an_fmu_of_the_family_are_skipped(results, family):
+    built = set(native.native_models()) if family == "native" else {*MODELS, FailingModel.spec.name}
+    for result in results:
+        assert (result.verdict == "skipped") == any(fmu.stem not in built for fmu in result.case.fmus), result
 
 
 @pytest.mark.slow
-def test_every_variable_value_and_model_and_a_long_soak(paths: robustness.FmuPath, results):
+def test_every_variable_value_and_model_and_a_long_soak(paths: robustness.FmuPath, family: str, results):
     """The cases the default run samples, and 100,000 bad/good alternations per FMI version with
     resident memory bounded."""
     sampled = {(r.case.fmi, r.case.kind, r.case.name) for r in results}
-    rest = [c for c in robustness.cases(paths, slow=True) if (c.fmi, c.kind, c.name) not in sampled]
+    rest = [c for c in robustness.cases(paths, slow=True, family=family) if (c.fmi, c.kind, c.name) not in sampled]
     slow_results = robustness.run_all(rest)
     assert not robustness.failures(slow_results), _report(slow_results)
