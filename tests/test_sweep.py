@@ -104,7 +104,7 @@ def test_critical_speed_margin_of_the_critical_speeds_model(client, tripod_fmu, 
     from driveline.rotor.model import SHAFT_PARAMETERS
 
     spec = MODELS["CriticalSpeeds"].spec
-    critical = one_piece_shaft(*(spec[name].start for name in SHAFT_PARAMETERS)).critical_speeds(4)
+    critical = one_piece_shaft(**{name: spec[name].start for name in SHAFT_PARAMETERS}).critical_speeds(4)
     speeds = [150.0, 700.0, -700.0]
     table = sweep(client, tripod_fmu, [{"beta": 0.3, "omega_in": s} for s in speeds], TIMING)
     nearest = [min(critical, key=lambda c: abs(c - abs(s))) for s in speeds]
