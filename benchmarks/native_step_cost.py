@@ -7,7 +7,8 @@ generated variable table: same variables, range checks and FMI traffic) and the 
 fmpy's low-level API each is stepped as in :mod:`benchmarks.step_cost` (one batched set of the Real
 inputs, doStep, one batched get of the Real outputs; CPU time, best of alternating rounds). From C,
 ``benchmarks/native_step_timer.c`` (compiled here) loads the shared library with dlopen and times
-the same three calls per step (CPU time, best of its rounds).
+the same three calls per step (CPU time, best of its rounds). The tripod runs in both kinematics
+modes (:data:`benchmarks.step_cost.VARIANTS`) against the same twin.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from benchmarks.step_cost import Stepper, best_alternating
+from benchmarks.step_cost import VARIANTS, Stepper, best_alternating
 from benchmarks.timing import machine
 from driveline.catalog import MODELS
 from fmu_harness.build import build, native
@@ -35,26 +36,28 @@ def compile_timer(folder: Path) -> Path:
     return executable
 
 
-def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path) -> float:
-    """Nanoseconds per step of ``fmu`` from the C timer."""
+def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path, integers: dict[str, int]) -> float:
+    """Nanoseconds per step of ``fmu`` from the C timer, with the Integer parameters ``integers``."""
     unzipdir = Path(extract(str(fmu), unzipdir=str(work)))
     description = read_model_description(str(fmu))
     token = description.instantiationToken if fmi == "3" else description.guid
     real = ("Real", "Float64")
     inputs = [v.valueReference for v in description.modelVariables if v.causality == "input" and v.type in real]
     outputs = [v.valueReference for v in description.modelVariables if v.causality == "output" and v.type in real]
+    references = {v.name: v.valueReference for v in description.modelVariables}
     library = next((unzipdir / "binaries").rglob("*.so"))
     done = subprocess.run([str(timer), str(library), fmi, token, description.defaultExperiment.stepSize,
-                           str(C_STEPS), str(C_ROUNDS), " ".join(map(str, inputs)), " ".join(map(str, outputs))],
+                           str(C_STEPS), str(C_ROUNDS), " ".join(map(str, inputs)), " ".join(map(str, outputs)),
+                           " ".join(f"{references[name]}={value}" for name, value in integers.items())],
                           check=True, capture_output=True, text=True)
     return float(done.stdout)
 
 
 def main() -> None:
     print(f"Per-step cost (set inputs, doStep, get outputs); {machine()}")
-    print("| FMU | FMI | native via fmpy us | no-physics twin via fmpy us | ratio | Python FMU via fmpy us "
+    print("| FMU | FMI | variant | native via fmpy us | no-physics twin via fmpy us | ratio | Python FMU via fmpy us "
           "| native from C ns | no-physics twin from C ns |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as folder:
         dest = Path(folder)
         timer = compile_timer(dest)
@@ -64,11 +67,13 @@ def main() -> None:
                 fmu = native.build(name, dest, fmi)
                 twin = native.build(name, dest / "twin", fmi, HERE / "native_minimal.c")
                 python_fmu = build(name, dest / "python", fmi)
-                ours, floor, python = best_alternating([Stepper(path, {}, inputs) for path in (fmu, twin, python_fmu)])
-                c_ours = c_host_cost(timer, fmu, fmi, dest / f"c_{name}_{fmi}")
-                c_floor = c_host_cost(timer, twin, fmi, dest / f"c_twin_{name}_{fmi}")
-                print(f"| {name} | {fmi}.0 | {ours:.2f} | {floor:.2f} | {ours / floor:.2f} | {python:.1f} "
-                      f"| {c_ours:.0f} | {c_floor:.0f} |", flush=True)
+                for variant, values in VARIANTS.get(name, {"default": {}}).items():
+                    ours, floor, python = best_alternating([Stepper(path, values, inputs)
+                                                            for path in (fmu, twin, python_fmu)])
+                    c_ours = c_host_cost(timer, fmu, fmi, dest / f"c_{name}_{fmi}_{variant}", values)
+                    c_floor = c_host_cost(timer, twin, fmi, dest / f"c_twin_{name}_{fmi}_{variant}", values)
+                    print(f"| {name} | {fmi}.0 | {variant} | {ours:.2f} | {floor:.2f} | {ours / floor:.2f} "
+                          f"| {python:.1f} | {c_ours:.0f} | {c_floor:.0f} |", flush=True)
 
 
 if __name__ == "__main__":

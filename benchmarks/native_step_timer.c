@@ -1,7 +1,8 @@
 /* Per-step cost of a native FMU from a C host (no Python in the process), for the benchmarks.
  *
- * Usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS "IN_VR..." "OUT_VR..."
- * Instantiates and initialises the FMU at its start values, then times ROUNDS rounds of STEPS
+ * Usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS "IN_VR..." "OUT_VR..." ["VR=VALUE..."]
+ * Instantiates and initialises the FMU at its start values (the optional Integer parameters set in
+ * initialisation mode), then times ROUNDS rounds of STEPS
  * steps, each one batched set of the Real inputs (their start values), doStep and one batched
  * get of the Real outputs; prints the best round's CPU nanoseconds per step.
  */
@@ -45,6 +46,17 @@ static int parse(const char *text, unsigned int vr[])
     return count;
 }
 
+/* "vr=value vr=value ...": Integer parameters. */
+static int parse_integers(const char *text, unsigned int vr[], int value[])
+{
+    int count = 0, used;
+    while (count < MAX_SIGNALS && sscanf(text, " %u=%d%n", &vr[count], &value[count], &used) == 2) {
+        text += used;
+        count++;
+    }
+    return count;
+}
+
 static void *symbol(void *library, const char *name)
 {
     void *found = dlsym(library, name);
@@ -66,12 +78,12 @@ static double seconds(void)
 
 int main(int argc, char **argv)
 {
-    unsigned int in[MAX_SIGNALS], out[MAX_SIGNALS];
+    unsigned int in[MAX_SIGNALS], out[MAX_SIGNALS], integer_vr[MAX_SIGNALS];
     double values[MAX_SIGNALS], results[MAX_SIGNALS], h, t = 0.0, best = 1e300;
-    int inputs, outputs, steps, rounds, round, k, fmi3;
+    int inputs, outputs, integers, integer[MAX_SIGNALS], steps, rounds, round, k, fmi3;
     void *library, *instance;
-    if (argc != 9) {
-        fprintf(stderr, "usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS IN_VRS OUT_VRS\n");
+    if (argc != 9 && argc != 10) {
+        fprintf(stderr, "usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS IN_VRS OUT_VRS [VR=VALUE...]\n");
         return 2;
     }
     fmi3 = argv[2][0] == '3';
@@ -80,6 +92,7 @@ int main(int argc, char **argv)
     rounds = atoi(argv[6]);
     inputs = parse(argv[7], in);
     outputs = parse(argv[8], out);
+    integers = argc == 10 ? parse_integers(argv[9], integer_vr, integer) : 0;
     library = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
     if (library == NULL || steps < 1 || rounds < 1) {
         fprintf(stderr, "cannot load %s\n", argv[1]);
@@ -90,6 +103,7 @@ int main(int argc, char **argv)
         fmi3EnterInitializationModeTYPE *enter;
         fmi3ExitInitializationModeTYPE *leave;
         fmi3SetFloat64TYPE *set;
+        fmi3SetInt32TYPE *set_integer;
         fmi3GetFloat64TYPE *get;
         fmi3DoStepTYPE *step;
         fmi3FreeInstanceTYPE *release;
@@ -99,11 +113,14 @@ int main(int argc, char **argv)
         LOAD(enter, "fmi3EnterInitializationMode");
         LOAD(leave, "fmi3ExitInitializationMode");
         LOAD(set, "fmi3SetFloat64");
+        LOAD(set_integer, "fmi3SetInt32");
         LOAD(get, "fmi3GetFloat64");
         LOAD(step, "fmi3DoStep");
         LOAD(release, "fmi3FreeInstance");
         instance = instantiate("timer", argv[3], "", 0, 0, 0, 0, NULL, 0, NULL, logger3, NULL);
-        if (instance == NULL || enter(instance, 0, 0.0, 0.0, 0, 0.0) != fmi3OK || leave(instance) != fmi3OK ||
+        if (instance == NULL || enter(instance, 0, 0.0, 0.0, 0, 0.0) != fmi3OK ||
+            set_integer(instance, integer_vr, (size_t)integers, integer, (size_t)integers) != fmi3OK ||
+            leave(instance) != fmi3OK ||
             get(instance, in, (size_t)inputs, values, (size_t)inputs) != fmi3OK) {
             return 3;
         }
@@ -128,6 +145,7 @@ int main(int argc, char **argv)
         fmi2EnterInitializationModeTYPE *enter;
         fmi2ExitInitializationModeTYPE *leave;
         fmi2SetRealTYPE *set;
+        fmi2SetIntegerTYPE *set_integer;
         fmi2GetRealTYPE *get;
         fmi2DoStepTYPE *step;
         fmi2FreeInstanceTYPE *release;
@@ -136,12 +154,13 @@ int main(int argc, char **argv)
         LOAD(enter, "fmi2EnterInitializationMode");
         LOAD(leave, "fmi2ExitInitializationMode");
         LOAD(set, "fmi2SetReal");
+        LOAD(set_integer, "fmi2SetInteger");
         LOAD(get, "fmi2GetReal");
         LOAD(step, "fmi2DoStep");
         LOAD(release, "fmi2FreeInstance");
         instance = instantiate("timer", fmi2CoSimulation, argv[3], "", &callbacks, 0, 0);
         if (instance == NULL || setup(instance, 0, 0.0, 0.0, 0, 0.0) != fmi2OK || enter(instance) != fmi2OK ||
-            leave(instance) != fmi2OK || get(instance, in, (size_t)inputs, values) != fmi2OK) {
+            set_integer(instance, integer_vr, (size_t)integers, integer) != fmi2OK || leave(instance) != fmi2OK || get(instance, in, (size_t)inputs, values) != fmi2OK) {
             return 3;
         }
         for (round = 0; round < rounds; round++) {

@@ -98,6 +98,11 @@ class SteppedModel(ABC):
         declared bounds and relations hold."""
         return []
 
+    #: Parameter values that break each check of :meth:`extra_parameter_errors` once, by a name
+    #: for its message; the first value named is the one the message shows. The native build cuts
+    #: the messages from the check run on these values, so their wording exists once.
+    extra_parameter_probes: ClassVar[dict[str, dict[str, float]]] = {}
+
     def extra_input_errors(self) -> list[str]:
         """Input checks the spec cannot declare, run once the declared ones pass."""
         return []

@@ -2,9 +2,10 @@
  *
  * Usage: native_host LIBRARY FMI_VERSION(2|3) TOKEN SCENARIO
  *
- * SCENARIO is a text file: "inputs N vr...", "outputs M vr...", "steps K h", then K + 1 rows
- * "t u_1..u_N y_1..y_M": the inputs at t_k and the outputs a reference FMU gave at t_k (row 0:
- * after initialisation). The host loads the FMU's shared library (dlopen), runs two instances
+ * SCENARIO is a text file: "inputs N vr...", "outputs M vr...", "parameters P (vr value)...",
+ * "integers Q (vr value)..." (Real and Integer parameters, set in initialisation mode), "steps K h",
+ * then K + 1 rows "t u_1..u_N y_1..y_M": the inputs at t_k and the outputs a reference FMU gave at
+ * t_k (row 0: after initialisation). The host loads the FMU's shared library (dlopen), runs two instances
  * side by side (the second must repeat the first bit for bit), stores, serializes and restores
  * the FMU state half way and replays the second half (bit for bit again), then sets the first
  * input to NaN (or steps by 0 if there is no input) and expects a refused step (Discard, a logged
@@ -26,8 +27,10 @@
 #define TOLERANCE 1e-12
 
 typedef struct {
-    int inputs, outputs, steps;
-    unsigned int input_vr[MAX_SIGNALS], output_vr[MAX_SIGNALS];
+    int inputs, outputs, steps, parameters, integers;
+    unsigned int input_vr[MAX_SIGNALS], output_vr[MAX_SIGNALS], parameter_vr[MAX_SIGNALS], integer_vr[MAX_SIGNALS];
+    double parameter[MAX_SIGNALS];
+    int integer[MAX_SIGNALS];
     double step_size;
     double *time, *input, *expected; /* rows of the scenario */
 } Scenario;
@@ -61,6 +64,7 @@ typedef struct {
     void *(*instantiate)(const char *name, const char *token);
     int (*initialize)(void *instance);
     int (*set)(void *instance, const unsigned int vr[], size_t n, const double values[]);
+    int (*set_integer)(void *instance, const unsigned int vr[], size_t n, const int values[]);
     int (*get)(void *instance, const unsigned int vr[], size_t n, double values[]);
     int (*step)(void *instance, double time, double step_size);
     int (*store)(void *instance, void **state);          /* get, serialize, deserialize: the copy */
@@ -77,6 +81,7 @@ static struct {
     fmi2EnterInitializationModeTYPE *EnterInitializationMode;
     fmi2ExitInitializationModeTYPE *ExitInitializationMode;
     fmi2SetRealTYPE *SetReal;
+    fmi2SetIntegerTYPE *SetInteger;
     fmi2GetRealTYPE *GetReal;
     fmi2DoStepTYPE *DoStep;
     fmi2TerminateTYPE *Terminate;
@@ -117,6 +122,11 @@ static int initialize2(void *instance)
 static int set2(void *instance, const unsigned int vr[], size_t n, const double values[])
 {
     return f2.SetReal(instance, vr, n, values) == fmi2OK;
+}
+
+static int set_integer2(void *instance, const unsigned int vr[], size_t n, const int values[])
+{
+    return f2.SetInteger(instance, vr, n, values) == fmi2OK;
 }
 
 static int get2(void *instance, const unsigned int vr[], size_t n, double values[])
@@ -166,12 +176,13 @@ static int exit_initialization2(void *instance)
 
 static int load2(Host *host)
 {
-    static const Host fmi2 = {instantiate2, initialize2, set2, get2, step2, store2, restore2, release2, finish2};
+    static const Host fmi2 = {instantiate2, initialize2, set2, set_integer2, get2, step2, store2, restore2, release2, finish2};
     *host = fmi2;
     return load("fmi2Instantiate", &f2.Instantiate) && load("fmi2FreeInstance", &f2.FreeInstance) &&
            load("fmi2SetupExperiment", &f2.SetupExperiment) &&
            load("fmi2EnterInitializationMode", &f2.EnterInitializationMode) &&
            load("fmi2ExitInitializationMode", &f2.ExitInitializationMode) && load("fmi2SetReal", &f2.SetReal) &&
+           load("fmi2SetInteger", &f2.SetInteger) &&
            load("fmi2GetReal", &f2.GetReal) && load("fmi2DoStep", &f2.DoStep) && load("fmi2Terminate", &f2.Terminate) &&
            load("fmi2GetFMUstate", &f2.GetFMUstate) && load("fmi2SetFMUstate", &f2.SetFMUstate) &&
            load("fmi2FreeFMUstate", &f2.FreeFMUstate) &&
@@ -187,6 +198,7 @@ static struct {
     fmi3EnterInitializationModeTYPE *EnterInitializationMode;
     fmi3ExitInitializationModeTYPE *ExitInitializationMode;
     fmi3SetFloat64TYPE *SetFloat64;
+    fmi3SetInt32TYPE *SetInt32;
     fmi3GetFloat64TYPE *GetFloat64;
     fmi3DoStepTYPE *DoStep;
     fmi3TerminateTYPE *Terminate;
@@ -219,6 +231,11 @@ static int initialize3(void *instance)
 static int set3(void *instance, const unsigned int vr[], size_t n, const double values[])
 {
     return f3.SetFloat64(instance, vr, n, values, n) == fmi3OK;
+}
+
+static int set_integer3(void *instance, const unsigned int vr[], size_t n, const int values[])
+{
+    return f3.SetInt32(instance, vr, n, values, n) == fmi3OK;
 }
 
 static int get3(void *instance, const unsigned int vr[], size_t n, double values[])
@@ -274,12 +291,13 @@ static int exit_initialization3(void *instance)
 
 static int load3(Host *host)
 {
-    static const Host fmi3 = {instantiate3, initialize3, set3, get3, step3, store3, restore3, release3, finish3};
+    static const Host fmi3 = {instantiate3, initialize3, set3, set_integer3, get3, step3, store3, restore3, release3, finish3};
     *host = fmi3;
     return load("fmi3InstantiateCoSimulation", &f3.InstantiateCoSimulation) &&
            load("fmi3FreeInstance", &f3.FreeInstance) &&
            load("fmi3EnterInitializationMode", &f3.EnterInitializationMode) &&
            load("fmi3ExitInitializationMode", &f3.ExitInitializationMode) && load("fmi3SetFloat64", &f3.SetFloat64) &&
+           load("fmi3SetInt32", &f3.SetInt32) &&
            load("fmi3GetFloat64", &f3.GetFloat64) && load("fmi3DoStep", &f3.DoStep) &&
            load("fmi3Terminate", &f3.Terminate) && load("fmi3GetFMUState", &f3.GetFMUState) &&
            load("fmi3SetFMUState", &f3.SetFMUState) && load("fmi3FreeFMUState", &f3.FreeFMUState) &&
@@ -304,6 +322,14 @@ static int read_scenario(const char *path, Scenario *s)
     ok = ok && fscanf(file, " outputs %d", &s->outputs) == 1 && s->outputs > 0 && s->outputs <= MAX_SIGNALS;
     for (i = 0; ok && i < s->outputs; i++) {
         ok = fscanf(file, "%u", &s->output_vr[i]) == 1;
+    }
+    ok = ok && fscanf(file, " parameters %d", &s->parameters) == 1 && s->parameters >= 0 && s->parameters <= MAX_SIGNALS;
+    for (i = 0; ok && i < s->parameters; i++) {
+        ok = fscanf(file, "%u %lf", &s->parameter_vr[i], &s->parameter[i]) == 2;
+    }
+    ok = ok && fscanf(file, " integers %d", &s->integers) == 1 && s->integers >= 0 && s->integers <= MAX_SIGNALS;
+    for (i = 0; ok && i < s->integers; i++) {
+        ok = fscanf(file, "%u %d", &s->integer_vr[i], &s->integer[i]) == 2;
     }
     ok = ok && fscanf(file, " steps %d %lf", &s->steps, &s->step_size) == 2 && s->steps > 1 && s->steps < 1000000;
     if (ok) {
@@ -371,6 +397,10 @@ int main(int argc, char **argv)
     b = host.instantiate("b", argv[3]);
     if (outputs == NULL || replay == NULL || a == NULL || b == NULL || !host.initialize(a) || !host.initialize(b) ||
         !host.set(a, s.input_vr, (size_t)s.inputs, s.input) || !host.set(b, s.input_vr, (size_t)s.inputs, s.input) ||
+        !host.set(a, s.parameter_vr, (size_t)s.parameters, s.parameter) ||
+        !host.set(b, s.parameter_vr, (size_t)s.parameters, s.parameter) ||
+        !host.set_integer(a, s.integer_vr, (size_t)s.integers, s.integer) ||
+        !host.set_integer(b, s.integer_vr, (size_t)s.integers, s.integer) ||
         !(argv[2][0] == '2' ? exit_initialization2(a) && exit_initialization2(b)
                             : exit_initialization3(a) && exit_initialization3(b)) ||
         !host.get(a, s.output_vr, (size_t)s.outputs, outputs)) {

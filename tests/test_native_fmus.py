@@ -53,7 +53,7 @@ def _standard_run(path: Path, name: str, **open_options) -> np.ndarray:
 
 
 def test_the_models_without_a_c_port_are_skipped(native_dir):
-    assert NATIVE == [name for name in ("CardanJoint", "UniversalReducer", "SpeedSource") if name in MODELS]
+    assert NATIVE == [name for name in ("TripodCoupling", "CardanJoint", "UniversalReducer", "SpeedSource") if name in MODELS]
     built = {path.relative_to(native_dir).as_posix() for path in native_dir.rglob("*.fmu")}
     assert built == {f"{native.SUBDIR[fmi]}/{name}.fmu" for name in NATIVE for fmi in VERSIONS}
 
@@ -125,6 +125,34 @@ def test_standard_scenario_matches_the_python_fmu(native_dir, fmu_path, name, fm
     assert _deviation(_standard_run(fmu_path(name, fmi), name), _standard_run(_native(native_dir, name, fmi), name)) <= TOLERANCE
 
 
+MODES = {  # parameters of the modes the standard scenario (spec start values) leaves out
+    "TripodCoupling": [
+        {"kinematics": 1},
+        {"kinematics": 1, "mu": 0.05},
+        {"kinematics": 1, "mu": 0.02, "v_slip": 1e-2, "seed_reactions": 1, "phi_in_start": 0.4},
+        {"seed_reactions": 1},
+        {"kinematics": 1, "beta_max": math.radians(60.0), "r": 0.07},
+    ],
+}
+
+
+def _mode_run(path: Path, name: str, parameters: dict) -> np.ndarray:
+    """The standard scenario with ``parameters``, a load and a speed rate on top of the spec's start values."""
+    case = scenario(MODELS[name].spec)
+    with FmuInstance(path) as fmu:
+        fmu.initialize({**parameters, **case.input_values(0.0), "T_load": 500.0, "alpha_in": 800.0})
+        return fmu.run(case.stop_time, case.step_size, {k: v for k, v in case.signals().items()
+                                                        if k not in ("T_load", "alpha_in")})
+
+
+@pytest.mark.parametrize("name, parameters", [(name, p) for name, modes in MODES.items() if name in NATIVE
+                                              for p in modes])
+def test_every_mode_matches_the_python_fmu(native_dir, fmu_path, name, parameters, fmi):
+    """Exact kinematics, friction and the seed's reactions: the standard scenario in each mode."""
+    reference = _mode_run(fmu_path(name, fmi), name, parameters)
+    assert _deviation(reference, _mode_run(_native(native_dir, name, fmi), name, parameters)) <= TOLERANCE
+
+
 ENGINES = [importer for importer in interop.IMPORTERS if importer.name in ("libcosimpy", "ecospy")]
 
 
@@ -139,13 +167,36 @@ def test_runs_in_libcosim_and_ecos(native_dir, name, fmi, importer):
     assert result.status == ("pass" if f"{fmi}.0" in importer.versions else "unsupported"), result
 
 
+@pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")
+def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
+    """A state stored half way through an exact run with friction, restored from its bytes into an
+    instance whose solver was warm-started elsewhere, continues bit for bit."""
+    path, parameters = _native(native_dir, "TripodCoupling", fmi), {"kinematics": 1, "mu": 0.05}
+    case = scenario(MODELS["TripodCoupling"].spec)
+    with FmuInstance(path) as fmu:
+        fmu.initialize({**parameters, **case.input_values(0.0)})
+        fmu.run(case.stop_time / 2, case.step_size, case.signals())
+        middle, state = fmu.time, fmu.get_state()
+        serialized = fmu.serialize_state(state)
+        fmu.free_state(state)
+        reference = fmu.run(case.stop_time, case.step_size, case.signals())
+    with FmuInstance(path) as other:
+        other.initialize({**parameters, "beta": 0.2, "phi_in_start": 1.0})
+        other.run(case.stop_time / 3, case.step_size)
+        restored = other.deserialize_state(serialized)
+        other.set_state(restored)
+        other.free_state(restored)
+        other.time = middle
+        assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
+
+
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="rebuilding from the carried sources needs cmake")
-def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, fmi):
+@pytest.mark.parametrize("name", NATIVE)
+def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, name, fmi):
     """What a Windows or macOS user does: fmpy's build_platform_binary (CMake) from the FMU's
     sources alone; the rebuilt binary gives the shipped one's results bit for bit."""
     from fmpy.build import build_platform_binary
 
-    name = "CardanJoint"
     unzipdir = Path(extract(str(_native(native_dir, name, fmi)), unzipdir=str(tmp_path / "fmu")))
     shutil.rmtree(unzipdir / "binaries")
     (tmp_path / "build").mkdir()
@@ -200,6 +251,12 @@ DECLARED_RULES = [  # every kind of declared bound and relation the native model
     ("UniversalReducer", {"alpha": 1.5}),
     ("UniversalReducer", {"alpha": 3.0}),
     ("SpeedSource", {"sine_amplitude": -1.0, "sine_frequency": math.inf}),
+    ("TripodCoupling", {"r": 0.0}),
+    ("TripodCoupling", {"l": 0.02}),
+    ("TripodCoupling", {"beta_max": 1.1, "kinematics": 2}),
+    ("TripodCoupling", {"beta": math.radians(50.0)}),
+    ("TripodCoupling", {"mu": 0.05}),  # the model's own check: friction needs the exact kinematics
+    ("TripodCoupling", {"mu": 2.0**-24}),  # repr 5.960464477539063e-08: not printf's nearest 16 digits
 ]
 
 
@@ -216,6 +273,26 @@ def test_declared_bounds_and_relations_refuse_word_for_word(native_dir, name, va
         with pytest.raises(StepRefused) as refused:
             fmu.step(1e-3)
     assert refused.value.messages == errors
+
+
+ARITHMETIC_FAILURES = [  # where the Python core fails arithmetically, the C port refuses with its words
+    ("TripodCoupling", {"phi_in_start": 1e308}),
+    ("TripodCoupling", {"phi_in_start": 1e308, "kinematics": 1}),
+    ("TripodCoupling", {"phi_in_start": 6e307, "kinematics": 1, "seed_reactions": 1}),
+    ("TripodCoupling", {"kinematics": 1, "mu": 5.0, "T_load": 500.0}),
+    ("TripodCoupling", {"kinematics": 1, "mu": 0.05, "v_slip": 1e-300, "omega_in": 1e150}),
+    ("TripodCoupling", {"kinematics": 1, "r": 0.6999, "beta": 1.0, "beta_max": 1.04}),
+    ("TripodCoupling", {"kinematics": 1, "omega_in": 1e200}),
+    ("TripodCoupling", {"omega_in": 1e300}),
+    ("TripodCoupling", {"T_load": 1e307}),
+    ("TripodCoupling", {"T_load": 1e307, "kinematics": 1}),
+    ("TripodCoupling", {"T_load": 1e306}),
+]
+
+
+@pytest.mark.parametrize("name, values", [case for case in ARITHMETIC_FAILURES if case[0] in NATIVE])
+def test_arithmetic_failures_refuse_word_for_word(native_dir, name, values, fmi):
+    test_declared_bounds_and_relations_refuse_word_for_word(native_dir, name, values, fmi)
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")

@@ -32,8 +32,15 @@ def host(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return executable
 
 
-def _host_command(native_dir: Path, fmu_path, name: str, fmi: str, work: Path) -> list[str]:
-    """Extract the native FMU and write its scenario with the Python FMU's outputs as reference."""
+# The standard scenario of every native model, and the modes it leaves out (its parameters
+# are the spec's start values).
+MODES = {"TripodCoupling": [{"kinematics": 1, "mu": 0.05}, {"kinematics": 1, "seed_reactions": 1}]}
+RUNS = [(name, parameters) for name in native.native_models() for parameters in ({}, *MODES.get(name, ()))]
+
+
+def _host_command(native_dir: Path, fmu_path, name: str, fmi: str, work: Path, parameters: dict) -> list[str]:
+    """Extract the native FMU and write its scenario with ``parameters`` and the Python FMU's outputs
+    as reference."""
     path = native.fmu_path(native_dir, name, fmi)
     unzipdir = Path(extract(str(path), unzipdir=str(work / "fmu")))
     description = read_model_description(str(path))
@@ -44,11 +51,14 @@ def _host_command(native_dir: Path, fmu_path, name: str, fmi: str, work: Path) -
     references = {v.name: v.valueReference for v in description.modelVariables}
     outputs = [v.name for v in spec.of("output") if v.type == "Real"]
     with FmuInstance(fmu_path(name, fmi)) as fmu:
-        fmu.initialize(case.input_values(0.0))
+        fmu.initialize({**parameters, **case.input_values(0.0)})
         expected = fmu.run(case.stop_time, case.step_size, case.signals(), outputs)
     inputs = list(case.inputs)
     lines = [f"inputs {len(inputs)} " + " ".join(str(references[n]) for n in inputs),
              f"outputs {len(outputs)} " + " ".join(str(references[n]) for n in outputs),
+             *(f"{kind} {len(chosen)} " + " ".join(f"{references[n]} {chosen[n]!r}" for n in chosen)
+               for kind, chosen in (("parameters", {n: v for n, v in parameters.items() if spec[n].type == "Real"}),
+                                    ("integers", {n: v for n, v in parameters.items() if spec[n].type == "Integer"}))),
              f"steps {case.steps} {case.step_size!r}"]
     for row in expected:
         time = float(row["time"])
@@ -59,9 +69,10 @@ def _host_command(native_dir: Path, fmu_path, name: str, fmi: str, work: Path) -
     return [str(library), fmi, token, str(scenario_file)]
 
 
-@pytest.mark.parametrize("name", native.native_models())
-def test_host_runs_the_standard_scenario_like_the_python_fmu(host, native_dir, fmu_path, tmp_path, name, fmi):
-    done = subprocess.run([str(host), *_host_command(native_dir, fmu_path, name, fmi, tmp_path)],
+@pytest.mark.parametrize("name, parameters", RUNS)
+def test_host_runs_the_standard_scenario_like_the_python_fmu(host, native_dir, fmu_path, tmp_path, name, parameters,
+                                                              fmi):
+    done = subprocess.run([str(host), *_host_command(native_dir, fmu_path, name, fmi, tmp_path, parameters)],
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "checks passed" in done.stdout
@@ -71,9 +82,11 @@ def test_host_runs_the_standard_scenario_like_the_python_fmu(host, native_dir, f
 
 
 @pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind is not installed (Debian: apt-get install valgrind)")
-@pytest.mark.parametrize("name", native.native_models())
-def test_host_under_valgrind_has_no_memory_errors_or_leaks(host, native_dir, fmu_path, tmp_path, name, fmi):
-    done = subprocess.run([*VALGRIND, str(host), *_host_command(native_dir, fmu_path, name, fmi, tmp_path)],
+@pytest.mark.parametrize("name, parameters", RUNS)
+def test_host_under_valgrind_has_no_memory_errors_or_leaks(host, native_dir, fmu_path, tmp_path, name, parameters,
+                                                           fmi):
+    done = subprocess.run([*VALGRIND, str(host), *_host_command(native_dir, fmu_path, name, fmi, tmp_path,
+                                                                parameters)],
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr[-3000:]
     assert "ERROR SUMMARY: 0 errors from 0 contexts" in done.stderr

@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..model import DrivenShaftModel
 from .outputs import coupling_outputs
 from .plane_solver import Solution
-from .spec import EXACT, SPEC
+from .spec import CLOSED_FORM, EXACT, SPEC
 
 
 class TripodCouplingModel(DrivenShaftModel):
@@ -25,6 +25,8 @@ class TripodCouplingModel(DrivenShaftModel):
                 and all(isinstance(value, float) for value in saved)):
             raise ValueError(f"the saved warm start of the solver is not {len(Solution._fields)} floats")
         return {"_solution": Solution(*saved)}
+
+    extra_parameter_probes = {"friction_needs_exact": {"mu": 0.05, "kinematics": CLOSED_FORM}}
 
     def extra_parameter_errors(self) -> list[str]:
         if self.mu > 0.0 and self.kinematics != EXACT:

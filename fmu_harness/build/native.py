@@ -5,7 +5,8 @@ others are skipped. For each native model and FMI version this module
 
 * generates ``model_variables.h``/``.c`` from the spec: the variable table (value reference =
   position in the spec, as in the Python FMUs) and the range checks' messages, cut from
-  :meth:`driveline.model.SteppedModel._range_error` itself so the wording exists once;
+  :meth:`driveline.model.SteppedModel._range_error` itself so the wording exists once, and the
+  messages of the model's own checks, cut from them run on the model's ``extra_parameter_probes``;
 * generates the model description with the Python FMUs' own completion
   (:mod:`model_description`: units, display units, min/max, descriptions, model structure), so a
   host can swap one FMU for the other, plus the sources the FMU carries (FMI 2.0 ``SourceFiles``,
@@ -200,9 +201,26 @@ def _relation_entry(spec: ModelSpec, relation: Relation) -> str:
     )
 
 
-def variable_table(spec: ModelSpec, token: str) -> dict[str, str]:
-    """``model_variables.h`` and ``model_variables.c`` of ``spec``."""
+def _extra_message(model: type[SteppedModel], probe: dict[str, float]) -> str:
+    """The message of one of ``model``'s own parameter checks, cut from the check run on its probe
+    (the other parameters at their start values), with the first probed value marked."""
+    spec = model.spec
+    shown = next(iter(probe))
+    values = {v.name: v.start for v in spec.variables} | probe
+    values[shown] = _marked(spec[shown], probe[shown])
+    errors = model.extra_parameter_errors(SimpleNamespace(**values))
+    if len(errors) != 1:
+        raise ValueError(f"{spec.name}: the probe {probe} gives {len(errors)} messages, not one")
+    return f"    {{V_{shown}, {_template(errors[0])}}},"
+
+
+def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
+    """``model_variables.h`` and ``model_variables.c`` of ``model``'s spec and own checks."""
+    spec = model.spec
+    probes = model.extra_parameter_probes
     names = "\n".join(f"    V_{v.name} = {index}," for index, v in enumerate(spec.variables))
+    extra_enum = "" if not probes else "\n/* messages of the model's own checks */\nenum {\n" + "".join(
+        f"    MESSAGE_{name} = {index},\n" for index, name in enumerate(probes)) + "};\n"
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
 #ifndef MODEL_VARIABLES_H
 #define MODEL_VARIABLES_H
@@ -211,17 +229,18 @@ def variable_table(spec: ModelSpec, token: str) -> dict[str, str]:
 #define MODEL_TOKEN {_c_string(token)}
 #define MODEL_VARIABLE_COUNT {len(spec.variables)}
 #define MODEL_RELATION_COUNT {len(spec.relations)}
+#define MODEL_EXTRA_MESSAGE_COUNT {len(probes)}
 
 /* value references */
 enum {{
 {names}
 }};
-
+{extra_enum}
 #endif
 """
     entries = "\n".join(_table_entry(v) for v in spec.variables)
     relations = "\n".join(_relation_entry(spec, r) for r in spec.relations)
-    source = f"""/* Variable table, declared bounds and relations of {spec.name} with their messages, generated
+    source = f"""/* Variable table, declared bounds and relations, own checks' messages of {spec.name}, generated
  * from its spec: do not edit. */
 #include <math.h>
 
@@ -235,6 +254,13 @@ const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
         source += f"""
 const RelationInfo model_relations[MODEL_RELATION_COUNT] = {{
 {relations}
+}};
+"""
+    if probes:
+        extra = "\n".join(_extra_message(model, probe) for probe in probes.values())
+        source += f"""
+const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT] = {{
+{extra}
 }};
 """
     return {"model_variables.h": header, "model_variables.c": source}
@@ -322,11 +348,10 @@ def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
     """Every source file the FMU carries, by name, with the token computed from all of them."""
     files = {source: (NATIVE_SRC / source).read_bytes() for source in (*SHARED_SOURCES, LAYER[fmi])}
     files[model_file.name] = model_file.read_bytes()
-    spec = MODELS[name].spec
-    untokened = variable_table(spec, "")
+    untokened = variable_table(MODELS[name], "")
     digest = hashlib.sha256(repr((name, fmi, sorted(files.items()), sorted(untokened.items()))).encode())
     token = str(uuid.uuid5(TOKEN_NAMESPACE, digest.hexdigest()))
-    files.update({key: text.encode() for key, text in variable_table(spec, token).items()})
+    files.update({key: text.encode() for key, text in variable_table(MODELS[name], token).items()})
     files["token"] = token.encode()
     return files
 

@@ -21,7 +21,7 @@ static void reset_internal(ModelData *data)
 }
 
 /* Outputs at the current phi_in; input_time is the communication point of the inputs. */
-static void evaluate(ModelData *data, double input_time)
+static const char *evaluate(ModelData *data, double input_time)
 {
     double elapsed = HAS_SAMPLE != 0.0 ? input_time - SAMPLE_TIME : 0.0;
     double alpha_in = elapsed > 0.0 ? (VALUE(omega_in) - OMEGA_SAMPLE) / elapsed : 0.0;
@@ -43,20 +43,9 @@ static void evaluate(ModelData *data, double input_time)
                                                                (denominator * denominator);
     VALUE(T_in) = VALUE(T_load) * ratio;
     VALUE(speed_fluctuation) = tan(beta) * sin(beta); /* (C5) */
-}
-
-static const char *start(ModelData *data, double start_time)
-{
-    VALUE(phi_in) = VALUE(phi_in_start);
-    evaluate(data, start_time);
     return NULL;
 }
 
-static const char *advance(ModelData *data, double current_time, double step_size)
-{
-    VALUE(phi_in) = VALUE(phi_in) + VALUE(omega_in) * step_size;
-    evaluate(data, current_time);
-    return NULL;
-}
+DRIVEN_SHAFT_HOOKS(evaluate)
 
 const ModelHooks model_hooks = {reset_internal, NULL, start, advance, NULL, NULL};

@@ -11,13 +11,6 @@
 #include "fmi2Functions.h"
 #include "fmu_instance.h"
 
-/* The instance behind the handle; a NULL handle gets ``result`` (there is no logger to tell). */
-#define INSTANCE(c, result)                                                                                     \
-    Instance *instance = (Instance *)(c);                                                                      \
-    if (instance == NULL) {                                                                                     \
-        return result;                                                                                          \
-    }
-
 static void emit(const Instance *instance, Status status, const char *category, const char *message)
 {
     fmi2CallbackLogger logger = (fmi2CallbackLogger)instance->host_logger;
@@ -60,10 +53,7 @@ void fmi2FreeInstance(fmi2Component c)
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn UNUSED, size_t nCategories,
                                const fmi2String categories[])
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories);
-}
+ON_INSTANCE(fmi2, instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories))
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined UNUSED, fmi2Real tolerance UNUSED,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined UNUSED, fmi2Real stopTime UNUSED)
@@ -86,144 +76,54 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c)
-{
-    INSTANCE(c, fmi2Error)
-    if (!instance_allows(instance, MODE_BIT(MODE_INITIALIZATION), "ExitInitializationMode")) {
-        return fmi2Error;
-    }
-    return (fmi2Status)instance_exit_initialization(instance);
-}
+ON_INSTANCE(fmi2, instance_exit_initialization(instance))
 
 fmi2Status fmi2Terminate(fmi2Component c)
-{
-    INSTANCE(c, fmi2Error)
-    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "Terminate")) {
-        return fmi2Error;
-    }
-    instance->mode = MODE_TERMINATED;
-    return fmi2OK;
-}
+ON_INSTANCE(fmi2, instance_terminate(instance))
 
 fmi2Status fmi2Reset(fmi2Component c)
-{
-    INSTANCE(c, fmi2Error)
-    instance_reset(instance);
-    return fmi2OK;
-}
+ON_INSTANCE(fmi2, instance_reset(instance))
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_get_real(instance, "GetReal", vr, nvr, value);
-}
+ON_INSTANCE(fmi2, instance_get_real(instance, "GetReal", vr, nvr, value))
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[])
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_get_integer(instance, "GetInteger", vr, nvr, value);
-}
+ON_INSTANCE(fmi2, instance_get_integer(instance, "GetInteger", vr, nvr, value))
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[] UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_no_variables_of(instance, "GetBoolean", vr, nvr, "Boolean", 0);
-}
+ON_INSTANCE(fmi2, instance_no_variables_of(instance, "GetBoolean", vr, nvr, "Boolean", 0))
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[] UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_no_variables_of(instance, "GetString", vr, nvr, "String", 0);
-}
+ON_INSTANCE(fmi2, instance_no_variables_of(instance, "GetString", vr, nvr, "String", 0))
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[])
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_set_real(instance, "SetReal", vr, nvr, value);
-}
+ON_INSTANCE(fmi2, instance_set_real(instance, "SetReal", vr, nvr, value))
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[])
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_set_integer(instance, "SetInteger", vr, nvr, value);
-}
+ON_INSTANCE(fmi2, instance_set_integer(instance, "SetInteger", vr, nvr, value))
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Boolean value[] UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_no_variables_of(instance, "SetBoolean", vr, nvr, "Boolean", 1);
-}
+ON_INSTANCE(fmi2, instance_no_variables_of(instance, "SetBoolean", vr, nvr, "Boolean", 1))
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[] UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_no_variables_of(instance, "SetString", vr, nvr, "String", 1);
-}
+ON_INSTANCE(fmi2, instance_no_variables_of(instance, "SetString", vr, nvr, "String", 1))
 
-fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)state_get(instance, "GetFMUstate", FMUstate);
-}
-
-fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)state_set(instance, "SetFMUstate", FMUstate);
-}
-
-fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)state_free(instance, "FreeFMUstate", FMUstate);
-}
-
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate UNUSED, size_t *size)
-{
-    INSTANCE(c, fmi2Error)
-    if (size == NULL) {
-        return (fmi2Status)instance_fail(instance, "fmi2SerializedFMUstateSize: null size pointer",
-                (const char *)NULL);
-    }
-    *size = state_serialized_size();
-    return fmi2OK;
-}
-
-fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)state_serialize(instance, "SerializeFMUstate", FMUstate, serializedState, size);
-}
-
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
-                                   fmi2FMUstate *FMUstate)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)state_deserialize(instance, "DeSerializeFMUstate", serializedState, size, FMUstate);
-}
+FMU_STATE_FUNCTIONS(fmi2, fmi2Component, FMUstate, DeSerialize)
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[] UNUSED,
                                         size_t nUnknown UNUSED,
                                         const fmi2ValueReference vKnown_ref[] UNUSED, size_t nKnown UNUSED,
                                         const fmi2Real dvKnown[] UNUSED, fmi2Real dvUnknown[] UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_unsupported(instance, "GetDirectionalDerivative");
-}
+ON_INSTANCE(fmi2, instance_unsupported(instance, "GetDirectionalDerivative"))
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                        const fmi2Integer order[] UNUSED, const fmi2Real value[] UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_unsupported(instance, "SetRealInputDerivatives");
-}
+ON_INSTANCE(fmi2, instance_unsupported(instance, "SetRealInputDerivatives"))
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                         const fmi2Integer order[] UNUSED, fmi2Real value[] UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_unsupported(instance, "GetRealOutputDerivatives");
-}
+ON_INSTANCE(fmi2, instance_unsupported(instance, "GetRealOutputDerivatives"))
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint UNUSED)
@@ -236,18 +136,12 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)
-{
-    INSTANCE(c, fmi2Error)
-    return (fmi2Status)instance_unsupported(instance, "CancelStep");
-}
+ON_INSTANCE(fmi2, instance_unsupported(instance, "CancelStep"))
 
 /* Only what the standard defines for a finished step is available: the last successful time and
  * fmi2Terminated (always false: a refused step is retryable); any other query gets fmi2Discard. */
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s UNUSED, fmi2Status *value UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return fmi2Discard;
-}
+ON_INSTANCE(fmi2, fmi2Discard)
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
 {
@@ -260,10 +154,7 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s UNUSED, fmi2Integer *value UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return fmi2Discard;
-}
+ON_INSTANCE(fmi2, fmi2Discard)
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
 {
@@ -276,7 +167,4 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s UNUSED, fmi2String *value UNUSED)
-{
-    INSTANCE(c, fmi2Error)
-    return fmi2Discard;
-}
+ON_INSTANCE(fmi2, fmi2Discard)

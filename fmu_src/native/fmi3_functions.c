@@ -13,13 +13,6 @@
 #include "fmi3Functions.h"
 #include "fmu_instance.h"
 
-/* The instance behind the handle; a NULL handle gets ``result`` (there is no logger to tell). */
-#define INSTANCE(c, result)                                                                                     \
-    Instance *instance = (Instance *)(c);                                                                      \
-    if (instance == NULL) {                                                                                     \
-        return result;                                                                                          \
-    }
-
 static void emit(const Instance *instance, Status status, const char *category, const char *message)
 {
     fmi3LogMessageCallback logger = (fmi3LogMessageCallback)instance->host_logger;
@@ -46,10 +39,7 @@ const char *fmi3GetVersion(void)
 
 fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean loggingOn UNUSED, size_t nCategories,
                                const fmi3String categories[])
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories);
-}
+ON_INSTANCE(fmi3, instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories))
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName UNUSED, fmi3String instantiationToken UNUSED,
                                           fmi3String resourcePath UNUSED, fmi3Boolean visible UNUSED,
@@ -116,98 +106,48 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean toleranceDefi
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    if (!instance_allows(instance, MODE_BIT(MODE_INITIALIZATION), "ExitInitializationMode")) {
-        return fmi3Error;
-    }
-    return (fmi3Status)instance_exit_initialization(instance);
-}
+ON_INSTANCE(fmi3, instance_exit_initialization(instance))
 
 fmi3Status fmi3EnterEventMode(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "EnterEventMode");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterEventMode"))
 
 fmi3Status fmi3Terminate(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "Terminate")) {
-        return fmi3Error;
-    }
-    instance->mode = MODE_TERMINATED;
-    return fmi3OK;
-}
+ON_INSTANCE(fmi3, instance_terminate(instance))
 
 fmi3Status fmi3Reset(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    instance_reset(instance);
-    return fmi3OK;
-}
+ON_INSTANCE(fmi3, instance_reset(instance))
 
 /* ---- values ------------------------------------------------------------------------------- */
 
 fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
                           size_t nValues)
-{
-    INSTANCE(c, fmi3Error)
-    if (!counts_match(instance, "GetFloat64", nvr, nValues)) {
-        return fmi3Error;
-    }
-    return (fmi3Status)instance_get_real(instance, "GetFloat64", vr, nvr, values);
-}
+ON_INSTANCE(fmi3, counts_match(instance, "GetFloat64", nvr, nValues)
+                  ? instance_get_real(instance, "GetFloat64", vr, nvr, values) : STATUS_ERROR)
 
 fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
                           size_t nValues)
-{
-    INSTANCE(c, fmi3Error)
-    if (!counts_match(instance, "SetFloat64", nvr, nValues)) {
-        return fmi3Error;
-    }
-    return (fmi3Status)instance_set_real(instance, "SetFloat64", vr, nvr, values);
-}
+ON_INSTANCE(fmi3, counts_match(instance, "SetFloat64", nvr, nValues)
+                  ? instance_set_real(instance, "SetFloat64", vr, nvr, values) : STATUS_ERROR)
 
 fmi3Status fmi3GetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 values[], size_t nValues)
-{
-    INSTANCE(c, fmi3Error)
-    if (!counts_match(instance, "GetInt32", nvr, nValues)) {
-        return fmi3Error;
-    }
-    return (fmi3Status)instance_get_integer(instance, "GetInt32", vr, nvr, values);
-}
+ON_INSTANCE(fmi3, counts_match(instance, "GetInt32", nvr, nValues)
+                  ? instance_get_integer(instance, "GetInt32", vr, nvr, values) : STATUS_ERROR)
 
 fmi3Status fmi3SetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 values[],
                         size_t nValues)
-{
-    INSTANCE(c, fmi3Error)
-    if (!counts_match(instance, "SetInt32", nvr, nValues)) {
-        return fmi3Error;
-    }
-    return (fmi3Status)instance_set_integer(instance, "SetInt32", vr, nvr, values);
-}
+ON_INSTANCE(fmi3, counts_match(instance, "SetInt32", nvr, nValues)
+                  ? instance_set_integer(instance, "SetInt32", vr, nvr, values) : STATUS_ERROR)
 
 /* The types no variable of these models has: every reference is refused by name. */
 #define NO_VARIABLES_OF(Type, CType)                                                                                \
     fmi3Status fmi3Get##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, CType values[] UNUSED,      \
                              size_t nValues)                                                                        \
-    {                                                                                                               \
-        INSTANCE(c, fmi3Error)                                                                                      \
-        if (!counts_match(instance, "Get" #Type, nvr, nValues)) {                                                   \
-            return fmi3Error;                                                                                       \
-        }                                                                                                           \
-        return (fmi3Status)instance_no_variables_of(instance, "Get" #Type, vr, nvr, #Type, 0);                      \
-    }                                                                                                               \
+    ON_INSTANCE(fmi3, counts_match(instance, "Get" #Type, nvr, nValues)                                             \
+                      ? instance_no_variables_of(instance, "Get" #Type, vr, nvr, #Type, 0) : STATUS_ERROR)          \
     fmi3Status fmi3Set##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,                             \
                              const CType values[] UNUSED, size_t nValues)                                           \
-    {                                                                                                               \
-        INSTANCE(c, fmi3Error)                                                                                      \
-        if (!counts_match(instance, "Set" #Type, nvr, nValues)) {                                                   \
-            return fmi3Error;                                                                                       \
-        }                                                                                                           \
-        return (fmi3Status)instance_no_variables_of(instance, "Set" #Type, vr, nvr, #Type, 1);                      \
-    }
+    ON_INSTANCE(fmi3, counts_match(instance, "Set" #Type, nvr, nValues)                                             \
+                      ? instance_no_variables_of(instance, "Set" #Type, vr, nvr, #Type, 1) : STATUS_ERROR)
 
 NO_VARIABLES_OF(Float32, fmi3Float32)
 NO_VARIABLES_OF(Int8, fmi3Int8)
@@ -222,74 +162,21 @@ NO_VARIABLES_OF(String, fmi3String)
 
 fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, size_t valueSizes[] UNUSED,
                          fmi3Binary values[] UNUSED, size_t nValues UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_no_variables_of(instance, "GetBinary", vr, nvr, "Binary", 0);
-}
+ON_INSTANCE(fmi3, instance_no_variables_of(instance, "GetBinary", vr, nvr, "Binary", 0))
 
 fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const size_t valueSizes[] UNUSED,
                          const fmi3Binary values[] UNUSED, size_t nValues UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_no_variables_of(instance, "SetBinary", vr, nvr, "Binary", 1);
-}
+ON_INSTANCE(fmi3, instance_no_variables_of(instance, "SetBinary", vr, nvr, "Binary", 1))
 
 fmi3Status fmi3GetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_no_variables_of(instance, "GetClock", vr, nvr, "Clock", 0);
-}
+ON_INSTANCE(fmi3, instance_no_variables_of(instance, "GetClock", vr, nvr, "Clock", 0))
 
 fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_no_variables_of(instance, "SetClock", vr, nvr, "Clock", 1);
-}
+ON_INSTANCE(fmi3, instance_no_variables_of(instance, "SetClock", vr, nvr, "Clock", 1))
 
 /* ---- FMU state ---------------------------------------------------------------------------- */
 
-fmi3Status fmi3GetFMUState(fmi3Instance c, fmi3FMUState *FMUState)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)state_get(instance, "GetFMUState", FMUState);
-}
-
-fmi3Status fmi3SetFMUState(fmi3Instance c, fmi3FMUState FMUState)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)state_set(instance, "SetFMUState", FMUState);
-}
-
-fmi3Status fmi3FreeFMUState(fmi3Instance c, fmi3FMUState *FMUState)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)state_free(instance, "FreeFMUState", FMUState);
-}
-
-fmi3Status fmi3SerializedFMUStateSize(fmi3Instance c, fmi3FMUState FMUState UNUSED, size_t *size)
-{
-    INSTANCE(c, fmi3Error)
-    if (size == NULL) {
-        return (fmi3Status)instance_fail(instance, "fmi3SerializedFMUStateSize: null size pointer",
-                (const char *)NULL);
-    }
-    *size = state_serialized_size();
-    return fmi3OK;
-}
-
-fmi3Status fmi3SerializeFMUState(fmi3Instance c, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)state_serialize(instance, "SerializeFMUState", FMUState, (char *)serializedState, size);
-}
-
-fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte serializedState[], size_t size,
-                                   fmi3FMUState *FMUState)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)state_deserialize(instance, "DeserializeFMUState", (const char *)serializedState, size,
-                                         FMUState);
-}
+FMU_STATE_FUNCTIONS(fmi3, fmi3Instance, FMUState, Deserialize)
 
 /* ---- stepping ----------------------------------------------------------------------------- */
 
@@ -318,10 +205,7 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance c, fmi3ValueReference valueReference UNUSED,
                                                size_t *nDependencies UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetNumberOfVariableDependencies");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetNumberOfVariableDependencies"))
 
 fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference dependent UNUSED,
                                        size_t elementIndicesOfDependent[] UNUSED,
@@ -329,10 +213,7 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference depend
                                        size_t elementIndicesOfIndependents[] UNUSED,
                                        fmi3DependencyKind dependencyKinds[] UNUSED,
                                        size_t nDependencies UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetVariableDependencies");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetVariableDependencies"))
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[] UNUSED,
                                         size_t nUnknowns UNUSED,
@@ -340,97 +221,58 @@ fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference
                                         const fmi3Float64 seed[] UNUSED,
                                         size_t nSeed UNUSED, fmi3Float64 sensitivity[] UNUSED,
                                         size_t nSensitivity UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetDirectionalDerivative");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetDirectionalDerivative"))
 
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unknowns[] UNUSED,
                                     size_t nUnknowns UNUSED,
                                     const fmi3ValueReference knowns[] UNUSED, size_t nKnowns UNUSED,
                                     const fmi3Float64 seed[] UNUSED,
                                     size_t nSeed UNUSED, fmi3Float64 sensitivity[] UNUSED, size_t nSensitivity UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetAdjointDerivative");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetAdjointDerivative"))
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "EnterConfigurationMode");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterConfigurationMode"))
 
 fmi3Status fmi3ExitConfigurationMode(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "ExitConfigurationMode");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "ExitConfigurationMode"))
 
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                   fmi3Float64 intervals[] UNUSED,
                                   fmi3IntervalQualifier qualifiers[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetIntervalDecimal");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetIntervalDecimal"))
 
 fmi3Status fmi3GetIntervalFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                    fmi3UInt64 counters[] UNUSED,
                                    fmi3UInt64 resolutions[] UNUSED, fmi3IntervalQualifier qualifiers[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetIntervalFraction");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetIntervalFraction"))
 
 fmi3Status fmi3GetShiftDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                fmi3Float64 shifts[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetShiftDecimal");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetShiftDecimal"))
 
 fmi3Status fmi3GetShiftFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                 fmi3UInt64 counters[] UNUSED,
                                 fmi3UInt64 resolutions[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetShiftFraction");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetShiftFraction"))
 
 fmi3Status fmi3SetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                   const fmi3Float64 intervals[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "SetIntervalDecimal");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "SetIntervalDecimal"))
 
 fmi3Status fmi3SetIntervalFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                    const fmi3UInt64 counters[] UNUSED, const fmi3UInt64 resolutions[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "SetIntervalFraction");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "SetIntervalFraction"))
 
 fmi3Status fmi3SetShiftDecimal(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                const fmi3Float64 shifts[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "SetShiftDecimal");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "SetShiftDecimal"))
 
 fmi3Status fmi3SetShiftFraction(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                 const fmi3UInt64 counters[] UNUSED, const fmi3UInt64 resolutions[] UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "SetShiftFraction");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "SetShiftFraction"))
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "EvaluateDiscreteStates");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "EvaluateDiscreteStates"))
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesNeedUpdate UNUSED,
                                     fmi3Boolean *terminateSimulation UNUSED,
@@ -438,94 +280,52 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesN
                                     fmi3Boolean *valuesOfContinuousStatesChanged UNUSED,
                                     fmi3Boolean *nextEventTimeDefined UNUSED,
                                     fmi3Float64 *nextEventTime UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "UpdateDiscreteStates");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "UpdateDiscreteStates"))
 
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "EnterContinuousTimeMode");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterContinuousTimeMode"))
 
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUStatePriorToCurrentPoint UNUSED,
                                        fmi3Boolean *enterEventMode UNUSED, fmi3Boolean *terminateSimulation UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "CompletedIntegratorStep");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "CompletedIntegratorStep"))
 
 fmi3Status fmi3SetTime(fmi3Instance c, fmi3Float64 time UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "SetTime");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "SetTime"))
 
 fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 continuousStates[] UNUSED,
                                    size_t nContinuousStates UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "SetContinuousStates");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "SetContinuousStates"))
 
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance c, fmi3Float64 derivatives[] UNUSED,
                                              size_t nContinuousStates UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetContinuousStateDerivatives");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetContinuousStateDerivatives"))
 
 fmi3Status fmi3GetEventIndicators(fmi3Instance c, fmi3Float64 eventIndicators[] UNUSED,
                                   size_t nEventIndicators UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetEventIndicators");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetEventIndicators"))
 
 fmi3Status fmi3GetContinuousStates(fmi3Instance c, fmi3Float64 continuousStates[] UNUSED,
                                    size_t nContinuousStates UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetContinuousStates");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetContinuousStates"))
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance c, fmi3Float64 nominals[] UNUSED,
                                              size_t nContinuousStates UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetNominalsOfContinuousStates");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetNominalsOfContinuousStates"))
 
 fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance c, size_t *nEventIndicators UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetNumberOfEventIndicators");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetNumberOfEventIndicators"))
 
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance c, size_t *nContinuousStates UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetNumberOfContinuousStates");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetNumberOfContinuousStates"))
 
 fmi3Status fmi3EnterStepMode(fmi3Instance c)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "EnterStepMode");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterStepMode"))
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                     const fmi3Int32 orders[] UNUSED, fmi3Float64 values[] UNUSED,
                                     size_t nValues UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "GetOutputDerivatives");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "GetOutputDerivatives"))
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance c, fmi3ValueReference clockReference UNUSED,
                                       fmi3Float64 activationTime UNUSED)
-{
-    INSTANCE(c, fmi3Error)
-    return (fmi3Status)instance_unsupported(instance, "ActivateModelPartition");
-}
+ON_INSTANCE(fmi3, instance_unsupported(instance, "ActivateModelPartition"))

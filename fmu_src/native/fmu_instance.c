@@ -5,6 +5,7 @@
  */
 #include "fmu_instance.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -44,10 +45,46 @@ void messages_add(Messages *out, const char *first, ...)
     out->count++;
 }
 
+/* The shortest decimal digits that read back as ``magnitude`` (finite, >= 0), the nearest such if
+ * several, and the decimal exponent of the first: what Python's repr() shows. Of the decimals with
+ * a given number of digits only the two around the value can read back as it; printf gives the
+ * nearer one, which misses the other where the doubles' spacing changes (at a power of two). */
+static int shortest_digits(double magnitude, char digits[24], int *exponent)
+{
+    char text[48];
+    unsigned long long mantissa = 0, other;
+    int precision, count, i, shift;
+    for (precision = 1; precision <= 17; precision++) {
+        snprintf(text, sizeof text, "%.*e", precision - 1, magnitude);
+        *exponent = atoi(strchr(text, 'e') + 1);
+        if (strtod(text, NULL) == magnitude) {
+            break;
+        }
+        for (mantissa = 0, i = 0; text[i] != 'e'; i++) {
+            mantissa = text[i] == '.' ? mantissa : 10 * mantissa + (unsigned long long)(text[i] - '0');
+        }
+        other = strtod(text, NULL) < magnitude ? mantissa + 1 : mantissa - 1;
+        shift = *exponent - (precision - 1);
+        snprintf(text, sizeof text, "%llue%d", other, shift);
+        if (strtod(text, NULL) == magnitude) {
+            count = (int)strcspn(text, "e");
+            *exponent = shift + count - 1;
+            memcpy(digits, text, (size_t)count);
+            return count;
+        }
+    }
+    for (count = 0, i = 0; text[i] != 'e'; i++) {
+        if (text[i] != '.') {
+            digits[count++] = text[i];
+        }
+    }
+    return count;
+}
+
 void python_float_repr(double value, char *out, size_t size)
 {
-    char scientific[40], digits[24], text[48], *mark;
-    int precision, exponent, count = 0, used = 0, i;
+    char digits[24], text[48];
+    int exponent, count, used = 0, i;
     if (isnan(value)) {
         snprintf(out, size, "nan");
         return;
@@ -56,20 +93,7 @@ void python_float_repr(double value, char *out, size_t size)
         snprintf(out, size, value < 0 ? "-inf" : "inf");
         return;
     }
-    for (precision = 1; precision < 17; precision++) { /* the fewest digits that read back */
-        snprintf(scientific, sizeof scientific, "%.*e", precision - 1, value);
-        if (strtod(scientific, NULL) == value) {
-            break;
-        }
-    }
-    snprintf(scientific, sizeof scientific, "%.*e", precision - 1, fabs(value));
-    mark = strchr(scientific, 'e');
-    exponent = atoi(mark + 1);
-    for (i = 0; scientific + i < mark; i++) {
-        if (scientific[i] != '.') {
-            digits[count++] = scientific[i];
-        }
-    }
+    count = shortest_digits(fabs(value), digits, &exponent);
     while (count > 1 && digits[count - 1] == '0') {
         count--;
     }
@@ -160,6 +184,14 @@ static double value_of(const ModelData *data, int variable)
                                                          : data->real_value[variable];
 }
 
+#if MODEL_EXTRA_MESSAGE_COUNT > 0
+void messages_add_extra(Messages *out, const ModelData *data, int message)
+{
+    const ExtraMessage *extra = &model_extra_messages[message];
+    add_message(out, &extra->message, &model_variables[extra->variable], value_of(data, extra->variable), 0.0, 0);
+}
+#endif
+
 /* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
 
 /* SteppedModel._range_error for every variable of ``causality``: finite, then the declared bounds. */
@@ -240,8 +272,14 @@ typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_OVERFLOW, SUM_OPPOSITE_INFINITIES
  * overflows, a ValueError when +inf and -inf meet, else a finite or non-finite sum. */
 static SumOutcome fsum_outcome(const double values[], int count)
 {
-    double partials[MODEL_VARIABLE_COUNT + 1], special = 0.0, infinities = 0.0;
+    double partials[MODEL_VARIABLE_COUNT + 1], special = 0.0, infinities = 0.0, magnitude = 0.0;
     int used = 0, i, j;
+    for (i = 0; i < count; i++) {
+        magnitude += fabs(values[i]);
+    }
+    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
+        return SUM_FINITE;
+    }
     for (i = 0; i < count; i++) {
         double x = values[i], original = values[i];
         int kept = 0;
@@ -439,7 +477,7 @@ int instance_allows(Instance *instance, unsigned allowed, const char *function)
 
 /* ---- life cycle ------------------------------------------------------------------------------ */
 
-void instance_reset(Instance *instance)
+Status instance_reset(Instance *instance)
 {
     int i;
     memset(&instance->data, 0, sizeof instance->data);
@@ -452,6 +490,7 @@ void instance_reset(Instance *instance)
     }
     instance->start_time = 0.0;
     instance->mode = MODE_INSTANTIATED;
+    return STATUS_OK;
 }
 
 Status instance_set_start_time(Instance *instance, const char *function, double start_time)
@@ -469,10 +508,22 @@ Status instance_set_start_time(Instance *instance, const char *function, double 
 
 Status instance_exit_initialization(Instance *instance)
 {
+    if (!instance_allows(instance, MODE_BIT(MODE_INITIALIZATION), "ExitInitializationMode")) {
+        return STATUS_ERROR;
+    }
     instance->messages.count = 0;
     initialize(instance, instance->start_time);
     instance_log_messages(instance, STATUS_ERROR); /* as the Python FMUs: logged, and OK */
     instance->mode = MODE_STEP;
+    return STATUS_OK;
+}
+
+Status instance_terminate(Instance *instance)
+{
+    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "Terminate")) {
+        return STATUS_ERROR;
+    }
+    instance->mode = MODE_TERMINATED;
     return STATUS_OK;
 }
 
@@ -661,7 +712,7 @@ Status instance_unsupported(Instance *instance, const char *function)
 /* ---- FMU state ---------------------------------------------------------------------------- */
 
 #define STATE_TAG 0x4452564C53544154ull /* marks a live StoredState */
-#define STATE_FORMAT 1u
+#define STATE_FORMAT 2u /* 2: six internal slots (1 had four) */
 static const char STATE_MAGIC[8] = {'D', 'R', 'V', 'L', 'S', 'T', 'A', 'T'};
 
 struct StoredState {
@@ -754,11 +805,20 @@ static size_t token_length(void)
     return strlen(MODEL_TOKEN);
 }
 
-size_t state_serialized_size(void)
+static size_t state_serialized_size(void)
 {
     return sizeof STATE_MAGIC + 5 * sizeof(uint32_t) + token_length() + 2 * sizeof(int32_t) + 2 * sizeof(double) +
            MODEL_VARIABLE_COUNT * (sizeof(double) + sizeof(int32_t)) + FMU_INTERNAL_SLOTS * sizeof(double) +
            sizeof(uint64_t);
+}
+
+Status state_size(Instance *instance, const char *function, size_t *size)
+{
+    if (size == NULL) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": null size pointer", (const char *)NULL);
+    }
+    *size = state_serialized_size();
+    return STATUS_OK;
 }
 
 static uint64_t checksum(const char *bytes, size_t size)

@@ -24,7 +24,9 @@
 #define FMU_PI 3.14159265358979323846
 #define FMU_MESSAGE_SIZE 400
 #define FMU_MAX_MESSAGES 48
-#define FMU_INTERNAL_SLOTS 4
+/* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
+ * five-number warm start); a new count needs a new STATE_FORMAT (fmu_instance.c). */
+#define FMU_INTERNAL_SLOTS 6
 
 typedef enum { VAR_REAL, VAR_INTEGER } VariableType;
 typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT } Causality;
@@ -68,9 +70,19 @@ typedef struct {
     MessageTemplate message;
 } RelationInfo;
 
+/* A message of one of the model's own checks (SteppedModel.extra_parameter_errors), cut from the
+ * Python check run on its declared probe; it shows the value of ``variable``. */
+typedef struct {
+    int variable;
+    MessageTemplate message;
+} ExtraMessage;
+
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
 #if MODEL_RELATION_COUNT > 0
 extern const RelationInfo model_relations[MODEL_RELATION_COUNT];
+#endif
+#if MODEL_EXTRA_MESSAGE_COUNT > 0
+extern const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT];
 #endif
 
 /* Everything a step may change: the FMU state. Values are indexed by value reference;
@@ -124,13 +136,33 @@ typedef struct {
 
 extern const ModelHooks model_hooks;
 
+/* ``start`` and ``advance`` of a model driven by an input shaft (DrivenShaftModel in
+ * driveline/model.py): phi_in starts at phi_in_start and integrates the held omega_in exactly;
+ * ``evaluate(data, input_time)`` gives the outputs at the current phi_in, input_time being the
+ * communication point at which the host set the inputs. */
+#define DRIVEN_SHAFT_HOOKS(evaluate)                                                                            \
+    static const char *start(ModelData *data, double start_time)                                                \
+    {                                                                                                           \
+        data->real_value[V_phi_in] = data->real_value[V_phi_in_start];                                          \
+        return evaluate(data, start_time);                                                                      \
+    }                                                                                                           \
+    static const char *advance(ModelData *data, double current_time, double step_size)                          \
+    {                                                                                                           \
+        data->real_value[V_phi_in] = data->real_value[V_phi_in] + data->real_value[V_omega_in] * step_size;     \
+        return evaluate(data, current_time);                                                                    \
+    }
+
 /* ---- helpers for model files ---------------------------------------------------------- */
 void messages_add(Messages *out, const char *first, ...);
+#if MODEL_EXTRA_MESSAGE_COUNT > 0
+/* Adds generated message ``message`` (a MESSAGE_* of model_variables.h) with its variable's value. */
+void messages_add_extra(Messages *out, const ModelData *data, int message);
+#endif
 /* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
 void python_float_repr(double value, char *out, size_t size);
 
 /* ---- life cycle (used by the FMI layers) -------------------------------------------- */
-void instance_reset(Instance *instance);
+Status instance_reset(Instance *instance);
 /* Sets the start time of the experiment; Error if it is not finite. */
 Status instance_set_start_time(Instance *instance, const char *function, double start_time);
 void instance_log(Instance *instance, Status status, const char *first, ...);
@@ -138,6 +170,7 @@ void instance_log_messages(Instance *instance, Status status);
 /* Error unless the instance is in one of the modes of ``allowed`` (a bit mask of 1 << mode). */
 int instance_allows(Instance *instance, unsigned allowed, const char *function);
 Status instance_exit_initialization(Instance *instance);
+Status instance_terminate(Instance *instance);
 Status instance_do_step(Instance *instance, double current_time, double step_size);
 Status instance_set_real(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                          const double value[]);
@@ -157,14 +190,48 @@ Status instance_unsupported(Instance *instance, const char *function);
 #define MODE_BIT(mode) (1u << (mode))
 #define ANY_MODE 0x1Fu
 
+/* The instance behind an FMI handle ``c``; a NULL handle gets ``result`` (there is no logger to tell). */
+#define INSTANCE(c, result)                                                                                     \
+    Instance *instance = (Instance *)(c);                                                                      \
+    if (instance == NULL) {                                                                                     \
+        return result;                                                                                          \
+    }
+
+/* A whole FMI function body: ``expression`` (of ``instance``, the instance behind handle ``c``) as
+ * the status of FMI version ``version`` (fmi2 or fmi3); a NULL handle gets the version's Error. */
+#define ON_INSTANCE(version, expression)                                                                        \
+    {                                                                                                           \
+        INSTANCE(c, version##Error)                                                                             \
+        return (version##Status)(expression);                                                                  \
+    }
+
 /* ---- FMU state ------------------------------------------------------------------------ */
 typedef struct StoredState StoredState;
 Status state_get(Instance *instance, const char *function, void **state);
 Status state_set(Instance *instance, const char *function, const void *state);
 Status state_free(Instance *instance, const char *function, void **state);
-size_t state_serialized_size(void);
+Status state_size(Instance *instance, const char *function, size_t *size);
 Status state_serialize(Instance *instance, const char *function, const void *state, char *bytes, size_t size);
 Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state);
+
+/* The six FMU state functions of FMI ``version`` (fmi2 or fmi3) over state_*: ``Handle`` is the
+ * version's instance type, ``State`` and ``Deserialize`` its spellings of those words (FMI 2.0:
+ * FMUstate, DeSerialize; FMI 3.0: FMUState, Deserialize). */
+#define FMU_STATE_FUNCTIONS(version, Handle, State, Deserialize)                                               \
+    version##Status version##Get##State(Handle c, version##State *state)                                       \
+    ON_INSTANCE(version, state_get(instance, "Get" #State, state))                                             \
+    version##Status version##Set##State(Handle c, version##State state)                                        \
+    ON_INSTANCE(version, state_set(instance, "Set" #State, state))                                             \
+    version##Status version##Free##State(Handle c, version##State *state)                                      \
+    ON_INSTANCE(version, state_free(instance, "Free" #State, state))                                           \
+    version##Status version##Serialized##State##Size(Handle c, version##State state UNUSED, size_t *size)      \
+    ON_INSTANCE(version, state_size(instance, "Serialized" #State "Size", size))                               \
+    version##Status version##Serialize##State(Handle c, version##State state, version##Byte bytes[],           \
+                                              size_t size)                                                     \
+    ON_INSTANCE(version, state_serialize(instance, "Serialize" #State, state, (char *)bytes, size))            \
+    version##Status version##Deserialize##State(Handle c, const version##Byte bytes[], size_t size,            \
+                                                version##State *state)                                         \
+    ON_INSTANCE(version, state_deserialize(instance, #Deserialize #State, (const char *)bytes, size, state))
 
 Instance *instance_new(const char *name, const char *token, const char *fmi_prefix, Emit emit,
                        void (*host_logger)(void), void *host_environment);

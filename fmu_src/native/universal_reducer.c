@@ -10,7 +10,7 @@
 #define INTEGER(name) (data->int_value[V_##name])
 
 typedef struct {
-    double M_E, M_C1, M_B, M_C; /* eqs 19-21 */
+    double moment_E, moment_C1, moment_B, moment_C; /* eqs 19-21 (math.h may define M_E) */
     double sigma, tau, sigma_eq;
 } Loads;
 
@@ -20,18 +20,18 @@ static void connecting_shaft(const ModelData *data, double M_in, double i, doubl
 {
     double half = 0.5 * VALUE(alpha), M_out = i * M_in, F_B = M_in / VALUE(e);
     double F_t = 2.0 * M_out / (VALUE(module) * INTEGER(z1)), shared, section_modulus;
-    loads->M_E = 2.0 * F_B * VALUE(L1) * sin(half);
-    loads->M_C1 = F_t * 0.5 * VALUE(module) * INTEGER(z2);
-    shared = loads->M_E / (2.0 * sin(half));
-    loads->M_B = loads->M_C1 / sin(VALUE(alpha)) + shared;
-    loads->M_C = loads->M_C1 * cos(VALUE(alpha)) / sin(VALUE(alpha)) + shared;
+    loads->moment_E = 2.0 * F_B * VALUE(L1) * sin(half);
+    loads->moment_C1 = F_t * 0.5 * VALUE(module) * INTEGER(z2);
+    shared = loads->moment_E / (2.0 * sin(half));
+    loads->moment_B = loads->moment_C1 / sin(VALUE(alpha)) + shared;
+    loads->moment_C = loads->moment_C1 * cos(VALUE(alpha)) / sin(VALUE(alpha)) + shared;
     section_modulus = 0.25 * FMU_PI * cube;
-    loads->sigma = loads->M_C / section_modulus;
-    loads->tau = loads->M_C1 / (2.0 * section_modulus);
+    loads->sigma = loads->moment_C / section_modulus;
+    loads->tau = loads->moment_C1 / (2.0 * section_modulus);
     loads->sigma_eq = sqrt(loads->sigma * loads->sigma + 4.0 * (loads->tau * loads->tau));
 }
 
-static const char *evaluate(ModelData *data)
+static const char *evaluate(ModelData *data, double input_time UNUSED)
 {
     double i = (double)INTEGER(z1) / (double)(INTEGER(z1) - INTEGER(z2)); /* eqs 4, 17 */
     double half = 0.5 * VALUE(alpha), cube = pow(VALUE(r_shaft), 3.0);
@@ -45,10 +45,10 @@ static const char *evaluate(ModelData *data)
     VALUE(T_in) = VALUE(T_load) / i;                                        /* eq 18, lossless */
     VALUE(s_b) = VALUE(e) * cos(half) / sin(half) * sin(VALUE(phi_in)); /* eq 15 */
     connecting_shaft(data, VALUE(T_in), i, cube, &loads);
-    VALUE(M_E) = loads.M_E;
-    VALUE(M_C1) = loads.M_C1;
-    VALUE(M_B) = loads.M_B;
-    VALUE(M_C) = loads.M_C;
+    VALUE(M_E) = loads.moment_E;
+    VALUE(M_C1) = loads.moment_C1;
+    VALUE(M_B) = loads.moment_B;
+    VALUE(M_C) = loads.moment_C;
     VALUE(sigma_bend) = loads.sigma;
     VALUE(tau_torsion) = loads.tau;
     VALUE(sigma_eq) = loads.sigma_eq;
@@ -61,18 +61,6 @@ static const char *evaluate(ModelData *data)
     return NULL;
 }
 
-static const char *start(ModelData *data, double start_time)
-{
-    (void)start_time;
-    VALUE(phi_in) = VALUE(phi_in_start);
-    return evaluate(data);
-}
-
-static const char *advance(ModelData *data, double current_time, double step_size)
-{
-    (void)current_time;
-    VALUE(phi_in) = VALUE(phi_in) + VALUE(omega_in) * step_size;
-    return evaluate(data);
-}
+DRIVEN_SHAFT_HOOKS(evaluate)
 
 const ModelHooks model_hooks = {NULL, NULL, start, advance, NULL, NULL};
