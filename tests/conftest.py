@@ -44,6 +44,7 @@ SLOW = (
     "tests/test_critical_speeds_model.py::test_fmu_follows_a_speed_ramp_and_refuses_overspeed",
     "tests/test_critical_speeds_model.py::test_shipped_layout_by_name",
     "tests/test_host_environment.py",
+    "tests/test_interop.py",
     "tests/test_packaging.py::test_different_fmus_alive_at_once_in_one_host",
     "tests/test_packaging.py::test_markers_follow_what_the_tests_use",
     "tests/test_robustness.py",
