@@ -10,7 +10,8 @@ and two co-simulation engines, libcosimpy and ecospy, that run the model's stand
 (:mod:`fmu_harness.scenario`): a run passes if every compared output stays within
 :data:`TOLERANCE` times the output's largest magnitude of the fmpy run of the model's Python FMU
 (same FMI version) at t_1 ... t_N, for a native FMU too: the equivalence a host relies on when
-it swaps one for the other. Each engine run is a subprocess of its own, so an importer that crashes fails one cell only.
+it swaps one for the other. Each engine run is a subprocess of its own, so an importer that
+crashes fails one cell only.
 """
 
 from __future__ import annotations
@@ -123,7 +124,7 @@ def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcom
     name = read_model_description(str(fmu)).modelName
     case = scenario(MODELS[name].spec)
     with FmuInstance(reference or fmu) as instance:
-        reference = standard_run(instance, case.outputs)
+        expected = standard_run(instance, case.outputs)
 
     def inputs(time: float) -> dict[str, float]:
         return {f"m.{k}": v for k, v in case.input_values(time).items()}
@@ -134,7 +135,7 @@ def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcom
     finally:
         session.close()
     deviation = max(
-        float(np.abs(result[:, i + 1] - reference[n][1:]).max() / (np.abs(reference[n]).max() or 1.0))
+        float(np.abs(result[:, i + 1] - expected[n][1:]).max() / (np.abs(expected[n]).max() or 1.0))
         for i, n in enumerate(case.outputs)
     )
     if deviation <= TOLERANCE:

@@ -160,9 +160,10 @@ def native_components(system: System, natives: Path | None) -> list[str]:
 def component_fmus(system: System, models: Path, natives: Path | None = None) -> dict[str, Path]:
     """``{model: FMI 2.0 FMU}`` for the models of ``system``: the native FMUs below ``natives``
     (``native/``) of :func:`native_components`, the Python FMUs in ``models`` of the others."""
-    ported = native_components(system, natives)
-    return {c.model: native.fmu_path(natives, c.model) if natives and c.model in ported else fmu_path(models, c.model)
-            for c in system.components}
+    fmus = {c.model: fmu_path(models, c.model) for c in system.components}
+    if natives is not None:
+        fmus |= {model: native.fmu_path(natives, model) for model in native_components(system, natives)}
+    return fmus
 
 
 def ssp_path(system: System, models: Path, natives: Path | None = None) -> Path:
