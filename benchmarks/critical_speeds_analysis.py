@@ -1,13 +1,18 @@
 """Cost of one structural analysis of the CriticalSpeeds model (what a tunable change costs).
 
 ``python -m benchmarks.critical_speeds_analysis``: ``driveline.rotor.model.analyse`` (three
-critical speeds, Campbell table of 41 speeds, order resonances 1, 2, 3 up to twice
-``omega_max = 1500 rad/s``) for the one-piece tube of the FMU's defaults, the shipped two-piece
-example, and the same tube cut into 20 equal segments with a joint mass at every node (the
-issue's targets: 50 ms and 0.5 s). Best of three runs after a warm-up.
+critical speeds and the finite-element check, Campbell table from 41 speeds, order resonances
+1, 2, 3 up to twice ``omega_max = 1500 rad/s``) and its parts, for the one-piece tube of the
+FMU's defaults, the shipped two-piece example, and the same tube cut into 20 equal segments with
+a joint mass at every node (the issue's targets: 50 ms and 0.5 s). A change of ``orders`` costs
+the resonances alone, one of ``omega_max`` the whirl table and the resonances. CPU time of the
+process, best of five runs after a warm-up.
 """
 
 from __future__ import annotations
+
+import os
+import time
 
 from benchmarks.timing import best_of, machine
 from driveline.rotor import (
@@ -19,7 +24,7 @@ from driveline.rotor import (
     load_driveline,
     one_piece_shaft,
 )
-from driveline.rotor.model import analyse
+from driveline.rotor.model import analyse, analyse_structure, resonances, whirl_table
 
 ORDERS, OMEGA_MAX = (1, 2, 3), 1500.0
 
@@ -42,14 +47,20 @@ CASES = {
 
 
 def main() -> None:
-    print(f"One structural analysis of CriticalSpeeds; {machine()}")
-    print("| driveline | analysis [s] | target [s] |")
-    print("|---|---|---|")
+    print(f"One structural analysis of CriticalSpeeds (CPU time [s]); {machine()}, "
+          f"load average {os.getloadavg()[0]:.1f}")
+    print("| driveline | structure | whirl table | resonances | analysis | target |")
+    print("|---|---|---|---|---|---|")
     for name, (build, target) in CASES.items():
         driveline = build()
-        analyse(driveline, ORDERS, OMEGA_MAX)  # warm-up
-        seconds = best_of(lambda: analyse(driveline, ORDERS, OMEGA_MAX), repeats=3)
-        print(f"| {name} | {seconds:.3f} | {'' if target is None else target} |")
+        structure = analyse_structure(driveline)
+        parts = (lambda: analyse_structure(driveline), lambda: whirl_table(structure, OMEGA_MAX),
+                 lambda: resonances(driveline, ORDERS, OMEGA_MAX), lambda: analyse(driveline, ORDERS, OMEGA_MAX))
+        seconds = []
+        for part in parts:
+            part()  # warm-up
+            seconds.append(best_of(part, repeats=5, clock=time.process_time))
+        print(f"| {name} | " + " | ".join(f"{s:.3f}" for s in seconds) + f" | {'' if target is None else target} |")
 
 
 if __name__ == "__main__":

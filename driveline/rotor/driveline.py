@@ -7,7 +7,7 @@ All frequencies and speeds are in rad/s. ``spin`` is the shaft speed ``Omega``,
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import transfer
 from .elements import Bearing, ConcentratedMass, EndCondition, PointElement, ShaftSegment
-from .roots import RootSearchReport, find_roots
+from .roots import find_roots_batch
 
 FloatArray = NDArray[np.float64]
 Whirl = Literal["forward", "backward"]
@@ -167,17 +167,19 @@ class Driveline:
         return transfer.mode_shape(self._chain, w, spin, points_per_segment)
 
     # -- grids and searches ----------------------------------------------------
-    def _grid(self, x_max: float, ratio: float) -> FloatArray:
+    def _grid(self, x_max: float, ratio: float, coarse: bool = False) -> FloatArray:
         """Search grid on ``(0, x_max]`` for the frequency ``ratio * x``.
 
         Uniform in the bare-shaft phase ``theta = kappa sqrt(|ratio| x)``. The shaft
         alone has one root per pi of ``theta``; each translational or rotational
         degree of freedom of a concentrated mass can add one root anywhere, and the
         8x8 (anisotropic) determinant holds both whirl senses. The grid has
-        ``POINTS_PER_ROOT`` points per expected root on that count, plus a
-        logarithmic lead-in for heavy masses on soft bearings near zero.
+        ``POINTS_PER_ROOT`` points per expected root on that count (``coarse``: per
+        bare-shaft root only), plus a logarithmic lead-in for heavy masses on soft
+        bearings near zero.
         """
         extra = sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
+        extra = 0 if coarse else extra
         per_pi = POINTS_PER_ROOT * (1 + extra) * (1 if self.is_isotropic else 2)
         kappa = self._kappa * math.sqrt(abs(ratio))
         theta_max = kappa * math.sqrt(x_max)
@@ -189,20 +191,43 @@ class Driveline:
         lead = np.geomspace(x[0] * 1e-4, x[0], 9)[:-1]
         return np.concatenate([lead, x])
 
-    def _search(self, g, ratio: float, n: int | None, x_max: float | None, limit: float) -> RootSearchReport:
-        """Roots of ``g(x)`` on (0, x_max], or the first ``n`` roots below ``limit``."""
+    def _line_roots(
+        self, lines: FloatArray, n: int | None, x_max: float | None, limit: float, coarse: ArrayLike = False
+    ) -> list[FloatArray]:
+        """Roots ``x > 0`` of ``f(w, spin)`` along every line ``(w, spin) = (w_k x, s_k x + o_k)``, one
+        batch search: all up to ``x_max`` (on ``coarse`` grids where asked, per line), or the first
+        ``n`` below ``limit``.
+
+        ``lines`` is (m, 3) with rows ``(w_k, s_k, o_k)``; each line's grid follows its ``|w_k|``.
+        A line short of ``n`` roots is searched again over a 4x wider range, until ``limit``.
+        """
+        lines = np.asarray(lines, dtype=float)
+        ratios = np.abs(lines[:, 0])
         if x_max is not None:
-            return find_roots(g, self._grid(x_max, ratio))
+            kinds = list(zip(ratios, np.broadcast_to(coarse, ratios.shape)))
+            grid = {kind: self._grid(x_max, *kind) for kind in set(kinds)}
+            return self._batch(lines, [grid[kind] for kind in kinds])
         if n is None or isinstance(n, bool) or not float(n).is_integer() or n < 1:
             raise ValueError(f"n must be a positive integer (or give an upper limit), got {n!r}")
         limit = _speed("limit", limit, positive=True)
-        kappa = self._kappa * math.sqrt(abs(ratio))
-        x_hi = min(((n + 2) * math.pi / kappa) ** 2, limit)
-        while True:
-            rep = find_roots(g, self._grid(x_hi, ratio), max_roots=n)
-            if rep.roots.size >= n or x_hi >= limit:
-                return rep
-            x_hi = min(4.0 * x_hi, limit)
+        x_hi = np.minimum(((n + 2) * math.pi / (self._kappa * np.sqrt(ratios))) ** 2, limit)
+        out: list[FloatArray] = [np.empty(0)] * len(lines)
+        todo = np.arange(len(lines))
+        while todo.size:
+            found = self._batch(lines[todo], [self._grid(x_hi[j], ratios[j]) for j in todo])
+            short = []
+            for j, roots in zip(todo, found):
+                out[j] = roots[:n]
+                if roots.size < n and x_hi[j] < limit:
+                    short.append(j)
+            todo = np.array(short, dtype=np.intp)
+            x_hi[todo] = np.minimum(4.0 * x_hi[todo], limit)
+        return out
+
+    def _batch(self, lines: FloatArray, grids: list[FloatArray]) -> list[FloatArray]:
+        """Roots of the determinant along ``lines`` (rows ``(w_k, s_k, o_k)``) on their ``grids``, one batch."""
+        w_k, s_k, o_k = lines.T
+        return find_roots_batch(lambda x, k: self.determinant(w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
 
     @staticmethod
     def _take(roots: FloatArray, n: int | None) -> FloatArray:
@@ -210,38 +235,44 @@ class Driveline:
 
     def _roots_by_whirl(
         self,
-        point: Callable[[ArrayLike], tuple[ArrayLike, ArrayLike]],
-        ratio: float,
+        cases: ArrayLike,
         whirls: tuple[Whirl, ...],
         n: int | None,
         x_max: float | None,
         limit: float,
-    ) -> dict[Whirl, FloatArray]:
-        """Roots ``x`` of ``f(w, spin) = 0`` with ``(w, spin) = point(x)``, ``w = ratio * x``, per whirl sense.
+    ) -> list[dict[Whirl, FloatArray]]:
+        """Roots ``x`` of ``f(+-w, spin) = 0`` on every case ``(w, spin) = (r x, s x + o)``, per whirl sense.
 
-        Isotropic: forward at ``+w``, backward at ``-w``, each searched alone.
+        ``cases`` is (m, 3) with rows ``(r > 0, s, o)``, all searched in one batch.
+        Isotropic: forward at ``+w``, backward at ``-w``, each a line of its own.
         Anisotropic: the ``2 n`` lowest roots at ``w > 0``, each classified by its
         mode shape (forward when the forward component carries more than half of
-        ``sum |U|^2``).
+        ``sum |U|^2``). At standstill (``s = o = 0``) the modes are planar: both
+        senses get the same roots, searched once.
         """
-        if self.is_isotropic:
-            out = {}
-            for wh in whirls:
-                sign = 1.0 if wh == "forward" else -1.0
-
-                def g(x: ArrayLike, sign: float = sign) -> FloatArray:
-                    w, spin = point(x)
-                    return self.determinant(sign * w, spin)
-
-                out[wh] = self._take(self._search(g, ratio, n, x_max, limit).roots, n)
-            return out
-        nn = None if n is None else 2 * n
-        roots = self._search(lambda x: self.determinant(*point(x)), ratio, nn, x_max, limit).roots
-        senses = []
-        for x in roots:
-            w, spin = point(x)
-            senses.append("forward" if self.mode_shape(w, spin, 4).forward_fraction >= 0.5 else "backward")
-        return {wh: self._take(np.array([x for x, s in zip(roots, senses) if s == wh]), n) for wh in whirls}
+        cases = np.atleast_2d(np.asarray(cases, dtype=float))
+        standstill = (cases[:, 1] == 0.0) & (cases[:, 2] == 0.0)
+        senses = (1.0, -1.0) if self.is_isotropic else (1.0,)
+        lines, owner = [], []
+        for c, case in enumerate(cases):
+            for sign in senses[: 1 if standstill[c] else None]:
+                lines.append((sign * case[0], case[1], case[2]))
+                owner.append((c, sign))
+        nn = n if n is None or self.is_isotropic else 2 * n
+        found = dict(zip(owner, self._line_roots(np.array(lines), nn, x_max, limit)))
+        out = []
+        for c, (r, s, o) in enumerate(cases):
+            if standstill[c]:
+                roots = self._take(found[c, 1.0], n)
+                out.append({wh: roots for wh in whirls})
+            elif self.is_isotropic:
+                out.append({wh: self._take(found[c, 1.0 if wh == "forward" else -1.0], n) for wh in whirls})
+            else:
+                roots = found[c, 1.0]
+                kinds = np.array(["forward" if self.mode_shape(r * x, s * x + o, 4).forward_fraction >= 0.5
+                                  else "backward" for x in roots], dtype=object)
+                out.append({wh: self._take(roots[kinds == wh], n) for wh in whirls})
+        return out
 
     # -- results -----------------------------------------------------------------
     def whirl_frequencies(
@@ -259,24 +290,20 @@ class Driveline:
         if w_max is not None:
             w_max = _speed("w_max", w_max, positive=True)
             n = None
-        if spin == 0.0:  # planar modes at standstill: report each in both lists
-            nn = n if n is None or self.is_isotropic else 2 * n
-            roots = self._take(self._search(lambda x: self.determinant(x, 0.0), 1.0, nn, w_max, limit).roots, n)
-            return WhirlFrequencies(spin, roots, roots)
-        found = self._roots_by_whirl(lambda x: (x, spin), 1.0, ("forward", "backward"), n, w_max, limit)
+        found = self._roots_by_whirl([(1.0, 0.0, spin)], ("forward", "backward"), n, w_max, limit)[0]
         return WhirlFrequencies(spin, found["forward"], found["backward"])
 
     def campbell(self, spins: ArrayLike, n_modes: int = 4) -> CampbellDiagram:
-        """Campbell diagram data: first ``n_modes`` forward and backward frequencies per speed."""
+        """Campbell diagram data: first ``n_modes`` forward and backward frequencies per speed, one batch search."""
         sp = np.atleast_1d(np.asarray(spins, dtype=float))
         for v in sp:
             _speed("spins", v)
         fwd = np.full((sp.size, n_modes), np.nan)
         bwd = np.full((sp.size, n_modes), np.nan)
-        for i, s in enumerate(sp):
-            r = self.whirl_frequencies(s, n_modes)
-            fwd[i, : r.forward.size] = r.forward[:n_modes]
-            bwd[i, : r.backward.size] = r.backward[:n_modes]
+        cases = np.column_stack([np.ones(sp.size), np.zeros(sp.size), sp])
+        for i, r in enumerate(self._roots_by_whirl(cases, ("forward", "backward"), n_modes, None, SEARCH_LIMIT)):
+            fwd[i, : r["forward"].size] = r["forward"]
+            bwd[i, : r["backward"].size] = r["backward"]
         return CampbellDiagram(sp, fwd, bwd)
 
     def order_resonances(
@@ -300,13 +327,16 @@ class Driveline:
         for wh in whirls:
             if wh not in ("forward", "backward"):
                 raise ValueError(f"whirl must be 'forward' or 'backward', got {wh!r}")
-        out: list[OrderResonance] = []
+        ks = []
         for k in orders:
             if isinstance(k, bool) or int(k) != k or k < 1:
                 raise ValueError(f"order must be a positive integer, got {k!r}")
-            k = int(k)
-            found = self._roots_by_whirl(lambda x, k=k: (k * x, x), k, whirls, n, spin_max, limit)
-            out.extend(OrderResonance(k, wh, float(x)) for wh in whirls for x in found[wh])
+            ks.append(int(k))
+        if not ks:
+            return []
+        cases = [(k, 1.0, 0.0) for k in ks]
+        found = self._roots_by_whirl(cases, whirls, n, spin_max, limit)
+        out = [OrderResonance(k, wh, float(x)) for k, roots in zip(ks, found) for wh in whirls for x in roots[wh]]
         return sorted(out, key=lambda r: (r.spin, r.order))
 
     def critical_speeds(

@@ -1,23 +1,27 @@
 """Time stepping of the critical-speed monitor: analysis when the structure changes, lookups per step.
 
-The driveline is analysed once per distinct set of structural parameters (at
-initialisation, and again when a tunable parameter changes): critical speeds, order
-resonances up to twice ``omega_max``, and a Campbell table of the first two forward
-and backward whirl frequencies, interpolated per step with cubic splines.
+The driveline is analysed at initialisation and again when a tunable parameter changes,
+and only in the parts the change affects: the structure (critical speeds and the
+finite-element check) per set of structural parameters, the Campbell table of the first
+two forward and backward whirl frequencies (each branch a cubic spline, sorted per step)
+per ``omega_max`` as well, and the order resonances up to twice ``omega_max`` per
+``orders`` as well. ``band`` only enters the per-step lookup.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 from scipy.linalg import eigh
 
 from ..model import SteppedModel
 from . import fem
+from .campbell import WhirlTable, whirl_branches
 from .driveline import SEARCH_LIMIT, Driveline, OrderResonance
 from .elements import Bearing
 from .loader import example_path, load_driveline, one_piece_shaft
@@ -26,24 +30,34 @@ from .spec import SPEC
 #: Orders watched at most, and the highest order (joints excite low orders: 1, 2, 3, 6).
 MAX_ORDERS = 16
 MAX_ORDER = 100
-#: Work limit of one analysis in units of :func:`searched_modes`: the default shaft needs 28 (0.6 s),
-#: a 10 m tube 197 (2 s); 250 keeps one analysis below about 5 s on one core.
+#: Work limit of one analysis in units of :func:`searched_modes`: the default shaft needs 17 (0.04 s CPU),
+#: a 10 m solid tube 146 (0.1 s); even 573 took 0.5 s, so 250 keeps one analysis well below a second.
 MAX_SEARCHED_MODES = 250.0
 #: Finite-element plausibility check of every analysis (:func:`implausibility`).
 FE_ELEMENTS = 4
 PLAUSIBLE_DEVIATION = 0.02
-CAMPBELL_POINTS = 41  # spline knots over [0, omega_max]; measured interpolation error <= 1e-12 relative
+CAMPBELL_POINTS = 41  # spline knots over [0, omega_max], more where a branch bends (campbell.SPLINE_RTOL)
 WHIRL_MODES = 2
 SHAFT_PARAMETERS = ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", "Jp_joint", "Jd_joint", "k_bearing")
 
 
 @dataclass(frozen=True)
-class Analysis:
-    """Everything a step needs, for one set of structural parameters."""
+class Structure:
+    """What depends on the structural parameters alone (not on ``orders``, ``band``, ``omega_max``)."""
 
+    driveline: Driveline
     critical_speeds: tuple[float, float, float]  # missing ones (beyond the search limit) = the limit
     critical_speed_count: int
-    whirl: CubicSpline  # |omega| -> (forward_1, forward_2, backward_1, backward_2)
+    natural: np.ndarray  # natural frequencies of the finite-element check [rad/s]
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Everything a step needs, for one set of structural parameters, orders and ``omega_max``."""
+
+    critical_speeds: tuple[float, float, float]
+    critical_speed_count: int
+    whirl: WhirlTable  # |omega| -> (forward_1, forward_2, backward_1, backward_2)
     resonances: tuple[OrderResonance, ...]
 
     @property
@@ -75,12 +89,9 @@ def searched_modes(driveline: Driveline, orders: tuple[int, ...], omega_max: flo
     return kappa * scanned / math.pi * (len(driveline.segments) + 1)
 
 
-def implausibility(driveline: Driveline, analysis: Analysis) -> str | None:
-    """Why ``analysis`` cannot be right, or None: its first two whirl frequencies at standstill
-    must each match a natural frequency of the independent finite-element model (:mod:`.fem`,
-    FE_ELEMENTS cubic elements per segment, within PLAUSIBLE_DEVIATION; a bearing with
-    kxx != kyy is checked in both planes). Catches roots that rounding invents when stiffness
-    or mass terms differ by more than double precision resolves."""
+def natural_frequencies(driveline: Driveline) -> np.ndarray:
+    """Natural frequencies at standstill of the independent finite-element model (:mod:`.fem`,
+    FE_ELEMENTS cubic elements per segment; a bearing with kxx != kyy in both planes)."""
     planes = {tuple(b.kxx for b in driveline.bearings), tuple(b.k_yy for b in driveline.bearings)}
     natural = []
     for stiffnesses in planes:
@@ -88,13 +99,20 @@ def implausibility(driveline: Driveline, analysis: Analysis) -> str | None:
         plane = replace(driveline, bearings=bearings)
         stiffness, mass, _, _ = fem.assemble(plane, FE_ELEMENTS)
         natural.extend(np.sqrt(np.abs(eigh(stiffness, mass, eigvals_only=True))))
-    natural = np.array(natural)
-    for whirl in analysis.whirl(0.0)[:WHIRL_MODES]:
-        if whirl >= SEARCH_LIMIT:  # beyond the search (a short, stiff shaft): nothing to check
+    return np.array(natural)
+
+
+def implausibility(natural: np.ndarray, whirl: WhirlTable) -> str | None:
+    """Why the whirl table cannot be right, or None: its first two whirl frequencies at standstill
+    must each match one of the ``natural`` frequencies of the finite-element check within
+    PLAUSIBLE_DEVIATION. Catches roots that rounding invents when stiffness or mass terms
+    differ by more than double precision resolves."""
+    for frequency in whirl(0.0)[:WHIRL_MODES]:
+        if frequency >= SEARCH_LIMIT:  # beyond the search (a short, stiff shaft): nothing to check
             continue
-        nearest = natural[np.argmin(np.abs(natural - whirl))]
-        if not abs(nearest - whirl) <= PLAUSIBLE_DEVIATION * whirl:
-            return (f"the whirl frequency {whirl:.6g} rad/s at standstill has no counterpart in the "
+        nearest = natural[np.argmin(np.abs(natural - frequency))]
+        if not abs(nearest - frequency) <= PLAUSIBLE_DEVIATION * frequency:
+            return (f"the whirl frequency {frequency:.6g} rad/s at standstill has no counterpart in the "
                     f"finite-element check (nearest {nearest:.6g} rad/s): the parameters are beyond "
                     "what double precision resolves")
     return None
@@ -107,53 +125,87 @@ def build_driveline(layout: str, shaft: dict[str, float]) -> Driveline:
     return load_driveline(Path(layout) if layout.lower().endswith(".toml") else example_path(layout))
 
 
-def analyse(driveline: Driveline, orders: tuple[int, ...], omega_max: float) -> Analysis:
-    """Critical speeds, Campbell table and order resonances; what lies beyond the search limit
-    (a short, stiff shaft) reads as the limit, and the critical speeds found are counted."""
+def analyse_structure(driveline: Driveline) -> Structure:
+    """Critical speeds (what lies beyond the search limit, a short, stiff shaft, reads as the
+    limit; the critical speeds found are counted) and the finite-element check's frequencies."""
     found = driveline.critical_speeds(3)
     critical = tuple(float(w) for w in found) + (SEARCH_LIMIT,) * (3 - found.size)
+    return Structure(driveline, critical, found.size, natural_frequencies(driveline))
+
+
+def whirl_table(structure: Structure, omega_max: float) -> WhirlTable:
+    """The Campbell table of the first two forward and backward whirl frequencies over
+    ``[0, omega_max]`` (``CAMPBELL_POINTS`` speeds, more where a branch bends); ValueError
+    when the finite-element check disagrees (:func:`implausibility`)."""
     spins = np.linspace(0.0, omega_max, CAMPBELL_POINTS)
-    campbell = driveline.campbell(spins, WHIRL_MODES)
-    table = np.hstack([campbell.forward, campbell.backward])
-    table = np.where(np.isfinite(table), table, SEARCH_LIMIT)  # a mode beyond the limit reads as the limit
-    resonances = driveline.order_resonances(orders, ("forward", "backward"), None, 2.0 * omega_max)
-    if not resonances:
-        resonances = driveline.order_resonances(orders, ("forward",), 1)
-    if not resonances:
+    table = WhirlTable(whirl_branches(structure.driveline, spins, WHIRL_MODES), WHIRL_MODES, SEARCH_LIMIT)
+    reason = implausibility(structure.natural, table)
+    if reason is not None:
+        raise ValueError(reason)
+    return table
+
+
+def resonances(driveline: Driveline, orders: tuple[int, ...], omega_max: float) -> tuple[OrderResonance, ...]:
+    """Every order resonance of ``orders`` (forward and backward whirl) up to ``2 omega_max``, or the
+    first forward one of each order when none lies there."""
+    found = driveline.order_resonances(orders, ("forward", "backward"), None, 2.0 * omega_max)
+    if not found:
+        found = driveline.order_resonances(orders, ("forward",), 1)
+    if not found:
         raise ValueError(f"no order resonance of the orders {orders} below the search limit {SEARCH_LIMIT:g} rad/s")
-    return Analysis(critical, found.size, CubicSpline(spins, table), tuple(resonances))
+    return tuple(found)
+
+
+def analyse(driveline: Driveline, orders: tuple[int, ...], omega_max: float) -> Analysis:
+    """The whole analysis of one driveline: :func:`analyse_structure`, :func:`whirl_table`, :func:`resonances`."""
+    structure = analyse_structure(driveline)
+    return Analysis(structure.critical_speeds, structure.critical_speed_count, whirl_table(structure, omega_max),
+                    resonances(driveline, orders, omega_max))
 
 
 class CriticalSpeedsModel(SteppedModel):
     """The ``CriticalSpeeds`` co-simulation model."""
 
     spec = SPEC
-    derived_state = ("_analysis", "_analysed_for", "_resonance_speeds")
+    derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts")
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None
         self._analysed_for: tuple | None = None
+        self._parts: dict[str, tuple[tuple, object]] = {}
 
     def _structure(self) -> tuple:
-        return (self.layout, self.orders, self.omega_max, *(getattr(self, n) for n in SHAFT_PARAMETERS))
+        return (self.layout, *(getattr(self, n) for n in SHAFT_PARAMETERS))
+
+    def _part(self, name: str, key: tuple, compute: Callable[[], Any]) -> Any:
+        """The part ``name`` of the analysis for ``key``: kept from the last analysis if its key is unchanged."""
+        kept = self._parts.get(name)
+        if kept is None or kept[0] != key:
+            self._parts[name] = (key, compute())
+        return self._parts[name][1]
 
     def extra_parameter_errors(self) -> list[str]:
-        """Build and analyse the driveline (only when the structure changed): its errors are the checks."""
-        key = self._structure()
+        """Analyse what a changed parameter affects: the structure (critical speeds, finite-element
+        check) only when a structural parameter changed, the Campbell table when it or ``omega_max``
+        did, the order resonances when either or ``orders`` did. Its errors are the checks."""
+        shape = self._structure()
+        key = (shape, self.orders, self.omega_max)
         if key == self._analysed_for:
             return []
         try:
             orders = parse_orders(self.orders)
-            driveline = build_driveline(self.layout, {n: getattr(self, n) for n in SHAFT_PARAMETERS})
+            driveline = self._part("driveline", shape, lambda: build_driveline(
+                self.layout, {n: getattr(self, n) for n in SHAFT_PARAMETERS}))
             work = searched_modes(driveline, orders, self.omega_max)
             if not work <= MAX_SEARCHED_MODES:
                 raise ValueError(f"the analysis would scan {work:.3g} shaft modes, more than the "
                                  f"{MAX_SEARCHED_MODES:.0f} accepted (shorter or stiffer shaft, fewer or "
                                  "lower orders, or a smaller omega_max)")
-            analysis = analyse(driveline, orders, self.omega_max)
-            reason = implausibility(driveline, analysis)
-            if reason is not None:
-                raise ValueError(reason)
+            structure = self._part("structure", shape, lambda: analyse_structure(driveline))
+            whirl = self._part("whirl", (shape, self.omega_max), lambda: whirl_table(structure, self.omega_max))
+            found = self._part("resonances", (shape, orders, self.omega_max),
+                               lambda: resonances(driveline, orders, self.omega_max))
+            analysis = Analysis(structure.critical_speeds, structure.critical_speed_count, whirl, found)
             self._analysis = analysis
             self._resonance_speeds = analysis.resonance_speeds
         except (ValueError, ArithmeticError) as error:  # e.g. a diameter of 1e300 overflows

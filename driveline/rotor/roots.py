@@ -1,41 +1,45 @@
-"""Bracketing root search on a vectorised scalar function (seed Sec. 8, Fig. 3, reworked).
+"""Bracketing root search on vectorised scalar functions (seed Sec. 8, Fig. 3, reworked).
 
 The seed scans ``f`` with a step of 1/100-1/1000 of the interval and refines a
-sign change by repeatedly dividing the step by ten. Here:
+sign change by repeatedly dividing the step by ten. Here every stage runs on all
+functions of a batch (e.g. the determinant at 41 spin speeds) and on all their
+brackets at once, one vectorised call per stage:
 
-1. ``f`` is evaluated on the whole grid in one vectorised call;
-2. every sign change is refined with :func:`scipy.optimize.brentq`; a bracket whose
-   converged point has a larger ``|f|`` than both its ends is a pole, not a root,
-   and is rejected (the scaled determinant has no poles; the guard is for any
-   other ``f`` passed in);
+1. ``f`` is evaluated on every grid in one call;
+2. all sign changes are refined together by a vectorised Chandrupatla iteration
+   (inverse quadratic interpolation where it is safe, bisection otherwise) to the
+   root tolerance; a bracket whose converged point has a larger ``|f|`` than both
+   its ends is a pole, not a root, and is rejected (the scaled determinant has no
+   poles; the guard is for any other ``f`` passed in);
 3. a pair of roots closer than the grid step shows no sign change, only a dip of
    ``|f|``: every grid point where ``|f|`` has a local minimum without a sign change
    and at most ``DIP_RATIO`` of its larger neighbour is re-scanned on a finer
-   sub-grid, recursively; a dip that persists down to the root tolerance is
-   reported as a double root.
+   sub-grid, all dips of one level together, recursively; a dip that persists
+   down to the root tolerance is reported as a double root.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
 VecFunc = Callable[[FloatArray], FloatArray]
+#: ``f(x, k)``: the ``k[i]``-th function of a batch at ``x[i]``.
+BatchFunc = Callable[[FloatArray, IntArray], FloatArray]
 
 SUBGRID = 24
 #: Sub-grid levels: each divides the dip's width by SUBGRID / 2 (16 levels span 1e17).
 MAX_DEPTH = 16
-#: Vectorised bracket narrowing before brentq (points per round, rounds).
-SHRINK_POINTS = 15
-SHRINK_ROUNDS = 2
 #: A dip is examined when |f| there is below this fraction of its larger neighbour
 #: (an isolated hidden pair gives at most 1/9; neighbouring roots raise that).
 DIP_RATIO = 0.9
+#: Iteration cap of the bracket refinement (it halves a bracket at least every third step).
+MAX_ITERATIONS = 200
 
 
 @dataclass(frozen=True)
@@ -49,25 +53,22 @@ class RootSearchReport:
     double_roots: int
 
 
-class _Counter:
-    def __init__(self, f: VecFunc) -> None:
-        self.f = f
-        self.n = 0
+@dataclass(frozen=True)
+class BatchReport:
+    """Roots of every function of a batch (ascending, double roots twice) and search diagnostics."""
 
-    def __call__(self, x: FloatArray) -> FloatArray:
-        self.n += x.size
-        return self.f(x)
-
-    def scalar(self, x: float) -> float:
-        return float(self(np.array([x]))[0])
+    roots: list[FloatArray]
+    evaluations: int
+    rejected_poles: int
+    dips_examined: int
+    double_roots: int
 
 
 def find_roots(
     f: VecFunc,
     grid: FloatArray,
     xtol: float = 1e-12,
-    rtol: float = 1e-13,
-    values: FloatArray | None = None,
+    rtol: float = 4.0 * np.finfo(float).eps,
     max_roots: int | None = None,
 ) -> RootSearchReport:
     """Roots of ``f`` inside ``[grid[0], grid[-1]]``, ascending, double roots twice.
@@ -75,117 +76,140 @@ def find_roots(
     ``f`` maps an array of abscissae to an array of values and must be continuous.
     ``grid`` must be strictly increasing; its spacing should resolve the function's
     oscillation (a few points between neighbouring roots). With ``max_roots`` only
-    the lowest ``max_roots`` roots are refined (brackets are processed in order).
+    the lowest ``max_roots`` roots are returned.
     """
-    x = np.asarray(grid, dtype=float)
-    if x.ndim != 1 or x.size < 3 or np.any(np.diff(x) <= 0):
-        raise ValueError("grid must be a strictly increasing 1-D array of at least 3 points")
-    fc = _Counter(f)
-    fx = fc(x) if values is None else np.asarray(values, float)
-    st = _State(fc, xtol, rtol, max_roots)
-    _scan(st, x, fx, 0)
-    roots = np.array(sorted(st.roots))
-    if max_roots is not None:
-        roots = roots[:max_roots]
-    return RootSearchReport(roots, fc.n, st.poles, st.dips, st.doubles)
+    rep = find_roots_batch(lambda x, k: f(x), [grid], xtol, rtol)
+    roots = rep.roots[0] if max_roots is None else rep.roots[0][:max_roots]
+    return RootSearchReport(roots, rep.evaluations, rep.rejected_poles, rep.dips_examined, rep.double_roots)
 
 
-class _State:
-    def __init__(self, fc: _Counter, xtol: float, rtol: float, max_roots: int | None) -> None:
-        self.fc, self.xtol, self.rtol, self.max_roots = fc, xtol, rtol, max_roots
-        self.roots: list[float] = []
-        self.poles = self.dips = self.doubles = 0
+def find_roots_batch(
+    f: BatchFunc, grids: Sequence[FloatArray], xtol: float = 1e-12, rtol: float = 4.0 * np.finfo(float).eps
+) -> BatchReport:
+    """Roots of the functions ``f(., k)`` inside ``[grids[k][0], grids[k][-1]]``, all searched together.
 
-    @property
-    def full(self) -> bool:
-        return self.max_roots is not None and len(self.roots) >= self.max_roots
-
-
-def _refine(st: _State, a: float, b: float, fa: float, fb: float) -> float | None:
-    if fa == 0.0:
-        return a
-    if fb == 0.0:
-        return b
-
-    # The ends keep their grid values, so that round-off between a batched and a
-    # scalar evaluation cannot flip the sign of a near-zero end value.
-    def g(t: float) -> float:
-        return fa if t == a else fb if t == b else st.fc.scalar(t)
-
-    r = brentq(g, a, b, xtol=st.xtol, rtol=st.rtol, maxiter=200)
-    fr = abs(st.fc.scalar(r))
-    if fr > max(abs(fa), abs(fb)):  # |f| grew towards the 'root': a pole
-        st.poles += 1
-        return None
-    return float(r)
-
-
-def _shrink(st: _State, a: FloatArray, b: FloatArray, fa: FloatArray, fb: FloatArray):
-    """Narrow all brackets at once: ``SHRINK_ROUNDS`` vectorised sub-scans of ``SHRINK_POINTS``.
-
-    Cuts the scalar ``brentq`` calls, whose per-call overhead dominates, by about half.
+    Each grid must be strictly increasing and resolve its function's oscillation. A
+    root is located to ``xtol + rtol |x|`` or better (the interpolation converges
+    superlinearly, so usually to round-off).
     """
-    t = np.linspace(0.0, 1.0, SHRINK_POINTS + 2)[1:-1]
-    for _ in range(SHRINK_ROUNDS):
-        xs = a[:, None] + (b - a)[:, None] * t[None, :]
-        fs = st.fc(xs.ravel()).reshape(xs.shape)
-        X = np.concatenate([a[:, None], xs, b[:, None]], axis=1)
-        F = np.concatenate([fa[:, None], fs, fb[:, None]], axis=1)
-        k = np.argmax(np.sign(F[:, :-1]) * np.sign(F[:, 1:]) <= 0, axis=1)
-        rows = np.arange(a.size)
-        a, b, fa, fb = X[rows, k], X[rows, k + 1], F[rows, k], F[rows, k + 1]
-    return a, b, fa, fb
+    xs = [np.asarray(g, dtype=float) for g in grids]
+    for x in xs:
+        if x.ndim != 1 or x.size < 3 or np.any(np.diff(x) <= 0):
+            raise ValueError("grid must be a strictly increasing 1-D array of at least 3 points")
+    st = _Search(f, xtol, rtol)
+    x = np.concatenate(xs)
+    line = np.repeat(np.arange(len(xs)), [g.size for g in xs])
+    seq, fx = line.copy(), st.eval(x, line)
+    depth = 0
+    while x.size:
+        x, fx, line, seq = _scan(st, x, fx, line, seq, depth)
+        depth += 1
+    _refine(st)
+    found = np.concatenate(st.roots)
+    where = np.concatenate(st.lines)
+    roots = [np.sort(found[where == k]) for k in range(len(xs))]
+    return BatchReport(roots, st.evaluations, st.poles, st.dips, st.doubles)
 
 
-def _scan(st: _State, x: FloatArray, fx: FloatArray, depth: int) -> None:
+class _Search:
+    """Evaluation counter, collected brackets and roots of one batch search."""
+
+    def __init__(self, f: BatchFunc, xtol: float, rtol: float) -> None:
+        self.f, self.xtol, self.rtol = f, xtol, rtol
+        self.evaluations = self.poles = self.dips = self.doubles = 0
+        self.roots: list[FloatArray] = [np.empty(0)]
+        self.lines: list[IntArray] = [np.empty(0, dtype=np.intp)]
+        self.brackets: list[tuple[FloatArray, ...]] = []
+
+    def eval(self, x: FloatArray, line: IntArray) -> FloatArray:
+        self.evaluations += x.size
+        return np.asarray(self.f(x, line), dtype=float) if x.size else np.empty(0)
+
+    def found(self, x: FloatArray, line: IntArray) -> None:
+        self.roots.append(x)
+        self.lines.append(line)
+
+
+def _scan(st: _Search, x: FloatArray, fx: FloatArray, line: IntArray, seq: IntArray, depth: int):
+    """Record the zeros and sign changes of the sampled sequences ``seq`` (``x`` ascending in each);
+    return the sub-grids of their dips, sampled, for the next level."""
     s = np.sign(fx)
     af = np.abs(fx)
     zero = s == 0.0
-    change = np.zeros(x.size, dtype=bool)
-    change[:-1] = s[:-1] * s[1:] < 0
-    idx = np.flatnonzero(change)
-    if st.max_roots is not None:
-        idx = idx[: max(st.max_roots - len(st.roots), 0)]
-    lo, hi, flo, fhi = x[:-1].copy(), x[1:].copy(), fx[:-1].copy(), fx[1:].copy()
-    if idx.size:
-        lo[idx], hi[idx], flo[idx], fhi[idx] = _shrink(st, lo[idx], hi[idx], flo[idx], fhi[idx])
+    st.found(x[zero], line[zero])
+    linked = seq[:-1] == seq[1:]
+    change = np.flatnonzero(linked & (s[:-1] * s[1:] < 0))
+    st.brackets.append((x[change], x[change + 1], fx[change], fx[change + 1], line[change]))
     # dips: local minima of |f| with the same sign on both neighbours
-    dip = np.zeros(x.size, dtype=bool)
+    inner = linked[:-1] & linked[1:]
     same = (s[:-2] == s[1:-1]) & (s[1:-1] == s[2:]) & ~zero[1:-1]
-    dip[1:-1] = same & (af[1:-1] < af[:-2]) & (af[1:-1] <= af[2:])
+    dip = inner & same & (af[1:-1] < af[:-2]) & (af[1:-1] <= af[2:])
     # A hidden pair r1 ~ r2 makes f ~ c (x - r1)(x - r2): the nearest grid point then
     # has at most 1/9 of its larger neighbour's |f|. Shallow dips (round-off ripple
     # on a flat stretch) are not examined.
-    dip[1:-1] &= af[1:-1] <= DIP_RATIO * np.maximum(af[:-2], af[2:])
-    for i in np.flatnonzero(zero | change | dip):
-        if st.full:
-            return
-        # an exact zero on the grid counts once
-        if zero[i] and (not st.roots or abs(st.roots[-1] - x[i]) > st.xtol):
-            st.roots.append(float(x[i]))
-        if change[i]:
-            r = _refine(st, lo[i], hi[i], flo[i], fhi[i])
-            if r is not None:
-                st.roots.append(r)
-        if dip[i]:
-            _dip(st, x, fx, s, af, i, depth)
+    dip &= af[1:-1] <= DIP_RATIO * np.maximum(af[:-2], af[2:])
+    i = np.flatnonzero(dip) + 1
+    st.dips += i.size
+    lo, hi, mid = x[i - 1], x[i + 1], x[i]
+    # a dip that persists down to the root tolerance is a double root
+    double = (hi - lo <= 2.0 * (st.xtol + st.rtol * np.abs(mid))) | (depth >= MAX_DEPTH)
+    st.doubles += int(np.count_nonzero(double))
+    st.found(np.repeat(mid[double], 2), np.repeat(line[i][double], 2))
+    i, lo, hi = i[~double], lo[~double], hi[~double]
+    t = np.linspace(0.0, 1.0, SUBGRID + 1)
+    sub = lo[:, None] + (hi - lo)[:, None] * t[None, 1:-1]
+    sub_line = np.repeat(line[i], SUBGRID - 1)
+    fsub = st.eval(sub.ravel(), sub_line).reshape(sub.shape)
+    xs = np.concatenate([lo[:, None], sub, hi[:, None]], axis=1)
+    fs = np.concatenate([fx[i - 1][:, None], fsub, fx[i + 1][:, None]], axis=1)
+    width = SUBGRID + 1
+    return xs.ravel(), fs.ravel(), np.repeat(line[i], width), np.repeat(np.arange(i.size), width)
 
 
-def _dip(st: _State, x: FloatArray, fx: FloatArray, s: FloatArray, af: FloatArray, i: int, depth: int) -> None:
-    """Look for a close pair of roots (or a double root) around the dip at ``x[i]``.
+def _refine(st: _Search) -> None:
+    """Refine every collected bracket together (Chandrupatla's method, vectorised).
 
-    The dip's neighbourhood is re-scanned on a finer sub-grid; a smooth non-zero
-    minimum stops the recursion by itself (its sub-grid values level out and fail
-    the ``DIP_RATIO`` test), a hidden pair is split by a sub-grid point, and a dip
-    that persists down to the root tolerance is a double root.
+    Each step puts the new point at a fraction ``t`` of the bracket from its newest
+    end: inverse quadratic interpolation through the last three points when the
+    function is monotone enough there (Chandrupatla's test), else ``t = 1/2``; ``t``
+    is kept at least the tolerance away from either end. A bracket is done when
+    narrower than twice the tolerance or on an exact zero; its root is the end with
+    the smaller ``|f|``. A converged point with ``|f|`` above both initial ends is a pole.
     """
-    st.dips += 1
-    lo, hi = x[i - 1], x[i + 1]
-    if hi - lo <= 2.0 * (st.xtol + st.rtol * abs(x[i])) or depth >= MAX_DEPTH:
-        st.doubles += 1
-        st.roots.extend([float(x[i]), float(x[i])])
-        return
-    sub = np.linspace(lo, hi, SUBGRID + 1)[1:-1]
-    xs = np.concatenate([[lo], sub, [hi]])
-    fs = np.concatenate([[fx[i - 1]], st.fc(sub), [fx[i + 1]]])
-    _scan(st, xs, fs, depth + 1)
+    a, b, fa, fb, line = (np.concatenate(parts) for parts in zip(*st.brackets))
+    f_ends = np.maximum(np.abs(fa), np.abs(fb))
+    c, fc = b.copy(), fb.copy()
+    t = np.full(a.size, 0.5)
+    root = np.empty(a.size)
+    f_root = np.empty(a.size)
+    active = np.arange(a.size)
+    for _ in range(MAX_ITERATIONS):
+        if not active.size:
+            break
+        xt = a + t * (b - a)
+        ft = st.eval(xt, line[active])
+        keep = np.sign(ft) == np.sign(fa)  # the new point replaces a; else b becomes a
+        c, fc = np.where(keep, a, b), np.where(keep, fa, fb)
+        b, fb = np.where(keep, b, a), np.where(keep, fb, fa)
+        a, fa = xt, ft
+        best_a = np.abs(fa) < np.abs(fb)
+        xm, fm = np.where(best_a, a, b), np.where(best_a, fa, fb)
+        with np.errstate(divide="ignore"):
+            tlim = (st.xtol + st.rtol * np.abs(xm)) / np.abs(b - a)
+        done = (fm == 0.0) | (tlim > 0.5)
+        root[active[done]], f_root[active[done]] = xm[done], fm[done]
+        go = ~done
+        a, b, c, fa, fb, fc, tlim = a[go], b[go], c[go], fa[go], fb[go], fc[go], tlim[go]
+        active = active[go]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xi = (a - b) / (c - b)
+            phi = (fa - fb) / (fc - fb)
+            quadratic = (phi * phi < xi) & ((1.0 - phi) ** 2 < 1.0 - xi)
+            t = np.where(quadratic, fa / (fb - fa) * fc / (fb - fc)
+                         + (c - a) / (b - a) * fa / (fc - fa) * fb / (fc - fb), 0.5)
+        t = np.clip(np.where(np.isfinite(t), t, 0.5), tlim, 1.0 - tlim)
+    else:
+        raise ArithmeticError("root refinement did not converge")
+    pole = np.abs(f_root) > f_ends  # |f| grew towards the 'root': a pole
+    st.poles += int(np.count_nonzero(pole))
+    st.found(root[~pole], line[~pole])

@@ -162,6 +162,7 @@ def _propagate(
     Y = _initial(chain, w.size)
     log_scale = np.zeros(w.size)
     sign = np.ones(w.size)
+    fields: dict[tuple[ShaftSegment, float], FloatArray] = {}
     z = 0.0
     if trace is not None:
         trace.add(z, Y)
@@ -190,7 +191,10 @@ def _propagate(
             growth = np.maximum(growth, backward)
         p = max(_segment_pieces(growth, seg.length), min_pieces)
         piece = seg.length / p
-        H = (seg.transfer_matrix_pair(w, spin, piece) if pair else seg.transfer_matrix(w, spin, piece)) * ratio
+        H = fields.get((seg, piece))
+        if H is None:  # equal segments (a tube cut into equal pieces) share one field matrix
+            H = (seg.transfer_matrix_pair(w, spin, piece) if pair else seg.transfer_matrix(w, spin, piece)) * ratio
+            fields[seg, piece] = H
         for _ in range(p):
             Y, R = _orthonormalize(H @ Y)
             log_scale += _log_det(R)
