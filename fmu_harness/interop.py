@@ -1,14 +1,17 @@
-"""Interoperability matrix: every built FMU (FMI 2.0 and 3.0) in every importer.
+"""Interoperability matrix: every built FMU (Python and native, FMI 2.0 and 3.0) in every importer.
 
 Usage: ``python -m fmu_harness.interop [--models models] [--update docs/interoperability.md]``
 after ``python build_fmu.py``. Prints the matrix as markdown; with ``--update`` it also rewrites
-that page's ``interop`` section (:mod:`fmu_harness.doc_sections`).
+that page's ``interop`` section (:mod:`fmu_harness.doc_sections`). The native FMUs are those
+under ``models/native/`` (:mod:`fmu_harness.build.native`).
 
 Importers: ``fmpy validate``, ``fmutool -input X.fmu -check`` (FMU Manipulation Toolbox),
 and two co-simulation engines, libcosimpy and ecospy, that run the model's standard scenario
 (:mod:`fmu_harness.scenario`): a run passes if every compared output stays within
-:data:`TOLERANCE` times the output's largest magnitude of the fmpy run at t_1 ... t_N. Each
-engine run is a subprocess of its own, so an importer that crashes fails one cell only.
+:data:`TOLERANCE` times the output's largest magnitude of the fmpy run of the model's Python FMU
+(same FMI version) at t_1 ... t_N, for a native FMU too: the equivalence a host relies on when
+it swaps one for the other. Each engine run is a subprocess of its own, so an importer that
+crashes fails one cell only.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from fmpy.validation import validate_fmu
 from driveline.catalog import MODELS
 
 from . import importers
+from .build import fmu_path, native
 from .doc_sections import replace_section
 from .runner import FmuInstance
 from .scenario import scenario, standard_run
@@ -38,6 +42,7 @@ from .scenario import scenario, standard_run
 TOLERANCE = 1e-9
 RESULT = "interop result: "
 Status = Literal["pass", "fail", "unsupported", "unavailable"]
+Family = Literal["Python", "native"]
 
 
 @dataclass(frozen=True)
@@ -49,13 +54,24 @@ class Outcome:
 
 @dataclass(frozen=True)
 class Importer:
-    """One column of the matrix: how to check an FMU, which FMI versions it takes, and why not others."""
+    """One column of the matrix: how to check an FMU (given the Python FMU its runs are compared
+    with), which FMI versions it takes, and why not others."""
 
     name: str
     package: str
     versions: tuple[str, ...]
-    check: Callable[[Path], Outcome]
+    check: Callable[[Path, Path], Outcome]
     unsupported: str = ""
+
+
+@dataclass(frozen=True)
+class Fmu:
+    """One row of the matrix: a built FMU, its family and the Python FMU of the same model and
+    FMI version whose fmpy run the engines' runs must match."""
+
+    family: Family
+    path: Path
+    reference: Path
 
 
 def _fmpy_validate(fmu: Path) -> Outcome:
@@ -73,11 +89,11 @@ def _fmutool_check(fmu: Path) -> Outcome:
     return Outcome("pass")
 
 
-def _engine(name: str) -> Callable[[Path], Outcome]:
+def _engine(name: str) -> Callable[[Path, Path], Outcome]:
     """Run the scenario in engine ``name`` in a subprocess (see :func:`simulate_in`)."""
 
-    def check(fmu: Path) -> Outcome:
-        command = [sys.executable, "-m", "fmu_harness.interop", "--worker", name, str(fmu)]
+    def check(fmu: Path, reference: Path) -> Outcome:
+        command = [sys.executable, "-m", "fmu_harness.interop", "--worker", name, str(fmu), str(reference)]
         done = subprocess.run(command, capture_output=True, text=True, timeout=300, cwd=Path(__file__).parents[1])
         if done.returncode:
             last = (done.stderr.strip().splitlines() or [""])[-1]
@@ -92,8 +108,8 @@ def _engine(name: str) -> Callable[[Path], Outcome]:
 
 
 IMPORTERS = (
-    Importer("fmpy validate", "fmpy", ("2.0", "3.0"), _fmpy_validate),
-    Importer("fmutool -check", "fmu_manipulation_toolbox", ("2.0", "3.0"), _fmutool_check),
+    Importer("fmpy validate", "fmpy", ("2.0", "3.0"), lambda fmu, reference: _fmpy_validate(fmu)),
+    Importer("fmutool -check", "fmu_manipulation_toolbox", ("2.0", "3.0"), lambda fmu, reference: _fmutool_check(fmu)),
     Importer("libcosimpy", "libcosimpy", ("2.0",), _engine("libcosimpy"),
              "libcosim loads FMI 1.0 and 2.0 only: it logs 'Unsupported FMI version' and libcosimpy "
              "0.0.6 then crashes the host (segmentation fault)"),
@@ -102,12 +118,13 @@ IMPORTERS = (
 SESSIONS = {"libcosimpy": importers.cosim_session, "ecospy": importers.ecos_session}
 
 
-def simulate_in(engine: str, fmu: Path) -> Outcome:
-    """The model's standard scenario in ``engine`` against fmpy (runs inside the worker)."""
+def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcome:
+    """The model's standard scenario in ``engine`` against fmpy's run of ``reference`` (default:
+    ``fmu`` itself; runs inside the worker)."""
     name = read_model_description(str(fmu)).modelName
     case = scenario(MODELS[name].spec)
-    with FmuInstance(fmu) as instance:
-        reference = standard_run(instance, case.outputs)
+    with FmuInstance(reference or fmu) as instance:
+        expected = standard_run(instance, case.outputs)
 
     def inputs(time: float) -> dict[str, float]:
         return {f"m.{k}": v for k, v in case.input_values(time).items()}
@@ -118,41 +135,54 @@ def simulate_in(engine: str, fmu: Path) -> Outcome:
     finally:
         session.close()
     deviation = max(
-        float(np.abs(result[:, i + 1] - reference[n][1:]).max() / (np.abs(reference[n]).max() or 1.0))
+        float(np.abs(result[:, i + 1] - expected[n][1:]).max() / (np.abs(expected[n]).max() or 1.0))
         for i, n in enumerate(case.outputs)
     )
     if deviation <= TOLERANCE:
         return Outcome("pass", deviation=deviation)
-    return Outcome("fail", f"largest relative deviation from fmpy {deviation:.3g} > {TOLERANCE:g}", deviation)
+    return Outcome("fail", f"largest relative deviation from the fmpy run {deviation:.3g} > {TOLERANCE:g}", deviation)
 
 
-def outcome(importer: Importer, fmu: Path) -> Outcome:
+def outcome(importer: Importer, fmu: Path, reference: Path | None = None) -> Outcome:
+    """``fmu`` in ``importer``, engine runs compared with fmpy's run of ``reference`` (default: ``fmu``)."""
     version = read_model_description(str(fmu)).fmiVersion
     if version not in importer.versions:
         return Outcome("unsupported", importer.unsupported)
     if importlib.util.find_spec(importer.package) is None:
         return Outcome("unavailable", f"{importer.package} is not installed (pip install '.[interop]')")
     try:
-        return importer.check(fmu)
+        return importer.check(fmu, reference or fmu)
     except (OSError, subprocess.SubprocessError) as error:
         return Outcome("fail", f"{type(error).__name__}: {error}")
 
 
-def fmus(models: Path) -> list[Path]:
-    """The catalog's FMUs in ``models`` (FMI 2.0) and ``models/fmi3`` (FMI 3.0)."""
-    return [path for name in MODELS for path in (models / f"{name}.fmu", models / "fmi3" / f"{name}.fmu") if path.exists()]
+def fmus(models: Path, natives: Path | None = None) -> list[Fmu]:
+    """The catalog's built FMUs, per model the Python ones in ``models`` (FMI 2.0) and
+    ``models/fmi3`` (FMI 3.0), then the native ones in ``native/`` and ``native/fmi3/`` below
+    ``natives`` (default: ``models``); a native FMU counts when its Python reference is built."""
+    found = []
+    for name in MODELS:
+        references = {fmi: fmu_path(models, name, fmi) for fmi in ("2", "3")}
+        found += [Fmu("Python", path, path) for path in references.values()]
+        found += [Fmu("native", native.fmu_path(natives or models, name, fmi), path) for fmi, path in references.items()]
+    return [fmu for fmu in found if fmu.path.exists() and fmu.reference.exists()]
 
 
-def matrix(models: Path) -> dict[tuple[str, str], dict[str, Outcome]]:
-    """``{(model, FMI version): {importer: outcome}}`` for every FMU in ``models``."""
-    table = {}
-    for fmu in fmus(models):
-        description = read_model_description(str(fmu))
-        table[description.modelName, description.fmiVersion] = {i.name: outcome(i, fmu) for i in IMPORTERS}
+Table = dict[tuple[str, Family, str], dict[str, Outcome]]
+
+
+def matrix(models: Path, natives: Path | None = None) -> Table:
+    """``{(model, family, FMI version): {importer: outcome}}`` for every FMU of :func:`fmus`."""
+    table: Table = {}
+    for fmu in fmus(models, natives):
+        description = read_model_description(str(fmu.path))
+        table[description.modelName, fmu.family, description.fmiVersion] = {
+            i.name: outcome(i, fmu.path, fmu.reference) for i in IMPORTERS
+        }
     return table
 
 
-def markdown(table: dict[tuple[str, str], dict[str, Outcome]]) -> str:
+def markdown(table: Table) -> str:
     """The matrix with one footnote per distinct reason."""
     notes: list[str] = []
 
@@ -164,11 +194,11 @@ def markdown(table: dict[tuple[str, str], dict[str, Outcome]]) -> str:
         return f"{result.status} [{notes.index(result.reason) + 1}]"
 
     lines = [
-        "| FMU | FMI | " + " | ".join(i.name for i in IMPORTERS) + " |",
-        "|---|---|" + "---|" * len(IMPORTERS),
+        "| FMU | family | FMI | " + " | ".join(i.name for i in IMPORTERS) + " |",
+        "|---|---|---|" + "---|" * len(IMPORTERS),
     ]
-    for (name, version), row in table.items():
-        lines.append(f"| `{name}` | {version} | " + " | ".join(cell(row[i.name]) for i in IMPORTERS) + " |")
+    for (name, family, version), row in table.items():
+        lines.append(f"| `{name}` | {family} | {version} | " + " | ".join(cell(row[i.name]) for i in IMPORTERS) + " |")
     lines += [""] + [f"[{n}] {reason}" for n, reason in enumerate(notes, start=1)]
     return "\n".join(lines).rstrip()
 
@@ -177,18 +207,19 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--update", type=Path, metavar="PAGE", help="markdown page whose matrix section to regenerate")
-    parser.add_argument("--worker", nargs=2, metavar=("ENGINE", "FMU"), help=argparse.SUPPRESS)
+    parser.add_argument("--worker", nargs=3, metavar=("ENGINE", "FMU", "REFERENCE"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
-        print(RESULT + json.dumps(asdict(simulate_in(args.worker[0], Path(args.worker[1])))), flush=True)
+        engine, fmu, reference = args.worker
+        print(RESULT + json.dumps(asdict(simulate_in(engine, Path(fmu), Path(reference)))), flush=True)
         return
     table = matrix(args.models)
     text = markdown(table)
     print(text)
-    for (name, version), row in table.items():
+    for (name, family, version), row in table.items():
         for importer, result in row.items():
             if result.deviation is not None:
-                print(f"{name} FMI {version} {importer}: largest relative deviation {result.deviation:.3g}", file=sys.stderr)
+                print(f"{name} {family} FMI {version} {importer}: largest relative deviation {result.deviation:.3g}", file=sys.stderr)
     if args.update:
         replace_section(args.update, "interop", text)
 

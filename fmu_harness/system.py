@@ -1,8 +1,11 @@
 """The driveline system: an SSP 1.0 package of the project's FMUs and a small fmpy master for it.
 
-Usage: ``python -m fmu_harness.system [--models models]`` after ``python build_fmu.py`` (which
-also writes the package): writes ``models/Driveline.ssp`` and prints the last values of the
-system's outputs from the fmpy master.
+Usage: ``python -m fmu_harness.system [--models models] [--native]`` after ``python build_fmu.py``
+(which also writes both packages): writes ``models/Driveline.ssp`` and prints the last values of
+the system's outputs from the fmpy master. With ``--native`` the same for the native variant,
+``models/native/Driveline.ssp``: each component's native (C) FMU where its model has one
+(:func:`fmu_harness.build.native.native_models`), its Python FMU otherwise; each component's
+``description`` in the package says which.
 
 The system: ``SpeedSource`` (a speed ramp with a superposed sine) drives ``TripodCoupling``'s
 input shaft; ``CriticalSpeeds``, when the catalog has it, watches the coupling's output shaft
@@ -21,7 +24,7 @@ from __future__ import annotations
 import argparse
 import math
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -31,6 +34,7 @@ import numpy as np
 from driveline.catalog import MODELS
 from driveline.variables import UNITS, ModelSpec, Variable
 
+from .build import fmu_path, native
 from .runner import FmuInstance
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
@@ -101,9 +105,9 @@ def _type_element(variable: Variable) -> ET.Element:
     return ET.Element(f"{{{SSC}}}{variable.type}", {"unit": variable.unit} if variable.unit and variable.type == "Real" else {})
 
 
-def _component(component: Component, connected: set[str], parameter_set: str) -> ET.Element:
-    element = ET.Element(f"{{{SSD}}}Component", name=component.name, type="application/x-fmu-sharedlibrary",
-                         source=f"resources/{component.model}.fmu")
+def _component(component: Component, connected: set[str], parameter_set: str, family: str) -> ET.Element:
+    element = ET.Element(f"{{{SSD}}}Component", name=component.name, description=f"{family} FMU of {component.model}",
+                         type="application/x-fmu-sharedlibrary", source=f"resources/{component.model}.fmu")
     connectors = ET.SubElement(element, f"{{{SSD}}}Connectors")
     for variable in component.spec.variables:
         if variable.causality in ("input", "output") and f"{component.name}.{variable.name}" in connected:
@@ -124,12 +128,15 @@ def _component(component: Component, connected: set[str], parameter_set: str) ->
     return element
 
 
-def system_structure(system: System) -> bytes:
-    """The SSP 1.0 ``SystemStructure.ssd`` of ``system``."""
+def system_structure(system: System, natives: Collection[str] = ()) -> bytes:
+    """The SSP 1.0 ``SystemStructure.ssd`` of ``system``, the components of the models in
+    ``natives`` described as native FMUs, the others as Python FMUs."""
     root = ET.Element(f"{{{SSD}}}SystemStructureDescription", version="1.0", name=system.name)
     element = ET.SubElement(root, f"{{{SSD}}}System", name=system.name)
     connected = {f"{c}.{v}" for connection in system.connections for c, v in (connection.start, connection.end)}
-    ET.SubElement(element, f"{{{SSD}}}Elements").extend(_component(c, connected, system.name) for c in system.components)
+    ET.SubElement(element, f"{{{SSD}}}Elements").extend(
+        _component(c, connected, system.name, "native" if c.model in natives else "Python") for c in system.components
+    )
     connections = ET.SubElement(element, f"{{{SSD}}}Connections")
     for connection in system.connections:
         ET.SubElement(connections, f"{{{SSD}}}Connection", startElement=connection.start[0],
@@ -144,22 +151,45 @@ def system_structure(system: System) -> bytes:
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def write_ssp(system: System, models: Path) -> Path:
-    """``models/<system>.ssp`` with the system structure and the FMI 2.0 FMUs from ``models``."""
-    path = models / f"{system.name}.ssp"
+def native_components(system: System, natives: Path | None) -> list[str]:
+    """The models of ``system`` that run as native FMUs: those with a C port, given ``natives``."""
+    models = {c.model for c in system.components}
+    return [] if natives is None else [model for model in native.native_models() if model in models]
+
+
+def component_fmus(system: System, models: Path, natives: Path | None = None) -> dict[str, Path]:
+    """``{model: FMI 2.0 FMU}`` for the models of ``system``: the native FMUs below ``natives``
+    (``native/``) of :func:`native_components`, the Python FMUs in ``models`` of the others."""
+    fmus = {c.model: fmu_path(models, c.model) for c in system.components}
+    if natives is not None:
+        fmus |= {model: native.fmu_path(natives, model) for model in native_components(system, natives)}
+    return fmus
+
+
+def ssp_path(system: System, models: Path, natives: Path | None = None) -> Path:
+    """Where :func:`write_ssp` puts the package: ``models/<system>.ssp``, the native variant
+    ``natives/native/<system>.ssp``."""
+    return models / f"{system.name}.ssp" if natives is None else native.fmu_path(natives, system.name).with_suffix(".ssp")
+
+
+def write_ssp(system: System, models: Path, natives: Path | None = None) -> Path:
+    """The SSP package of ``system`` at :func:`ssp_path` with the FMUs of :func:`component_fmus`."""
+    fmus = component_fmus(system, models, natives)
+    path = ssp_path(system, models, natives)
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
-        archive.writestr("SystemStructure.ssd", system_structure(system))
-        for model in sorted({c.model for c in system.components}):
-            archive.write(models / f"{model}.fmu", f"resources/{model}.fmu")
+        archive.writestr("SystemStructure.ssd", system_structure(system, native_components(system, natives)))
+        for model in sorted(fmus):
+            archive.write(fmus[model], f"resources/{model}.fmu")
     return path
 
 
 # -- fmpy master ----------------------------------------------------------------------------
-def simulate(system: System, models: Path, outputs: list[str] | None = None) -> np.ndarray:
-    """Run ``system`` with the FMI 2.0 FMUs in ``models``; rows of t_k and ``outputs``
+def simulate(system: System, models: Path, outputs: list[str] | None = None, natives: Path | None = None) -> np.ndarray:
+    """Run ``system`` with the FMUs of :func:`component_fmus`; rows of t_k and ``outputs``
     (default: all Real outputs) for t_1 ... t_N."""
     names = outputs or system.outputs()
-    instances = {c.name: FmuInstance(models / f"{c.model}.fmu", c.name) for c in system.components}
+    fmus = component_fmus(system, models, natives)
+    instances = {c.name: FmuInstance(fmus[c.model], c.name) for c in system.components}
     try:
 
         def value(name: str) -> float:
@@ -193,10 +223,12 @@ def simulate(system: System, models: Path, outputs: list[str] | None = None) -> 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
+    parser.add_argument("--native", action="store_true", help="the native FMUs where a model has one")
     args = parser.parse_args(argv)
     system = driveline()
-    print(write_ssp(system, args.models))
-    result = simulate(system, args.models)
+    natives = args.models if args.native else None
+    print(write_ssp(system, args.models, natives))
+    result = simulate(system, args.models, natives=natives)
     for name, last in zip(system.outputs(), result[-1, 1:]):
         print(f"{name} = {last:.9g}")
 

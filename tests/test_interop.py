@@ -1,5 +1,6 @@
-"""Every FMU in the real importers (fmpy validate, fmutool -check, libcosimpy, ecospy) through
-``fmu_harness.interop``, and the interoperability page's matrix matches what they give here."""
+"""Every FMU, Python and native, in the real importers (fmpy validate, fmutool -check, libcosimpy,
+ecospy) through ``fmu_harness.interop``, and the interoperability page's matrix matches what they
+give here."""
 
 from __future__ import annotations
 
@@ -10,29 +11,32 @@ import pytest
 
 from driveline.catalog import MODELS
 from fmu_harness import interop
+from fmu_harness.build import native
 from fmu_harness.doc_sections import section
 
 PAGE = Path(__file__).resolve().parents[1] / "docs" / "interoperability.md"
 
 
 @pytest.fixture(scope="module")
-def matrix(fmu_dir: Path) -> dict:
+def matrix(fmu_dir: Path, native_dir: Path) -> interop.Table:
     missing = [i.package for i in interop.IMPORTERS if importlib.util.find_spec(i.package) is None]
     if missing:
         pytest.skip(f"importers not installed on this platform: {', '.join(missing)} (pip install '.[interop]')")
-    return interop.matrix(fmu_dir)
+    return interop.matrix(fmu_dir, native_dir)
 
 
 def test_every_fmu_passes_every_importer_that_supports_its_fmi_version(matrix):
     """Engines run the standard scenario; a pass means every output within
-    interop.TOLERANCE (1e-9) of its largest fmpy magnitude (measured: at most 1.4e-13, from
-    the hosts' different time grids)."""
-    assert set(matrix) == {(name, version) for name in MODELS for version in ("2.0", "3.0")}
-    for (name, version), row in matrix.items():
+    interop.TOLERANCE (1e-9) of its largest magnitude in fmpy's run of the Python FMU (measured:
+    at most 1.4e-13, from the hosts' different time grids; a native FMU's deviations are its
+    Python FMU's)."""
+    families = [(name, "Python") for name in MODELS] + [(name, "native") for name in native.native_models()]
+    assert set(matrix) == {(name, family, version) for name, family in families for version in ("2.0", "3.0")}
+    for (name, family, version), row in matrix.items():
         for importer in interop.IMPORTERS:
             result = row[importer.name]
             expected = "pass" if version in importer.versions else "unsupported"
-            assert result.status == expected, f"{name} FMI {version} in {importer.name}: {result}"
+            assert result.status == expected, f"{name} {family} FMI {version} in {importer.name}: {result}"
 
 
 def test_docs_hold_the_generated_matrix(matrix):

@@ -4,7 +4,6 @@ same refusals word for word, and misuse answered with Error (never Fatal, never 
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import shutil
 import subprocess
@@ -151,20 +150,6 @@ def test_every_mode_matches_the_python_fmu(native_dir, fmu_path, name, parameter
     """Exact kinematics, friction and the seed's reactions: the standard scenario in each mode."""
     reference = _mode_run(fmu_path(name, fmi), name, parameters)
     assert _deviation(reference, _mode_run(_native(native_dir, name, fmi), name, parameters)) <= TOLERANCE
-
-
-ENGINES = [importer for importer in interop.IMPORTERS if importer.name in ("libcosimpy", "ecospy")]
-
-
-@pytest.mark.parametrize("importer", ENGINES, ids=lambda importer: importer.name)
-@pytest.mark.parametrize("name", NATIVE)
-def test_runs_in_libcosim_and_ecos(native_dir, name, fmi, importer):
-    """The standard scenario in the engine agrees with fmpy's run of the same FMU within
-    interop.TOLERANCE (libcosim takes FMI 2.0 only)."""
-    if importlib.util.find_spec(importer.package) is None:
-        pytest.skip(f"{importer.package} is not installed (pip install '.[interop]')")
-    result = interop.outcome(importer, _native(native_dir, name, fmi))
-    assert result.status == ("pass" if f"{fmi}.0" in importer.versions else "unsupported"), result
 
 
 @pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")

@@ -4,7 +4,8 @@ Usage: ``driveline-fmus build [--dest models] [--fmi 2 3] [--no-references] [NAM
 ``python build_fmu.py ...``). Every model of ``driveline.catalog.MODELS`` becomes one FMU per
 FMI version (:mod:`.fmu`). Then the FMI Cross-Check reference results are written next to
 each FMU (:mod:`fmu_harness.crosscheck`) and, once its FMI 2.0 FMUs are there, the driveline
-system's SSP package (:mod:`fmu_harness.system`). The native (C) FMUs of the models with a C port
+system's SSP packages, with the Python FMUs and with the native ones where they exist
+(:mod:`fmu_harness.system`). The native (C) FMUs of the models with a C port
 go to ``native/`` and ``native/fmi3/`` below ``--dest`` (:mod:`.native`).
 """
 
@@ -33,8 +34,9 @@ def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Pa
         paths += [fmu] + ([] if args.no_references else crosscheck.write(fmu))
     paths += native.build_all(args.dest, args.names or None, tuple(args.fmi))
     driveline = system.driveline()
-    if all((args.dest / f"{c.model}.fmu").exists() for c in driveline.components):
-        paths.append(system.write_ssp(driveline, args.dest))
+    for natives in (None, args.dest):  # the Python system, then its native variant
+        if all(fmu.exists() for fmu in system.component_fmus(driveline, args.dest, natives).values()):
+            paths.append(system.write_ssp(driveline, args.dest, natives))
     here = Path.cwd()
     for path in paths:
         print(path.relative_to(here) if path.is_relative_to(here) else path)
