@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -215,6 +216,21 @@ class DampedRotor:
         fq = (kb.conj() + w * cb.conj()) * a + (ka.conj() + w * ca.conj()) * q
         return np.where(held, np.abs(fa) + np.abs(fq), 0.0)
 
+    @cached_property
+    def _scale(self) -> float:
+        """``s`` of ``y = [x, x'/s]``: balances stiffness and mass in the first-order form."""
+        return float(np.sqrt(np.max(np.abs(np.diag(self.K))) / np.max(np.diag(self.M))))
+
+    @cached_property
+    def _dense_blocks(self) -> tuple[ComplexArray, ComplexArray, ComplexArray, ComplexArray]:
+        """``B^-1 A`` of :meth:`modes` in blocks, without the spin: ``[0, s I]``, ``-M2^-1 K2 / s``,
+        ``-M2^-1 C2`` and ``-M2^-1 Gv`` (the spin multiplies the last), factorised once."""
+        size = self.M.shape[0]
+        upper = np.hstack([np.zeros((size, size)), self._scale * np.eye(size)]).astype(complex)
+        stiffness, damping, gyroscopic = (-np.linalg.solve(self.M, matrix).astype(complex)
+                                          for matrix in (self.K / self._scale, self.C, self.G))
+        return upper, stiffness, damping, gyroscopic
+
     # -- results -----------------------------------------------------------------
     def modes(self, spin: float = 0.0, n: int | None = None) -> list[DampedMode]:
         """Damped whirl modes at ``spin`` [rad/s], ascending in damped frequency (the first ``n``).
@@ -226,18 +242,18 @@ class DampedRotor:
         them and dropped).
         """
         size = self.M.shape[0]
-        eye = sparse.identity(size, format="csc")
-        scale = np.sqrt(np.max(np.abs(np.diag(self.K))) / np.max(np.diag(self.M)))  # y = [x, x' / scale]
-        a = sparse.bmat([[None, scale * eye], [sparse.csc_matrix(-self.K / scale),
-                                               sparse.csc_matrix(-(self.C + spin * self.G))]], format="csc")
-        b = sparse.block_diag([eye, sparse.csc_matrix(self.M)], format="csc")
+        scale = self._scale
         count = None if n is None else 2 * n + EXTRA_EIGENVALUES
         if count is None or 2 * size <= DENSE_SIZE:  # B^-1 A: only the mass block is inverted
-            dense = a.toarray()
-            dense[size:] = np.linalg.solve(self.M, dense[size:])
+            upper, stiffness, damping, gyroscopic = self._dense_blocks
+            dense = np.block([[upper], [stiffness, damping + spin * gyroscopic]])
             # an axisymmetric model needs no eigenvectors: the sign of Im lam is the whirl sense
             lam, vectors = np.linalg.eig(dense) if self.doubled else (np.linalg.eigvals(dense), None)
         else:
+            eye = sparse.identity(size, format="csc")
+            a = sparse.bmat([[None, scale * eye], [sparse.csc_matrix(-self.K / scale),
+                                                   sparse.csc_matrix(-(self.C + spin * self.G))]], format="csc")
+            b = sparse.block_diag([eye, sparse.csc_matrix(self.M)], format="csc")
             factor = splu((a - SHIFT * b).astype(complex).tocsc())
             operator = LinearOperator(a.shape, matvec=lambda v: factor.solve(b @ v), dtype=complex)
             nu, vectors = eigs(operator, k=count, which="LM") if self.doubled else (
