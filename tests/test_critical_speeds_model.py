@@ -10,6 +10,7 @@ import pytest
 from driveline.rotor import Unbalance, example_path, load_driveline, one_piece_shaft
 from driveline.rotor.damped import DampedRotor
 from driveline.rotor.driveline import EXCITED_SHARE
+from driveline.rotor.fem import elements_by_length
 from driveline.rotor.model import CriticalSpeedsModel
 from driveline.rotor.unbalance_outputs import DAMPED_MODES, DAMPING_POINTS, FE_ELEMENTS, TABLE_ELEMENTS
 from fmu_harness.runner import FmuInstance, StepRefused, simulate
@@ -154,7 +155,7 @@ def test_unbalance_outputs_match_the_damped_model():
     model = model_checks.started(CriticalSpeedsModel, c_bearing=800.0, unbalance=2e-4, unbalance_position=0.3,
                                  response_position=0.6)
     d = dataclasses.replace(one_piece_shaft(**ROTOR_B, c_bearing=800.0), unbalances=[Unbalance(0.42, 2e-4)])
-    rotor, coarse = DampedRotor(d, FE_ELEMENTS), DampedRotor(d, TABLE_ELEMENTS)
+    rotor, coarse = DampedRotor(d, elements_by_length(d, FE_ELEMENTS)), DampedRotor(d, elements_by_length(d, TABLE_ELEMENTS))
     speeds = np.linspace(0.0, 1500.0, DAMPING_POINTS)
     for speed in (*speeds, 123.4, 655.0, 1234.5):
         model.omega = speed
@@ -181,8 +182,8 @@ def test_fmu_unbalance_response_peaks_at_the_first_critical_speed(fmu_path, fmi)
     assert speed_at_peak == pytest.approx(critical, rel=3e-4)
     assert result["bearing_force_max"][peak] == np.max(result["bearing_force_max"])
     d = one_piece_shaft(**ROTOR_B, c_bearing=800.0)
-    rotor = DampedRotor(d, FE_ELEMENTS)
-    first = min(DampedRotor(d, TABLE_ELEMENTS).modes(speed_at_peak, 4), key=lambda m: abs(m.frequency - speed_at_peak))
+    rotor = DampedRotor(d, elements_by_length(d, FE_ELEMENTS))
+    first = min(DampedRotor(d, elements_by_length(d, TABLE_ELEMENTS)).modes(speed_at_peak, 4), key=lambda m: abs(m.frequency - speed_at_peak))
     fine = min(DampedRotor(d, 48).modes(speed_at_peak, 4), key=lambda m: abs(m.frequency - speed_at_peak))
     assert first.whirl == "forward"
     assert result["damping_ratio"][peak] == pytest.approx(first.damping_ratio, rel=1e-4)
@@ -206,7 +207,7 @@ def test_a_layout_brings_its_own_unbalance_and_damping(tmp_path):
     layout.write_text(text + "\n[[unbalances]]\nposition = 0.35\namount = 5e-5\nphase = 1.0\n")
     model = model_checks.started(CriticalSpeedsModel, layout=str(layout), unbalance=1.0, response_position=0.25)
     d = load_driveline(layout)
-    expected = DampedRotor(d, FE_ELEMENTS).unbalance_response([300.0], positions=[0.25 * d.length])
+    expected = DampedRotor(d, elements_by_length(d, FE_ELEMENTS)).unbalance_response([300.0], positions=[0.25 * d.length])
     assert model.unbalance_response == pytest.approx(expected.major[0, 0], rel=1e-12)  # the FMU's unbalance is not used
     assert model.bearing_force_max == pytest.approx(np.max(expected.bearing_forces), rel=1e-12)
     plain = model_checks.started(CriticalSpeedsModel, layout="two_piece_propshaft")

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from scipy.optimize import newton
 
-from driveline.rotor import Bearing, Driveline, Unbalance, one_piece_shaft
+from driveline.rotor import Bearing, Driveline, ShaftSegment, Unbalance, one_piece_shaft
 from driveline.rotor.damped import DampedRotor
+from driveline.rotor.fem import elements_by_length
 
 from rotor_checks import damped_transfer_chain, response_peaks
 
@@ -104,3 +105,16 @@ def test_critical_speeds_are_the_peaks_of_the_lightly_damped_response(kyy):
         shares = [c.forward_share for c in d.unbalance_critical_speeds(4)]
         assert [c.whirl for c in d.unbalance_critical_speeds(4)] == ["backward", "forward", "backward", "forward"]
         assert min(shares) > 0.45
+
+
+def test_short_segments_get_proportionally_fewer_elements():
+    """A segment of half the length or longer gets the most, a shorter one a share (at least one),
+    so a tube cut into 20 segments is meshed like a two-span shaft, not 20 times finer."""
+    def tube(*lengths: float) -> Driveline:
+        return Driveline([ShaftSegment(length, 0.0762, 0.0729) for length in lengths], [],
+                         [Bearing(0, 1e7), Bearing(len(lengths), 1e7)])
+
+    assert elements_by_length(tube(1.4), 16) == [16]
+    assert elements_by_length(tube(*[0.07] * 20), 16) == [2] * 20
+    assert elements_by_length(tube(0.7, 0.1, 0.8), 16) == [14, 2, 16]
+    assert elements_by_length(tube(1.0, 1e-6), 16) == [16, 1]

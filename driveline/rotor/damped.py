@@ -130,10 +130,11 @@ def _band_storage(matrix: ComplexArray, lower: int, upper: int) -> ComplexArray:
 
 
 class DampedRotor:
-    """Finite-element model of ``driveline`` (``elements_per_segment`` beam elements per segment)
+    """Finite-element model of ``driveline`` (``elements_per_segment`` beam elements per segment,
+    one count for all or one per segment)
     with the bearings' damping and anisotropy: damped modes and unbalance response."""
 
-    def __init__(self, driveline: Driveline, elements_per_segment: int = 40) -> None:
+    def __init__(self, driveline: Driveline, elements_per_segment: int | Sequence[int] = 40) -> None:
         self.driveline = driveline
         fe = fem.assemble_damped(driveline, elements_per_segment)
         self._fe = fe

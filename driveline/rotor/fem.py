@@ -11,6 +11,8 @@ as the reference for root counts; eigenvalue errors fall as ``h**4`` (``h**2`` w
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,16 +57,26 @@ class Mesh:
         return np.setdiff1d(np.arange(self.n_dof), self.fixed)
 
 
-def mesh(d: Driveline, elements_per_segment: int = 40, undamped: bool = True) -> Mesh:
+def elements_by_length(d: Driveline, most: int) -> list[int]:
+    """Beam elements per segment: ``most`` on a segment of half the driveline's length or longer,
+    proportionally fewer (at least one) on a shorter one, so that many short segments cost no more
+    than a two-span shaft."""
+    half = 0.5 * math.fsum(s.length for s in d.segments)
+    return [min(most, max(1, math.ceil(most * s.length / half - 1e-9))) for s in d.segments]
+
+
+def mesh(d: Driveline, elements_per_segment: int | Sequence[int] = 40, undamped: bool = True) -> Mesh:
     """Number the dofs and collect the element matrices.
 
     Every element contributes its own ``fe_matrices``: a segment over its
-    ``elements_per_segment`` beam elements, a point element on the dofs ``[U, psi]``
+    ``elements_per_segment`` beam elements (one count for all, or one per segment), a point element on the dofs ``[U, psi]``
     of its node; an element that splits the slope (a hinge) adds a dof ``psi_out``,
     from which the next segment starts. End conditions act on the slope outside
     the end node's point elements (as in the transfer path). With ``undamped`` false the
     bearings are left out (the damped assembly adds their components).
     """
+    counts = ([elements_per_segment] * len(d.segments) if isinstance(elements_per_segment, int)
+              else list(elements_per_segment))
     at_node: list[list] = [[] for _ in range(len(d.segments) + 1)]
     for element in d.point_elements:
         if undamped or not isinstance(element, Bearing):
@@ -88,13 +100,13 @@ def mesh(d: Driveline, elements_per_segment: int = 40, undamped: bool = True) ->
         if node == len(d.segments):
             fixed += _fixed_dofs(d.right, u, psi)
             break
-        seg = d.segments[node]
-        dofs = [u, psi, *range(n_dof, n_dof + 2 * elements_per_segment)]
-        n_dof += 2 * elements_per_segment
+        seg, count = d.segments[node], counts[node]
+        dofs = [u, psi, *range(n_dof, n_dof + 2 * count)]
+        n_dof += 2 * count
         u, psi = dofs[-2], dofs[-1]
-        blocks.append((dofs, seg.fe_matrices(elements_per_segment)))
-        h = seg.length / elements_per_segment
-        for e in range(elements_per_segment):
+        blocks.append((dofs, seg.fe_matrices(count)))
+        h = seg.length / count
+        for e in range(count):
             elements.append(dofs[2 * e: 2 * e + 4])
             z.append(z[-1] + h)
     return Mesh(n_dof, blocks, fixed, np.array(z), np.array(elements), np.array(node_u))
@@ -129,7 +141,7 @@ class DampedMatrices:
     index: NDArray[np.int_]
 
 
-def assemble_damped(d: Driveline, elements_per_segment: int = 40) -> DampedMatrices:
+def assemble_damped(d: Driveline, elements_per_segment: int | Sequence[int] = 40) -> DampedMatrices:
     """:class:`DampedMatrices` of ``d``: the undamped elements as in :func:`assemble`, and every
     bearing's stiffness and damping components on its node's translation dof."""
     m = mesh(d, elements_per_segment, undamped=False)

@@ -1,7 +1,7 @@
 """What the ``CriticalSpeeds`` FMU reports about unbalance: response, bearing force, damping.
 
-Built once per analysis from the damped finite-element model (:class:`DampedRotor`, FE_ELEMENTS
-beam elements per segment): a step solves the synchronous response at the current speed (one
+Built once per analysis from the damped finite-element model (:class:`DampedRotor`, up to
+FE_ELEMENTS beam elements per segment): a step solves the synchronous response at the current speed (one
 banded solve) and interpolates a table of the damped modes over ``[0, omega_max]`` (from a
 coarser model, TABLE_ELEMENTS per segment).
 """
@@ -18,10 +18,12 @@ from scipy.interpolate import CubicSpline
 from .damped import DampedRotor
 from .driveline import EXCITED_SHARE, SEARCH_LIMIT, Driveline
 from .elements import Unbalance
+from .fem import elements_by_length
 
-#: Beam elements per segment. Timoshenko elements converge as h**2: at 16 the first three whirl
-#: frequencies of the default tube and of the two-piece examples lie within 6.5e-5 of the exact
-#: transfer-matrix roots (2.8e-5 at 24, for 2.4 times the cost of the mode table).
+#: Beam elements on a segment of half the driveline's length or longer, proportionally fewer on a
+#: shorter one (:func:`.fem.elements_by_length`). Timoshenko elements converge as h**2: at 16 the first
+#: three whirl frequencies of the default tube and of the two-piece examples lie within 6.5e-5 of the
+#: exact transfer-matrix roots (2.8e-5 at 24, for 2.4 times the cost of the mode table).
 FE_ELEMENTS = 16
 #: Beam elements per segment of the model whose damped modes are tabulated: the first four
 #: excited modes' damping ratios lie within 0.4 % (frequencies 0.15 %) of a 48-element model's for
@@ -47,7 +49,8 @@ class UnbalanceOutputs:
     def build(cls, driveline: Driveline, unbalances: Sequence[Unbalance], response_fraction: float,
               omega_max: float) -> UnbalanceOutputs:
         """Outputs for ``unbalances`` on ``driveline``, the response taken at ``response_fraction`` of its length."""
-        rotor, coarse = DampedRotor(driveline, FE_ELEMENTS), DampedRotor(driveline, TABLE_ELEMENTS)
+        rotor, coarse = (DampedRotor(driveline, elements_by_length(driveline, most))
+                         for most in (FE_ELEMENTS, TABLE_ELEMENTS))
         spins = np.linspace(0.0, omega_max, DAMPING_POINTS)
         table = np.empty((spins.size, 2 * DAMPED_MODES))
         for i, spin in enumerate(spins):
