@@ -22,9 +22,16 @@ from driveline.rotor import (
     load_driveline,
     one_piece_shaft,
 )
-from driveline.rotor.roots import find_roots
+from driveline.rotor.roots import BatchReport, find_roots_batch
 
 from rotor_checks import rayleigh
+
+
+
+def find_roots(f, grid) -> BatchReport:
+    """The root search on one function: its roots are ``roots[0]``."""
+    return find_roots_batch(lambda x, k: f(x), [grid])
+
 
 #: FE elements per segment.
 N_EL = 40
@@ -129,9 +136,9 @@ def test_close_pair_is_found(gap):
     # the grid; the dip refinement must still return both.
     rep = find_roots(lambda x: (x - 1.0) * (x - 1.0 - gap) * np.cos(x), GRID)
     expected = np.sort(np.r_[1.0, 1.0 + gap, np.pi / 2 + np.pi * np.arange(3)])
-    assert rep.roots.size == expected.size
+    assert rep.roots[0].size == expected.size
     # brentq xtol = 1e-12 (absolute) on these O(1) roots: 1e-11
-    assert np.allclose(rep.roots, expected, rtol=0, atol=1e-11)
+    assert np.allclose(rep.roots[0], expected, rtol=0, atol=1e-11)
 
 
 def test_double_root_reported_twice():
@@ -139,28 +146,28 @@ def test_double_root_reported_twice():
     assert rep.double_roots == 1
     # located by the dip recursion down to ~1e-12 wide; f ~ (x - r)^2 is flat
     # within round-off over ~1e-8 around r, hence 1e-9 (measured 8e-15 here)
-    assert np.allclose(rep.roots, [1.2345678, 1.2345678], atol=1e-9)
+    assert np.allclose(rep.roots[0], [1.2345678, 1.2345678], atol=1e-9)
 
 
 def test_poles_are_rejected():
     # tan changes sign at its poles pi/2 + k pi as well as at its roots k pi.
     rep = find_roots(np.tan, np.linspace(0.1, 10.0, 101))
     # brentq tolerance: 1e-11
-    assert np.allclose(rep.roots, np.pi * np.arange(1, 4), atol=1e-11)
+    assert np.allclose(rep.roots[0], np.pi * np.arange(1, 4), atol=1e-11)
     assert rep.rejected_poles == 3
 
 
 def test_no_spurious_roots_from_dips_or_round_off():
     # A positive dip and a flat stretch carrying round-off ripple: no roots.
-    assert find_roots(lambda x: (x - 0.3) ** 2 + 1e-3, np.linspace(-1, 1, 101)).roots.size == 0
+    assert find_roots(lambda x: (x - 0.3) ** 2 + 1e-3, np.linspace(-1, 1, 101)).roots[0].size == 0
     ripple = lambda x: 0.3 + 1e-16 * np.sin(1e6 * x)
     rep = find_roots(ripple, np.linspace(0.0, 1.0, 101))
-    assert rep.roots.size == 0 and rep.dips_examined == 0
+    assert rep.roots[0].size == 0 and rep.dips_examined == 0
 
 
-def test_max_roots_returns_the_lowest():
-    rep = find_roots(np.sin, GRID, max_roots=2)
-    assert np.allclose(rep.roots, [np.pi, 2 * np.pi], atol=1e-11)
+def test_roots_come_lowest_first():
+    rep = find_roots(np.sin, GRID)
+    assert np.allclose(rep.roots[0][:2], [np.pi, 2 * np.pi], atol=1e-11)
 
 
 def test_grid_validation():

@@ -28,7 +28,6 @@ from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
-VecFunc = Callable[[FloatArray], FloatArray]
 #: ``f(x, k)``: the ``k[i]``-th function of a batch at ``x[i]``.
 BatchFunc = Callable[[FloatArray, IntArray], FloatArray]
 
@@ -43,17 +42,6 @@ MAX_ITERATIONS = 200
 
 
 @dataclass(frozen=True)
-class RootSearchReport:
-    """Diagnostics of one search: evaluations, rejected poles, dips examined."""
-
-    roots: FloatArray
-    evaluations: int
-    rejected_poles: int
-    dips_examined: int
-    double_roots: int
-
-
-@dataclass(frozen=True)
 class BatchReport:
     """Roots of every function of a batch (ascending, double roots twice) and search diagnostics."""
 
@@ -62,25 +50,6 @@ class BatchReport:
     rejected_poles: int
     dips_examined: int
     double_roots: int
-
-
-def find_roots(
-    f: VecFunc,
-    grid: FloatArray,
-    xtol: float = 1e-12,
-    rtol: float = 4.0 * np.finfo(float).eps,
-    max_roots: int | None = None,
-) -> RootSearchReport:
-    """Roots of ``f`` inside ``[grid[0], grid[-1]]``, ascending, double roots twice.
-
-    ``f`` maps an array of abscissae to an array of values and must be continuous.
-    ``grid`` must be strictly increasing; its spacing should resolve the function's
-    oscillation (a few points between neighbouring roots). With ``max_roots`` only
-    the lowest ``max_roots`` roots are returned.
-    """
-    rep = find_roots_batch(lambda x, k: f(x), [grid], xtol, rtol)
-    roots = rep.roots[0] if max_roots is None else rep.roots[0][:max_roots]
-    return RootSearchReport(roots, rep.evaluations, rep.rejected_poles, rep.dips_examined, rep.double_roots)
 
 
 def find_roots_batch(
