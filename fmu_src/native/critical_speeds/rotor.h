@@ -1,0 +1,186 @@
+/* The rotor library of the native CriticalSpeeds FMU: a C port of driveline/rotor/ (the Python core
+ * stays the readable reference; every function names the Python function it ports).
+ *
+ * One header for the library's modules, one module per concern:
+ *   layout.c     the driveline (segments, point elements, unbalances), the one-piece tube and the
+ *                TOML-subset layout reader with the Python loader's messages and work limits
+ *   pyrepr.c     Python's repr() of the values the messages show
+ *   transfer.c   element transfer matrices and the scaled frequency determinant (seed Eqs. 16-31)
+ *   roots.c      the batched bracketing root search and the searches along lines (w, spin)
+ *   spline.c     not-a-knot cubic splines (scipy's CubicSpline default)
+ *   campbell.c   whirl branches over the speed and the Campbell table
+ *   fem.c        finite-element model: the plausibility check's natural frequencies
+ *   damped.c     damped finite-element model: damped modes, unbalance response, bearing forces
+ * Every function that can fail returns 0 on success, or -1 with a message in ``error`` (``size``
+ * bytes, always terminated) worded as the Python core's exception text. No global state.
+ */
+#ifndef ROTOR_H
+#define ROTOR_H
+
+#include <stddef.h>
+
+/* ---- limits and constants (driveline/rotor/*.py) ------------------------------------------- */
+#define ROTOR_SEARCH_LIMIT 1.0e5     /* driveline.SEARCH_LIMIT [rad/s] */
+#define ROTOR_EXCITED_SHARE 0.01     /* driveline.EXCITED_SHARE */
+#define LAYOUT_MAX_FILE_BYTES 65536  /* loader.MAX_FILE_BYTES */
+#define LAYOUT_MAX_NESTING 16        /* loader.MAX_NESTING */
+#define LAYOUT_MAX_SEGMENTS 100      /* loader.MAX_SEGMENTS */
+#define LAYOUT_MAX_POINT_ELEMENTS 202 /* loader.MAX_POINT_ELEMENTS */
+
+/* ---- the driveline (elements.py, driveline.py) --------------------------------------------- */
+typedef enum { END_FREE, END_PINNED, END_CLAMPED } EndCondition;
+
+/* elements.ShaftSegment */
+typedef struct {
+    double length, outer_diameter, inner_diameter, youngs_modulus, density, poisson_ratio;
+    int rotary_inertia, gyroscopic, shear;
+} RotorSegment;
+
+/* elements.ConcentratedMass */
+typedef struct {
+    int node;
+    double mass, polar_inertia, diametral_inertia;
+} RotorMass;
+
+/* elements.Bearing, kyy and cyy resolved (kyy = kxx, cyy = cxx where the Python one has None) */
+typedef struct {
+    int node;
+    double kxx, kyy, cxx, cyy, kxy, kyx, cxy, cyx;
+} RotorBearing;
+
+/* elements.Hinge */
+typedef struct {
+    int node;
+    double bending_stiffness;
+} RotorHinge;
+
+/* elements.Unbalance */
+typedef struct {
+    double position, amount, phase;
+} RotorUnbalance;
+
+/* driveline.Driveline: node k is the start of segment k. At a node the point elements act in the
+ * order masses, bearings, hinges, each kind in the order given (Driveline.point_elements). The
+ * arrays are owned (driveline_free). */
+typedef struct {
+    int n_segments, n_masses, n_bearings, n_hinges, n_unbalances;
+    RotorSegment *segments;
+    RotorMass *masses;
+    RotorBearing *bearings;
+    RotorHinge *hinges;
+    RotorUnbalance *unbalances;
+    EndCondition left, right;
+} Driveline;
+
+/* The parameters of loader.one_piece_shaft (the FMU's one-piece tube). */
+typedef struct {
+    double L_shaft, D_outer, D_inner, E, density, m_joint, Jp_joint, Jd_joint, k_bearing, c_bearing;
+    int shear;
+} OnePieceShaft;
+
+/* ---- layout.c ------------------------------------------------------------------------------ */
+void driveline_free(Driveline *driveline);
+/* loader.one_piece_shaft */
+int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error, size_t size);
+/* model.build_driveline for a non-empty ``layout``: a file path ending in ".toml" (any case; relative
+ * to the working directory; messages name it by its absolute path, as pathlib's absolute()) or the
+ * name of a description shipped in ``resources`` (the FMU's resources folder: loader.example_path). */
+int driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size);
+/* loader.loads_driveline: TOML text (``length`` bytes, not necessarily terminated) from ``source``. */
+int driveline_from_text(const char *text, size_t length, const char *source, Driveline *out, char *error,
+                        size_t size);
+/* Driveline.length (math.fsum of the segment lengths) */
+double driveline_length(const Driveline *driveline);
+/* Driveline.is_isotropic: every bearing has kxx == kyy */
+int driveline_isotropic(const Driveline *driveline);
+
+/* ---- pyrepr.c -------------------------------------------------------------------------------- */
+/* repr() of a Python str holding the UTF-8 ``text`` cut to its first ``max_chars`` code points (0: all). */
+void python_str_repr(const char *text, size_t max_chars, char *out, size_t size);
+
+/* ---- transfer.c: the scaled frequency determinant (transfer.py) ---------------------------- */
+typedef struct Chain Chain; /* transfer.Chain of a driveline (it keeps no pointer to it) */
+/* transfer.Chain.build; fails with elements.Bearing._undamped_stiffness's message on cross-coupling */
+Chain *chain_new(const Driveline *driveline, char *error, size_t size);
+void chain_free(Chain *chain);
+int chain_isotropic(const Chain *chain);
+/* Driveline._kappa: sum of L (m'/EI)^(1/4) */
+double chain_kappa(const Chain *chain);
+/* transfer.determinant at ``n`` points (w[i], spin[i]); signed w for an isotropic chain. */
+void chain_determinant(const Chain *chain, size_t n, const double *w, const double *spin, double *f);
+/* transfer.mode_shape(chain, w, spin, 4).forward_fraction */
+double chain_forward_fraction(const Chain *chain, double w, double spin);
+
+/* ---- roots.c: searches (roots.py and Driveline's searches) --------------------------------- */
+/* A line (w, spin) = (w x, s x + o) of Driveline._line_roots, or a case (r, s, o) of _roots_by_whirl. */
+typedef struct {
+    double w, s, o;
+} RotorLine;
+
+/* Roots x of one line or one whirl sense, ascending (owned: rotor_roots_free). */
+typedef struct {
+    int count;
+    double *x;
+} RotorRoots;
+
+void rotor_roots_free(RotorRoots *roots, int m);
+/* Driveline._line_roots: ``x_max`` > 0: every root up to x_max (``coarse`` per line, NULL: none
+ * coarse); x_max = 0: the first ``n`` below ``limit``. ``roots`` has ``m`` entries. */
+int rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
+                     const unsigned char *coarse, RotorRoots *roots, char *error, size_t size);
+/* Driveline._roots_by_whirl for both senses: ``forward`` and ``backward`` have ``m`` entries;
+ * n = 0 means all up to x_max. */
+int rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
+                         RotorRoots *forward, RotorRoots *backward, char *error, size_t size);
+
+/* driveline.OrderResonance; whirl 1 forward, -1 backward */
+typedef struct {
+    int order, whirl;
+    double spin;
+} OrderResonance;
+
+#define WHIRL_FORWARD 1
+#define WHIRL_BACKWARD 2
+/* Driveline.order_resonances(orders, whirls (WHIRL_* bits, forward first), n (0: all up to
+ * spin_max), spin_max (0: none), limit), sorted by (spin, order); *found is owned (free()). */
+int rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n, double spin_max,
+                           double limit, OrderResonance **found, int *count, char *error, size_t size);
+/* Driveline.critical_speeds(n) (forward: unbalance_critical_speeds); ``spins`` holds n. */
+int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size);
+
+/* ---- spline.c: scipy.interpolate.CubicSpline(x, y) (not-a-knot), y of shape (n, m) -------- */
+typedef struct {
+    int n, m;
+    double *x;
+    double *c; /* (n - 1) intervals x 4 powers x m columns */
+} CubicSpline;
+
+int cubic_spline_build(CubicSpline *spline, int n, const double *x, int m, const double *y);
+/* All m columns at ``x`` (extrapolated beyond the ends, as scipy's). */
+void cubic_spline_evaluate(const CubicSpline *spline, double x, double *out);
+void cubic_spline_free(CubicSpline *spline);
+
+/* ---- campbell.c: model.whirl_table (campbell.whirl_branches + WhirlTable) ------------------ */
+typedef struct WhirlTable WhirlTable;
+/* The first ``n_modes`` forward and backward whirl frequencies over ``points`` equal speeds on
+ * [0, omega_max], refined where a branch bends; missing values read as ROTOR_SEARCH_LIMIT. */
+WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, char *error, size_t size);
+/* WhirlTable.__call__: forward_1..n, backward_1..n at ``speed`` */
+void whirl_table_evaluate(const WhirlTable *table, double speed, double *out);
+void whirl_table_free(WhirlTable *table);
+
+/* ---- fem.c, damped.c: finite elements ------------------------------------------------------ */
+/* model.natural_frequencies: sqrt|eigenvalues| of the undamped FE model with ``elements``
+ * elements per segment (both planes for anisotropic bearings); *frequencies is owned (free()). */
+int fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count, char *error,
+                           size_t size);
+
+typedef struct UnbalanceOutputs UnbalanceOutputs;
+/* unbalance_outputs.UnbalanceOutputs.build */
+UnbalanceOutputs *unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
+                                        double response_fraction, double omega_max, char *error, size_t size);
+/* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio */
+void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3]);
+void unbalance_outputs_free(UnbalanceOutputs *outputs);
+
+#endif
