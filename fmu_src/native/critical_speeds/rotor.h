@@ -19,7 +19,7 @@
 
 #include <stddef.h>
 
-/* ---- limits and constants (driveline/rotor/*.py) ------------------------------------------- */
+/* ---- limits and constants (driveline/rotor/) ------------------------------------------- */
 #define ROTOR_SEARCH_LIMIT 1.0e5     /* driveline.SEARCH_LIMIT [rad/s] */
 #define ROTOR_EXCITED_SHARE 0.01     /* driveline.EXCITED_SHARE */
 #define LAYOUT_MAX_FILE_BYTES 65536  /* loader.MAX_FILE_BYTES */
