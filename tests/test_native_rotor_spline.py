@@ -28,6 +28,8 @@ def library(tmp_path_factory):
     lib.cubic_spline_build.restype = ctypes.c_int
     lib.cubic_spline_evaluate.argtypes = [ctypes.POINTER(Spline), ctypes.c_double, double_p]
     lib.cubic_spline_evaluate.restype = None
+    lib.cubic_spline_value.argtypes = [ctypes.POINTER(Spline), ctypes.c_double, ctypes.c_int]
+    lib.cubic_spline_value.restype = ctypes.c_double
     lib.cubic_spline_free.argtypes = [ctypes.POINTER(Spline)]
     lib.cubic_spline_free.restype = None
     return lib
@@ -55,6 +57,8 @@ def native_spline(lib, x: np.ndarray, y: np.ndarray, at: np.ndarray) -> np.ndarr
         for i, v in enumerate(at):
             lib.cubic_spline_evaluate(ctypes.byref(spline), float(v), _pointer(row))
             out[i] = row
+            single = [lib.cubic_spline_value(ctypes.byref(spline), float(v), j) for j in range(y.shape[1])]
+            np.testing.assert_array_equal(single, row)  # one column alone: the same value
         return out
     finally:
         lib.cubic_spline_free(ctypes.byref(spline))

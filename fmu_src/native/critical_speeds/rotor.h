@@ -158,6 +158,8 @@ typedef struct {
 int cubic_spline_build(CubicSpline *spline, int n, const double *x, int m, const double *y);
 /* All m columns at ``x`` (extrapolated beyond the ends, as scipy's). */
 void cubic_spline_evaluate(const CubicSpline *spline, double x, double *out);
+/* Column ``column`` alone of cubic_spline_evaluate. */
+double cubic_spline_value(const CubicSpline *spline, double x, int column);
 void cubic_spline_free(CubicSpline *spline);
 
 /* ---- campbell.c: model.whirl_table (campbell.whirl_branches + WhirlTable) ------------------ */
@@ -167,6 +169,8 @@ typedef struct WhirlTable WhirlTable;
 WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, char *error, size_t size);
 /* WhirlTable.__call__: forward_1..n, backward_1..n at ``speed`` */
 void whirl_table_evaluate(const WhirlTable *table, double speed, double *out);
+/* The speeds the splines pass through (whirl_branches' knots: ``points`` and those added). */
+int whirl_table_knots(const WhirlTable *table);
 void whirl_table_free(WhirlTable *table);
 
 /* ---- fem.c, damped.c: finite elements ------------------------------------------------------ */

@@ -214,40 +214,60 @@ int cubic_spline_build(CubicSpline *spline, int n, const double *x, int m, const
     return 0;
 }
 
-/* PPoly.__call__ with extrapolation: the interval holding ``x`` (a knot starts the interval on its
- * right, the last knot ends the last one), the end intervals beyond the knots; NaN gives NaN. */
+/* PPoly's interval search with extrapolation: the interval holding ``x`` (a knot starts the interval
+ * on its right, the last knot ends the last one), the end intervals beyond the knots. */
+static int interval_of(const CubicSpline *spline, double x)
+{
+    int lo = 0, hi = spline->n - 2;
+    if (x >= spline->x[hi]) {
+        return hi;
+    }
+    while (lo < hi) { /* the last interval lo with x[lo] <= x, or 0 */
+        int mid = lo + (hi - lo + 1) / 2;
+        if (spline->x[mid] <= x) {
+            lo = mid;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    return lo;
+}
+
+/* The polynomial of interval ``i`` of column ``j`` at ``t`` = x - x[i], ascending powers summed
+ * (PPoly's evaluation). */
+static double polynomial(const CubicSpline *spline, int i, int j, double t)
+{
+    const double *c = spline->c + (size_t)4 * i * spline->m + j;
+    double value = 0.0, power = 1.0;
+    for (int k = 0; k < 4; ++k) {
+        value += c[(size_t)k * spline->m] * power;
+        power *= t;
+    }
+    return value;
+}
+
+/* PPoly.__call__ (extrapolating); NaN gives NaN. */
 void cubic_spline_evaluate(const CubicSpline *spline, double x, double *out)
 {
-    int n = spline->n, m = spline->m;
     if (isnan(x)) {
-        for (int j = 0; j < m; ++j) {
+        for (int j = 0; j < spline->m; ++j) {
             out[j] = x;
         }
         return;
     }
-    int lo = 0, hi = n - 2; /* interval index */
-    if (x >= spline->x[n - 2]) {
-        lo = n - 2;
-    } else {
-        while (lo < hi) { /* the last interval lo with x[lo] <= x, or 0 */
-            int mid = lo + (hi - lo + 1) / 2;
-            if (spline->x[mid] <= x) {
-                lo = mid;
-            } else {
-                hi = mid - 1;
-            }
-        }
+    int i = interval_of(spline, x);
+    for (int j = 0; j < spline->m; ++j) {
+        out[j] = polynomial(spline, i, j, x - spline->x[i]);
     }
-    double t = x - spline->x[lo];
-    const double *c = spline->c + (size_t)4 * lo * m;
-    for (int j = 0; j < m; ++j) {
-        double value = 0.0, power = 1.0;
-        for (int k = 0; k < 4; ++k) {
-            value += c[k * m + j] * power;
-            power *= t;
-        }
-        out[j] = value;
+}
+
+double cubic_spline_value(const CubicSpline *spline, double x, int column)
+{
+    if (isnan(x)) {
+        return x;
     }
+    int i = interval_of(spline, x);
+    return polynomial(spline, i, column, x - spline->x[i]);
 }
 
 void cubic_spline_free(CubicSpline *spline)

@@ -1,0 +1,200 @@
+"""The native rotor library's Campbell table (``campbell.c`` on ``transfer.c``/``roots.c``) against the
+Python core's ``model.whirl_table``: the same branches through the same knots, so the same table."""
+
+from __future__ import annotations
+
+import ctypes
+import dataclasses
+import time
+
+import numpy as np
+import pytest
+
+from driveline.rotor import Bearing, Driveline, example_path, load_driveline, one_piece_shaft
+from driveline.rotor.campbell import whirl_branches
+from driveline.rotor.elements import Hinge
+from driveline.rotor.model import CAMPBELL_POINTS, WHIRL_MODES, analyse_structure, whirl_table
+
+from native_rotor import ROTOR_SOURCES, compile_rotor
+
+#: Agreement of every whirl frequency, relative to the largest magnitude of its column over the speeds
+#: compared. The C port evaluates the same determinant at the same points, follows the same branches
+#: through the same knots (counted below) and splines them as scipy does, so the roots differ by the
+#: root search's round-off alone (its brackets close to a few ulps of the root) and the splines by their
+#: own round-off (about 1e-14 of the data, tests/test_native_rotor_spline.py); 1e-12 leaves a margin
+#: of ten over both without hiding a different knot or branch, which moves a value by far more.
+RTOL = 1e-12
+#: Speeds compared: knots, between knots and both ends.
+SPEEDS = 200
+
+
+class Segment(ctypes.Structure):
+    _fields_ = [(name, ctypes.c_double) for name in ("length", "outer_diameter", "inner_diameter",
+                                                     "youngs_modulus", "density", "poisson_ratio")] + \
+               [(name, ctypes.c_int) for name in ("rotary_inertia", "gyroscopic", "shear")]
+
+
+class Mass(ctypes.Structure):
+    _fields_ = [("node", ctypes.c_int), ("mass", ctypes.c_double), ("polar_inertia", ctypes.c_double),
+                ("diametral_inertia", ctypes.c_double)]
+
+
+class CBearing(ctypes.Structure):
+    _fields_ = [("node", ctypes.c_int)] + [(name, ctypes.c_double) for name in
+                                           ("kxx", "kyy", "cxx", "cyy", "kxy", "kyx", "cxy", "cyx")]
+
+
+class CHinge(ctypes.Structure):
+    _fields_ = [("node", ctypes.c_int), ("bending_stiffness", ctypes.c_double)]
+
+
+class CUnbalance(ctypes.Structure):
+    _fields_ = [("position", ctypes.c_double), ("amount", ctypes.c_double), ("phase", ctypes.c_double)]
+
+
+class CDriveline(ctypes.Structure):
+    _fields_ = [(name, ctypes.c_int) for name in ("n_segments", "n_masses", "n_bearings", "n_hinges",
+                                                  "n_unbalances")] + \
+               [("segments", ctypes.POINTER(Segment)), ("masses", ctypes.POINTER(Mass)),
+                ("bearings", ctypes.POINTER(CBearing)), ("hinges", ctypes.POINTER(CHinge)),
+                ("unbalances", ctypes.POINTER(CUnbalance)), ("left", ctypes.c_int), ("right", ctypes.c_int)]
+
+
+ENDS = {"free": 0, "pinned": 1, "clamped": 2}
+
+
+def c_driveline(d: Driveline) -> tuple[CDriveline, list]:
+    """The C driveline of ``d`` and the arrays it points into (keep them alive with it)."""
+    assert all(isinstance(j, Hinge) for j in d.joints)
+    segments = (Segment * len(d.segments))(*[
+        Segment(s.length, s.outer_diameter, s.inner_diameter, s.youngs_modulus, s.density, s.poisson_ratio,
+                int(s.rotary_inertia), int(s.gyroscopic), int(s.shear)) for s in d.segments])
+    masses = (Mass * max(len(d.masses), 1))(*[
+        Mass(m.node, m.mass, m.polar_inertia, m.diametral_inertia) for m in d.masses])
+    bearings = (CBearing * max(len(d.bearings), 1))(*[
+        CBearing(b.node, b.kxx, b.kxx if b.kyy is None else b.kyy, b.cxx, b.cxx if b.cyy is None else b.cyy,
+                 b.kxy, b.kyx, b.cxy, b.cyx) for b in d.bearings])
+    hinges = (CHinge * max(len(d.joints), 1))(*[CHinge(h.node, h.bending_stiffness) for h in d.joints])
+    unbalances = (CUnbalance * max(len(d.unbalances), 1))(*[
+        CUnbalance(u.position, u.amount, u.phase) for u in d.unbalances])
+    ends = [ENDS[str(getattr(end, "value", end))] for end in (d.left, d.right)]
+    out = CDriveline(len(d.segments), len(d.masses), len(d.bearings), len(d.joints), len(d.unbalances),
+                     segments, masses, bearings, hinges, unbalances, *ends)
+    return out, [segments, masses, bearings, hinges, unbalances]
+
+
+@pytest.fixture(scope="module")
+def library(tmp_path_factory):
+    missing = [m for m in ("transfer", "roots") if not (ROTOR_SOURCES / f"{m}.c").is_file()]
+    if missing:
+        pytest.skip(f"the rotor library has no {' or '.join(missing)} module yet")
+    lib = compile_rotor(tmp_path_factory.mktemp("campbell"), ["transfer", "roots", "spline", "campbell"])
+    lib.chain_new.argtypes = [ctypes.POINTER(CDriveline), ctypes.c_char_p, ctypes.c_size_t]
+    lib.chain_new.restype = ctypes.c_void_p
+    lib.chain_free.argtypes = [ctypes.c_void_p]
+    lib.chain_free.restype = None
+    lib.whirl_table_new.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_int, ctypes.c_int, ctypes.c_char_p,
+                                    ctypes.c_size_t]
+    lib.whirl_table_new.restype = ctypes.c_void_p
+    lib.whirl_table_evaluate.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.POINTER(ctypes.c_double)]
+    lib.whirl_table_evaluate.restype = None
+    lib.whirl_table_knots.argtypes = [ctypes.c_void_p]
+    lib.whirl_table_knots.restype = ctypes.c_int
+    lib.whirl_table_free.argtypes = [ctypes.c_void_p]
+    lib.whirl_table_free.restype = None
+    return lib
+
+
+class NativeTable:
+    """whirl_table_new on the chain of a driveline; ``seconds``: the CPU time it took."""
+
+    def __init__(self, lib, d: Driveline, omega_max: float, n_modes: int = WHIRL_MODES,
+                 points: int = CAMPBELL_POINTS) -> None:
+        self._lib, self._n = lib, n_modes
+        driveline, self._keep = c_driveline(d)
+        error = ctypes.create_string_buffer(512)
+        self._chain = lib.chain_new(ctypes.byref(driveline), error, len(error))
+        assert self._chain, error.value.decode()
+        start = time.process_time()
+        self._table = lib.whirl_table_new(self._chain, omega_max, points, n_modes, error, len(error))
+        self.seconds = time.process_time() - start
+        self.error = error.value.decode()
+
+    def close(self) -> None:
+        if self._table:
+            self._lib.whirl_table_free(self._table)
+        self._lib.chain_free(self._chain)
+        self._table = self._chain = None
+
+    @property
+    def knots(self) -> int:
+        return self._lib.whirl_table_knots(self._table)
+
+    def __call__(self, speed: float) -> np.ndarray:
+        out = (ctypes.c_double * (2 * self._n))()
+        self._lib.whirl_table_evaluate(self._table, speed, out)
+        return np.array(out)
+
+
+def tube(shear: bool = True) -> Driveline:
+    """The FMU's default one-piece tube (Timoshenko, or Rayleigh)."""
+    return one_piece_shaft(1.4, 0.0762, 0.0729, 2.1e11, 7850.0, 2.5, 0.004, 0.002, 1e7, shear=shear)
+
+
+def crossing() -> Driveline:
+    """tests/test_rotor_campbell.py's heavy joints on soft bearings: two backward branches cross."""
+    return one_piece_shaft(1.4, 0.0762, 0.0729, 2.1e11, 7850.0, 10.0, 0.2, 0.1, 3e5)
+
+
+def anisotropic() -> Driveline:
+    """The default tube with bearings five times softer vertically."""
+    d = tube()
+    return dataclasses.replace(d, bearings=[Bearing(b.node, b.kxx, 0.2 * b.kxx) for b in d.bearings])
+
+
+CASES = {
+    "tube-1500": (tube, 1500.0),
+    "tube-6000": (tube, 6000.0),
+    "rayleigh-tube-1500": (lambda: tube(False), 1500.0),
+    "rayleigh-tube-6000": (lambda: tube(False), 6000.0),
+    "two-piece": (lambda: load_driveline(example_path("two_piece_propshaft")), 1500.0),
+    "two-piece-hinged": (lambda: load_driveline(example_path("two_piece_propshaft_hinged")), 1500.0),
+    "crossing": (crossing, 1500.0),
+    "anisotropic": (anisotropic, 1500.0),
+}
+
+
+def speeds_for(omega_max: float, knots: np.ndarray) -> np.ndarray:
+    """About SPEEDS speeds over [0, omega_max]: equal steps off the knots, some knots, both ends."""
+    between = np.linspace(0.0, omega_max, SPEEDS - 20)[1:-1] + 0.123 * omega_max / SPEEDS
+    return np.unique(np.concatenate([[0.0, omega_max], between, knots[:: max(knots.size // 18, 1)]]))
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_native_whirl_table_matches_the_python_one(library, case):
+    make, omega_max = CASES[case]
+    d = make()
+    expected_table = whirl_table(analyse_structure(d), omega_max)
+    branches = whirl_branches(d, np.linspace(0.0, omega_max, CAMPBELL_POINTS), WHIRL_MODES)
+    native = NativeTable(library, d, omega_max)
+    try:
+        assert native.error == ""
+        assert native.knots == branches.spins.size
+        speeds = speeds_for(omega_max, branches.spins)
+        expected = np.array([expected_table(s) for s in speeds])
+        got = np.array([native(s) for s in speeds])
+    finally:
+        native.close()
+    scale = np.max(np.abs(expected), axis=0)
+    difference = np.max(np.abs(got - expected), axis=0) / scale
+    assert np.all(difference <= RTOL), f"{case}: relative differences {difference}"
+
+
+def test_bad_speed_ranges_are_refused(library):
+    for omega_max, points in ((0.0, 41), (-1.0, 41), (float("nan"), 41), (1500.0, 1)):
+        native = NativeTable(library, tube(), omega_max, points=points)
+        try:
+            assert native.error == "spins must be at least two increasing finite speeds >= 0 rad/s"
+            assert not native._table
+        finally:
+            native.close()
