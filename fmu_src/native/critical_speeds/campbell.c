@@ -89,7 +89,7 @@ static int roots_over_speeds(const Chain *chain, const double *spin, int count, 
     RotorLine *lines = malloc((size_t)total * sizeof *lines);
     unsigned char *coarse = malloc((size_t)total);
     RotorRoots *roots = calloc((size_t)total, sizeof *roots);
-    int status = -1;
+    int status = -1, failed = 0;
     if (!lines || !coarse || !roots || found_alloc(out, count)) {
         free(lines);
         free(coarse);
@@ -108,7 +108,6 @@ static int roots_over_speeds(const Chain *chain, const double *spin, int count, 
     if (rotor_line_roots(chain, lines, total, 0, x_hi, ROTOR_SEARCH_LIMIT, coarse, roots, error, size)) {
         goto done;
     }
-    int failed = 0;
     for (int i = 0; i < count && !failed; ++i) {
         for (int s = 0; s < 2; ++s) {
             int here = roots[2 * i + s].count;
@@ -344,7 +343,8 @@ static double *side_by_side(const Branches branches[2], int speeds, int pad, dou
 
 /* campbell._spline_error: the relative error of the branches' splines at the middle of every knot
  * interval (largest of all branches) by one Newton step on the determinant there, zero within NOISE
- * times the same step at the interval's ends; ``error_of`` has count - 1 entries. */
+ * times the same step at the interval's ends; ``error_of`` has count - 1 entries. A branch missing at
+ * some speed fails with the message of scipy's CubicSpline, as the Python one does. */
 static int spline_error(const Chain *chain, const Found *found, const Branches branches[2], double *error_of,
                         char *error, size_t size)
 {
@@ -359,6 +359,13 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
     CubicSpline spline;
     if (!table) {
         return out_of_memory(error, size);
+    }
+    for (size_t v = 0; v < (size_t)knots * (size_t)m; ++v) {
+        if (isnan(table[v])) {
+            free(table);
+            snprintf(error, size, "`y` must contain only finite values.");
+            return -1;
+        }
     }
     if (cubic_spline_build(&spline, knots, found->spin, m, table)) {
         free(table);
@@ -386,29 +393,19 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
         double at = p < knots - 1 ? 0.5 * (found->spin[p] + found->spin[p + 1]) : found->spin[p - (knots - 1)];
         double *row = w + (size_t)p * m;
         cubic_spline_evaluate(&spline, at, row);
-        for (int c = 0; c < m; ++c) {
+        for (int c = 0; c < m; ++c, ++n) {
             double sign = c < forward ? 1.0 : -1.0, h = SLOPE_STEP * row[c];
-            if (!isfinite(row[c])) { /* a NaN branch: no estimate */
-                continue;
-            }
             at_w[3 * n] = sign * row[c];
             at_w[3 * n + 1] = sign * (row[c] + h);
             at_w[3 * n + 2] = sign * (row[c] - h);
             at_spin[3 * n] = at_spin[3 * n + 1] = at_spin[3 * n + 2] = at;
-            ++n;
         }
     }
-    chain_determinant(chain, 3 * n, at_w, at_spin, f);
-    n = 0;
-    for (size_t cell = 0; cell < cells; ++cell) {
-        double x = w[cell];
-        step[cell] = 0.0;
-        if (isfinite(x)) {
-            double h = SLOPE_STEP * x;
-            double estimate = fabs(f[3 * n] * 2.0 * h / (f[3 * n + 1] - f[3 * n + 2])) / x;
-            step[cell] = isfinite(estimate) ? estimate : 0.0;
-            ++n;
-        }
+    chain_determinant(chain, 3 * cells, at_w, at_spin, f);
+    for (n = 0; n < cells; ++n) {
+        double x = w[n], h = SLOPE_STEP * x;
+        double estimate = fabs(f[3 * n] * 2.0 * h / (f[3 * n + 1] - f[3 * n + 2])) / x;
+        step[n] = isfinite(estimate) ? estimate : 0.0;
     }
     for (int i = 0; i + 1 < knots; ++i) {
         const double *middle = step + (size_t)i * m, *lo = step + (size_t)(knots - 1 + i) * m, *hi = lo + m;
