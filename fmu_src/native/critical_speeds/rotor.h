@@ -19,7 +19,7 @@
 
 #include <stddef.h>
 
-/* ---- limits and constants (driveline/rotor/) ------------------------------------------- */
+/* ---- limits and constants (the modules of driveline/rotor/) -------------------------------- */
 #define ROTOR_SEARCH_LIMIT 1.0e5     /* driveline.SEARCH_LIMIT [rad/s] */
 #define ROTOR_EXCITED_SHARE 0.01     /* driveline.EXCITED_SHARE */
 #define LAYOUT_MAX_FILE_BYTES 65536  /* loader.MAX_FILE_BYTES */
@@ -106,6 +106,9 @@ void chain_free(Chain *chain);
 int chain_isotropic(const Chain *chain);
 /* Driveline._kappa: sum of L (m'/EI)^(1/4) */
 double chain_kappa(const Chain *chain);
+/* Driveline._grid's ``extra``: the distinct freedoms (translation, tilt, hinge) of each node's point
+ * elements, summed over the nodes */
+int chain_freedoms(const Chain *chain);
 /* transfer.determinant at ``n`` points (w[i], spin[i]); signed w for an isotropic chain. */
 void chain_determinant(const Chain *chain, size_t n, const double *w, const double *spin, double *f);
 /* transfer.mode_shape(chain, w, spin, 4).forward_fraction */

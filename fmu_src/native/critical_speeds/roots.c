@@ -1,0 +1,684 @@
+/* The bracketing root search and the searches along lines (w, spin): a port of
+ * driveline/rotor/roots.py (find_roots_batch) and of Driveline's searches in driveline/rotor/driveline.py
+ * (_kappa, _grid, _line_roots, _roots_by_whirl, order_resonances, critical_speeds); seed Sec. 8, Fig. 3.
+ *
+ * The Python core searches many lines in one vectorised batch; here every line is searched on its
+ * own, which finds the same roots: the grid scan, the dip sub-grids and the bracket refinement of
+ * one line never depend on another line. */
+#include "rotor.h"
+
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#define SUBGRID 24          /* roots.SUBGRID */
+#define MAX_DEPTH 16        /* roots.MAX_DEPTH */
+#define DIP_RATIO 0.9       /* roots.DIP_RATIO */
+#define MAX_ITERATIONS 200  /* roots.MAX_ITERATIONS */
+#define XTOL 1e-12          /* find_roots_batch's xtol */
+#define RTOL (4.0 * DBL_EPSILON)
+#define POINTS_PER_ROOT 16  /* driveline.POINTS_PER_ROOT */
+#define GRID_OFFSET 0.6180339887498949
+#define LEAD_POINTS 9
+#define N_NONE INT_MIN      /* n = None */
+
+/* One search: the determinant along the line (w, spin) = (w x, s x + o) and the roots found so far. */
+typedef struct {
+    const Chain *chain;
+    double w, s, o;
+    double *x;
+    int count, capacity;
+    char *error;
+    size_t size;
+} Search;
+
+static void set_error(char *error, size_t size, const char *text)
+{
+    if (error != NULL && size > 0) {
+        snprintf(error, size, "%s", text);
+    }
+}
+
+/* repr() of a Python float: the shortest digits that read back, fixed for 1e-4 <= |v| < 1e16 */
+static void float_repr(double v, char *out, size_t size)
+{
+    char digits[40], text[48];
+    int precision, exponent, n, i;
+    char *mantissa_end;
+    if (isnan(v)) {
+        snprintf(out, size, "nan");
+        return;
+    }
+    if (isinf(v)) {
+        snprintf(out, size, v > 0 ? "inf" : "-inf");
+        return;
+    }
+    for (precision = 1; precision <= 17; precision++) {
+        snprintf(text, sizeof text, "%.*e", precision - 1, v);
+        if (strtod(text, NULL) == v) {
+            break;
+        }
+    }
+    mantissa_end = strchr(text, 'e');
+    exponent = atoi(mantissa_end + 1);
+    n = 0;
+    for (i = 0; text + i < mantissa_end; i++) { /* the significant digits, sign and point dropped */
+        if (text[i] >= '0' && text[i] <= '9') {
+            digits[n++] = text[i];
+        }
+    }
+    while (n > 1 && digits[n - 1] == '0') {
+        n--;
+    }
+    digits[n] = '\0';
+    if (exponent < -4 || exponent >= 16) {
+        snprintf(out, size, "%s%c%s%se%c%02d", signbit(v) ? "-" : "", digits[0], n > 1 ? "." : "", digits + 1,
+                 exponent < 0 ? '-' : '+', abs(exponent));
+        return;
+    }
+    i = 0;
+    if (signbit(v)) {
+        text[i++] = '-';
+    }
+    if (exponent < 0) { /* 0.000ddd */
+        text[i++] = '0';
+        text[i++] = '.';
+        for (precision = 0; precision < -exponent - 1; precision++) {
+            text[i++] = '0';
+        }
+        for (precision = 0; precision < n; precision++) {
+            text[i++] = digits[precision];
+        }
+    } else { /* ddd.ddd, at least one digit after the point */
+        for (precision = 0; precision <= exponent; precision++) {
+            text[i++] = precision < n ? digits[precision] : '0';
+        }
+        text[i++] = '.';
+        if (n <= exponent + 1) {
+            text[i++] = '0';
+        }
+        for (precision = exponent + 1; precision < n; precision++) {
+            text[i++] = digits[precision];
+        }
+    }
+    text[i] = '\0';
+    snprintf(out, size, "%s", text);
+}
+
+/* driveline._speed's message */
+static int speed_error(const char *name, double value, char *error, size_t size)
+{
+    char text[64];
+    float_repr(value, text, sizeof text);
+    if (error != NULL && size > 0) {
+        snprintf(error, size, "%s must be a finite speed > 0 rad/s, got %s", name, text);
+    }
+    return -1;
+}
+
+static double line_f(const Search *st, double x)
+{
+    double w = st->w * x, spin = st->s * x + st->o, f;
+    chain_determinant(st->chain, 1, &w, &spin, &f);
+    return f;
+}
+
+static int found(Search *st, double x)
+{
+    if (st->count == st->capacity) {
+        int capacity = st->capacity ? 2 * st->capacity : 16;
+        double *grown = realloc(st->x, (size_t)capacity * sizeof *grown);
+        if (grown == NULL) {
+            set_error(st->error, st->size, "out of memory");
+            return -1;
+        }
+        st->x = grown;
+        st->capacity = capacity;
+    }
+    st->x[st->count++] = x;
+    return 0;
+}
+
+static double sign_of(double v)
+{ /* numpy.sign (nan for nan) */
+    return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : v;
+}
+
+/* roots._refine for one bracket: Chandrupatla's method (inverse quadratic interpolation where safe,
+ * else bisection); a converged point with |f| above both ends is a pole and is rejected. */
+static int refine(Search *st, double a, double b, double fa, double fb)
+{
+    double f_ends = fabs(fa) > fabs(fb) ? fabs(fa) : fabs(fb);
+    double c, fc, t = 0.5;
+    int iteration;
+    for (iteration = 0; iteration < MAX_ITERATIONS; iteration++) {
+        double xt = a + t * (b - a), ft = line_f(st, xt), xm, fm, tlim, xi, phi;
+        if (sign_of(ft) == sign_of(fa)) { /* the new point replaces a; else b becomes a */
+            c = a;
+            fc = fa;
+        } else {
+            c = b;
+            fc = fb;
+            b = a;
+            fb = fa;
+        }
+        a = xt;
+        fa = ft;
+        if (fabs(fa) < fabs(fb)) {
+            xm = a;
+            fm = fa;
+        } else {
+            xm = b;
+            fm = fb;
+        }
+        tlim = (XTOL + RTOL * fabs(xm)) / fabs(b - a);
+        if (fm == 0.0 || tlim > 0.5) {
+            if (fabs(fm) > f_ends) { /* |f| grew towards the 'root': a pole */
+                return 0;
+            }
+            return found(st, xm);
+        }
+        xi = (a - b) / (c - b);
+        phi = (fa - fb) / (fc - fb);
+        t = 0.5;
+        if (phi * phi < xi && (1.0 - phi) * (1.0 - phi) < 1.0 - xi) {
+            t = fa / (fb - fa) * fc / (fb - fc) + (c - a) / (b - a) * fa / (fc - fa) * fb / (fc - fb);
+            if (!isfinite(t)) {
+                t = 0.5;
+            }
+        }
+        t = t > tlim ? t : tlim;
+        t = t < 1.0 - tlim ? t : 1.0 - tlim;
+    }
+    set_error(st->error, st->size, "root refinement did not converge");
+    return -1;
+}
+
+/* roots._scan for one sampled sequence: its zeros and sign changes, then its dips re-scanned on
+ * sub-grids of SUBGRID steps (a dip that persists down to the root tolerance is a double root). */
+static int scan(Search *st, const double *x, const double *fx, int n, int depth)
+{
+    int i, j;
+    for (i = 0; i < n; i++) {
+        if (fx[i] == 0.0 && found(st, x[i])) {
+            return -1;
+        }
+    }
+    for (i = 0; i + 1 < n; i++) {
+        if (sign_of(fx[i]) * sign_of(fx[i + 1]) < 0.0 && refine(st, x[i], x[i + 1], fx[i], fx[i + 1])) {
+            return -1;
+        }
+    }
+    for (i = 1; i + 1 < n; i++) {
+        double s = sign_of(fx[i]), lo = x[i - 1], hi = x[i + 1], mid = x[i];
+        double a0 = fabs(fx[i - 1]), a1 = fabs(fx[i]), a2 = fabs(fx[i + 1]);
+        double sx[SUBGRID + 1], sf[SUBGRID + 1];
+        if (!(sign_of(fx[i - 1]) == s && s == sign_of(fx[i + 1]) && s != 0.0)) {
+            continue;
+        }
+        if (!(a1 < a0 && a1 <= a2 && a1 <= DIP_RATIO * (a0 > a2 ? a0 : a2))) {
+            continue;
+        }
+        if (hi - lo <= 2.0 * (XTOL + RTOL * fabs(mid)) || depth >= MAX_DEPTH) {
+            if (found(st, mid) || found(st, mid)) {
+                return -1;
+            }
+            continue;
+        }
+        sx[0] = lo;
+        sf[0] = fx[i - 1];
+        for (j = 1; j < SUBGRID; j++) {
+            sx[j] = lo + (hi - lo) * (j * (1.0 / SUBGRID)); /* numpy.linspace(0, 1, SUBGRID + 1) */
+            sf[j] = line_f(st, sx[j]);
+        }
+        sx[SUBGRID] = hi;
+        sf[SUBGRID] = fx[i + 1];
+        if (scan(st, sx, sf, SUBGRID + 1, depth + 1)) {
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* roots.find_roots_batch for one function: the roots on [grid[0], grid[n - 1]], ascending */
+static int find_roots(Search *st, const double *grid, int n)
+{
+    double *fx = malloc((size_t)n * sizeof *fx);
+    int i, status;
+    if (fx == NULL) {
+        set_error(st->error, st->size, "out of memory");
+        return -1;
+    }
+    for (i = 0; i < n; i++) {
+        fx[i] = line_f(st, grid[i]);
+    }
+    status = scan(st, grid, fx, n, 0);
+    free(fx);
+    if (status == 0 && st->count > 1) {
+        qsort(st->x, (size_t)st->count, sizeof *st->x, compare_doubles);
+    }
+    return status;
+}
+
+/* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with POINTS_PER_ROOT points per
+ * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] 1e-4, x[0], 9)[:-1]). */
+static double *grid_new(const Chain *chain, double x_max, double ratio, int coarse, int *count, char *error,
+                        size_t size)
+{
+    int extra = coarse ? 0 : chain_freedoms(chain), per_pi, n, i;
+    double kappa = chain_kappa(chain) * sqrt(fabs(ratio)), theta_max, steps, step, log_start, log_stop, *x;
+    per_pi = POINTS_PER_ROOT * (1 + extra) * (chain_isotropic(chain) ? 1 : 2);
+    theta_max = kappa * sqrt(x_max);
+    steps = ceil(theta_max / M_PI * per_pi);
+    if (!(steps < (double)(INT_MAX / 2))) {
+        set_error(error, size, "out of memory");
+        return NULL;
+    }
+    n = steps > 8.0 ? (int)steps : 8;
+    x = malloc((size_t)(LEAD_POINTS - 1 + n + 1) * sizeof *x);
+    if (x == NULL) {
+        set_error(error, size, "out of memory");
+        return NULL;
+    }
+    step = theta_max / n;
+    for (i = 0; i < n; i++) { /* offset by an irrational fraction of a step */
+        double t = (i + GRID_OFFSET) * step / kappa;
+        x[LEAD_POINTS - 1 + i] = t * t;
+    }
+    x[LEAD_POINTS - 1 + n] = (theta_max / kappa) * (theta_max / kappa);
+    x[0] = x[LEAD_POINTS - 1] * 1e-4;
+    log_start = log10(x[0]);
+    log_stop = log10(x[LEAD_POINTS - 1]);
+    for (i = 1; i < LEAD_POINTS - 1; i++) {
+        x[i] = pow(10.0, i * ((log_stop - log_start) / (LEAD_POINTS - 1)) + log_start);
+    }
+    *count = LEAD_POINTS + n;
+    return x;
+}
+
+/* The roots on one line over its grid (x_max, ratio |w|, coarse) into *roots */
+static int search_line(const Chain *chain, const RotorLine *line, double x_max, int coarse, RotorRoots *roots,
+                       char *error, size_t size)
+{
+    Search st;
+    int n, status;
+    double *grid = grid_new(chain, x_max, line->w, coarse, &n, error, size);
+    if (grid == NULL) {
+        return -1;
+    }
+    st.chain = chain;
+    st.w = line->w;
+    st.s = line->s;
+    st.o = line->o;
+    st.x = NULL;
+    st.count = st.capacity = 0;
+    st.error = error;
+    st.size = size;
+    status = find_roots(&st, grid, n);
+    free(grid);
+    if (status) {
+        free(st.x);
+        return -1;
+    }
+    free(roots->x);
+    roots->x = st.x;
+    roots->count = st.count;
+    return 0;
+}
+
+void rotor_roots_free(RotorRoots *roots, int m)
+{
+    int i;
+    for (i = 0; roots != NULL && i < m; i++) {
+        free(roots[i].x);
+        roots[i].x = NULL;
+        roots[i].count = 0;
+    }
+}
+
+/* Driveline._line_roots with n = N_NONE for None */
+static int line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
+                      const unsigned char *coarse, RotorRoots *roots, char *error, size_t size)
+{
+    int j;
+    for (j = 0; j < m; j++) {
+        roots[j].count = 0;
+        roots[j].x = NULL;
+    }
+    if (x_max != 0.0) {
+        if (!(x_max > 0.0) || isinf(x_max)) {
+            return speed_error("x_max", x_max, error, size);
+        }
+        for (j = 0; j < m; j++) {
+            if (search_line(chain, &lines[j], x_max, coarse != NULL && coarse[j], &roots[j], error, size)) {
+                rotor_roots_free(roots, m);
+                return -1;
+            }
+        }
+        return 0;
+    }
+    if (n == N_NONE || n < 1) {
+        if (error != NULL && size > 0) {
+            if (n == N_NONE) {
+                snprintf(error, size, "n must be a positive integer (or give an upper limit), got None");
+            } else {
+                snprintf(error, size, "n must be a positive integer (or give an upper limit), got %d", n);
+            }
+        }
+        return -1;
+    }
+    if (!(limit > 0.0) || isinf(limit)) {
+        return speed_error("limit", limit, error, size);
+    }
+    for (j = 0; j < m; j++) {
+        double ratio = fabs(lines[j].w), x_hi = (n + 2) * M_PI / (chain_kappa(chain) * sqrt(ratio));
+        x_hi = x_hi * x_hi;
+        x_hi = x_hi < limit ? x_hi : limit;
+        for (;;) { /* a line short of n roots is searched again over a 4x wider range, until limit */
+            if (search_line(chain, &lines[j], x_hi, 0, &roots[j], error, size)) {
+                rotor_roots_free(roots, m);
+                return -1;
+            }
+            if (roots[j].count >= n || !(x_hi < limit)) {
+                break;
+            }
+            x_hi = 4.0 * x_hi < limit ? 4.0 * x_hi : limit;
+        }
+        if (roots[j].count > n) {
+            roots[j].count = n;
+        }
+    }
+    return 0;
+}
+
+int rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
+                     const unsigned char *coarse, RotorRoots *roots, char *error, size_t size)
+{
+    return line_roots(chain, lines, m, n, x_max, limit, coarse, roots, error, size);
+}
+
+/* a copy of the first ``n`` roots (all for N_NONE) of ``from`` that ``keep`` selects (NULL: all) */
+static int take(const RotorRoots *from, const unsigned char *keep, int n, RotorRoots *to, char *error, size_t size)
+{
+    int i;
+    to->count = 0;
+    to->x = malloc((size_t)(from->count > 0 ? from->count : 1) * sizeof *to->x);
+    if (to->x == NULL) {
+        set_error(error, size, "out of memory");
+        return -1;
+    }
+    for (i = 0; i < from->count && (n == N_NONE || to->count < n); i++) {
+        if (keep == NULL || keep[i]) {
+            to->x[to->count++] = from->x[i];
+        }
+    }
+    return 0;
+}
+
+/* Driveline._roots_by_whirl: isotropic, forward at +w and backward at -w; anisotropic, the 2 n lowest
+ * roots at w > 0 classified by their mode's forward fraction (>= 0.5 forward); standstill cases
+ * (s = o = 0) are searched once and both senses get their roots. n = N_NONE: all up to x_max. */
+static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
+                          RotorRoots *forward, RotorRoots *backward, char *error, size_t size)
+{
+    int iso = chain_isotropic(chain), c, count = 0, status = 0, nn;
+    RotorLine *lines = malloc((size_t)(2 * m > 0 ? 2 * m : 1) * sizeof *lines);
+    int *first = malloc((size_t)(m > 0 ? m : 1) * sizeof *first);
+    RotorRoots *found_roots = malloc((size_t)(2 * m > 0 ? 2 * m : 1) * sizeof *found_roots);
+    unsigned char *kinds = NULL;
+    for (c = 0; c < m; c++) {
+        forward[c].count = backward[c].count = 0;
+        forward[c].x = backward[c].x = NULL;
+    }
+    if (lines == NULL || first == NULL || found_roots == NULL) {
+        free(lines);
+        free(first);
+        free(found_roots);
+        set_error(error, size, "out of memory");
+        return -1;
+    }
+    for (c = 0; c < m; c++) {
+        int standstill = cases[c].s == 0.0 && cases[c].o == 0.0;
+        first[c] = count;
+        lines[count++] = cases[c];
+        if (iso && !standstill) {
+            lines[count] = cases[c];
+            lines[count++].w = -cases[c].w;
+        }
+    }
+    nn = n == N_NONE || iso ? n : 2 * n;
+    if (line_roots(chain, lines, count, nn, x_max, limit, NULL, found_roots, error, size)) {
+        free(lines);
+        free(first);
+        free(found_roots);
+        return -1;
+    }
+    for (c = 0; c < m && status == 0; c++) {
+        const RotorRoots *roots = &found_roots[first[c]];
+        int standstill = cases[c].s == 0.0 && cases[c].o == 0.0, i;
+        if (standstill) {
+            status = take(roots, NULL, n, &forward[c], error, size) || take(roots, NULL, n, &backward[c], error, size);
+        } else if (iso) {
+            status = take(roots, NULL, n, &forward[c], error, size) ||
+                     take(roots + 1, NULL, n, &backward[c], error, size);
+        } else {
+            kinds = malloc((size_t)(2 * roots->count + 2));
+            if (kinds == NULL) {
+                set_error(error, size, "out of memory");
+                status = -1;
+                break;
+            }
+            for (i = 0; i < roots->count; i++) {
+                double x = roots->x[i];
+                kinds[i] = chain_forward_fraction(chain, cases[c].w * x, cases[c].s * x + cases[c].o) >= 0.5;
+                kinds[roots->count + i] = !kinds[i];
+            }
+            status = take(roots, kinds, n, &forward[c], error, size) ||
+                     take(roots, kinds + roots->count, n, &backward[c], error, size);
+            free(kinds);
+            kinds = NULL;
+        }
+    }
+    rotor_roots_free(found_roots, count);
+    free(found_roots);
+    free(lines);
+    free(first);
+    if (status) {
+        rotor_roots_free(forward, m);
+        rotor_roots_free(backward, m);
+        return -1;
+    }
+    return 0;
+}
+
+int rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
+                         RotorRoots *forward, RotorRoots *backward, char *error, size_t size)
+{
+    return roots_by_whirl(chain, cases, m, n == 0 ? N_NONE : n, x_max, limit, forward, backward, error, size);
+}
+
+/* sorted(..., key=lambda r: (r.spin, r.order)) keeps the given order among equal keys */
+typedef struct {
+    OrderResonance resonance;
+    int index;
+} Ranked;
+
+static int compare_ranked(const void *a, const void *b)
+{
+    const Ranked *x = a, *y = b;
+    if (x->resonance.spin != y->resonance.spin) {
+        return x->resonance.spin < y->resonance.spin ? -1 : 1;
+    }
+    if (x->resonance.order != y->resonance.order) {
+        return x->resonance.order < y->resonance.order ? -1 : 1;
+    }
+    return (x->index > y->index) - (x->index < y->index);
+}
+
+/* Driveline.order_resonances with n = N_NONE for None and spin_max = 0 for None */
+static int order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n, double spin_max,
+                            double limit, OrderResonance **out, int *count, char *error, size_t size)
+{
+    RotorLine *cases;
+    RotorRoots *forward, *backward;
+    Ranked *ranked;
+    int k, i, total = 0, at = 0;
+    *out = NULL;
+    *count = 0;
+    if (spin_max != 0.0 && (!(spin_max > 0.0) || isinf(spin_max))) {
+        return speed_error("spin_max", spin_max, error, size);
+    }
+    for (k = 0; k < n_orders; k++) {
+        if (orders[k] < 1) {
+            if (error != NULL && size > 0) {
+                snprintf(error, size, "order must be a positive integer, got %d", orders[k]);
+            }
+            return -1;
+        }
+    }
+    if (n_orders < 1) {
+        return 0;
+    }
+    cases = malloc((size_t)n_orders * sizeof *cases);
+    forward = malloc((size_t)n_orders * sizeof *forward);
+    backward = malloc((size_t)n_orders * sizeof *backward);
+    if (cases == NULL || forward == NULL || backward == NULL) {
+        free(cases);
+        free(forward);
+        free(backward);
+        set_error(error, size, "out of memory");
+        return -1;
+    }
+    for (k = 0; k < n_orders; k++) {
+        cases[k].w = orders[k];
+        cases[k].s = 1.0;
+        cases[k].o = 0.0;
+    }
+    if (roots_by_whirl(chain, cases, n_orders, n, spin_max, limit, forward, backward, error, size)) {
+        free(cases);
+        free(forward);
+        free(backward);
+        return -1;
+    }
+    for (k = 0; k < n_orders; k++) {
+        total += (whirls & WHIRL_FORWARD ? forward[k].count : 0) + (whirls & WHIRL_BACKWARD ? backward[k].count : 0);
+    }
+    ranked = malloc((size_t)(total > 0 ? total : 1) * sizeof *ranked);
+    *out = malloc((size_t)(total > 0 ? total : 1) * sizeof **out);
+    if (ranked == NULL || *out == NULL) {
+        free(ranked);
+        free(*out);
+        *out = NULL;
+        set_error(error, size, "out of memory");
+        total = -1;
+    }
+    for (k = 0; k < n_orders && total >= 0; k++) {
+        const RotorRoots *senses[2] = {&forward[k], &backward[k]};
+        int s;
+        for (s = 0; s < 2; s++) {
+            if (!(whirls & (s == 0 ? WHIRL_FORWARD : WHIRL_BACKWARD))) {
+                continue;
+            }
+            for (i = 0; i < senses[s]->count; i++) {
+                ranked[at].resonance.order = orders[k];
+                ranked[at].resonance.whirl = s == 0 ? 1 : -1;
+                ranked[at].resonance.spin = senses[s]->x[i];
+                ranked[at].index = at;
+                at++;
+            }
+        }
+    }
+    rotor_roots_free(forward, n_orders);
+    rotor_roots_free(backward, n_orders);
+    free(cases);
+    free(forward);
+    free(backward);
+    if (total < 0) {
+        return -1;
+    }
+    qsort(ranked, (size_t)total, sizeof *ranked, compare_ranked);
+    for (i = 0; i < total; i++) {
+        (*out)[i] = ranked[i].resonance;
+    }
+    free(ranked);
+    *count = total;
+    return 0;
+}
+
+int rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n, double spin_max,
+                           double limit, OrderResonance **found_out, int *count, char *error, size_t size)
+{
+    return order_resonances(chain, orders, n_orders, whirls, n == 0 ? N_NONE : n, spin_max, limit, found_out, count,
+                            error, size);
+}
+
+typedef struct {
+    double spin, share;
+} Share;
+
+static int compare_shares(const void *a, const void *b)
+{
+    const Share *x = a, *y = b;
+    if (x->spin != y->spin) {
+        return x->spin < y->spin ? -1 : 1;
+    }
+    return (x->share > y->share) - (x->share < y->share);
+}
+
+/* Driveline.critical_speeds(n) = unbalance_critical_speeds(n): isotropic, the forward synchronous roots;
+ * anisotropic, those of the 2 (n + 1) lowest synchronous roots whose forward share is at least
+ * EXCITED_SHARE. */
+int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size)
+{
+    static const int first_order[1] = {1};
+    OrderResonance *found_list = NULL;
+    int found_count = 0, i;
+    *count = 0;
+    if (chain_isotropic(chain)) {
+        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD, n, 0.0, ROTOR_SEARCH_LIMIT, &found_list,
+                             &found_count, error, size)) {
+            return -1;
+        }
+        for (i = 0; i < found_count && i < n; i++) {
+            spins[(*count)++] = found_list[i].spin;
+        }
+    } else {
+        Share *shares;
+        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD | WHIRL_BACKWARD, n + 1, 0.0, ROTOR_SEARCH_LIMIT,
+                             &found_list, &found_count, error, size)) {
+            return -1;
+        }
+        shares = malloc((size_t)(found_count > 0 ? found_count : 1) * sizeof *shares);
+        if (shares == NULL) {
+            free(found_list);
+            set_error(error, size, "out of memory");
+            return -1;
+        }
+        for (i = 0; i < found_count; i++) {
+            shares[i].spin = found_list[i].spin;
+            shares[i].share = chain_forward_fraction(chain, found_list[i].spin, found_list[i].spin);
+        }
+        qsort(shares, (size_t)found_count, sizeof *shares, compare_shares);
+        for (i = 0; i < found_count && *count < n; i++) {
+            if (shares[i].share >= ROTOR_EXCITED_SHARE) {
+                spins[(*count)++] = shares[i].spin;
+            }
+        }
+        free(shares);
+    }
+    free(found_list);
+    return 0;
+}
