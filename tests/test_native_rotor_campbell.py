@@ -19,10 +19,12 @@ from native_rotor import ROTOR_SOURCES, compile_rotor
 
 #: Agreement of every whirl frequency, relative to the largest magnitude of its column over the speeds
 #: compared. The C port evaluates the same determinant at the same points, follows the same branches
-#: through the same knots (counted below) and splines them as scipy does, so the roots differ by the
-#: root search's round-off alone (its brackets close to a few ulps of the root) and the splines by their
-#: own round-off (about 1e-14 of the data, tests/test_native_rotor_spline.py); 1e-12 leaves a margin
-#: of ten over both without hiding a different knot or branch, which moves a value by far more.
+#: through the same knots (their count is compared exactly) and splines them as scipy does, so the
+#: tables differ by round-off alone: measured at most 1.5e-15 (tubes, two-piece layouts), 6.7e-15
+#: (crossing branches), 7.6e-15 (anisotropic bearings: the roots' own search round-off). 1e-12 is
+#: campbell.SPLINE_RTOL, the interpolation error the table aims at: a difference below it is below what
+#: the table claims to resolve, and a different refinement, which would hide under it, shows in the
+#: knot count.
 RTOL = 1e-12
 #: Speeds compared: knots, between knots and both ends.
 SPEEDS = 200
