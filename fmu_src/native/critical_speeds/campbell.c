@@ -372,7 +372,7 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
         return out_of_memory(error, size);
     }
     free(table);
-    int points = 2 * knots - 1;
+    int points = 2 * knots - 1, status = 0;
     size_t cells = (size_t)points * (size_t)m;
     double *w = malloc(cells * sizeof *w);
     double *step = malloc(cells * sizeof *step);
@@ -380,39 +380,34 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
     double *at_spin = malloc(3 * cells * sizeof *at_spin);
     double *f = malloc(3 * cells * sizeof *f);
     if (!w || !step || !at_w || !at_spin || !f) {
-        free(w);
-        free(step);
-        free(at_w);
-        free(at_spin);
-        free(f);
-        cubic_spline_free(&spline);
-        return out_of_memory(error, size);
-    }
-    size_t n = 0;
-    for (int p = 0; p < points; ++p) {
-        double at = p < knots - 1 ? 0.5 * (found->spin[p] + found->spin[p + 1]) : found->spin[p - (knots - 1)];
-        double *row = w + (size_t)p * m;
-        cubic_spline_evaluate(&spline, at, row);
-        for (int c = 0; c < m; ++c, ++n) {
-            double sign = c < forward ? 1.0 : -1.0, h = SLOPE_STEP * row[c];
-            at_w[3 * n] = sign * row[c];
-            at_w[3 * n + 1] = sign * (row[c] + h);
-            at_w[3 * n + 2] = sign * (row[c] - h);
-            at_spin[3 * n] = at_spin[3 * n + 1] = at_spin[3 * n + 2] = at;
+        status = out_of_memory(error, size);
+    } else {
+        size_t n = 0;
+        for (int p = 0; p < points; ++p) { /* the middles, then the knots */
+            double at = p < knots - 1 ? 0.5 * (found->spin[p] + found->spin[p + 1]) : found->spin[p - (knots - 1)];
+            double *row = w + (size_t)p * m;
+            cubic_spline_evaluate(&spline, at, row);
+            for (int c = 0; c < m; ++c, ++n) {
+                double sign = c < forward ? 1.0 : -1.0, h = SLOPE_STEP * row[c];
+                at_w[3 * n] = sign * row[c];
+                at_w[3 * n + 1] = sign * (row[c] + h);
+                at_w[3 * n + 2] = sign * (row[c] - h);
+                at_spin[3 * n] = at_spin[3 * n + 1] = at_spin[3 * n + 2] = at;
+            }
         }
-    }
-    chain_determinant(chain, 3 * cells, at_w, at_spin, f);
-    for (n = 0; n < cells; ++n) {
-        double x = w[n], h = SLOPE_STEP * x;
-        double estimate = fabs(f[3 * n] * 2.0 * h / (f[3 * n + 1] - f[3 * n + 2])) / x;
-        step[n] = isfinite(estimate) ? estimate : 0.0;
-    }
-    for (int i = 0; i + 1 < knots; ++i) {
-        const double *middle = step + (size_t)i * m, *lo = step + (size_t)(knots - 1 + i) * m, *hi = lo + m;
-        for (int c = 0; c < m; ++c) {
-            double noise = NOISE * (lo[c] > hi[c] ? lo[c] : hi[c]);
-            double e = middle[c] > noise ? middle[c] : 0.0;
-            error_of[i] = e > error_of[i] ? e : error_of[i];
+        chain_determinant(chain, 3 * cells, at_w, at_spin, f);
+        for (n = 0; n < cells; ++n) {
+            double x = w[n], h = SLOPE_STEP * x;
+            double estimate = fabs(f[3 * n] * 2.0 * h / (f[3 * n + 1] - f[3 * n + 2])) / x;
+            step[n] = isfinite(estimate) ? estimate : 0.0;
+        }
+        for (int i = 0; i + 1 < knots; ++i) {
+            const double *middle = step + (size_t)i * m, *lo = step + (size_t)(knots - 1 + i) * m, *hi = lo + m;
+            for (int c = 0; c < m; ++c) {
+                double noise = NOISE * (lo[c] > hi[c] ? lo[c] : hi[c]);
+                double e = middle[c] > noise ? middle[c] : 0.0;
+                error_of[i] = e > error_of[i] ? e : error_of[i];
+            }
         }
     }
     free(w);
@@ -421,7 +416,7 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
     free(at_spin);
     free(f);
     cubic_spline_free(&spline);
-    return 0;
+    return status;
 }
 
 /* campbell._insert (and np.insert of the speeds): ``added`` speed k after old speed ``rough[k]``;
