@@ -503,6 +503,8 @@ INVALID = [
     ONE + "[[masses]]\nposition = 'left'\nmass = 1\n",
     ONE + "[[masses]]\nposition = 1.5\nmass = 1\n",
     ONE + "[[bearings]]\nposition = 3\nstiffness = 1\n",
+    ONE + "[[masses]]\nposition = 1.0000000015\nmass = 1\n",
+    ONE + "[[unbalances]]\nposition = 1.0000000015\namount = 1\n",
     TWO + "[[hinges]]\nposition = 1.50000001\n",
     ONE + "[[masses]]\nnode = 0\nmass = 1\nspin = 2\n",
     ONE + "[[masses]]\nnode = 0\n",
@@ -725,3 +727,109 @@ def test_one_piece_shaft(lib):
         for shear in (True, False):
             native = native_result(lib, lib.driveline_one_piece, ctypes.byref(OnePiece(**params, shear=shear)))
             same(native, python_result(lambda: one_piece_shaft(**params, shear=shear)))
+
+
+#: TOML documents whose ``left_end`` the loader shows as its repr: the reader's values and tables.
+TOML_CASES = [
+    "left_end = {}", "left_end = []", "left_end = [[], [[]], {}]", "left_end = [1, 2, ]", "left_end = [\n1, # one\n2\n]",
+    "left_end = [1, [2, [3, {a = [4]}]]]", "left_end = {a.b.c = 1, a.b.d = 2, a.e = 3}", "left_end = {a = 1, a.b = 2}",
+    "left_end = {a = {b = 1}, a.c = 2}", "left_end = {'quoted key' = 1, \"esc\\tkey\" = 2, '' = 3}",
+    "left_end.a = 1\nleft_end.b.c = 2\nleft_end.b.d = 3", "[left_end]\na = 1\n[left_end.b]\nc = 2",
+    "[left_end.b]\nc = 2\n[left_end]\na = 1", "[left_end]\n[left_end]", "[left_end]\na.b = 1\n[left_end.a]",
+    "[left_end]\na.b = 1\n[left_end.a.c]", "[left_end.a.b]\n[left_end]\na.c = 1", "[left_end.a.b]\n[left_end]\na.b.c = 1",
+    "[[left_end.x]]\na = 1\n[[left_end.x]]\nb = 2\n[left_end.x.sub]\nc = 3",
+    "[[left_end.x]]\n[left_end.x]", "[left_end.x]\n[[left_end.x]]", "left_end.x = [1]\n[[left_end.x]]",
+    "left_end.x = {a = 1}\n[left_end.x.b]", "left_end.x = {a = 1}\n[left_end.x]", "left_end = 1\n[left_end.x]",
+    "[[left_end.x]]\ny.z = 1\n[[left_end.x]]\ny.z = 2", "[[left_end.x]]\n[[left_end.x.y]]\na = 1\n[[left_end.x.y]]",
+    "[left_end]\nx.y = 1\nx.z = 2\n[left_end.w]\n", "[ left_end . 'a b' . \"c\" ]\nk = 1",
+    "[[ left_end.x ]]\nk = 1", "[left_end\n]", "[[left_end.x]\n", "[left_end.x]]", "[left_end] x = 1",
+    "left_end = 1 # comment\n# another", "left_end = 1 \\", "left_end =", "left_end = \n1",
+    "left_end = 'literal \\n'", "left_end = \"\\u00e9\\U0001F600\\\\\\\"\"", "left_end = \"\\x41\"",
+    "left_end = \"\\u12\"", "left_end = \"\\U00110000\"", "left_end = \"\\uDFFF\"", "left_end = 'tab\there'",
+    "left_end = \"\"\"\none\ntwo\"\"\"", "left_end = \"\"\"a\\\n\n   b\"\"\"", "left_end = \"\"\"a\\   \n  b\"\"\"",
+    "left_end = \"\"\"a\\ b\"\"\"", "left_end = \"\"\"\"\"\"", "left_end = \"\"\"\"a\"\"\"\"", "left_end = '''''''",
+    "left_end = ''''a''''", "left_end = '''\n'''", "left_end = '''a''''''", "left_end = \"\"\"a\"\"\"\"\"\"",
+    "left_end = \"a\"\"", "left_end = \"\"\"\\\"\"\"\"", "left_end = \"\"\"tab\tand\u00e9\"\"\"",
+    "left_end = 0", "left_end = -0", "left_end = +17", "left_end = 1_000", "left_end = 0xDEAD_beef", "left_end = 0o17",
+    "left_end = 0b1010", "left_end = 0x", "left_end = 0X10", "left_end = 0b2", "left_end = -0x1", "left_end = 00",
+    "left_end = 9223372036854775807", "left_end = -9223372036854775808", "left_end = 1.5", "left_end = -0.0",
+    "left_end = +0.0", "left_end = 1e3", "left_end = 1E-3", "left_end = 1e+03", "left_end = 6.626e-34",
+    "left_end = 1_0.0_1e1_0", "left_end = 1.e3", "left_end = 1.0e", "left_end = 1e3.5", "left_end = 0.1_",
+    "left_end = inf", "left_end = +inf", "left_end = -inf", "left_end = nan", "left_end = -nan", "left_end = +nan",
+    "left_end = Inf", "left_end = infinity", "left_end = true", "left_end = false", "left_end = True",
+    "left_end = [true,false]", "left_end = {a=true}", "left_end = 1.7976931348623157e308", "left_end = 1e309",
+    "left_end = 4.9e-324", "left_end = 2.4e-324", "left_end = 0.30000000000000004", "left_end = 123456789012345678",
+    "left_end = 1 = 2", "left_end = [1 2]", "left_end = [,]", "left_end = {,}", "left_end = {a = 1 b = 2}",
+    "left_end = {a = 1}}", "left_end = [1]]", "left_end.\"a\".'b' = 1", "left_end . a = 1", "left_end.a. = 1",
+    "left_end..a = 1", "left-end = 1", "left_end = 1\r\n", "left_end = 1\r", "left_end = \"a\rb\"",
+    "left_end = [\r\n1]", "\ufeffleft_end = 1", "left_end = 'ü' # ü", "left_end = 1\nleft_end = 2",
+    "left_end = \"\x00\"", "left_end = [1] # \x00", "left_end.a = 1\nleft_end.a.b = 2",
+]
+
+
+def toml_message(lib, text: str) -> tuple[str, str]:
+    return from_text(lib, text), python_result(loads_driveline, text)
+
+
+@pytest.mark.parametrize("index", range(len(TOML_CASES)))
+def test_toml_values_read_as_tomllib_reads_them(lib, index):
+    native, python = toml_message(lib, TOML_CASES[index])
+    same(native, python)
+
+
+def random_value(rng: random.Random, depth: int = 0) -> str:
+    kind = rng.randrange(10 if depth < 3 else 7)
+    if kind == 0:
+        return rng.choice(["0", "-0", "+5", "1_000", "0x1F", "0o7", "0b101", "42", "-17", "9_223_372"])
+    if kind == 1:
+        return rng.choice(["1.5", "-0.0", "1e10", "6.02e+23", "1E-7", "3_1.4_1", "inf", "-nan", "1e-320", "0.1"])
+    if kind == 2:
+        return rng.choice(["true", "false"])
+    if kind == 3:
+        body = "".join(rng.choice(["a", " ", "'", "\\\"", "\\\\", "\\t", "\\n", "\\u00e9", "é", "\\U0001F600", "\\b"])
+                       for _ in range(rng.randrange(6)))
+        return f'"{body}"'
+    if kind == 4:
+        return "'" + "".join(rng.choice(["a", " ", '"', "\\", "é", "\t"]) for _ in range(rng.randrange(6))) + "'"
+    if kind == 5:
+        return '"""' + "".join(rng.choice(["a", "\n", '"', '""', "\\\n  ", "\\t"]) for _ in range(rng.randrange(5))) + '"""'
+    if kind == 6:
+        return "'''" + "".join(rng.choice(["a", "\n", "'", "''", "\\"]) for _ in range(rng.randrange(5))) + "'''"
+    if kind in (7, 8):
+        items = [random_value(rng, depth + 1) for _ in range(rng.randrange(4))]
+        sep = rng.choice([", ", ",\n", " , ", ",  # note\n"])
+        return "[" + sep.join(items) + rng.choice(["", ",", "\n"]) + "]"
+    keys = rng.sample(["a", "b", "c.d", "c.e", "'q k'", '"x"', "f.g.h"], rng.randrange(4))
+    return "{" + ", ".join(f"{k} = {random_value(rng, depth + 1)}" for k in keys) + "}"
+
+
+def mutate(rng: random.Random, text: str) -> str:
+    at = rng.randrange(len(text) + 1)
+    choice = rng.randrange(3)
+    if choice == 0 and at < len(text):
+        return text[:at] + text[at + 1:]
+    insert = rng.choice(["'", '"', "[", "]", "{", "}", ",", "=", ".", "\n", " ", "#", "\\", "_", "e", "0", "x"])
+    return text[:at] + insert + text[at + (choice == 1):]
+
+
+def test_random_toml_reads_as_tomllib_reads_it(lib):
+    rng = random.Random(3)
+    read = 0
+    for _ in range(3000):
+        lines = []
+        for _ in range(rng.randint(1, 4)):
+            if rng.random() < 0.3:
+                lines.append(rng.choice(["[left_end]", "[left_end.t]", "[[left_end.l]]", "[left_end.t.u]"]))
+            key = rng.choice(["v", "w.x", "w.y", "'z'", "t.k", "l"])
+            lines.append(f"{key} = {random_value(rng)}")
+        text = "\n".join(lines)
+        if rng.random() < 0.5 and not text.startswith("["):
+            text = "left_end." + text
+        elif not text.startswith("["):
+            text = "[left_end]\n" + text
+        if rng.random() < 0.5:
+            text = mutate(rng, text)
+        native, python = toml_message(lib, text)
+        same(native, python)
+        read += "malformed" not in python
+    assert read > 1000
