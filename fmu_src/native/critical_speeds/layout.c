@@ -2233,7 +2233,10 @@ static int load_driveline(const char *path, Driveline *out, char *error, size_t 
     long bad;
     int status;
     memset(out, 0, sizeof *out);
-    if (p == NULL) {
+    if (p == NULL && errno == ENOMEM) {
+        return fail(error, size, "out of memory");
+    }
+    if (p == NULL) { /* the working directory is gone (os.getcwd's OSError) */
         char reason_text[128];
         int err = errno;
         if (strerror_r(err, reason_text, sizeof reason_text) != 0) {
