@@ -40,15 +40,7 @@ typedef struct {
 
 static void put_bytes(Text *text, const char *bytes, size_t count)
 {
-    if (text->size == 0 || text->used + 1 >= text->size) {
-        return;
-    }
-    if (count > text->size - 1 - text->used) {
-        count = text->size - 1 - text->used;
-    }
-    memcpy(text->out + text->used, bytes, count);
-    text->used += count;
-    text->out[text->used] = '\0';
+    text_append(text->out, text->size, &text->used, bytes, count);
 }
 
 static void put(Text *text, const char *piece)
@@ -378,23 +370,24 @@ static Value *find(const Value *table, const char *key, size_t key_length)
     return NULL;
 }
 
-/* A new table named ``key`` in ``parent`` (get_or_create_nest's step). */
-static Value *add_table(Reader *reader, Value *parent, const char *key, size_t key_length)
+/* A new empty table or array named ``key`` in the table ``parent`` (get_or_create_nest's step), or
+ * at the end of the array ``parent`` (key NULL). */
+static Value *add_child(Reader *reader, Value *parent, Kind kind, const char *key, size_t key_length)
 {
-    Value *table;
+    Value *child;
     if (parent->depth >= TREE_DEPTH) {
         malformed(reader, "tables and arrays nest too deep");
         return NULL;
     }
-    table = new_value(reader, V_TABLE, parent->depth + 1);
-    if (table == NULL) {
+    child = new_value(reader, kind, parent->depth + 1);
+    if (child == NULL) {
         out_of_memory(reader);
         return NULL;
     }
-    if (append(reader, parent, key, key_length, table) != 0) {
+    if (append(reader, parent, key, key_length, child) != 0) {
         return NULL;
     }
-    return table;
+    return child;
 }
 
 static int hex_digit(int c)
@@ -756,6 +749,16 @@ static int descend_error(Reader *reader)
     return malformed(reader, "cannot overwrite a value");
 }
 
+/* Whether ``c`` stands at pos (then passed). */
+static int closes(Reader *reader, int c)
+{
+    if (peek(reader, 0) != c) {
+        return 0;
+    }
+    reader->pos++;
+    return 1;
+}
+
 /* parse_array: [ values, ... ] over lines, with comments and a trailing comma. */
 static int read_array(Reader *reader, Value *array)
 {
@@ -763,8 +766,7 @@ static int read_array(Reader *reader, Value *array)
     if (skip_array_space(reader) != 0) {
         return -1;
     }
-    if (peek(reader, 0) == ']') {
-        reader->pos++;
+    if (closes(reader, ']')) {
         return 0;
     }
     for (;;) {
@@ -773,8 +775,7 @@ static int read_array(Reader *reader, Value *array)
             skip_array_space(reader) != 0) {
             return -1;
         }
-        if (peek(reader, 0) == ']') {
-            reader->pos++;
+        if (closes(reader, ']')) {
             return 0;
         }
         if (peek(reader, 0) != ',') {
@@ -784,8 +785,7 @@ static int read_array(Reader *reader, Value *array)
         if (skip_array_space(reader) != 0) {
             return -1;
         }
-        if (peek(reader, 0) == ']') {
-            reader->pos++;
+        if (closes(reader, ']')) {
             return 0;
         }
     }
@@ -808,43 +808,59 @@ static int read_pair(Reader *reader, const Value *parent, Key *key, Value **valu
     return read_value(reader, parent->depth + key->count, value);
 }
 
+/* The pair's place below ``table``: the tables of the dotted key's parts (made where missing), then the
+ * value under its last part. ``section``: a statement of a section (key_value_rule: a table declared
+ * before is closed to dotted keys; the ones passed count as declared from the next header on); else
+ * a pair of an inline table (parse_inline_table). Literal arrays and inline tables stay closed. */
+static int place_pair(Reader *reader, Value *table, const Key *key, Value *value, int section)
+{
+    Value *nest = table;
+    int i;
+    for (i = 0; i + 1 < key->count; i++) {
+        Value *next = find(nest, key->part[i], key->length[i]);
+        if (next == NULL) {
+            next = add_child(reader, nest, V_TABLE, key->part[i], key->length[i]);
+            if (next == NULL) {
+                return -1;
+            }
+        } else if (section && next->declared) {
+            return malformed(reader, "cannot redefine a namespace");
+        } else if (next->kind != V_TABLE || next->frozen) {
+            return descend_error(reader);
+        }
+        if (section) {
+            Pending *pending = arena_alloc(&reader->arena, sizeof *pending);
+            if (pending == NULL) {
+                return out_of_memory(reader);
+            }
+            pending->table = next;
+            pending->next = reader->pending;
+            reader->pending = pending;
+        }
+        nest = next;
+    }
+    if (find(nest, key->part[key->count - 1], key->length[key->count - 1]) != NULL) {
+        return descend_error(reader);
+    }
+    return append(reader, nest, key->part[key->count - 1], key->length[key->count - 1], value);
+}
+
 /* parse_inline_table: { key = value, ... } on one line; dotted keys make tables inside. */
 static int read_inline_table(Reader *reader, Value *table)
 {
     reader->pos++;
     skip_blanks(reader);
-    if (peek(reader, 0) == '}') {
-        reader->pos++;
+    if (closes(reader, '}')) {
         return 0;
     }
     for (;;) {
         Key key;
-        Value *value, *nest = table;
-        int i;
-        if (read_pair(reader, table, &key, &value) != 0) {
-            return -1;
-        }
-        for (i = 0; i + 1 < key.count; i++) {
-            Value *next = find(nest, key.part[i], key.length[i]);
-            if (next == NULL) {
-                next = add_table(reader, nest, key.part[i], key.length[i]);
-                if (next == NULL) {
-                    return -1;
-                }
-            } else if (next->kind != V_TABLE || next->frozen) {
-                return descend_error(reader);
-            }
-            nest = next;
-        }
-        if (find(nest, key.part[key.count - 1], key.length[key.count - 1]) != NULL) {
-            return malformed(reader, "duplicate inline table key");
-        }
-        if (append(reader, nest, key.part[key.count - 1], key.length[key.count - 1], value) != 0) {
+        Value *value;
+        if (read_pair(reader, table, &key, &value) != 0 || place_pair(reader, table, &key, value, 0) != 0) {
             return -1;
         }
         skip_blanks(reader);
-        if (peek(reader, 0) == '}') {
-            reader->pos++;
+        if (closes(reader, '}')) {
             return 0;
         }
         if (peek(reader, 0) != ',') {
@@ -901,7 +917,7 @@ static Value *header_nest(Reader *reader, Value *root, const Key *key, int parts
     for (i = 0; i < parts; i++) {
         Value *next = find(nest, key->part[i], key->length[i]);
         if (next == NULL) {
-            next = add_table(reader, nest, key->part[i], key->length[i]);
+            next = add_child(reader, nest, V_TABLE, key->part[i], key->length[i]);
             if (next == NULL) {
                 return NULL;
             }
@@ -953,7 +969,7 @@ static Value *read_header(Reader *reader, Value *root)
             malformed(reader, existing->declared ? "cannot declare a table twice" : "cannot overwrite a value");
             return NULL;
         }
-        table = existing != NULL ? existing : add_table(reader, parent, stem, stem_length);
+        table = existing != NULL ? existing : add_child(reader, parent, V_TABLE, stem, stem_length);
         if (table != NULL) {
             table->declared = 1;
             reader->pos += 1;
@@ -965,33 +981,17 @@ static Value *read_header(Reader *reader, Value *root)
         return NULL;
     }
     if (existing == NULL) {
-        if (parent->depth >= TREE_DEPTH) {
-            malformed(reader, "tables and arrays nest too deep");
-            return NULL;
-        }
-        existing = new_value(reader, V_ARRAY, parent->depth + 1);
-        if (existing == NULL || append(reader, parent, stem, stem_length, existing) != 0) {
-            if (existing == NULL) {
-                out_of_memory(reader);
-            }
+        existing = add_child(reader, parent, V_ARRAY, stem, stem_length);
+        if (existing == NULL) {
             return NULL;
         }
         existing->of_tables = 1;
         existing->declared = 1;
     }
-    if (existing->depth >= TREE_DEPTH) {
-        malformed(reader, "tables and arrays nest too deep");
-        return NULL;
+    table = add_child(reader, existing, V_TABLE, NULL, 0);
+    if (table != NULL) {
+        reader->pos += 2;
     }
-    table = new_value(reader, V_TABLE, existing->depth + 1);
-    if (table == NULL) {
-        out_of_memory(reader);
-        return NULL;
-    }
-    if (append(reader, existing, NULL, 0, table) != 0) {
-        return NULL;
-    }
-    reader->pos += 2;
     return table;
 }
 
@@ -999,42 +999,8 @@ static Value *read_header(Reader *reader, Value *root)
 static int read_statement_pair(Reader *reader, Value *header)
 {
     Key key;
-    Value *value, *nest = header;
-    int i;
-    if (read_pair(reader, header, &key, &value) != 0) {
-        return -1;
-    }
-    for (i = 0; i + 1 < key.count; i++) {
-        Value *next = find(nest, key.part[i], key.length[i]);
-        Pending *pending;
-        if (next == NULL) {
-            next = add_table(reader, nest, key.part[i], key.length[i]);
-            if (next == NULL) {
-                return -1;
-            }
-        } else if (next->declared) {
-            return malformed(reader, "cannot redefine a namespace");
-        } else if (next->frozen) {
-            return malformed(reader, "cannot mutate an immutable namespace");
-        } else if (next->kind != V_TABLE) {
-            return descend_error(reader);
-        }
-        pending = arena_alloc(&reader->arena, sizeof *pending);
-        if (pending == NULL) {
-            return out_of_memory(reader);
-        }
-        pending->table = next;
-        pending->next = reader->pending;
-        reader->pending = pending;
-        nest = next;
-    }
-    if (nest->frozen) {
-        return malformed(reader, "cannot mutate an immutable namespace");
-    }
-    if (find(nest, key.part[key.count - 1], key.length[key.count - 1]) != NULL) {
-        return descend_error(reader);
-    }
-    return append(reader, nest, key.part[key.count - 1], key.length[key.count - 1], value);
+    Value *value;
+    return read_pair(reader, header, &key, &value) != 0 ? -1 : place_pair(reader, header, &key, value, 1);
 }
 
 /* tomllib.loads: the document's table (in the reader's arena), NULL with the message. */

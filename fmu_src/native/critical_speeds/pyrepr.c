@@ -8,23 +8,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The output of one repr, cut where ``size`` ends. */
-typedef struct {
-    char *out;
-    size_t size, used;
-} Sink;
-
-static void sink_bytes(Sink *sink, const char *bytes, size_t count)
+void text_append(char *out, size_t size, size_t *used, const char *bytes, size_t count)
 {
-    if (sink->size == 0 || sink->used + 1 >= sink->size) {
+    if (size == 0 || *used + 1 >= size) {
         return;
     }
-    if (count > sink->size - 1 - sink->used) {
-        count = sink->size - 1 - sink->used;
+    if (count > size - 1 - *used) {
+        count = size - 1 - *used;
     }
-    memcpy(sink->out + sink->used, bytes, count);
-    sink->used += count;
-    sink->out[sink->used] = '\0';
+    memcpy(out + *used, bytes, count);
+    *used += count;
+    out[*used] = '\0';
 }
 
 /* The code point at ``text`` (``left`` bytes) and its length in ``*width``; -1 for a byte that starts
@@ -95,7 +89,7 @@ static int printable(long code)
 void python_str_repr_n(const char *text, size_t length, size_t max_chars, char *out, size_t size)
 {
     const unsigned char *bytes = (const unsigned char *)text;
-    Sink sink = {out, size, 0};
+    size_t used = 0;
     size_t at, width, end = 0, chars = 0;
     int single = 0, double_ = 0;
     char quote, piece[16];
@@ -111,7 +105,7 @@ void python_str_repr_n(const char *text, size_t length, size_t max_chars, char *
         chars++;
     }
     quote = single && !double_ ? '"' : '\'';
-    sink_bytes(&sink, &quote, 1);
+    text_append(out, size, &used, &quote, 1);
     for (at = 0; at < end; at += width) {
         long code = next_code_point(bytes + at, end - at, &width);
         if (code < 0) {
@@ -134,9 +128,9 @@ void python_str_repr_n(const char *text, size_t length, size_t max_chars, char *
         } else {
             snprintf(piece, sizeof piece, "\\U%08lx", (unsigned long)code & 0x1FFFFFUL);
         }
-        sink_bytes(&sink, piece, strlen(piece));
+        text_append(out, size, &used, piece, strlen(piece));
     }
-    sink_bytes(&sink, &quote, 1);
+    text_append(out, size, &used, &quote, 1);
 }
 
 void python_str_repr(const char *text, size_t max_chars, char *out, size_t size)
