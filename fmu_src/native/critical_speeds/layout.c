@@ -191,7 +191,7 @@ static int fail(char *error, size_t size, const char *format, ...)
     va_start(args, format);
     for (c = format; *c != '\0'; c++) {
         const char *s;
-        if (*c != '%') {
+        if (*c != '%' || c[1] == '\0') {
             put_bytes(&text, c, 1);
             continue;
         }
