@@ -556,6 +556,8 @@ INVALID = [
     "left_end = \"\\u0000\\u001f\\u007f\\u00a0\\u00ad\\u2028\\u00e9\\U0001F600\"\n" + ONE,
     seg("length = [1, 2.5, -0.0, 1e16, 1e-5, true, 'x', {}, [], {a = {b = 1}}]\nouter_diameter = 0.05"),
     seg("length = 1e400\nouter_diameter = 0.05\nmaterial = 'steel'"),
+    seg("length = {" + ".".join(["k"] * 55) + " = [[[1]], {}], z = 2}\nouter_diameter = 0.05"),
+    "[left_end" + ".t" * 60 + "]\nx = [[1, [2]], {a = 'b'}]\n" + ONE,
     seg("length = 0x7fffffffffffffff\nouter_diameter = 0.05\nmaterial = 'steel'\npoisson_ratio = -9223372036854775808"),
 ]
 
@@ -569,6 +571,8 @@ DEPARTURES = [
     ONE + "label = 99999999999999999999\n",
     ONE + "label = -9223372036854775809\n",
     ONE + "label = 0x10000000000000000\n",
+    ONE + "label." + ".".join(["k"] * 70) + " = 1\n",
+    ONE + "[label" + ".t" * 70 + "]\n",
 ]
 
 
@@ -638,7 +642,8 @@ def test_file_checks(lib, tmp_path, monkeypatch):
     (tmp_path / "sub" / "malformed.toml").write_text(ONE + "x = \n")
     layouts = ["missing.toml", "dir.toml", "fifo.toml", "big.toml", "limit.toml", *bad_bytes, "a" * 295 + ".toml",
                "./sub//good.toml", "sub/./bad.TOML".replace("TOML", "toml"), ".//sub/../sub/malformed.toml",
-               str(tmp_path) + "//sub/./good.toml", "sub/nothing/../good.toml", "SUB.TOML"]
+               str(tmp_path) + "//sub/./good.toml", "sub/nothing/../good.toml", "SUB.TOML",
+               "/" + str(tmp_path) + "/sub/bad.toml", "//" + str(tmp_path) + "/sub/bad.toml"]
     messages = []
     for layout in layouts:
         python = python_result(build_driveline, layout, {})
@@ -649,7 +654,8 @@ def test_file_checks(lib, tmp_path, monkeypatch):
     for expected in ("No such file or directory", "is not a regular file", "is larger than 65536 bytes",
                      "File name too long", "invalid start byte", "invalid continuation byte",
                      "unexpected end of data", str(tmp_path / "sub" / "bad.toml") + ": masses[0].node = 7",
-                     str(tmp_path / "sub" / ".." / "sub" / "malformed.toml") + ": malformed TOML"):
+                     str(tmp_path / "sub" / ".." / "sub" / "malformed.toml") + ": malformed TOML",
+                     "/" + str(tmp_path / "sub" / "bad.toml") + ": masses[0]"):
         assert expected in text, expected
 
 

@@ -140,40 +140,61 @@ struct Item {
     Item *next;
 };
 
-/* repr() of a value as Python shows the loaded one (str, int, float, bool, list, dict). */
-static void put_repr(Text *text, const Value *value)
+/* repr() of a scalar as Python shows the loaded one (str, int, float, bool). */
+static void put_scalar_repr(Text *text, const Value *value)
 {
-    const Item *item;
     char shown[32];
-    switch (value->kind) {
-    case V_STRING:
+    if (value->kind == V_STRING) {
         put_str_repr(text, value->text, value->length);
-        break;
-    case V_INTEGER:
+    } else if (value->kind == V_INTEGER) {
         snprintf(shown, sizeof shown, "%lld", value->integer);
         put(text, shown);
-        break;
-    case V_FLOAT:
+    } else if (value->kind == V_FLOAT) {
         put_float(text, value->number);
-        break;
-    case V_BOOL:
+    } else {
         put(text, value->integer ? "True" : "False");
-        break;
-    case V_ARRAY:
-    case V_TABLE:
-        put(text, value->kind == V_ARRAY ? "[" : "{");
-        for (item = value->first; item != NULL; item = item->next) {
-            if (item != value->first) {
+    }
+}
+
+/* repr() of a value as Python shows the loaded one, lists and dicts too: walked with a stack of the
+ * open containers (no recursion; the reader makes none deeper than TREE_DEPTH). */
+static void put_repr(Text *text, const Value *value)
+{
+    const Value *open[TREE_DEPTH + 2];
+    const Item *next[TREE_DEPTH + 2];
+    int top = -1;
+    for (;;) {
+        if ((value->kind == V_ARRAY || value->kind == V_TABLE) && top + 1 < TREE_DEPTH + 2) {
+            put(text, value->kind == V_ARRAY ? "[" : "{");
+            open[++top] = value;
+            next[top] = value->first;
+        } else if (value->kind == V_ARRAY || value->kind == V_TABLE) {
+            put(text, "...");
+        } else {
+            put_scalar_repr(text, value);
+        }
+        for (;;) { /* the next value to show, after the ends of the containers done */
+            const Item *item;
+            if (top < 0) {
+                return;
+            }
+            item = next[top];
+            if (item == NULL) {
+                put(text, open[top]->kind == V_ARRAY ? "]" : "}");
+                top--;
+                continue;
+            }
+            if (item != open[top]->first) {
                 put(text, ", ");
             }
-            if (value->kind == V_TABLE) {
+            if (open[top]->kind == V_TABLE) {
                 put_str_repr(text, item->key, item->key_length);
                 put(text, ": ");
             }
-            put_repr(text, item->value);
+            next[top] = item->next;
+            value = item->value;
+            break;
         }
-        put(text, value->kind == V_ARRAY ? "]" : "}");
-        break;
     }
 }
 
