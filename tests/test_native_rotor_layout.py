@@ -572,7 +572,7 @@ DEPARTURES = [
     ONE + "label = -9223372036854775809\n",
     ONE + "label = 0x10000000000000000\n",
     ONE + "label." + ".".join(["k"] * 70) + " = 1\n",
-    ONE + "[label" + ".t" * 70 + "]\n",
+    ONE + "[segments.label" + ".t" * 70 + "]\n",
 ]
 
 
