@@ -164,29 +164,14 @@ youngs_modulus = 2.1e11
 density = 7850.0
 """
 
-SEGMENTS = STEEL + """
-[[segments]]
-length = 0.7
-outer_diameter = 0.0762
-wall_thickness = 0.00165
-material = "steel"
-
-[[segments]]
-length = 0.1
-outer_diameter = 0.035
-material = "steel"
-
-[[segments]]
-length = 0.8
-outer_diameter = 0.0635
-wall_thickness = 0.0016
-material = "steel"
-"""
+SHIPPED = (DATA / "two_piece_propshaft.toml").read_text()
+#: The shipped layout's material and its three segments (0.7 m, 0.1 m, 0.8 m long).
+SEGMENTS = SHIPPED[SHIPPED.index("[materials.steel]"):SHIPPED.index("[[masses]]")]
 
 ONE = '[[segments]]\nlength = 1.0\nouter_diameter = 0.05\nyoungs_modulus = 2.1e11\ndensity = 7850.0\n'
 
 VALID = {
-    "shipped": (DATA / "two_piece_propshaft.toml").read_text(),
+    "shipped": SHIPPED,
     "shipped hinged": (DATA / "two_piece_propshaft_hinged.toml").read_text(),
     "positions cut segments": SEGMENTS + """
 [[masses]]
@@ -216,15 +201,15 @@ position = 0.9
 node = 2
 bending_stiffness = 250.0
 [[unbalances]]
-position = 0.123
-amount = 1e-4
 phase = -0.5
+amount = 1e-4
+position = 0.123
 [[unbalances]]
-node = 3
 amount = 2e-4
+node = 3
 [[unbalances]]
-position = 1.6000000009
 amount = 0
+position = 1.6000000009  # within NODE_SNAP beyond the right end: at the end
 """,
     "inline tables and dotted keys": """
 name = 'inline'   # literal string
