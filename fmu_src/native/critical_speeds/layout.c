@@ -28,7 +28,8 @@
 #endif
 
 #define NODE_SNAP 1e-9 /* loader.NODE_SNAP */
-/* Tables and arrays below the document at the most (a bound on the reader's recursion). */
+/* Tables and arrays nested below the document at the most (deeper is refused as malformed TOML:
+ * a bound on a key's parts and on the stack of put_repr). */
 #define TREE_DEPTH (4 * LAYOUT_MAX_NESTING)
 
 /* ---- messages ----------------------------------------------------------------------------- */
