@@ -2293,6 +2293,9 @@ int driveline_from_layout(const char *layout, const char *resources, Driveline *
         put(&text, " (names are letters, digits and '_')");
         return -1;
     }
+    if (resources == NULL) {
+        return fail(error, size, "no shipped example named %r", layout);
+    }
     path = malloc(strlen(resources) + n + 8);
     if (path == NULL) {
         return fail(error, size, "out of memory");
