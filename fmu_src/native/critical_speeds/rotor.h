@@ -97,6 +97,13 @@ int driveline_isotropic(const Driveline *driveline);
 /* ---- pyrepr.c -------------------------------------------------------------------------------- */
 /* repr() of a Python str holding the UTF-8 ``text`` cut to its first ``max_chars`` code points (0: all). */
 void python_str_repr(const char *text, size_t max_chars, char *out, size_t size);
+/* The same for ``length`` bytes (the text may hold NUL characters). */
+void python_str_repr_n(const char *text, size_t length, size_t max_chars, char *out, size_t size);
+/* repr() of a Python float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05", "1e+16". */
+void pyrepr_float(double value, char *out, size_t size);
+/* Appends ``count`` bytes to the text of ``*used`` bytes in ``out`` (``size`` bytes), cut to fit,
+ * always terminated; ``*used`` grows by what was written. */
+void text_append(char *out, size_t size, size_t *used, const char *bytes, size_t count);
 
 /* ---- transfer.c: the scaled frequency determinant (transfer.py) ---------------------------- */
 typedef struct Chain Chain; /* transfer.Chain of a driveline (it keeps no pointer to it) */
