@@ -12,8 +12,10 @@ Tolerances, and why:
   round-off by up to 1e-9 relative in the anisotropic 8x8 state at w ~ 1e5 rad/s). Both then do
   the same operations; what is left is libm/SIMD round-off of sinh, exp and pow (numpy vectorises
   them) and the order of sums, amplified by the cancellation in the final 2x2 minor or 4x4
-  determinant: measured 1.1e-12 (isotropic) and 2e-12 (anisotropic up to 5000 rad/s), checked at
-  5e-12 (1e-10 anisotropic, up to 2e4 rad/s). Next to a root, where |f| is small against its size
+  determinant: measured 1.1e-12 (isotropic) and 7e-12 (anisotropic up to 5000 rad/s), checked at
+  5e-12. The anisotropic 8x8 propagation, whose forward and backward parts grow at different rates,
+  is itself noisy above 5000 rad/s: at w = 10447, spin = 2182 rad/s the Python core's f moves by
+  1.4e-10 when w moves by 3 ulp (the C port differs by 1.5e-10), so it is checked at 1e-9 up to 2e4 rad/s. Next to a root, where |f| is small against its size
   at w +- 1 % (at high w that window holds roots), the error is bounded by 1e-12 of that size instead
   (measured: 4e-11 relative at a point with 1 % of the local size, w = 78 000 rad/s);
 * roots (lines, whirl senses, order resonances, critical speeds): both refine to xtol 1e-12 +
@@ -265,12 +267,12 @@ def test_chain_constants(pair):
 
 
 def test_determinant(pair):
-    """f(w, spin) at 250 points, low and high frequencies, signed w for isotropic chains; the Python
+    """f(w, spin) at 150 points, low and high frequencies, signed w for isotropic chains; the Python
     core evaluated point by point (see the module docstring)."""
     driveline, native = pair
     rng = np.random.default_rng(7)
     anisotropic = not driveline.is_isotropic
-    w = np.concatenate([rng.uniform(0.0, 5000.0, 200), rng.uniform(5000.0, 1e5 if not anisotropic else 2e4, 50)])
+    w = np.concatenate([rng.uniform(0.0, 5000.0, 120), rng.uniform(5000.0, 1e5 if not anisotropic else 2e4, 30)])
     if not anisotropic:
         w *= rng.choice([-1.0, 1.0], w.size)
     spin = rng.uniform(0.0, 3000.0, w.size)
@@ -279,7 +281,7 @@ def test_determinant(pair):
     assert np.all(np.isfinite(native_f))
     # next to a root |f| is small against its size at w +- 1 %: there the error is set against that size
     local = np.maximum(np.abs(native.determinant(0.99 * w, spin)), np.abs(native.determinant(1.01 * w, spin)))
-    rtol = 1e-10 if anisotropic else 5e-12
+    rtol = 1e-9 if anisotropic else 5e-12
     error = np.abs(native_f - python)
     assert np.all(error <= rtol * np.abs(python) + 1e-12 * local), np.max(error / np.abs(python))
     away = np.abs(python) > 1e-3 * local
