@@ -413,3 +413,16 @@ def test_default_tube_cost(lib):
     for _ in range(10):
         native.critical_speeds(3)
     assert (time.process_time() - start) / 10 < 0.02
+
+
+def test_close_pairs_found_in_dips(lib):
+    """Bearings 0.1 % apart in x and y split every planar mode into a pair closer than the grid step:
+    the pairs show as dips of |f| only and are found on the sub-grids (seed Sec. 8 reworked)."""
+    driveline = Driveline([ShaftSegment(1.4, 0.0762, 0.0729)], [_joint(0), _joint(1)],
+                          [Bearing(0, 1e7, kyy=0.999e7), Bearing(1, 1e7)])
+    native = NativeChain(lib, driveline)
+    line = np.array([(1.0, 0.0, 0.0)])
+    python = driveline._line_roots(line, None, 2500.0, 1e5)
+    assert np.min(np.diff(python[0])) < 1e-4 * python[0][0]  # a pair closer than a grid step
+    _assert_roots(native.line_roots(line, None, 2500.0), python)
+    _assert_roots(native.line_roots(line, 8, None), driveline._line_roots(line, 8, None, 1e5))
