@@ -20,7 +20,7 @@ Tolerances, and why:
   (measured: 4e-11 relative at a point with 1 % of the local size, w = 78 000 rad/s);
 * roots (lines, whirl senses, order resonances, critical speeds): both refine to xtol 1e-12 +
   4 eps |x| on functions that agree to ~1e-12, so the roots agree to round-off: measured 3e-15
-  isotropic, 8e-14 anisotropic; checked at 1e-12 relative, and the counts, order, orders and whirl
+  isotropic, 1.1e-13 anisotropic; checked at 1e-12 relative, and the counts, order, orders and whirl
   senses exactly;
 * forward fraction (anisotropic mode classification): the C port sums the squared amplitudes as
   quadratic forms of the null vector instead of mapping the vector back, measured 3e-14 absolute;
