@@ -39,6 +39,13 @@ typedef struct {
     size_t size;
 } Search;
 
+static void free_all(void *a, void *b, void *c)
+{
+    free(a);
+    free(b);
+    free(c);
+}
+
 static void set_error(char *error, size_t size, const char *text)
 {
     if (error != NULL && size > 0) {
@@ -444,9 +451,7 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
         forward[c].x = backward[c].x = NULL;
     }
     if (lines == NULL || first == NULL || found_roots == NULL) {
-        free(lines);
-        free(first);
-        free(found_roots);
+        free_all(lines, first, found_roots);
         set_error(error, size, "out of memory");
         return -1;
     }
@@ -461,9 +466,7 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
     }
     nn = n == N_NONE || iso ? n : 2 * n;
     if (line_roots(chain, lines, count, nn, x_max, limit, NULL, found_roots, error, size)) {
-        free(lines);
-        free(first);
-        free(found_roots);
+        free_all(lines, first, found_roots);
         return -1;
     }
     for (c = 0; c < m && status == 0; c++) {
@@ -493,9 +496,7 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
         }
     }
     rotor_roots_free(found_roots, count);
-    free(found_roots);
-    free(lines);
-    free(first);
+    free_all(lines, first, found_roots);
     if (status) {
         rotor_roots_free(forward, m);
         rotor_roots_free(backward, m);
@@ -556,9 +557,7 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
     forward = malloc((size_t)n_orders * sizeof *forward);
     backward = malloc((size_t)n_orders * sizeof *backward);
     if (cases == NULL || forward == NULL || backward == NULL) {
-        free(cases);
-        free(forward);
-        free(backward);
+        free_all(cases, forward, backward);
         set_error(error, size, "out of memory");
         return -1;
     }
@@ -568,9 +567,7 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
         cases[k].o = 0.0;
     }
     if (roots_by_whirl(chain, cases, n_orders, n, spin_max, limit, forward, backward, error, size)) {
-        free(cases);
-        free(forward);
-        free(backward);
+        free_all(cases, forward, backward);
         return -1;
     }
     for (k = 0; k < n_orders; k++) {
@@ -603,9 +600,7 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
     }
     rotor_roots_free(forward, n_orders);
     rotor_roots_free(backward, n_orders);
-    free(cases);
-    free(forward);
-    free(backward);
+    free_all(cases, forward, backward);
     if (total < 0) {
         return -1;
     }

@@ -270,6 +270,21 @@ static void field_matrix(const Chain *chain, const ChainSegment *seg, double w, 
 
 /* ---- small dense linear algebra ------------------------------------------------------------- */
 
+/* x <- (I - tau v v^T) x for the reflector v = [0..0, 1, V[k+1..m-1][k]] of column k; x[i * stride] is row i */
+static void reflect(int m, int k, double V[8][4], double tau, double *x, int stride)
+{
+    int i;
+    double s = x[k * stride];
+    for (i = k + 1; i < m; i++) {
+        s += V[i][k] * x[i * stride];
+    }
+    s *= tau;
+    x[k * stride] -= s;
+    for (i = k + 1; i < m; i++) {
+        x[i * stride] -= s * V[i][k];
+    }
+}
+
 /* Householder QR of the m x n (n <= m <= 8, n <= 4) matrix A as LAPACK's dgeqrf: A is overwritten
  * by R in its upper triangle, v (below the diagonal) and tau hold the reflectors. Returns the number
  * of non-trivial reflectors (det Q = (-1)^that). */
@@ -296,16 +311,8 @@ static int householder(int m, int n, double A[8][4], double tau[4])
         }
         A[j][j] = beta;
         reflections++;
-        for (k = j + 1; k < n; k++) { /* apply I - tau v v^T to the remaining columns */
-            double s = A[j][k];
-            for (i = j + 1; i < m; i++) {
-                s += A[i][j] * A[i][k];
-            }
-            s *= tau[j];
-            A[j][k] -= s;
-            for (i = j + 1; i < m; i++) {
-                A[i][k] -= s * A[i][j];
-            }
+        for (k = j + 1; k < n; k++) { /* the remaining columns */
+            reflect(m, j, A, tau[j], &A[0][k], 4);
         }
     }
     return reflections;
@@ -325,15 +332,7 @@ static void householder_q(int m, int n, int cols, double V[8][4], const double t
             continue;
         }
         for (j = 0; j < cols; j++) {
-            double s = Q[k][j];
-            for (i = k + 1; i < m; i++) {
-                s += V[i][k] * Q[i][j];
-            }
-            s *= tau[k];
-            Q[k][j] -= s;
-            for (i = k + 1; i < m; i++) {
-                Q[i][j] -= s * V[i][k];
-            }
+            reflect(m, k, V, tau[k], &Q[0][j], 8);
         }
     }
 }
@@ -527,34 +526,37 @@ static void transpose(int n, double M[4][4])
     }
 }
 
+static void mat_product(int n, double A[4][4], double B[4][4])
+{ /* A <- A B */
+    double C[4][4];
+    int i, j, k;
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) {
+            double s = 0.0;
+            for (k = 0; k < n; k++) {
+                s += A[i][k] * B[k][j];
+            }
+            C[i][j] = s;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        for (j = 0; j < n; j++) {
+            A[i][j] = C[i][j];
+        }
+    }
+}
+
 /* G <- M^T G M for the snapshot map: R^-1 ("solve") or T ("multiply") */
 static void gram_map(int n, double G[4][4], double R[4][4], double T[4][4])
 {
-    int i, j, k;
     if (R != NULL) {
         right_solve(n, G, R); /* G R^-1 */
         transpose(n, G);
         right_solve(n, G, R); /* (G R^-1)^T R^-1 = R^-T G R^-1 (G symmetric) */
     } else if (T != NULL) {
-        double GT[4][4];
-        for (i = 0; i < n; i++) {
-            for (j = 0; j < n; j++) {
-                double s = 0.0;
-                for (k = 0; k < n; k++) {
-                    s += G[i][k] * T[k][j];
-                }
-                GT[i][j] = s;
-            }
-        }
-        for (i = 0; i < n; i++) {
-            for (j = 0; j < n; j++) {
-                double s = 0.0;
-                for (k = 0; k < n; k++) {
-                    s += T[k][i] * GT[k][j];
-                }
-                G[i][j] = s;
-            }
-        }
+        mat_product(n, G, T); /* G T */
+        transpose(n, G);
+        mat_product(n, G, T); /* (G T)^T T = T^T G T */
     }
 }
 
@@ -581,26 +583,6 @@ static void trace_add(Gram *g, const Basis *Y, double R[4][4], double T[4][4])
 
 static const int FREE_COMPONENTS[3][2] = {{0, 1}, {1, 3}, {2, 3}}; /* EndCondition.free_components */
 static const int ZERO_COMPONENTS[3][2] = {{2, 3}, {0, 2}, {0, 1}}; /* EndCondition.zero_components */
-
-static void mat_product(int n, double A[4][4], double B[4][4])
-{ /* A <- A B */
-    double C[4][4];
-    int i, j, k;
-    for (i = 0; i < n; i++) {
-        for (j = 0; j < n; j++) {
-            double s = 0.0;
-            for (k = 0; k < n; k++) {
-                s += A[i][k] * B[k][j];
-            }
-            C[i][j] = s;
-        }
-    }
-    for (i = 0; i < n; i++) {
-        for (j = 0; j < n; j++) {
-            A[i][j] = C[i][j];
-        }
-    }
-}
 
 /* the point elements at node ``k`` (_propagate.points): returns whether a T was formed */
 static int apply_points(const Chain *chain, int node, double w, double spin, Basis *Y, double *sign, double T[4][4])
