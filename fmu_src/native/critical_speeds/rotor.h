@@ -170,6 +170,26 @@ void whirl_table_evaluate(const WhirlTable *table, double speed, double *out);
 void whirl_table_free(WhirlTable *table);
 
 /* ---- fem.c, damped.c: finite elements ------------------------------------------------------ */
+/* fem.Mesh with its matrices (Mesh.matrices restricted to Mesh.kept), shared by fem.c and damped.c */
+typedef struct {
+    int n_dof, n_kept;   /* all dofs; those the end conditions leave */
+    int *index;          /* n_dof: the row of a dof, -1 where an end condition fixes it */
+    int n_elements;      /* beam elements */
+    int *elements;       /* 4 per beam element: its dofs [U1, psi1, U2, psi2] */
+    double *z;           /* n_elements + 1 axial positions of the beam nodes */
+    int *node_u;         /* n_segments + 1: the translation dof of each driveline node */
+    double *K, *M, *G;   /* n_kept x n_kept, row-major, end conditions applied */
+} FeModel;
+
+/* fem.elements_by_length: ``counts`` has n_segments entries */
+void fe_elements_by_length(const Driveline *driveline, int most, int *counts);
+/* fem.mesh(driveline, counts, undamped = with_bearings) and its kept K, M, G (fem.assemble) */
+int fe_model_build(const Driveline *driveline, const int *counts, int with_bearings, FeModel *model, char *error,
+                   size_t size);
+void fe_model_free(FeModel *model);
+/* math.fsum of the segment lengths (Driveline.length) */
+double fe_driveline_length(const Driveline *driveline);
+
 /* model.natural_frequencies: sqrt|eigenvalues| of the undamped FE model with ``elements``
  * elements per segment (both planes for anisotropic bearings); *frequencies is owned (free()). */
 int fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count, char *error,
