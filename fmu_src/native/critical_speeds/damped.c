@@ -157,10 +157,20 @@ static int hessenberg_eigenvalues(cplx *h, int n, cplx *lambda)
     while (hi >= 0) {
         int lo = hi;
         while (lo > 0) {
-            double near = cabs1(H(lo - 1, lo - 1)) + cabs1(H(lo, lo));
-            if (cabs1(H(lo, lo - 1)) <= DBL_EPSILON * near || H(lo, lo - 1) == 0.0) {
-                H(lo, lo - 1) = 0.0;
+            if (H(lo, lo - 1) == 0.0) {
                 break;
+            }
+            /* negligible against its diagonal neighbours, and (Ahues and Tisseur) the deflation
+             * perturbs the eigenvalues of the 2 x 2 around it no more than rounding does */
+            double near = cabs1(H(lo - 1, lo - 1)) + cabs1(H(lo, lo)), sub = cabs1(H(lo, lo - 1));
+            if (sub <= DBL_EPSILON * near) {
+                double super = cabs1(H(lo - 1, lo)), ab = fmax(sub, super), ba = fmin(sub, super);
+                double d1 = cabs1(H(lo, lo)), d2 = cabs1(H(lo - 1, lo - 1) - H(lo, lo));
+                double aa = fmax(d1, d2), bb = fmin(d1, d2), s = aa + ab;
+                if (ba * (ab / s) <= fmax(DBL_MIN, DBL_EPSILON * (bb * (aa / s)))) {
+                    H(lo, lo - 1) = 0.0;
+                    break;
+                }
             }
             lo--;
         }
@@ -605,49 +615,69 @@ static void dense_free(Dense *dense)
     memset(dense, 0, sizeof *dense);
 }
 
-/* Cholesky factor of the real symmetric positive definite ``m`` (lower triangle); -1 if it is not */
-static int cholesky_factor(double *m, int n)
+/* LU factors with partial pivoting of the real ``m`` (numpy.linalg.solve); -1 if it is singular */
+static int lu_factor(double *m, int n, int *pivots)
 {
     for (int j = 0; j < n; j++) {
-        double *row_j = m + (size_t)j * (size_t)n, diagonal = row_j[j];
-        for (int k = 0; k < j; k++) {
-            diagonal -= row_j[k] * row_j[k];
+        int pivot = j;
+        for (int i = j + 1; i < n; i++) {
+            if (fabs(m[(size_t)i * (size_t)n + (size_t)j]) > fabs(m[(size_t)pivot * (size_t)n + (size_t)j])) {
+                pivot = i;
+            }
         }
-        if (!(diagonal > 0.0)) {
+        pivots[j] = pivot;
+        if (m[(size_t)pivot * (size_t)n + (size_t)j] == 0.0) {
             return -1;
         }
-        row_j[j] = diagonal = sqrt(diagonal);
-        for (int i = j + 1; i < n; i++) {
-            double *row_i = m + (size_t)i * (size_t)n, sum = row_i[j];
-            for (int k = 0; k < j; k++) {
-                sum -= row_i[k] * row_j[k];
+        if (pivot != j) {
+            for (int c = 0; c < n; c++) {
+                double t = m[(size_t)j * (size_t)n + (size_t)c];
+                m[(size_t)j * (size_t)n + (size_t)c] = m[(size_t)pivot * (size_t)n + (size_t)c];
+                m[(size_t)pivot * (size_t)n + (size_t)c] = t;
             }
-            row_i[j] = sum / diagonal;
+        }
+        const double *row_j = m + (size_t)j * (size_t)n;
+        for (int i = j + 1; i < n; i++) {
+            double *row_i = m + (size_t)i * (size_t)n;
+            double factor = row_i[j] / row_j[j];
+            row_i[j] = factor;
+            if (factor != 0.0) {
+                for (int c = j + 1; c < n; c++) {
+                    row_i[c] -= factor * row_j[c];
+                }
+            }
         }
     }
     return 0;
 }
 
-/* x <- -factor * M^-1 x for the n rows of x starting at ``x`` (``stride`` apart), L the Cholesky factor */
-static void mass_solve(const double *l, int n, cplx *x, int columns, int stride, double factor)
+/* x <- -M^-1 x for the n rows of x (``columns`` wide, ``stride`` apart), M by its LU factors */
+static void mass_solve(const double *lu, const int *pivots, int n, cplx *x, int columns, int stride)
 {
     for (int c = 0; c < columns; c++) {
         for (int i = 0; i < n; i++) {
+            if (pivots[i] != i) {
+                cplx t = x[(size_t)i * (size_t)stride + (size_t)c];
+                x[(size_t)i * (size_t)stride + (size_t)c] = x[(size_t)pivots[i] * (size_t)stride + (size_t)c];
+                x[(size_t)pivots[i] * (size_t)stride + (size_t)c] = t;
+            }
+        }
+        for (int i = 0; i < n; i++) {
             cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
             for (int k = 0; k < i; k++) {
-                sum -= l[(size_t)i * (size_t)n + (size_t)k] * x[(size_t)k * (size_t)stride + (size_t)c];
+                sum -= lu[(size_t)i * (size_t)n + (size_t)k] * x[(size_t)k * (size_t)stride + (size_t)c];
             }
-            x[(size_t)i * (size_t)stride + (size_t)c] = sum / l[(size_t)i * (size_t)n + (size_t)i];
+            x[(size_t)i * (size_t)stride + (size_t)c] = sum;
         }
         for (int i = n - 1; i >= 0; i--) {
             cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
             for (int k = i + 1; k < n; k++) {
-                sum -= l[(size_t)k * (size_t)n + (size_t)i] * x[(size_t)k * (size_t)stride + (size_t)c];
+                sum -= lu[(size_t)i * (size_t)n + (size_t)k] * x[(size_t)k * (size_t)stride + (size_t)c];
             }
-            x[(size_t)i * (size_t)stride + (size_t)c] = sum / l[(size_t)i * (size_t)n + (size_t)i];
+            x[(size_t)i * (size_t)stride + (size_t)c] = sum / lu[(size_t)i * (size_t)n + (size_t)i];
         }
         for (int i = 0; i < n; i++) {
-            x[(size_t)i * (size_t)stride + (size_t)c] *= -factor;
+            x[(size_t)i * (size_t)stride + (size_t)c] = -x[(size_t)i * (size_t)stride + (size_t)c];
         }
     }
 }
@@ -676,17 +706,20 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
     dense->modes = malloc((size_t)order * sizeof(Mode));
     dense->index = malloc((size_t)order * sizeof(int));
     double *l = malloc((size_t)n * (size_t)n * sizeof *l + 1);
+    int *pivots = malloc((size_t)n * sizeof *pivots + 1);
     if (!dense->stiffness || !dense->damping || !dense->gyro || !dense->a || !dense->h ||
         (rotor->doubled && !dense->saved) || !dense->v || !dense->multiplier || !dense->lambda || !dense->x ||
-        !dense->tau || !dense->d || !dense->swapped || !dense->modes || !dense->index || !l) {
+        !dense->tau || !dense->d || !dense->swapped || !dense->modes || !dense->index || !l || !pivots) {
         free(l);
+        free(pivots);
         dense_free(dense);
         set_error(error, size, OUT_OF_MEMORY);
         return -1;
     }
     memcpy(l, rotor->fe.M, (size_t)n * (size_t)n * sizeof *l);
-    if (cholesky_factor(l, n)) {
+    if (lu_factor(l, n, pivots)) {
         free(l);
+        free(pivots);
         dense_free(dense);
         set_error(error, size, "Singular matrix");
         return -1;
@@ -698,11 +731,12 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
     }
     for (int half = 0; half < m / n; half++) { /* M2 = diag(M, M) */
         size_t first = (size_t)half * (size_t)n * (size_t)m;
-        mass_solve(l, n, dense->stiffness + first, m, m, 1.0);
-        mass_solve(l, n, dense->damping + first, m, m, 1.0);
-        mass_solve(l, n, dense->gyro + first, m, m, 1.0);
+        mass_solve(l, pivots, n, dense->stiffness + first, m, m);
+        mass_solve(l, pivots, n, dense->damping + first, m, m);
+        mass_solve(l, pivots, n, dense->gyro + first, m, m);
     }
     free(l);
+    free(pivots);
     return 0;
 }
 
@@ -1008,10 +1042,19 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         unbalance_outputs_free(outputs);
         return NULL;
     }
-    if (cubic_spline_build(&outputs->modes, DAMPING_POINTS, spins, 2 * DAMPED_MODES, table)) {
+    /* CubicSpline(spins, table) and its checks */
+    const char *refused = NULL;
+    for (int i = 0; i < DAMPING_POINTS * 2 * DAMPED_MODES; i++) {
+        refused = isfinite(table[i]) ? refused : "`y` must contain only finite values.";
+    }
+    for (int i = 0; i < DAMPING_POINTS; i++) {
+        refused = i > 0 && !(spins[i] > spins[i - 1]) && !refused ? "`x` must be strictly increasing sequence." : refused;
+    }
+    refused = isfinite(omega_max) ? refused : "`x` must contain only finite values.";
+    if (refused || cubic_spline_build(&outputs->modes, DAMPING_POINTS, spins, 2 * DAMPED_MODES, table)) {
         memset(&outputs->modes, 0, sizeof outputs->modes);
         unbalance_outputs_free(outputs);
-        set_error(error, size, OUT_OF_MEMORY);
+        set_error(error, size, refused ? refused : OUT_OF_MEMORY);
         return NULL;
     }
     return outputs;
