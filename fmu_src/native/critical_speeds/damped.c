@@ -39,6 +39,18 @@ static cplx make_complex(double re, double im)
     return z;
 }
 
+/* a b and conj(a) b written out: C99's complex product guards against infinities through a library
+ * call in every product, which the inner loops cannot afford (finite values give the same result) */
+static cplx mul(cplx a, cplx b)
+{
+    return make_complex(creal(a) * creal(b) - cimag(a) * cimag(b), creal(a) * cimag(b) + cimag(a) * creal(b));
+}
+
+static cplx mul_conj(cplx a, cplx b)
+{
+    return make_complex(creal(a) * creal(b) + cimag(a) * cimag(b), creal(a) * cimag(b) - cimag(a) * creal(b));
+}
+
 static double cabs1(cplx z)
 {
     return fabs(creal(z)) + fabs(cimag(z));
@@ -89,8 +101,9 @@ static void balance(cplx *a, int n, double *d)
 }
 
 /* Householder reduction to upper Hessenberg form, A = Q H Q^*; the reflector of column k is
- * I - tau_k v v^* with v = (1, a[k+2..][k]) over rows k+1.. (kept for the eigenvectors). */
-static void hessenberg(cplx *a, int n, cplx *v, double *tau)
+ * I - tau_k v v^* with v = (1, a[k+2..][k]) over rows k+1.. (kept for the eigenvectors); v and w
+ * are n long. */
+static void hessenberg(cplx *a, int n, cplx *v, cplx *w, double *tau)
 {
     for (int k = 0; k + 2 < n; k++) {
         int m = n - k - 1;
@@ -114,15 +127,23 @@ static void hessenberg(cplx *a, int n, cplx *v, double *tau)
             vv += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
         }
         double t = 2.0 / vv;
-        /* left: rows k+1.., columns k.. */
+        /* left: rows k+1.., columns k.., through w = t v^* A row by row */
         for (int j = k; j < n; j++) {
-            cplx sum = 0.0;
-            for (int i = 0; i < m; i++) {
-                sum += conj(v[i]) * a[(size_t)(k + 1 + i) * (size_t)n + (size_t)j];
+            w[j] = 0.0;
+        }
+        for (int i = 0; i < m; i++) {
+            const cplx *row = a + (size_t)(k + 1 + i) * (size_t)n;
+            for (int j = k; j < n; j++) {
+                w[j] += mul_conj(v[i], row[j]);
             }
-            sum *= t;
-            for (int i = 0; i < m; i++) {
-                a[(size_t)(k + 1 + i) * (size_t)n + (size_t)j] -= v[i] * sum;
+        }
+        for (int j = k; j < n; j++) {
+            w[j] *= t;
+        }
+        for (int i = 0; i < m; i++) {
+            cplx *row = a + (size_t)(k + 1 + i) * (size_t)n;
+            for (int j = k; j < n; j++) {
+                row[j] -= mul(v[i], w[j]);
             }
         }
         /* right: all rows, columns k+1.. */
@@ -130,11 +151,11 @@ static void hessenberg(cplx *a, int n, cplx *v, double *tau)
             cplx *row = a + (size_t)i * (size_t)n + (size_t)(k + 1);
             cplx sum = 0.0;
             for (int j = 0; j < m; j++) {
-                sum += row[j] * v[j];
+                sum += mul(row[j], v[j]);
             }
             sum *= t;
             for (int j = 0; j < m; j++) {
-                row[j] -= sum * conj(v[j]);
+                row[j] -= mul_conj(v[j], sum);
             }
         }
         /* the column below the subdiagonal is zero now: keep v there, scaled to v[0] = 1 (see
@@ -211,8 +232,8 @@ static int hessenberg_eigenvalues(cplx *h, int n, cplx *lambda)
             int first = k > lo ? k - 1 : lo;
             for (int j = first; j <= hi; j++) {
                 cplx top = H(k, j), bottom = H(k + 1, j);
-                H(k, j) = c * top + s * bottom;
-                H(k + 1, j) = -conj(s) * top + c * bottom;
+                H(k, j) = c * top + mul(s, bottom);
+                H(k + 1, j) = c * bottom - mul_conj(s, top);
             }
             if (k > lo) {
                 H(k + 1, k - 1) = 0.0;
@@ -220,8 +241,8 @@ static int hessenberg_eigenvalues(cplx *h, int n, cplx *lambda)
             int last = k + 2 < hi ? k + 2 : hi;
             for (int i = lo; i <= last; i++) {
                 cplx left = H(i, k), right = H(i, k + 1);
-                H(i, k) = left * c + right * conj(s);
-                H(i, k + 1) = -left * s + right * c;
+                H(i, k) = left * c + mul_conj(s, right);
+                H(i, k + 1) = right * c - mul(left, s);
             }
         }
     }
@@ -259,7 +280,7 @@ static void inverse_iteration(const cplx *h, int n, cplx lambda, cplx *lu, cplx 
         }
         multiplier[k] = next[k] / row[k];
         for (int j = k + 1; j < n; j++) {
-            next[j] -= multiplier[k] * row[j];
+            next[j] -= mul(multiplier[k], row[j]);
         }
         next[k] = 0.0;
     }
@@ -277,14 +298,14 @@ static void inverse_iteration(const cplx *h, int n, cplx lambda, cplx *lu, cplx 
                     x[k] = x[k + 1];
                     x[k + 1] = t;
                 }
-                x[k + 1] -= multiplier[k] * x[k];
+                x[k + 1] -= mul(multiplier[k], x[k]);
             }
         }
         for (int i = n - 1; i >= 0; i--) {
             const cplx *row = lu + (size_t)i * (size_t)n;
             cplx sum = x[i];
             for (int j = i + 1; j < n; j++) {
-                sum -= row[j] * x[j];
+                sum -= mul(row[j], x[j]);
             }
             x[i] = sum / row[i];
         }
@@ -317,12 +338,12 @@ static void back_transform(const cplx *a, int n, const double *tau, const double
         }
         cplx sum = x[k + 1];
         for (int i = k + 2; i < n; i++) {
-            sum += conj(a[(size_t)i * (size_t)n + (size_t)k]) * x[i];
+            sum += mul_conj(a[(size_t)i * (size_t)n + (size_t)k], x[i]);
         }
         sum *= tau[k];
         x[k + 1] -= sum;
         for (int i = k + 2; i < n; i++) {
-            x[i] -= a[(size_t)i * (size_t)n + (size_t)k] * sum;
+            x[i] -= mul(a[(size_t)i * (size_t)n + (size_t)k], sum);
         }
     }
     for (int i = 0; i < n; i++) {
@@ -374,16 +395,16 @@ static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
                 continue;
             }
             for (int c = j + 1; c <= end; c++) {
-                AB(band, ab, i, c) -= factor * AB(band, ab, j, c);
+                AB(band, ab, i, c) -= mul(factor, AB(band, ab, j, c));
             }
-            b[i] -= factor * b[j];
+            b[i] -= mul(factor, b[j]);
         }
     }
     for (int i = n - 1; i >= 0; i--) {
         int end = i + width < n ? i + width : n - 1;
         cplx sum = b[i];
         for (int c = i + 1; c <= end; c++) {
-            sum -= AB(band, ab, i, c) * b[c];
+            sum -= mul(AB(band, ab, i, c), b[c]);
         }
         b[i] = sum / AB(band, ab, i, i);
     }
@@ -759,7 +780,7 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
         }
     }
     balance(a, order, dense->d);
-    hessenberg(a, order, dense->v, dense->tau);
+    hessenberg(a, order, dense->v, dense->x, dense->tau);
     hessenberg_part(a, order, dense->h);
     if (rotor->doubled) {
         memcpy(dense->saved, dense->h, (size_t)order * (size_t)order * sizeof(cplx));
@@ -1089,7 +1110,7 @@ void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, d
     double squared = speed * speed;
     size_t cells = (size_t)band.rows * (size_t)m;
     for (size_t i = 0; i < cells; i++) {
-        outputs->ab[i] = rotor->banded[0][i] + spin_c * rotor->banded[1][i] + spin_g * rotor->banded[2][i] -
+        outputs->ab[i] = rotor->banded[0][i] + mul(spin_c, rotor->banded[1][i]) + mul(spin_g, rotor->banded[2][i]) -
                          squared * rotor->banded[3][i];
     }
     for (int i = 0; i < m; i++) {
