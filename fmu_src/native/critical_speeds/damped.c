@@ -508,11 +508,11 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
     rotor->n = n;
     rotor->doubled = doubled;
     rotor->size = m;
-    size_t big = (size_t)m * (size_t)m;
+    size_t big = (size_t)m * (size_t)m + 1;
     rotor->K = calloc(big, sizeof *rotor->K);
     rotor->C = calloc(big, sizeof *rotor->C);
     rotor->G = calloc(big, sizeof *rotor->G);
-    rotor->order = malloc((size_t)m * sizeof *rotor->order);
+    rotor->order = malloc(((size_t)m + 1) * sizeof *rotor->order);
     if (!rotor->K || !rotor->C || !rotor->G || !rotor->order) {
         goto out_of_memory;
     }

@@ -595,6 +595,10 @@ int fe_natural_frequencies(const Driveline *d, int elements, double **frequencie
 {
     *frequencies = NULL;
     *count = 0;
+    if (elements < 1) { /* ShaftSegment.fe_matrices: length / n_elements */
+        set_error(error, size, "float division by zero");
+        return -1;
+    }
     int n_bearings = d->n_bearings, planes = 1, total = 2 + d->n_hinges;
     for (int i = 0; i < n_bearings; i++) {
         planes = d->bearings[i].kxx != d->bearings[i].kyy ? 2 : planes;
