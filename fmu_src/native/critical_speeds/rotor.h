@@ -191,15 +191,19 @@ void fe_model_free(FeModel *model);
 double fe_driveline_length(const Driveline *driveline);
 
 /* model.natural_frequencies: sqrt|eigenvalues| of the undamped FE model with ``elements``
- * elements per segment (both planes for anisotropic bearings); *frequencies is owned (free()). */
+ * elements per segment (both planes for anisotropic bearings: the kxx plane first, each plane
+ * ascending); *frequencies is owned (free()). */
 int fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count, char *error,
                            size_t size);
 
 typedef struct UnbalanceOutputs UnbalanceOutputs;
-/* unbalance_outputs.UnbalanceOutputs.build */
+/* unbalance_outputs.UnbalanceOutputs.build; the mode table from the dense eigensolver at every size
+ * (Python: ARPACK above DENSE_SIZE first-order unknowns, whose selection it reproduces) */
 UnbalanceOutputs *unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
                                         double response_fraction, double omega_max, char *error, size_t size);
-/* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio */
+/* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio (an exactly singular
+ * dynamic stiffness: infinite response and force). It allocates nothing: the object holds the
+ * solve's work arrays, so one object is evaluated by one caller at a time. */
 void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3]);
 void unbalance_outputs_free(UnbalanceOutputs *outputs);
 
