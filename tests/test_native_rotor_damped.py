@@ -193,13 +193,15 @@ def test_speed_zero_gives_no_response_and_the_tabulated_damping(library):
     assert got[0, 2] == pytest.approx(python[2], rel=1e-9)
 
 
-def test_refusals_are_worded_as_pythons(library):
-    """omega_max = 0 gives equal knots, which CubicSpline refuses."""
+@pytest.mark.parametrize("omega_max", [0.0, -5.0, float("nan"), float("inf")])
+def test_refusals_are_worded_as_pythons(library, omega_max):
+    """Equal or falling knots, which CubicSpline refuses; knots that are not finite, which numpy's eig
+    refuses."""
     with pytest.raises(ValueError) as refused:
-        UnbalanceOutputs.build(DEFAULT, excitation(DEFAULT), 0.5, 0.0)
+        UnbalanceOutputs.build(DEFAULT, excitation(DEFAULT), 0.5, omega_max)
     c = c_driveline(DEFAULT)
     _, pointer = kept = unbalances(excitation(DEFAULT))
     error = ctypes.create_string_buffer(512)
-    assert not library.unbalance_outputs_new(ctypes.byref(c), pointer, 1, 0.5, 0.0, error, 512)
+    assert not library.unbalance_outputs_new(ctypes.byref(c), pointer, 1, 0.5, omega_max, error, 512)
     assert error.value.decode() == str(refused.value)
     del kept

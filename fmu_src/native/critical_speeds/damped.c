@@ -779,6 +779,12 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
             }
         }
     }
+    for (size_t i = 0; i < (size_t)order * (size_t)order; i++) {
+        if (!isfinite(creal(a[i])) || !isfinite(cimag(a[i]))) { /* numpy.linalg's check */
+            set_error(error, size, "Array must not contain infs or NaNs");
+            return -1;
+        }
+    }
     balance(a, order, dense->d);
     hessenberg(a, order, dense->v, dense->x, dense->tau);
     hessenberg_part(a, order, dense->h);

@@ -577,6 +577,13 @@ static int plane_frequencies(const Driveline *d, const int *counts, RotorBearing
         return -1;
     }
     int n = model.n_kept;
+    for (size_t i = 0; i < (size_t)n * (size_t)n; i++) {
+        if (!isfinite(model.K[i]) || !isfinite(model.M[i])) { /* scipy.linalg.eigh's check_finite */
+            set_error(error, size, "array must not contain infs or NaNs");
+            fe_model_free(&model);
+            return -1;
+        }
+    }
     if (generalized_eigenvalues(model.K, model.M, n, out, error, size)) {
         fe_model_free(&model);
         return -1;
