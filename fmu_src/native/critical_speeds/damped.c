@@ -39,8 +39,8 @@ static cplx make_complex(double re, double im)
     return z;
 }
 
-/* a b and conj(a) b written out: C99's complex product guards against infinities through a library
- * call in every product, which the inner loops cannot afford (finite values give the same result) */
+/* a b and conj(a) b written out, without the recovery of infinities (C99 Annex G) that the operator
+ * adds to every product of the inner loops; finite values give the same result */
 static cplx mul(cplx a, cplx b)
 {
     return make_complex(creal(a) * creal(b) - cimag(a) * cimag(b), creal(a) * cimag(b) + cimag(a) * creal(b));
