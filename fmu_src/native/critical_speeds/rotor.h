@@ -184,16 +184,40 @@ int whirl_table_knots(const WhirlTable *table);
 void whirl_table_free(WhirlTable *table);
 
 /* ---- fem.c, damped.c: finite elements ------------------------------------------------------ */
+/* fem.Mesh with its matrices (Mesh.matrices restricted to Mesh.kept), shared by fem.c and damped.c */
+typedef struct {
+    int n_dof, n_kept;   /* all dofs; those the end conditions leave */
+    int *index;          /* n_dof: the row of a dof, -1 where an end condition fixes it */
+    int n_elements;      /* beam elements */
+    int *elements;       /* 4 per beam element: its dofs [U1, psi1, U2, psi2] */
+    double *z;           /* n_elements + 1 axial positions of the beam nodes */
+    int *node_u;         /* n_segments + 1: the translation dof of each driveline node */
+    double *K, *M, *G;   /* n_kept x n_kept, row-major, end conditions applied */
+} FeModel;
+
+/* fem.elements_by_length: ``counts`` has n_segments entries */
+void fe_elements_by_length(const Driveline *driveline, int most, int *counts);
+/* fem.mesh(driveline, counts, undamped = with_bearings) and its kept K, M, G (fem.assemble) */
+int fe_model_build(const Driveline *driveline, const int *counts, int with_bearings, FeModel *model, char *error,
+                   size_t size);
+void fe_model_free(FeModel *model);
+/* math.fsum of the segment lengths (Driveline.length) */
+double fe_driveline_length(const Driveline *driveline);
+
 /* model.natural_frequencies: sqrt|eigenvalues| of the undamped FE model with ``elements``
- * elements per segment (both planes for anisotropic bearings); *frequencies is owned (free()). */
+ * elements per segment (both planes for anisotropic bearings: the kxx plane first, each plane
+ * ascending); *frequencies is owned (free()). */
 int fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count, char *error,
                            size_t size);
 
 typedef struct UnbalanceOutputs UnbalanceOutputs;
-/* unbalance_outputs.UnbalanceOutputs.build */
+/* unbalance_outputs.UnbalanceOutputs.build; the mode table from the dense eigensolver at every size
+ * (Python: ARPACK above DENSE_SIZE first-order unknowns, whose selection it reproduces) */
 UnbalanceOutputs *unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
                                         double response_fraction, double omega_max, char *error, size_t size);
-/* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio */
+/* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio (an exactly singular
+ * dynamic stiffness: infinite response and force). It allocates nothing: the object holds the
+ * solve's work arrays, so one object is evaluated by one caller at a time. */
 void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3]);
 void unbalance_outputs_free(UnbalanceOutputs *outputs);
 

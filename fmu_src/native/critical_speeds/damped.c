@@ -1,0 +1,1159 @@
+/* Damped finite-element model of a driveline (damped.DampedRotor) and what the FMU reports of it
+ * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver, the synchronous
+ * unbalance response from a banded complex LU solve. */
+#include "rotor.h"
+
+#include <complex.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef double complex cplx;
+
+#define OUT_OF_MEMORY "out of memory"
+/* damped.py */
+#define EXTRA_EIGENVALUES 6
+#define DENSE_SIZE 160
+#define SHIFT (-1.0)
+/* unbalance_outputs.py */
+#define FE_ELEMENTS 16
+#define TABLE_ELEMENTS 8
+#define DAMPING_POINTS 11
+#define DAMPED_MODES 4
+
+static void set_error(char *error, size_t size, const char *message)
+{
+    if (error && size) {
+        snprintf(error, size, "%s", message);
+    }
+}
+
+/* re + i im (C99 has no CMPLX; a complex is laid out as two doubles) */
+static cplx make_complex(double re, double im)
+{
+    double parts[2] = {re, im};
+    cplx z;
+    memcpy(&z, parts, sizeof z);
+    return z;
+}
+
+/* a b and conj(a) b written out, without the recovery of infinities (C99 Annex G) that the operator
+ * adds to every product of the inner loops; finite values give the same result */
+static cplx mul(cplx a, cplx b)
+{
+    return make_complex(creal(a) * creal(b) - cimag(a) * cimag(b), creal(a) * cimag(b) + cimag(a) * creal(b));
+}
+
+static cplx mul_conj(cplx a, cplx b)
+{
+    return make_complex(creal(a) * creal(b) + cimag(a) * cimag(b), creal(a) * cimag(b) - cimag(a) * creal(b));
+}
+
+static double cabs1(cplx z)
+{
+    return fabs(creal(z)) + fabs(cimag(z));
+}
+
+/* ---- the dense complex eigenproblem (numpy.linalg.eig) ------------------------------------- */
+/* Balancing by powers of two: a[i][j] -> a[i][j] d[j] / d[i] with row and column norms brought
+ * together, as LAPACK's gebal does before the QR iteration. */
+static void balance(cplx *a, int n, double *d)
+{
+    for (int i = 0; i < n; i++) {
+        d[i] = 1.0;
+    }
+    for (int sweep = 0, changed = 1; changed && sweep < 100; sweep++) {
+        changed = 0;
+        for (int i = 0; i < n; i++) {
+            double c = 0.0, r = 0.0;
+            for (int j = 0; j < n; j++) {
+                if (j != i) {
+                    cplx column = a[(size_t)j * (size_t)n + (size_t)i], row = a[(size_t)i * (size_t)n + (size_t)j];
+                    c += creal(column) * creal(column) + cimag(column) * cimag(column);
+                    r += creal(row) * creal(row) + cimag(row) * cimag(row);
+                }
+            }
+            c = sqrt(c);
+            r = sqrt(r);
+            if (c == 0.0 || r == 0.0 || !isfinite(c) || !isfinite(r)) {
+                continue;
+            }
+            /* f = 2^k nearest sqrt(r / c): the column times f, the row over f */
+            int exponent;
+            frexp(sqrt(r / c), &exponent);
+            double f = ldexp(1.0, exponent - 1);
+            if (sqrt(r / c) / f > 1.4142135623730951) {
+                f *= 2.0;
+            }
+            if (f == 1.0 || c * f + r / f >= 0.95 * (c + r)) {
+                continue;
+            }
+            changed = 1;
+            d[i] *= f;
+            for (int j = 0; j < n; j++) {
+                a[(size_t)j * (size_t)n + (size_t)i] *= f;
+                a[(size_t)i * (size_t)n + (size_t)j] /= f;
+            }
+        }
+    }
+}
+
+/* Householder reduction to upper Hessenberg form, A = Q H Q^*; the reflector of column k is
+ * I - tau_k v v^* with v = (1, a[k+2..][k]) over rows k+1.. (kept for the eigenvectors); v and w
+ * are n long. */
+static void hessenberg(cplx *a, int n, cplx *v, cplx *w, double *tau)
+{
+    for (int k = 0; k + 2 < n; k++) {
+        int m = n - k - 1;
+        double norm2 = 0.0;
+        for (int i = 0; i < m; i++) {
+            cplx x = a[(size_t)(k + 1 + i) * (size_t)n + (size_t)k];
+            v[i] = x;
+            norm2 += creal(x) * creal(x) + cimag(x) * cimag(x);
+        }
+        double below = norm2 - (creal(v[0]) * creal(v[0]) + cimag(v[0]) * cimag(v[0]));
+        if (below == 0.0) {
+            tau[k] = 0.0;
+            continue;
+        }
+        double norm = sqrt(norm2), first = cabs(v[0]);
+        cplx phase = first == 0.0 ? 1.0 : v[0] / first;
+        cplx alpha = -phase * norm;
+        v[0] -= alpha;
+        double vv = 0.0;
+        for (int i = 0; i < m; i++) {
+            vv += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
+        }
+        double t = 2.0 / vv;
+        /* left: rows k+1.., columns k.., through w = t v^* A row by row */
+        for (int j = k; j < n; j++) {
+            w[j] = 0.0;
+        }
+        for (int i = 0; i < m; i++) {
+            const cplx *row = a + (size_t)(k + 1 + i) * (size_t)n;
+            for (int j = k; j < n; j++) {
+                w[j] += mul_conj(v[i], row[j]);
+            }
+        }
+        for (int j = k; j < n; j++) {
+            w[j] *= t;
+        }
+        for (int i = 0; i < m; i++) {
+            cplx *row = a + (size_t)(k + 1 + i) * (size_t)n;
+            for (int j = k; j < n; j++) {
+                row[j] -= mul(v[i], w[j]);
+            }
+        }
+        /* right: all rows, columns k+1.. */
+        for (int i = 0; i < n; i++) {
+            cplx *row = a + (size_t)i * (size_t)n + (size_t)(k + 1);
+            cplx sum = 0.0;
+            for (int j = 0; j < m; j++) {
+                sum += mul(row[j], v[j]);
+            }
+            sum *= t;
+            for (int j = 0; j < m; j++) {
+                row[j] -= mul_conj(v[j], sum);
+            }
+        }
+        /* the column below the subdiagonal is zero now: keep v there, scaled to v[0] = 1 (see
+         * hessenberg_part) */
+        a[(size_t)(k + 1) * (size_t)n + (size_t)k] = alpha;
+        for (int i = 1; i < m; i++) {
+            a[(size_t)(k + 1 + i) * (size_t)n + (size_t)k] = v[i] / v[0];
+        }
+        tau[k] = t * (creal(v[0]) * creal(v[0]) + cimag(v[0]) * cimag(v[0]));
+    }
+}
+
+/* The eigenvalues of the upper Hessenberg ``h`` (destroyed): implicitly single-shifted complex QR
+ * with Wilkinson shifts, exceptional shifts after 10 and 20 steps on one eigenvalue, deflation of
+ * negligible subdiagonal entries; -1 after 30 max(10, n) steps in all. */
+static int hessenberg_eigenvalues(cplx *h, int n, cplx *lambda)
+{
+#define H(i, j) h[(size_t)(i) * (size_t)n + (size_t)(j)]
+    int hi = n - 1, steps = 0, cap = 30 * (n > 10 ? n : 10), its = 0;
+    while (hi >= 0) {
+        int lo = hi;
+        while (lo > 0) {
+            if (H(lo, lo - 1) == 0.0) {
+                break;
+            }
+            /* negligible against its diagonal neighbours, and (Ahues and Tisseur) the deflation
+             * perturbs the eigenvalues of the 2 x 2 around it no more than rounding does */
+            double near = cabs1(H(lo - 1, lo - 1)) + cabs1(H(lo, lo)), sub = cabs1(H(lo, lo - 1));
+            if (sub <= DBL_EPSILON * near) {
+                double super = cabs1(H(lo - 1, lo)), ab = fmax(sub, super), ba = fmin(sub, super);
+                double d1 = cabs1(H(lo, lo)), d2 = cabs1(H(lo - 1, lo - 1) - H(lo, lo));
+                double aa = fmax(d1, d2), bb = fmin(d1, d2), s = aa + ab;
+                if (ba * (ab / s) <= fmax(DBL_MIN, DBL_EPSILON * (bb * (aa / s)))) {
+                    H(lo, lo - 1) = 0.0;
+                    break;
+                }
+            }
+            lo--;
+        }
+        if (lo == hi) {
+            lambda[hi] = H(hi, hi);
+            hi--;
+            its = 0;
+            continue;
+        }
+        if (++steps > cap) {
+            return -1;
+        }
+        its++;
+        cplx mu;
+        if (its == 10 || its == 20) {
+            mu = H(hi, hi) + 0.75 * cabs1(H(hi, hi - 1));
+        } else { /* the eigenvalue of the trailing 2 x 2 nearer its last diagonal entry */
+            cplx a = H(hi - 1, hi - 1), b = H(hi - 1, hi), c = H(hi, hi - 1), d = H(hi, hi);
+            cplx p = 0.5 * (a - d), bc = b * c, root = csqrt(p * p + bc);
+            cplx plus = p + root, minus = p - root, den = cabs(plus) >= cabs(minus) ? plus : minus;
+            mu = den == 0.0 ? d : d - bc / den;
+        }
+        cplx x = H(lo, lo) - mu, y = H(lo + 1, lo);
+        for (int k = lo; k < hi; k++) {
+            if (k > lo) {
+                x = H(k, k - 1);
+                y = H(k + 1, k - 1);
+            }
+            double ax = cabs(x), norm = hypot(ax, cabs(y));
+            if (norm == 0.0) {
+                continue;
+            }
+            double c = ax / norm;
+            cplx s = (ax == 0.0 ? 1.0 : x / ax) * conj(y) / norm;
+            if (ax == 0.0) {
+                s = conj(y) / norm;
+            }
+            int first = k > lo ? k - 1 : lo;
+            for (int j = first; j <= hi; j++) {
+                cplx top = H(k, j), bottom = H(k + 1, j);
+                H(k, j) = c * top + mul(s, bottom);
+                H(k + 1, j) = c * bottom - mul_conj(s, top);
+            }
+            if (k > lo) {
+                H(k + 1, k - 1) = 0.0;
+            }
+            int last = k + 2 < hi ? k + 2 : hi;
+            for (int i = lo; i <= last; i++) {
+                cplx left = H(i, k), right = H(i, k + 1);
+                H(i, k) = left * c + mul_conj(s, right);
+                H(i, k + 1) = right * c - mul(left, s);
+            }
+        }
+    }
+    return 0;
+#undef H
+}
+
+/* An eigenvector of the Hessenberg ``h`` for ``lambda`` by inverse iteration, into ``x`` (n):
+ * the LU of h - lambda I with row interchanges between neighbours (``lu`` n x n, ``multiplier`` and
+ * ``swapped`` n), a first solve U x = ones (any right-hand side will do) and a second full solve. */
+static void inverse_iteration(const cplx *h, int n, cplx lambda, cplx *lu, cplx *multiplier, unsigned char *swapped,
+                              cplx *x)
+{
+    double norm = 0.0;
+    for (size_t i = 0; i < (size_t)n * (size_t)n; i++) {
+        norm = fmax(norm, cabs1(h[i]));
+    }
+    double tiny = DBL_EPSILON * (norm > 0.0 ? norm : 1.0);
+    memcpy(lu, h, (size_t)n * (size_t)n * sizeof *lu);
+    for (int i = 0; i < n; i++) {
+        lu[(size_t)i * (size_t)n + (size_t)i] -= lambda;
+    }
+    for (int k = 0; k + 1 < n; k++) {
+        cplx *row = lu + (size_t)k * (size_t)n, *next = row + n;
+        swapped[k] = cabs1(next[k]) > cabs1(row[k]);
+        if (swapped[k]) {
+            for (int j = k; j < n; j++) {
+                cplx t = row[j];
+                row[j] = next[j];
+                next[j] = t;
+            }
+        }
+        if (row[k] == 0.0) { /* exactly singular: perturb the pivot by the rounding level */
+            row[k] = tiny;
+        }
+        multiplier[k] = next[k] / row[k];
+        for (int j = k + 1; j < n; j++) {
+            next[j] -= mul(multiplier[k], row[j]);
+        }
+        next[k] = 0.0;
+    }
+    if (lu[(size_t)n * (size_t)n - 1] == 0.0) {
+        lu[(size_t)n * (size_t)n - 1] = tiny;
+    }
+    for (int i = 0; i < n; i++) {
+        x[i] = 1.0;
+    }
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass) { /* L^-1 P */
+            for (int k = 0; k + 1 < n; k++) {
+                if (swapped[k]) {
+                    cplx t = x[k];
+                    x[k] = x[k + 1];
+                    x[k + 1] = t;
+                }
+                x[k + 1] -= mul(multiplier[k], x[k]);
+            }
+        }
+        for (int i = n - 1; i >= 0; i--) {
+            const cplx *row = lu + (size_t)i * (size_t)n;
+            cplx sum = x[i];
+            for (int j = i + 1; j < n; j++) {
+                sum -= mul(row[j], x[j]);
+            }
+            x[i] = sum / row[i];
+        }
+        double largest = 0.0;
+        for (int i = 0; i < n; i++) {
+            largest = fmax(largest, cabs1(x[i]));
+        }
+        for (int i = 0; i < n && largest > 0.0 && isfinite(largest); i++) {
+            x[i] /= largest;
+        }
+    }
+}
+
+/* The Hessenberg matrix of hessenberg()'s ``a`` without the reflectors below its subdiagonal */
+static void hessenberg_part(const cplx *a, int n, cplx *h)
+{
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < n; j++) {
+            h[(size_t)i * (size_t)n + (size_t)j] = j + 1 >= i ? a[(size_t)i * (size_t)n + (size_t)j] : 0.0;
+        }
+    }
+}
+
+/* x <- D Q x: an eigenvector of the Hessenberg matrix back to the balanced, then the original one */
+static void back_transform(const cplx *a, int n, const double *tau, const double *d, cplx *x)
+{
+    for (int k = n - 3; k >= 0; k--) {
+        if (tau[k] == 0.0) {
+            continue;
+        }
+        cplx sum = x[k + 1];
+        for (int i = k + 2; i < n; i++) {
+            sum += mul_conj(a[(size_t)i * (size_t)n + (size_t)k], x[i]);
+        }
+        sum *= tau[k];
+        x[k + 1] -= sum;
+        for (int i = k + 2; i < n; i++) {
+            x[i] -= mul(a[(size_t)i * (size_t)n + (size_t)k], sum);
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        x[i] *= d[i];
+    }
+}
+
+/* ---- the banded complex LU solve (LAPACK gbsv's storage: (i, j) at ab[j][kl + ku + i - j]) ---- */
+typedef struct {
+    int n, kl, ku, rows; /* rows = 2 kl + ku + 1 per column */
+} Band;
+
+#define AB(band, ab, i, j) (ab)[(size_t)(j) * (size_t)(band).rows + (size_t)((band).kl + (band).ku + (i) - (j))]
+
+/* Solves ab x = b in place (ab factorised, ``pivots`` n); -1 on an exactly zero pivot (singular) */
+static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
+{
+    int n = band.n, kl = band.kl, width = kl + band.ku;
+    for (int j = 0; j < n; j++) {
+        int last = j + kl < n ? j + kl : n - 1, pivot = j;
+        double best = cabs1(AB(band, ab, j, j));
+        for (int i = j + 1; i <= last; i++) {
+            double size = cabs1(AB(band, ab, i, j));
+            if (size > best) {
+                best = size;
+                pivot = i;
+            }
+        }
+        pivots[j] = pivot;
+        if (AB(band, ab, pivot, j) == 0.0) {
+            return -1;
+        }
+        int end = j + width < n ? j + width : n - 1;
+        if (pivot != j) {
+            for (int c = j; c <= end; c++) {
+                cplx t = AB(band, ab, j, c);
+                AB(band, ab, j, c) = AB(band, ab, pivot, c);
+                AB(band, ab, pivot, c) = t;
+            }
+            cplx t = b[j];
+            b[j] = b[pivot];
+            b[pivot] = t;
+        }
+        cplx diagonal = AB(band, ab, j, j);
+        for (int i = j + 1; i <= last; i++) {
+            cplx factor = AB(band, ab, i, j) / diagonal;
+            AB(band, ab, i, j) = factor;
+            if (factor == 0.0) {
+                continue;
+            }
+            for (int c = j + 1; c <= end; c++) {
+                AB(band, ab, i, c) -= mul(factor, AB(band, ab, j, c));
+            }
+            b[i] -= mul(factor, b[j]);
+        }
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        int end = i + width < n ? i + width : n - 1;
+        cplx sum = b[i];
+        for (int c = i + 1; c <= end; c++) {
+            sum -= mul(AB(band, ab, i, c), b[c]);
+        }
+        b[i] = sum / AB(band, ab, i, i);
+    }
+    return 0;
+}
+
+/* ---- damped.DampedRotor ---------------------------------------------------------------------- */
+typedef struct {
+    FeModel fe;                /* fem.assemble_damped's mesh and real K, M, G (bearings left out) */
+    int n, doubled, size;      /* p unknowns; [p, q] when doubled; size = n or 2 n */
+    cplx *K, *C, *G;           /* K2, C2, Gv (size x size); NULL once the rotor only solves */
+    Band band;                 /* the interleaved order [p0, q0, p1, q1, ...] */
+    cplx *banded[4];           /* k, c, g, m in band storage */
+    int *order;                /* size: the unknown at each row of the interleaved order */
+    int n_translations, *translations;
+    int n_bearings, *bearing_rows; /* per bearing, -1 on a pinned or clamped end */
+    cplx *coefficients;        /* per bearing: k_a, k_b, c_a, c_b */
+    double scale;              /* DampedRotor._scale */
+} Rotor;
+
+static void rotor_free(Rotor *rotor)
+{
+    fe_model_free(&rotor->fe);
+    free(rotor->K);
+    free(rotor->C);
+    free(rotor->G);
+    for (int k = 0; k < 4; k++) {
+        free(rotor->banded[k]);
+    }
+    free(rotor->order);
+    free(rotor->translations);
+    free(rotor->bearing_rows);
+    free(rotor->coefficients);
+    memset(rotor, 0, sizeof *rotor);
+}
+
+/* elements._components: the coefficients of u and conj(u) of [[xx, xy], [yx, yy]] */
+static void components(double xx, double yy, double xy, double yx, cplx *a, cplx *b)
+{
+    *a = make_complex(0.5 * (xx + yy), 0.5 * (yx - xy));
+    *b = make_complex(0.5 * (xx - yy), 0.5 * (yx + xy));
+}
+
+/* DampedRotor.__init__ (with fem.assemble_damped) */
+static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char *error, size_t size)
+{
+    memset(rotor, 0, sizeof *rotor);
+    if (fe_model_build(d, counts, 0, &rotor->fe, error, size)) {
+        return -1;
+    }
+    const FeModel *fe = &rotor->fe;
+    int n = fe->n_kept, nb = d->n_bearings;
+    size_t cells = (size_t)n * (size_t)n;
+    cplx *Kb = calloc(cells + 1, sizeof *Kb), *Cb = calloc(cells + 1, sizeof *Cb);
+    cplx *Ka = calloc(cells + 1, sizeof *Ka), *Ca = calloc(cells + 1, sizeof *Ca);
+    rotor->bearing_rows = malloc((size_t)(nb + 1) * sizeof *rotor->bearing_rows);
+    rotor->coefficients = malloc(4 * (size_t)(nb + 1) * sizeof *rotor->coefficients);
+    rotor->translations = malloc((size_t)(fe->n_elements + 1) * sizeof *rotor->translations);
+    if (!Kb || !Cb || !Ka || !Ca || !rotor->bearing_rows || !rotor->coefficients || !rotor->translations) {
+        goto out_of_memory;
+    }
+    for (size_t i = 0; i < cells; i++) {
+        Ka[i] = fe->K[i];
+    }
+    int doubled = 0;
+    rotor->n_bearings = nb;
+    for (int i = 0; i < nb; i++) {
+        const RotorBearing *b = &d->bearings[i];
+        cplx *c = rotor->coefficients + 4 * i;
+        components(b->kxx, b->kyy, b->kxy, b->kyx, &c[0], &c[1]);
+        components(b->cxx, b->cyy, b->cxy, b->cyx, &c[2], &c[3]);
+        int row = fe->index[fe->node_u[b->node]];
+        rotor->bearing_rows[i] = row;
+        if (row < 0) { /* on a pinned or clamped end: the support holds it already */
+            continue;
+        }
+        size_t at = (size_t)row * (size_t)n + (size_t)row;
+        Ka[at] += c[0];
+        Kb[at] += c[1];
+        Ca[at] += c[2];
+        Cb[at] += c[3];
+    }
+    for (int i = 0; i < nb; i++) {
+        int row = rotor->bearing_rows[i];
+        if (row >= 0) {
+            size_t at = (size_t)row * (size_t)n + (size_t)row;
+            doubled |= Kb[at] != 0.0 || Cb[at] != 0.0;
+        }
+    }
+    /* the translation rows of the beam nodes (np.unique of the elements' U dofs) */
+    int count = 0;
+    for (int e = 0; e <= fe->n_elements; e++) {
+        int dof = e < fe->n_elements ? fe->elements[4 * e] : fe->elements[4 * (e - 1) + 2];
+        int row = fe->index[dof];
+        if (row >= 0) {
+            rotor->translations[count++] = row;
+        }
+    }
+    rotor->n_translations = count;
+    int m = doubled ? 2 * n : n;
+    rotor->n = n;
+    rotor->doubled = doubled;
+    rotor->size = m;
+    size_t big = (size_t)m * (size_t)m + 1;
+    rotor->K = calloc(big, sizeof *rotor->K);
+    rotor->C = calloc(big, sizeof *rotor->C);
+    rotor->G = calloc(big, sizeof *rotor->G);
+    rotor->order = malloc(((size_t)m + 1) * sizeof *rotor->order);
+    if (!rotor->K || !rotor->C || !rotor->G || !rotor->order) {
+        goto out_of_memory;
+    }
+    /* K2 = [[K, K_b], [conj(K_b), conj(K)]], C2 likewise, Gv = diag(-i G, i G) */
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < n; j++) {
+            size_t at = (size_t)i * (size_t)n + (size_t)j, top = (size_t)i * (size_t)m + (size_t)j;
+            rotor->K[top] = Ka[at];
+            rotor->C[top] = Ca[at];
+            rotor->G[top] = make_complex(0.0, -fe->G[at]);
+            if (doubled) {
+                size_t right = top + (size_t)n, below = top + (size_t)n * (size_t)m, across = below + (size_t)n;
+                rotor->K[right] = Kb[at];
+                rotor->C[right] = Cb[at];
+                rotor->K[below] = conj(Kb[at]);
+                rotor->C[below] = conj(Cb[at]);
+                rotor->K[across] = conj(Ka[at]);
+                rotor->C[across] = conj(Ca[at]);
+                rotor->G[across] = make_complex(0.0, fe->G[at]);
+            }
+        }
+    }
+    free(Ka);
+    free(Kb);
+    free(Ca);
+    free(Cb);
+    Ka = Kb = Ca = Cb = NULL;
+    /* the dofs of p and q interleaved make the dynamic stiffness banded */
+    for (int i = 0; i < m; i++) {
+        rotor->order[i] = doubled ? (i % 2) * n + i / 2 : i;
+    }
+    int kl = 0, ku = 0;
+    for (int i = 0; i < m; i++) {
+        for (int j = 0; j < m; j++) {
+            size_t at = (size_t)rotor->order[i] * (size_t)m + (size_t)rotor->order[j];
+            int mass = rotor->order[i] / n == rotor->order[j] / n &&
+                       fe->M[(size_t)(rotor->order[i] % n) * (size_t)n + (size_t)(rotor->order[j] % n)] != 0.0;
+            if (rotor->K[at] != 0.0 || rotor->C[at] != 0.0 || rotor->G[at] != 0.0 || mass) {
+                kl = i - j > kl ? i - j : kl;
+                ku = j - i > ku ? j - i : ku;
+            }
+        }
+    }
+    Band band = {m, kl, ku, 2 * kl + ku + 1};
+    rotor->band = band;
+    for (int k = 0; k < 4; k++) {
+        rotor->banded[k] = calloc((size_t)band.rows * (size_t)m, sizeof *rotor->banded[k]);
+        if (!rotor->banded[k]) {
+            goto out_of_memory;
+        }
+    }
+    for (int j = 0; j < m; j++) {
+        int first = j - ku > 0 ? j - ku : 0, last = j + kl < m ? j + kl : m - 1;
+        for (int i = first; i <= last; i++) {
+            int r = rotor->order[i], c = rotor->order[j];
+            size_t at = (size_t)r * (size_t)m + (size_t)c;
+            AB(band, rotor->banded[0], i, j) = rotor->K[at];
+            AB(band, rotor->banded[1], i, j) = rotor->C[at];
+            AB(band, rotor->banded[2], i, j) = rotor->G[at];
+            AB(band, rotor->banded[3], i, j) =
+                r / n == c / n ? fe->M[(size_t)(r % n) * (size_t)n + (size_t)(c % n)] : 0.0;
+        }
+    }
+    /* DampedRotor._scale = sqrt(max |diag K2| / max diag M2) */
+    double k_max = 0.0, m_max = -INFINITY;
+    for (int i = 0; i < m; i++) {
+        double k = cabs(rotor->K[(size_t)i * (size_t)m + (size_t)i]);
+        k_max = k > k_max || isnan(k) ? k : k_max;
+        m_max = fmax(m_max, fe->M[(size_t)(i % n) * (size_t)n + (size_t)(i % n)]);
+    }
+    rotor->scale = sqrt(k_max / m_max);
+    return 0;
+out_of_memory:
+    free(Ka);
+    free(Kb);
+    free(Ca);
+    free(Cb);
+    rotor_free(rotor);
+    set_error(error, size, OUT_OF_MEMORY);
+    return -1;
+}
+
+/* One damped mode (damped.DampedMode) */
+typedef struct {
+    cplx eigenvalue;
+    double forward_share;
+    int place; /* among the eigenvalues: list.sort keeps the order of equal frequencies */
+} Mode;
+
+/* by damped frequency, stable */
+static int by_frequency(const void *a, const void *b)
+{
+    const Mode *x = a, *y = b;
+    double u = cimag(x->eigenvalue), v = cimag(y->eigenvalue);
+    if (u != v) {
+        return (u > v) - (u < v);
+    }
+    return (x->place > y->place) - (x->place < y->place);
+}
+
+/* The dense work of DampedRotor.modes: the blocks of B^-1 A without the spin (_dense_blocks) and
+ * the eigen solver's arrays, for a 2 size first-order system. */
+typedef struct {
+    int size, order;                   /* size of x; order = 2 size of y = [x, x'/s] */
+    cplx *stiffness, *damping, *gyro;  /* -M2^-1 K2 / s, -M2^-1 C2, -M2^-1 Gv */
+    cplx *a, *h, *saved, *v, *multiplier, *lambda, *x;
+    double *tau, *d;
+    unsigned char *swapped;
+    Mode *modes;
+    int *index;
+} Dense;
+
+static void dense_free(Dense *dense)
+{
+    void *all[] = {dense->stiffness, dense->damping, dense->gyro, dense->a, dense->h, dense->saved, dense->v,
+                   dense->multiplier, dense->lambda, dense->x, dense->tau, dense->d, dense->swapped, dense->modes,
+                   dense->index};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
+        free(all[i]);
+    }
+    memset(dense, 0, sizeof *dense);
+}
+
+/* LU factors with partial pivoting of the real ``m`` (numpy.linalg.solve); -1 if it is singular */
+static int lu_factor(double *m, int n, int *pivots)
+{
+    for (int j = 0; j < n; j++) {
+        int pivot = j;
+        for (int i = j + 1; i < n; i++) {
+            if (fabs(m[(size_t)i * (size_t)n + (size_t)j]) > fabs(m[(size_t)pivot * (size_t)n + (size_t)j])) {
+                pivot = i;
+            }
+        }
+        pivots[j] = pivot;
+        if (m[(size_t)pivot * (size_t)n + (size_t)j] == 0.0) {
+            return -1;
+        }
+        if (pivot != j) {
+            for (int c = 0; c < n; c++) {
+                double t = m[(size_t)j * (size_t)n + (size_t)c];
+                m[(size_t)j * (size_t)n + (size_t)c] = m[(size_t)pivot * (size_t)n + (size_t)c];
+                m[(size_t)pivot * (size_t)n + (size_t)c] = t;
+            }
+        }
+        const double *row_j = m + (size_t)j * (size_t)n;
+        for (int i = j + 1; i < n; i++) {
+            double *row_i = m + (size_t)i * (size_t)n;
+            double factor = row_i[j] / row_j[j];
+            row_i[j] = factor;
+            if (factor != 0.0) {
+                for (int c = j + 1; c < n; c++) {
+                    row_i[c] -= factor * row_j[c];
+                }
+            }
+        }
+    }
+    return 0;
+}
+
+/* x <- -M^-1 x for the n rows of x (``columns`` wide, ``stride`` apart), M by its LU factors */
+static void mass_solve(const double *lu, const int *pivots, int n, cplx *x, int columns, int stride)
+{
+    for (int c = 0; c < columns; c++) {
+        for (int i = 0; i < n; i++) {
+            if (pivots[i] != i) {
+                cplx t = x[(size_t)i * (size_t)stride + (size_t)c];
+                x[(size_t)i * (size_t)stride + (size_t)c] = x[(size_t)pivots[i] * (size_t)stride + (size_t)c];
+                x[(size_t)pivots[i] * (size_t)stride + (size_t)c] = t;
+            }
+        }
+        for (int i = 0; i < n; i++) {
+            cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
+            for (int k = 0; k < i; k++) {
+                sum -= lu[(size_t)i * (size_t)n + (size_t)k] * x[(size_t)k * (size_t)stride + (size_t)c];
+            }
+            x[(size_t)i * (size_t)stride + (size_t)c] = sum;
+        }
+        for (int i = n - 1; i >= 0; i--) {
+            cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
+            for (int k = i + 1; k < n; k++) {
+                sum -= lu[(size_t)i * (size_t)n + (size_t)k] * x[(size_t)k * (size_t)stride + (size_t)c];
+            }
+            x[(size_t)i * (size_t)stride + (size_t)c] = sum / lu[(size_t)i * (size_t)n + (size_t)i];
+        }
+        for (int i = 0; i < n; i++) {
+            x[(size_t)i * (size_t)stride + (size_t)c] = -x[(size_t)i * (size_t)stride + (size_t)c];
+        }
+    }
+}
+
+/* DampedRotor._dense_blocks and the eigen solver's arrays */
+static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size)
+{
+    memset(dense, 0, sizeof *dense);
+    int m = rotor->size, n = rotor->n, order = 2 * m;
+    size_t block = (size_t)m * (size_t)m, full = (size_t)order * (size_t)order;
+    dense->size = m;
+    dense->order = order;
+    dense->stiffness = malloc(block * sizeof(cplx));
+    dense->damping = malloc(block * sizeof(cplx));
+    dense->gyro = malloc(block * sizeof(cplx));
+    dense->a = malloc(full * sizeof(cplx));
+    dense->h = malloc(full * sizeof(cplx));
+    dense->saved = rotor->doubled ? malloc(full * sizeof(cplx)) : NULL;
+    dense->v = malloc((size_t)order * sizeof(cplx));
+    dense->multiplier = malloc((size_t)order * sizeof(cplx));
+    dense->lambda = malloc((size_t)order * sizeof(cplx));
+    dense->x = malloc((size_t)order * sizeof(cplx));
+    dense->tau = malloc((size_t)order * sizeof(double));
+    dense->d = malloc((size_t)order * sizeof(double));
+    dense->swapped = malloc((size_t)order);
+    dense->modes = malloc((size_t)order * sizeof(Mode));
+    dense->index = malloc((size_t)order * sizeof(int));
+    double *l = malloc((size_t)n * (size_t)n * sizeof *l + 1);
+    int *pivots = malloc((size_t)n * sizeof *pivots + 1);
+    if (!dense->stiffness || !dense->damping || !dense->gyro || !dense->a || !dense->h ||
+        (rotor->doubled && !dense->saved) || !dense->v || !dense->multiplier || !dense->lambda || !dense->x ||
+        !dense->tau || !dense->d || !dense->swapped || !dense->modes || !dense->index || !l || !pivots) {
+        free(l);
+        free(pivots);
+        dense_free(dense);
+        set_error(error, size, OUT_OF_MEMORY);
+        return -1;
+    }
+    memcpy(l, rotor->fe.M, (size_t)n * (size_t)n * sizeof *l);
+    if (lu_factor(l, n, pivots)) {
+        free(l);
+        free(pivots);
+        dense_free(dense);
+        set_error(error, size, "Singular matrix");
+        return -1;
+    }
+    for (size_t i = 0; i < block; i++) {
+        dense->stiffness[i] = rotor->K[i] / rotor->scale;
+        dense->damping[i] = rotor->C[i];
+        dense->gyro[i] = rotor->G[i];
+    }
+    for (int half = 0; half < m / n; half++) { /* M2 = diag(M, M) */
+        size_t first = (size_t)half * (size_t)n * (size_t)m;
+        mass_solve(l, pivots, n, dense->stiffness + first, m, m);
+        mass_solve(l, pivots, n, dense->damping + first, m, m);
+        mass_solve(l, pivots, n, dense->gyro + first, m, m);
+    }
+    free(l);
+    free(pivots);
+    return 0;
+}
+
+/* DampedRotor.modes(spin, n): the first ``n`` damped modes into ``out`` (n), their number in *found */
+static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mode *out, int *found, char *error,
+                       size_t size)
+{
+    int m = dense->size, order = dense->order;
+    cplx *a = dense->a;
+    /* [[0, s I], [-M2^-1 K2 / s, -M2^-1 (C2 + spin Gv)]] */
+    for (int i = 0; i < order; i++) {
+        for (int j = 0; j < order; j++) {
+            size_t at = (size_t)i * (size_t)order + (size_t)j;
+            if (i < m) {
+                a[at] = j == m + i ? rotor->scale : 0.0;
+            } else {
+                size_t b = (size_t)(i - m) * (size_t)m + (size_t)(j < m ? j : j - m);
+                a[at] = j < m ? dense->stiffness[b] : dense->damping[b] + spin * dense->gyro[b];
+            }
+        }
+    }
+    for (size_t i = 0; i < (size_t)order * (size_t)order; i++) {
+        if (!isfinite(creal(a[i])) || !isfinite(cimag(a[i]))) { /* numpy.linalg's check */
+            set_error(error, size, "Array must not contain infs or NaNs");
+            return -1;
+        }
+    }
+    balance(a, order, dense->d);
+    hessenberg(a, order, dense->v, dense->x, dense->tau);
+    hessenberg_part(a, order, dense->h);
+    if (rotor->doubled) {
+        memcpy(dense->saved, dense->h, (size_t)order * (size_t)order * sizeof(cplx));
+    }
+    if (hessenberg_eigenvalues(dense->h, order, dense->lambda)) {
+        set_error(error, size, "Eigenvalues did not converge");
+        return -1;
+    }
+    /* above DENSE_SIZE Python takes the 2 n + EXTRA_EIGENVALUES nearest SHIFT (shift-invert Arnoldi) */
+    int count = order, *index = dense->index;
+    for (int i = 0; i < order; i++) {
+        index[i] = i;
+    }
+    if (order > DENSE_SIZE && 2 * n + EXTRA_EIGENVALUES < order) {
+        int wanted = 2 * n + EXTRA_EIGENVALUES;
+        for (int k = 0; k < wanted; k++) { /* partial selection by |lambda - SHIFT| */
+            int best = k;
+            for (int i = k + 1; i < order; i++) {
+                if (cabs(dense->lambda[index[i]] - SHIFT) < cabs(dense->lambda[index[best]] - SHIFT)) {
+                    best = i;
+                }
+            }
+            int t = index[k];
+            index[k] = index[best];
+            index[best] = t;
+        }
+        count = wanted;
+    }
+    double largest = 0.0;
+    for (int k = 0; k < count; k++) {
+        double size_k = cabs(dense->lambda[index[k]]);
+        largest = size_k > largest || isnan(size_k) ? size_k : largest;
+    }
+    /* whirling: not overdamped or static */
+    int kept = 0;
+    for (int k = 0; k < count; k++) {
+        cplx value = dense->lambda[index[k]];
+        if (!isfinite(creal(value)) || !isfinite(cimag(value)) || !(fabs(cimag(value)) > 1e-9 * largest)) {
+            continue;
+        }
+        Mode *mode = &dense->modes[kept];
+        mode->place = k;
+        if (!rotor->doubled) { /* u = p exp(lam t): Im lam < 0 whirls backward */
+            mode->eigenvalue = make_complex(creal(value), fabs(cimag(value)));
+            mode->forward_share = cimag(value) > 0.0 ? 1.0 : 0.0;
+            kept++;
+        } else if (cimag(value) > 0.0) { /* each mode also appears conjugated, at -w_d */
+            mode->eigenvalue = value;
+            mode->forward_share = 0.0; /* from its eigenvector below */
+            kept++;
+        }
+    }
+    qsort(dense->modes, (size_t)kept, sizeof(Mode), by_frequency);
+    int take = kept < n ? kept : n;
+    for (int k = 0; k < take; k++) {
+        out[k] = dense->modes[k];
+        if (rotor->doubled) { /* the forward share sum |p_U|^2 / sum (|p_U|^2 + |q_U|^2) of its eigenvector */
+            cplx value = out[k].eigenvalue;
+            inverse_iteration(dense->saved, order, value, dense->h, dense->multiplier, dense->swapped, dense->x);
+            back_transform(a, order, dense->tau, dense->d, dense->x);
+            double forward = 0.0, backward = 0.0;
+            for (int t = 0; t < rotor->n_translations; t++) {
+                cplx p = dense->x[rotor->translations[t]], q = dense->x[rotor->n + rotor->translations[t]];
+                forward += creal(p) * creal(p) + cimag(p) * cimag(p);
+                backward += creal(q) * creal(q) + cimag(q) * cimag(q);
+            }
+            out[k].forward_share = forward / (forward + backward);
+        }
+    }
+    *found = take;
+    return 0;
+}
+
+/* ---- unbalance_outputs.UnbalanceOutputs ------------------------------------------------------ */
+struct UnbalanceOutputs {
+    Rotor rotor;        /* the response model (FE_ELEMENTS), its band matrices only */
+    cplx *load;         /* DampedRotor.load per unit Omega^2, rotor.size */
+    cplx *row;          /* DampedRotor.shape_rows at the response position, rotor.n */
+    CubicSpline modes;  /* DAMPED_MODES damped frequencies, then their damping ratios */
+    cplx *ab, *x;       /* evaluate's work: one object is evaluated by one caller at a time */
+    int *pivots;
+};
+
+/* repr() of a finite float: the shortest digits that read back to it, in Python's layout */
+static void float_repr(double value, char *out, size_t size)
+{
+    if (!isfinite(value)) {
+        snprintf(out, size, "%s", isnan(value) ? "nan" : value > 0 ? "inf" : "-inf");
+        return;
+    }
+    char digits[40];
+    int precision = 1;
+    for (; precision < 17; precision++) {
+        snprintf(digits, sizeof digits, "%.*e", precision - 1, value);
+        if (strtod(digits, NULL) == value) {
+            break;
+        }
+    }
+    snprintf(digits, sizeof digits, "%.*e", precision - 1, value);
+    char *e = strchr(digits, 'e');
+    int exponent = atoi(e + 1);
+    *e = '\0';
+    char mantissa[24];
+    const char *sign = digits[0] == '-' ? "-" : "";
+    int count = 0;
+    for (const char *c = digits + (*sign ? 1 : 0); *c && count < 20; c++) {
+        if (*c != '.') {
+            mantissa[count++] = *c;
+        }
+    }
+    mantissa[count] = '\0';
+    if (exponent < -4 || exponent >= 16) {
+        snprintf(out, size, "%s%c%s%s%se%c%02d", sign, mantissa[0], count > 1 ? "." : "", mantissa + 1, "",
+                 exponent < 0 ? '-' : '+', abs(exponent));
+    } else if (exponent < 0) {
+        snprintf(out, size, "%s0.%0*d%s", sign, -exponent - 1, 0, mantissa);
+        if (exponent == -1) {
+            snprintf(out, size, "%s0.%s", sign, mantissa);
+        }
+    } else if (count <= exponent + 1) {
+        snprintf(out, size, "%s%s%0*d.0", sign, mantissa, exponent + 1 - count, 0);
+        if (count == exponent + 1) {
+            snprintf(out, size, "%s%s.0", sign, mantissa);
+        }
+    } else {
+        snprintf(out, size, "%s%.*s.%s", sign, exponent + 1, mantissa, mantissa + exponent + 1);
+    }
+}
+
+/* DampedRotor.shape_rows for one position: ``row`` (rotor.n) */
+static int shape_row(const Rotor *rotor, double z, double length, cplx *row, char *error, size_t size)
+{
+    const FeModel *fe = &rotor->fe;
+    if (!isfinite(z) || z < 0.0 || z > length * (1 + 1e-12)) {
+        char shown[40], at[40];
+        float_repr(length, shown, sizeof shown);
+        float_repr(z, at, sizeof at);
+        if (error && size) {
+            snprintf(error, size, "positions must lie on the shaft, 0 to %s m, got [%s]", shown, at);
+        }
+        return -1;
+    }
+    int e = -1;
+    while (e + 1 <= fe->n_elements && fe->z[e + 1] <= z) { /* searchsorted(side="right") - 1 */
+        e++;
+    }
+    e = e < 0 ? 0 : e > fe->n_elements - 1 ? fe->n_elements - 1 : e;
+    double h = fe->z[e + 1] - fe->z[e], xi = (z - fe->z[e]) / h;
+    xi = xi < 0.0 ? 0.0 : xi > 1.0 ? 1.0 : xi;
+    double x2 = xi * xi, x3 = pow(xi, 3.0);
+    double shape[4] = {1 - 3 * x2 + 2 * x3, h * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, h * (x3 - x2)};
+    for (int i = 0; i < rotor->n; i++) {
+        row[i] = 0.0;
+    }
+    for (int k = 0; k < 4; k++) {
+        int target = fe->index[fe->elements[4 * e + k]];
+        if (target >= 0) {
+            row[target] += shape[k];
+        }
+    }
+    return 0;
+}
+
+void unbalance_outputs_free(UnbalanceOutputs *outputs)
+{
+    if (!outputs) {
+        return;
+    }
+    rotor_free(&outputs->rotor);
+    free(outputs->load);
+    free(outputs->row);
+    cubic_spline_free(&outputs->modes);
+    free(outputs->ab);
+    free(outputs->x);
+    free(outputs->pivots);
+    free(outputs);
+}
+
+/* The mode table of UnbalanceOutputs.build: DAMPING_POINTS rows of 2 DAMPED_MODES */
+static int mode_table(const Driveline *d, const int *counts, const double *spins, double *table, char *error,
+                      size_t size)
+{
+    Rotor coarse;
+    Dense dense;
+    if (rotor_init(&coarse, d, counts, error, size)) {
+        return -1;
+    }
+    if (dense_init(&dense, &coarse, error, size)) {
+        rotor_free(&coarse);
+        return -1;
+    }
+    int status = 0;
+    Mode modes[4 * DAMPED_MODES];
+    for (int i = 0; i < DAMPING_POINTS && !status; i++) {
+        int found = 0, excited = 0;
+        status = rotor_modes(&coarse, &dense, spins[i], 4 * DAMPED_MODES, modes, &found, error, size);
+        double *out = table + (size_t)i * 2 * DAMPED_MODES;
+        for (int k = 0; k < found && excited < DAMPED_MODES && !status; k++) {
+            if (modes[k].forward_share >= ROTOR_EXCITED_SHARE) {
+                cplx value = modes[k].eigenvalue;
+                out[excited] = cimag(value);
+                out[DAMPED_MODES + excited] = -creal(value) / cabs(value);
+                excited++;
+            }
+        }
+        for (; excited < DAMPED_MODES; excited++) { /* a short model: beyond the search limit, undamped */
+            out[excited] = ROTOR_SEARCH_LIMIT;
+            out[DAMPED_MODES + excited] = 0.0;
+        }
+    }
+    dense_free(&dense);
+    rotor_free(&coarse);
+    return status;
+}
+
+/* UnbalanceOutputs.build */
+UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbalances, int n_unbalances,
+                                        double response_fraction, double omega_max, char *error, size_t size)
+{
+    int *counts = malloc((size_t)(d->n_segments + 1) * sizeof *counts);
+    UnbalanceOutputs *outputs = calloc(1, sizeof *outputs);
+    if (!counts || !outputs) {
+        free(counts);
+        free(outputs);
+        set_error(error, size, OUT_OF_MEMORY);
+        return NULL;
+    }
+    double spins[DAMPING_POINTS], table[DAMPING_POINTS * 2 * DAMPED_MODES];
+    double step = omega_max / (DAMPING_POINTS - 1); /* numpy.linspace */
+    for (int i = 0; i < DAMPING_POINTS; i++) {
+        spins[i] = i * step + 0.0;
+    }
+    spins[DAMPING_POINTS - 1] = omega_max;
+    fe_elements_by_length(d, TABLE_ELEMENTS, counts);
+    if (mode_table(d, counts, spins, table, error, size)) {
+        free(counts);
+        free(outputs);
+        return NULL;
+    }
+    fe_elements_by_length(d, FE_ELEMENTS, counts);
+    Rotor *rotor = &outputs->rotor;
+    if (rotor_init(rotor, d, counts, error, size)) {
+        free(counts);
+        free(outputs);
+        return NULL;
+    }
+    free(counts);
+    free(rotor->K); /* the response needs the band matrices only */
+    free(rotor->C);
+    free(rotor->G);
+    rotor->K = rotor->C = rotor->G = NULL;
+    int m = rotor->size;
+    outputs->load = calloc((size_t)m, sizeof *outputs->load);
+    outputs->row = calloc((size_t)rotor->n + 1, sizeof *outputs->row);
+    outputs->ab = malloc((size_t)rotor->band.rows * (size_t)m * sizeof *outputs->ab);
+    outputs->x = malloc((size_t)m * sizeof *outputs->x);
+    outputs->pivots = malloc((size_t)m * sizeof *outputs->pivots);
+    cplx *rows = malloc(((size_t)rotor->n + 1) * sizeof *rows);
+    if (!outputs->load || !outputs->row || !outputs->ab || !outputs->x || !outputs->pivots || !rows) {
+        free(rows);
+        unbalance_outputs_free(outputs);
+        set_error(error, size, OUT_OF_MEMORY);
+        return NULL;
+    }
+    /* DampedRotor.load: the unbalances' phasors times their shape rows */
+    double length = fe_driveline_length(d);
+    for (int u = 0; u < n_unbalances; u++) {
+        if (shape_row(rotor, unbalances[u].position, length, rows, error, size)) {
+            free(rows);
+            unbalance_outputs_free(outputs);
+            return NULL;
+        }
+        cplx phasor = unbalances[u].amount * cexp(make_complex(0.0, unbalances[u].phase));
+        for (int i = 0; i < rotor->n; i++) {
+            outputs->load[i] += phasor * rows[i];
+        }
+    }
+    free(rows);
+    if (shape_row(rotor, response_fraction * length, length, outputs->row, error, size)) {
+        unbalance_outputs_free(outputs);
+        return NULL;
+    }
+    /* CubicSpline(spins, table) and its checks */
+    const char *refused = NULL;
+    for (int i = 0; i < DAMPING_POINTS * 2 * DAMPED_MODES; i++) {
+        refused = isfinite(table[i]) ? refused : "`y` must contain only finite values.";
+    }
+    for (int i = 0; i < DAMPING_POINTS; i++) {
+        refused = i > 0 && !(spins[i] > spins[i - 1]) && !refused ? "`x` must be strictly increasing sequence." : refused;
+    }
+    refused = isfinite(omega_max) ? refused : "`x` must contain only finite values.";
+    if (refused || cubic_spline_build(&outputs->modes, DAMPING_POINTS, spins, 2 * DAMPED_MODES, table)) {
+        memset(&outputs->modes, 0, sizeof outputs->modes);
+        unbalance_outputs_free(outputs);
+        set_error(error, size, refused ? refused : OUT_OF_MEMORY);
+        return NULL;
+    }
+    return outputs;
+}
+
+/* UnbalanceOutputs.evaluate (DampedRotor.solve, components and bearing_forces at one speed) */
+void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3])
+{
+    double table[2 * DAMPED_MODES];
+    cubic_spline_evaluate(&outputs->modes, speed, table);
+    int nearest = 0; /* numpy.argmin: the first of equal ones, the first nan */
+    for (int k = 0; k < DAMPED_MODES; k++) {
+        double distance = fabs(table[k] - speed);
+        if (isnan(distance)) {
+            nearest = k;
+            break;
+        }
+        if (distance < fabs(table[nearest] - speed)) {
+            nearest = k;
+        }
+    }
+    out[2] = table[DAMPED_MODES + nearest];
+    if (speed == 0.0) {
+        out[0] = out[1] = 0.0;
+        return;
+    }
+    const Rotor *rotor = &outputs->rotor;
+    Band band = rotor->band;
+    int m = rotor->size, n = rotor->n;
+    /* K2 + i Omega (C2 + Omega Gv) - Omega^2 M2 */
+    cplx spin_c = make_complex(0.0, speed), spin_g = make_complex(0.0, speed * speed);
+    double squared = speed * speed;
+    size_t cells = (size_t)band.rows * (size_t)m;
+    for (size_t i = 0; i < cells; i++) {
+        outputs->ab[i] = rotor->banded[0][i] + mul(spin_c, rotor->banded[1][i]) + mul(spin_g, rotor->banded[2][i]) -
+                         squared * rotor->banded[3][i];
+    }
+    for (int i = 0; i < m; i++) {
+        outputs->x[i] = squared * outputs->load[rotor->order[i]];
+    }
+    if (band_solve(band, outputs->ab, outputs->pivots, outputs->x)) { /* an undamped resonance hit exactly */
+        out[0] = out[1] = INFINITY;
+        return;
+    }
+    /* the solution back in the order [p, q]: x[i] is unknown order[i] */
+    cplx forward = 0.0, backward = 0.0;
+    const cplx *x = outputs->x;
+    int *place = outputs->pivots; /* free again after the solve */
+    for (int i = 0; i < m; i++) {
+        place[rotor->order[i]] = i;
+    }
+    for (int j = 0; j < n; j++) {
+        forward += x[place[j]] * outputs->row[j];
+        if (rotor->doubled) {
+            backward += x[place[n + j]] * outputs->row[j];
+        }
+    }
+    out[0] = cabs(forward) + cabs(conj(backward));
+    double largest = 0.0; /* np.max(forces, initial=0.0), nan propagated */
+    for (int b = 0; b < rotor->n_bearings; b++) {
+        int row = rotor->bearing_rows[b];
+        double force = 0.0;
+        if (row >= 0) {
+            const cplx *c = rotor->coefficients + 4 * b;
+            cplx a = x[place[row]], q = rotor->doubled ? x[place[n + row]] : 0.0;
+            cplx fa = (c[0] + spin_c * c[2]) * a + (c[1] + spin_c * c[3]) * q;
+            cplx fq = (conj(c[1]) + spin_c * conj(c[3])) * a + (conj(c[0]) + spin_c * conj(c[2])) * q;
+            force = cabs(fa) + cabs(fq);
+        }
+        if (isnan(force) || force > largest) {
+            largest = isnan(largest) ? largest : force;
+        }
+    }
+    out[1] = largest;
+}

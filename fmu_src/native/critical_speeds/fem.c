@@ -1,0 +1,650 @@
+/* Finite-element model of a driveline (fem.py, the fe_matrices of elements.py) and the natural
+ * frequencies of its plausibility check (model.natural_frequencies). */
+#include "rotor.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+#define OUT_OF_MEMORY "out of memory"
+
+static void set_error(char *error, size_t size, const char *message)
+{
+    if (error && size) {
+        snprintf(error, size, "%s", message);
+    }
+}
+
+/* math.fsum: the correctly rounded sum (partials of the exact sum, as Python's) */
+static double exact_sum(const double *values, int count, int stride)
+{
+    double partials[64];
+    int used = 0;
+    for (int k = 0; k < count; k++) {
+        double x = values[(size_t)k * (size_t)stride];
+        int kept = 0;
+        for (int j = 0; j < used; j++) {
+            double y = partials[j];
+            if (fabs(x) < fabs(y)) {
+                double t = x;
+                x = y;
+                y = t;
+            }
+            double hi = x + y;
+            double lo = y - (hi - x);
+            if (lo != 0.0 && kept < 63) {
+                partials[kept++] = lo;
+            }
+            x = hi;
+        }
+        partials[kept] = x;
+        used = kept + 1;
+    }
+    if (used == 0) {
+        return 0.0;
+    }
+    int n = used - 1;
+    double hi = partials[n], lo = 0.0;
+    while (n > 0) {
+        double x = hi, y = partials[--n];
+        hi = x + y;
+        lo = y - (hi - x);
+        if (lo != 0.0) {
+            break;
+        }
+    }
+    /* half-way cases: round as the exact sum would */
+    if (n > 0 && ((lo < 0.0 && partials[n - 1] < 0.0) || (lo > 0.0 && partials[n - 1] > 0.0))) {
+        double y = 2.0 * lo, x = hi + y;
+        if (y == x - hi) {
+            hi = x;
+        }
+    }
+    return hi;
+}
+
+/* Driveline.length */
+double fe_driveline_length(const Driveline *driveline)
+{
+    return exact_sum(&driveline->segments[0].length, driveline->n_segments,
+                     (int)(sizeof(RotorSegment) / sizeof(double)));
+}
+
+/* fem.elements_by_length */
+void fe_elements_by_length(const Driveline *driveline, int most, int *counts)
+{
+    double half = 0.5 * fe_driveline_length(driveline);
+    for (int k = 0; k < driveline->n_segments; k++) {
+        double share = ceil(most * driveline->segments[k].length / half - 1e-9);
+        int count = share >= most ? most : (int)share;
+        counts[k] = count < 1 ? 1 : count;
+    }
+}
+
+/* ---- elements.ShaftSegment ------------------------------------------------------------------ */
+static double segment_area(const RotorSegment *s)
+{
+    return PI / 4.0 * (pow(s->outer_diameter, 2.0) - pow(s->inner_diameter, 2.0));
+}
+
+static double segment_second_moment(const RotorSegment *s)
+{
+    return PI / 64.0 * (pow(s->outer_diameter, 4.0) - pow(s->inner_diameter, 4.0));
+}
+
+/* ShaftSegment.shear_stiffness (Cowper's coefficient of a hollow circle) */
+static double segment_shear_stiffness(const RotorSegment *s)
+{
+    double nu = s->poisson_ratio;
+    double m2 = pow(s->inner_diameter / s->outer_diameter, 2.0);
+    double r12 = pow(1.0 + m2, 2.0);
+    double kappa = 6.0 * (1.0 + nu) * r12 / ((7.0 + 6.0 * nu) * r12 + (20.0 + 12.0 * nu) * m2);
+    return kappa * s->youngs_modulus / (2.0 * (1.0 + nu)) * segment_area(s);
+}
+
+/* elements._symmetric_element times ``scale`` */
+static void symmetric_element(double scale, double d11, double d12, double d13, double d14, double d22, double d23,
+                              double d24, double out[16])
+{
+    const double entries[16] = {d11, d12, d13, d14, d12, d22, d23, d24, d13, d23, d11, -d12, d14, d24, -d12, d22};
+    for (int i = 0; i < 16; i++) {
+        out[i] = scale * entries[i];
+    }
+}
+
+/* ShaftSegment.fe_matrices: one element's k, m, g (Hermite, or Timoshenko with shear) */
+static void segment_element(const RotorSegment *s, double h, double k[16], double m[16], double g[16])
+{
+    double I = segment_second_moment(s);
+    double EI = s->youngs_modulus * I;
+    double rhoA = s->density * segment_area(s);
+    double rhoI = s->density * I;
+    double phi = s->shear ? 12.0 * EI / (segment_shear_stiffness(s) * h * h) : 0.0;
+    double mt[16], mr[16];
+    if (phi == 0.0) {
+        double kh = EI / pow(h, 3.0), mh = rhoA * h / 420, rh = rhoI / (30 * h);
+        const double ke[16] = {12, 6 * h, -12, 6 * h, 6 * h, 4 * h * h, -6 * h, 2 * h * h,
+                               -12, -6 * h, 12, -6 * h, 6 * h, 2 * h * h, -6 * h, 4 * h * h};
+        const double me[16] = {156, 22 * h, 54, -13 * h, 22 * h, 4 * h * h, 13 * h, -3 * h * h,
+                               54, 13 * h, 156, -22 * h, -13 * h, -3 * h * h, -22 * h, 4 * h * h};
+        const double re[16] = {36, 3 * h, -36, 3 * h, 3 * h, 4 * h * h, -3 * h, -h * h,
+                               -36, -3 * h, 36, -3 * h, 3 * h, -h * h, -3 * h, 4 * h * h};
+        for (int i = 0; i < 16; i++) {
+            k[i] = kh * ke[i];
+            mt[i] = mh * me[i];
+            mr[i] = rh * re[i];
+        }
+    } else { /* elements._shear_element */
+        double p2 = phi * phi;
+        symmetric_element(EI / ((1 + phi) * pow(h, 3.0)), 12, 6 * h, -12, 6 * h, (4 + phi) * h * h, -6 * h,
+                          (2 - phi) * h * h, k);
+        symmetric_element(rhoA * h / pow(1 + phi, 2.0), 13.0 / 35 + 7 * phi / 10 + p2 / 3,
+                          (11.0 / 210 + 11 * phi / 120 + p2 / 24) * h, 9.0 / 70 + 3 * phi / 10 + p2 / 6,
+                          -(13.0 / 420 + 3 * phi / 40 + p2 / 24) * h, (1.0 / 105 + phi / 60 + p2 / 120) * h * h,
+                          (13.0 / 420 + 3 * phi / 40 + p2 / 24) * h, -(1.0 / 140 + phi / 60 + p2 / 120) * h * h, mt);
+        symmetric_element(rhoI / (pow(1 + phi, 2.0) * h), 6.0 / 5, (1.0 / 10 - phi / 2) * h, -6.0 / 5,
+                          (1.0 / 10 - phi / 2) * h, (2.0 / 15 + phi / 6 + p2 / 3) * h * h, -(1.0 / 10 - phi / 2) * h,
+                          (-1.0 / 30 - phi / 6 + p2 / 6) * h * h, mr);
+    }
+    for (int i = 0; i < 16; i++) {
+        m[i] = s->rotary_inertia ? mt[i] + mr[i] : mt[i];
+        g[i] = s->gyroscopic ? 2.0 * mr[i] : 0.0;
+    }
+}
+
+/* ---- fem.mesh ------------------------------------------------------------------------------- */
+/* One element's contribution on ``n`` dofs (Mesh.blocks): row-major n x n each, NULL for zero. */
+typedef struct {
+    const int *dofs;
+    int n;
+    const double *K, *M, *G;
+} Block;
+
+static void add_block(const FeModel *model, const Block *block)
+{
+    int n_kept = model->n_kept;
+    for (int i = 0; i < block->n; i++) {
+        int row = model->index[block->dofs[i]];
+        if (row < 0) {
+            continue;
+        }
+        for (int j = 0; j < block->n; j++) {
+            int col = model->index[block->dofs[j]];
+            if (col < 0) {
+                continue;
+            }
+            size_t at = (size_t)row * (size_t)n_kept + (size_t)col, local = (size_t)i * (size_t)block->n + (size_t)j;
+            if (block->K) {
+                model->K[at] += block->K[local];
+            }
+            if (block->M) {
+                model->M[at] += block->M[local];
+            }
+            if (block->G) {
+                model->G[at] += block->G[local];
+            }
+        }
+    }
+}
+
+void fe_model_free(FeModel *model)
+{
+    if (!model) {
+        return;
+    }
+    free(model->index);
+    free(model->elements);
+    free(model->z);
+    free(model->node_u);
+    free(model->K);
+    free(model->M);
+    free(model->G);
+    memset(model, 0, sizeof *model);
+}
+
+/* fem._fixed_dofs */
+static void fix_end(EndCondition end, int u, int psi, int *fixed)
+{
+    if (end == END_PINNED || end == END_CLAMPED) {
+        fixed[u] = 1;
+    }
+    if (end == END_CLAMPED) {
+        fixed[psi] = 1;
+    }
+}
+
+/* One point element's block on [U, psi] (or [U, psi_in, psi_out]) */
+static void add_point(const FeModel *model, int here, int n, const int *dofs, const double *K, const double *M,
+                      const double *G)
+{
+    if (model->K && here) {
+        Block block = {dofs, n, K, M, G};
+        add_block(model, &block);
+    }
+}
+
+/* fem.mesh: numbers the dofs (``fixed`` marks those of the end conditions, model->node_u, elements
+ * and z are filled) and, once model->K exists, adds every block in the Python order. ``segment``
+ * holds 3 (2 (count + 1))^2 and ``dofs`` 2 (count + 1) for the largest count. Returns n_dof. */
+static int walk_mesh(const Driveline *d, const int *counts, int with_bearings, FeModel *model, int *fixed,
+                     double *segment, int *dofs)
+{
+    int u = 0, psi = 1, n_dof = 2, element = 0;
+    model->z[0] = 0.0;
+    for (int node = 0; node <= d->n_segments; node++) {
+        model->node_u[node] = u;
+        if (node == 0) {
+            fix_end(d->left, u, psi, fixed);
+        }
+        /* Driveline.point_elements at the node: masses, bearings, hinges */
+        for (int i = 0; i < d->n_masses; i++) {
+            const RotorMass *mass = &d->masses[i];
+            int pair[2] = {u, psi};
+            double M[4] = {mass->mass, 0.0, 0.0, mass->diametral_inertia}, G[4] = {0.0, 0.0, 0.0, mass->polar_inertia};
+            add_point(model, mass->node == node, 2, pair, NULL, M, G);
+        }
+        for (int i = 0; with_bearings && i < d->n_bearings; i++) {
+            const RotorBearing *bearing = &d->bearings[i];
+            int pair[2] = {u, psi};
+            double K[4] = {0.5 * (bearing->kxx + bearing->kyy), 0.0, 0.0, 0.0};
+            add_point(model, bearing->node == node, 2, pair, K, NULL, NULL);
+        }
+        for (int i = 0; i < d->n_hinges; i++) {
+            if (d->hinges[i].node != node) {
+                continue;
+            }
+            double k = d->hinges[i].bending_stiffness;
+            int triple[3] = {u, psi, n_dof};
+            double K[9] = {0.0, 0.0, 0.0, 0.0, k, -k, 0.0, -k, k};
+            psi = n_dof++;
+            add_point(model, 1, 3, triple, K, NULL, NULL);
+        }
+        if (node == d->n_segments) {
+            fix_end(d->right, u, psi, fixed);
+            break;
+        }
+        /* ShaftSegment.fe_matrices(count): the segment's own assembly, added as one block */
+        const RotorSegment *s = &d->segments[node];
+        int count = counts[node], n = 2 * (count + 1);
+        double h = s->length / count;
+        dofs[0] = u;
+        dofs[1] = psi;
+        for (int i = 2; i < n; i++) {
+            dofs[i] = n_dof + i - 2;
+        }
+        n_dof += 2 * count;
+        u = dofs[n - 2];
+        psi = dofs[n - 1];
+        if (model->K) {
+            double *K = segment, *M = segment + (size_t)n * (size_t)n, *G = M + (size_t)n * (size_t)n;
+            double k[16], m[16], g[16];
+            memset(segment, 0, 3 * (size_t)n * (size_t)n * sizeof *segment);
+            segment_element(s, h, k, m, g);
+            for (int e = 0; e < count; e++) {
+                for (int i = 0; i < 4; i++) {
+                    for (int j = 0; j < 4; j++) {
+                        size_t at = (size_t)(2 * e + i) * (size_t)n + (size_t)(2 * e + j);
+                        K[at] += k[4 * i + j];
+                        M[at] += m[4 * i + j];
+                        G[at] += g[4 * i + j];
+                    }
+                }
+            }
+            Block block = {dofs, n, K, M, G};
+            add_block(model, &block);
+        }
+        for (int e = 0; e < count; e++, element++) {
+            for (int i = 0; i < 4; i++) {
+                model->elements[4 * element + i] = dofs[2 * e + i];
+            }
+            model->z[element + 1] = model->z[element] + h;
+        }
+    }
+    return n_dof;
+}
+
+/* fem.mesh, Mesh.matrices and the kept rows (fem.assemble) */
+int fe_model_build(const Driveline *d, const int *counts, int with_bearings, FeModel *model, char *error,
+                   size_t size)
+{
+    memset(model, 0, sizeof *model);
+    int n_nodes = d->n_segments + 1, n_elements = 0, local = 0;
+    for (int k = 0; k < d->n_segments; k++) {
+        n_elements += counts[k];
+        local = counts[k] > local ? counts[k] : local;
+    }
+    for (int i = 0; with_bearings && i < d->n_bearings; i++) {
+        if (d->bearings[i].kxx != d->bearings[i].kyy) { /* Bearing.fe_matrices */
+            set_error(error, size, "the finite-element check covers isotropic bearings only");
+            return -1;
+        }
+    }
+    int max_dof = 2 + 2 * n_elements + d->n_hinges, local_n = 2 * (local + 1);
+    int *fixed = calloc((size_t)max_dof, sizeof *fixed);
+    double *segment = malloc(3 * (size_t)local_n * (size_t)local_n * sizeof *segment);
+    int *dofs = malloc((size_t)local_n * sizeof *dofs);
+    model->index = malloc((size_t)max_dof * sizeof *model->index);
+    model->elements = malloc(4 * (size_t)n_elements * sizeof *model->elements);
+    model->z = malloc((size_t)(n_elements + 1) * sizeof *model->z);
+    model->node_u = malloc((size_t)n_nodes * sizeof *model->node_u);
+    if (!fixed || !segment || !dofs || !model->index || !model->elements || !model->z || !model->node_u) {
+        goto out_of_memory;
+    }
+    int n_dof = walk_mesh(d, counts, with_bearings, model, fixed, segment, dofs);
+    model->n_dof = n_dof;
+    model->n_elements = n_elements;
+    int n_kept = 0;
+    for (int g = 0; g < n_dof; g++) {
+        model->index[g] = fixed[g] ? -1 : n_kept++;
+    }
+    model->n_kept = n_kept;
+    size_t cells = (size_t)n_kept * (size_t)n_kept + 1;
+    model->K = calloc(cells, sizeof *model->K);
+    model->M = calloc(cells, sizeof *model->M);
+    model->G = calloc(cells, sizeof *model->G);
+    if (!model->K || !model->M || !model->G) {
+        goto out_of_memory;
+    }
+    memset(fixed, 0, (size_t)max_dof * sizeof *fixed);
+    walk_mesh(d, counts, with_bearings, model, fixed, segment, dofs);
+    free(fixed);
+    free(segment);
+    free(dofs);
+    return 0;
+out_of_memory:
+    set_error(error, size, OUT_OF_MEMORY);
+    fe_model_free(model);
+    free(fixed);
+    free(segment);
+    free(dofs);
+    return -1;
+}
+
+/* ---- scipy.linalg.eigh(K, M, eigvals_only=True) ---------------------------------------------- */
+/* Cholesky factor M = L L^T in the lower triangle of ``m``; the order of the failing minor, or 0. */
+static int cholesky(double *m, int n)
+{
+    for (int j = 0; j < n; j++) {
+        double *row_j = m + (size_t)j * (size_t)n;
+        double diagonal = row_j[j];
+        for (int k = 0; k < j; k++) {
+            diagonal -= row_j[k] * row_j[k];
+        }
+        if (!(diagonal > 0.0)) {
+            return j + 1;
+        }
+        diagonal = sqrt(diagonal);
+        row_j[j] = diagonal;
+        for (int i = j + 1; i < n; i++) {
+            double *row_i = m + (size_t)i * (size_t)n, sum = row_i[j];
+            for (int k = 0; k < j; k++) {
+                sum -= row_i[k] * row_j[k];
+            }
+            row_i[j] = sum / diagonal;
+        }
+    }
+    return 0;
+}
+
+/* a = L^-1 a L^-T for the symmetric ``a`` (both triangles on return) */
+static void reduce_to_standard(double *a, const double *l, int n)
+{
+    /* rows of L^-1 a: forward substitution down each column */
+    for (int c = 0; c < n; c++) {
+        for (int i = 0; i < n; i++) {
+            double sum = a[(size_t)i * (size_t)n + (size_t)c];
+            for (int k = 0; k < i; k++) {
+                sum -= l[(size_t)i * (size_t)n + (size_t)k] * a[(size_t)k * (size_t)n + (size_t)c];
+            }
+            a[(size_t)i * (size_t)n + (size_t)c] = sum / l[(size_t)i * (size_t)n + (size_t)i];
+        }
+    }
+    /* (L^-1 a) L^-T: the same substitution along each row */
+    for (int r = 0; r < n; r++) {
+        double *row = a + (size_t)r * (size_t)n;
+        for (int j = 0; j < n; j++) {
+            double sum = row[j];
+            const double *lj = l + (size_t)j * (size_t)n;
+            for (int k = 0; k < j; k++) {
+                sum -= row[k] * lj[k];
+            }
+            row[j] = sum / lj[j];
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        for (int j = 0; j < i; j++) {
+            double mean = 0.5 * (a[(size_t)i * (size_t)n + (size_t)j] + a[(size_t)j * (size_t)n + (size_t)i]);
+            a[(size_t)i * (size_t)n + (size_t)j] = mean;
+            a[(size_t)j * (size_t)n + (size_t)i] = mean;
+        }
+    }
+}
+
+/* Householder reduction of the symmetric ``a`` to tridiagonal: diagonal d, off-diagonal e (n - 1) */
+static void tridiagonalize(double *a, int n, double *d, double *e, double *v, double *p)
+{
+    for (int k = 0; k + 2 < n; k++) {
+        int m = n - k - 1; /* the column below the diagonal: rows k + 1 .. n - 1 */
+        double scale = 0.0;
+        for (int i = 0; i < m; i++) {
+            v[i] = a[(size_t)(k + 1 + i) * (size_t)n + (size_t)k];
+            scale = fmax(scale, fabs(v[i]));
+        }
+        if (scale == 0.0) {
+            e[k] = 0.0;
+            continue;
+        }
+        double norm2 = 0.0;
+        for (int i = 0; i < m; i++) {
+            v[i] /= scale;
+            norm2 += v[i] * v[i];
+        }
+        double alpha = v[0] >= 0.0 ? -sqrt(norm2) : sqrt(norm2);
+        e[k] = alpha * scale;
+        v[0] -= alpha;
+        double vv = norm2 - 2.0 * alpha * (v[0] + alpha) + alpha * alpha; /* |x - alpha e1|^2 */
+        vv = 0.0;
+        for (int i = 0; i < m; i++) {
+            vv += v[i] * v[i];
+        }
+        double tau = 2.0 / vv, vp = 0.0;
+        /* p = tau A v on the trailing block; w = p - (tau/2)(v.p) v; A -= v w^T + w v^T */
+        for (int i = 0; i < m; i++) {
+            const double *row = a + (size_t)(k + 1 + i) * (size_t)n + (size_t)(k + 1);
+            double sum = 0.0;
+            for (int j = 0; j < m; j++) {
+                sum += row[j] * v[j];
+            }
+            p[i] = tau * sum;
+            vp += v[i] * p[i];
+        }
+        for (int i = 0; i < m; i++) {
+            p[i] -= 0.5 * tau * vp * v[i];
+        }
+        for (int i = 0; i < m; i++) {
+            double *row = a + (size_t)(k + 1 + i) * (size_t)n + (size_t)(k + 1);
+            for (int j = 0; j < m; j++) {
+                row[j] -= v[i] * p[j] + p[i] * v[j];
+            }
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        d[i] = a[(size_t)i * (size_t)n + (size_t)i];
+    }
+    if (n >= 2) {
+        e[n - 2] = a[(size_t)(n - 1) * (size_t)n + (size_t)(n - 2)];
+    }
+}
+
+/* Eigenvalues of the symmetric tridiagonal (d, e) by implicitly shifted QR steps (Wilkinson shift)
+ * with deflation; 0, or -1 when a block does not converge within the iteration cap. */
+static int tridiagonal_eigenvalues(double *d, double *e, int n)
+{
+    int iterations = 0, cap = 30 * (n > 10 ? n : 10);
+    int hi = n - 1;
+    while (hi > 0) {
+        /* deflate at the bottom */
+        if (fabs(e[hi - 1]) <= DBL_EPSILON * (fabs(d[hi - 1]) + fabs(d[hi]))) {
+            e[hi - 1] = 0.0;
+            hi--;
+            continue;
+        }
+        int lo = hi - 1;
+        while (lo > 0 && fabs(e[lo - 1]) > DBL_EPSILON * (fabs(d[lo - 1]) + fabs(d[lo]))) {
+            lo--;
+        }
+        if (lo > 0) {
+            e[lo - 1] = 0.0;
+        }
+        if (++iterations > cap) {
+            return -1;
+        }
+        /* Wilkinson shift from the trailing 2 x 2 */
+        double delta = 0.5 * (d[hi - 1] - d[hi]), b = e[hi - 1];
+        double root = hypot(delta, b);
+        double mu = d[hi] - b * b / (delta + (delta >= 0.0 ? root : -root));
+        if (delta == 0.0 && b == 0.0) {
+            mu = d[hi];
+        }
+        double x = d[lo] - mu, z = e[lo];
+        for (int k = lo; k < hi; k++) {
+            double r = hypot(x, z), c = r == 0.0 ? 1.0 : x / r, s = r == 0.0 ? 0.0 : z / r;
+            if (k > lo) {
+                e[k - 1] = r;
+            }
+            double a = d[k], bk = e[k], dd = d[k + 1];
+            double cs = c * s, cc = c * c, ss = s * s;
+            d[k] = cc * a + 2.0 * cs * bk + ss * dd;
+            d[k + 1] = ss * a - 2.0 * cs * bk + cc * dd;
+            e[k] = cs * (dd - a) + (cc - ss) * bk;
+            if (k + 1 < hi) {
+                z = s * e[k + 1];
+                e[k + 1] *= c;
+                x = e[k];
+            }
+        }
+    }
+    return 0;
+}
+
+static int ascending(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* eigh(K, M, eigvals_only=True) ascending into ``values``; K and M are overwritten */
+static int generalized_eigenvalues(double *K, double *M, int n, double *values, char *error, size_t size)
+{
+    int minor = cholesky(M, n);
+    if (minor) {
+        if (error && size) {
+            snprintf(error, size,
+                     "The leading minor of order %d of B is not positive definite. The factorization of B could "
+                     "not be completed and no eigenvalues or eigenvectors were computed.", minor);
+        }
+        return -1;
+    }
+    double *work = malloc(3 * (size_t)(n + 1) * sizeof *work);
+    if (!work) {
+        set_error(error, size, OUT_OF_MEMORY);
+        return -1;
+    }
+    reduce_to_standard(K, M, n);
+    double *e = work, *v = work + n + 1, *p = v + n + 1;
+    tridiagonalize(K, n, values, e, v, p);
+    int status = tridiagonal_eigenvalues(values, e, n);
+    free(work);
+    if (status) {
+        set_error(error, size, "the eigenvalue iteration did not converge");
+        return -1;
+    }
+    qsort(values, (size_t)n, sizeof *values, ascending);
+    return 0;
+}
+
+/* The natural frequencies of one plane: bearings isotropic with ``stiffness`` */
+static int plane_frequencies(const Driveline *d, const int *counts, RotorBearing *plane, double *out, int *count,
+                             char *error, size_t size)
+{
+    Driveline copy = *d;
+    copy.bearings = plane;
+    FeModel model;
+    if (fe_model_build(&copy, counts, 1, &model, error, size)) {
+        return -1;
+    }
+    int n = model.n_kept;
+    for (size_t i = 0; i < (size_t)n * (size_t)n; i++) {
+        if (!isfinite(model.K[i]) || !isfinite(model.M[i])) { /* scipy.linalg.eigh's check_finite */
+            set_error(error, size, "array must not contain infs or NaNs");
+            fe_model_free(&model);
+            return -1;
+        }
+    }
+    if (generalized_eigenvalues(model.K, model.M, n, out, error, size)) {
+        fe_model_free(&model);
+        return -1;
+    }
+    for (int i = 0; i < n; i++) {
+        out[i] = sqrt(fabs(out[i]));
+    }
+    *count = n;
+    fe_model_free(&model);
+    return 0;
+}
+
+/* model.natural_frequencies: the kxx plane, then (anisotropic bearings) the kyy plane */
+int fe_natural_frequencies(const Driveline *d, int elements, double **frequencies, int *count, char *error,
+                           size_t size)
+{
+    *frequencies = NULL;
+    *count = 0;
+    if (elements < 1) { /* ShaftSegment.fe_matrices: length / n_elements */
+        set_error(error, size, "float division by zero");
+        return -1;
+    }
+    int n_bearings = d->n_bearings, planes = 1, total = 2 + d->n_hinges;
+    for (int i = 0; i < n_bearings; i++) {
+        planes = d->bearings[i].kxx != d->bearings[i].kyy ? 2 : planes;
+    }
+    for (int k = 0; k < d->n_segments; k++) {
+        total += 2 * elements;
+    }
+    int *counts = malloc((size_t)(d->n_segments + 1) * sizeof *counts);
+    RotorBearing *plane = malloc((size_t)(n_bearings + 1) * sizeof *plane);
+    double *out = malloc((size_t)planes * (size_t)total * sizeof *out);
+    if (!counts || !plane || !out) {
+        free(counts);
+        free(plane);
+        free(out);
+        set_error(error, size, OUT_OF_MEMORY);
+        return -1;
+    }
+    for (int k = 0; k < d->n_segments; k++) {
+        counts[k] = elements;
+    }
+    int found = 0;
+    for (int p = 0; p < planes; p++) {
+        for (int i = 0; i < n_bearings; i++) { /* Bearing(b.node, k) */
+            double k = p == 0 ? d->bearings[i].kxx : d->bearings[i].kyy;
+            RotorBearing isotropic = {d->bearings[i].node, k, k, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            plane[i] = isotropic;
+        }
+        int n = 0;
+        if (plane_frequencies(d, counts, plane, out + found, &n, error, size)) {
+            free(counts);
+            free(plane);
+            free(out);
+            return -1;
+        }
+        found += n;
+    }
+    free(counts);
+    free(plane);
+    *frequencies = out;
+    *count = found;
+    return 0;
+}

@@ -1,0 +1,207 @@
+"""The native rotor library's finite elements (``fem.c``, ``damped.c``) against the Python core:
+the plausibility check's natural frequencies (model.natural_frequencies, scipy's eigh) and the
+FMU's unbalance outputs (UnbalanceOutputs.build and evaluate: numpy's eig, ARPACK above
+DENSE_SIZE, LAPACK's banded solve).
+
+Both sides round differently (their own eigensolvers and factorisations), so they agree to the
+rounding level of each problem, which the tolerances below state and bound.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import dataclasses
+
+import numpy as np
+import pytest
+
+from driveline.rotor import Bearing, Driveline, ShaftSegment, Unbalance, model, one_piece_shaft
+from driveline.rotor.damped import DENSE_SIZE, DampedRotor
+from driveline.rotor.fem import elements_by_length
+from driveline.rotor.loader import example_path, load_driveline, loads_driveline
+from driveline.rotor.unbalance_outputs import TABLE_ELEMENTS, UnbalanceOutputs
+
+from native_rotor import compile_rotor
+from native_rotor_driveline import CDriveline, c_driveline, unbalances
+
+EPS = np.finfo(float).eps
+#: Natural frequencies, relative: scipy's and the C Cholesky reduction both lose the lowest
+#: frequency's last digits to the stiffest elements (a 40-digit reference puts both 1.5e-11 off
+#: on the hinged two-piece layout); they differ from each other by at most 1.7e-12 (measured).
+FREQUENCY_RTOL = 5e-12
+#: Response and largest bearing force, relative to their largest value over the run: the banded
+#: solves round differently, amplified near a lightly damped resonance (measured at most 1.1e-10,
+#: 0.07 % from the resonance of the Rayleigh tube's zeta = 0.0016 mode).
+RESPONSE_RTOL = 1e-9
+#: Damping ratios, absolute, in units of eps times the spread max|lam| / min|lam| of the mode
+#: table's first-order eigenproblem: an eigensolver determines Re(lam) only to about eps ||A||, and
+#: zeta = -Re(lam) / |lam| (numpy's own errors against a 30-digit reference reach 2e-13 on the
+#: 20-segment shaft, 2e-13 on the default tube's zeta = 0.0016 mode). Measured differences: at most
+#: 16 units on the one- and two-piece layouts, 51 on the 20-segment shaft, 103 against ARPACK on the
+#: 60-segment one (2.6e-11 absolute).
+ZETA_UNITS = 200.0
+
+TUBE = dict(L_shaft=1.4, D_outer=0.0762, D_inner=0.0729, E=2.1e11, density=7850.0, m_joint=2.5, Jp_joint=0.004,
+            Jd_joint=0.002, k_bearing=1e7)
+DEFAULT = one_piece_shaft(**TUBE, c_bearing=500.0)  # the FMU's defaults (Timoshenko)
+RAYLEIGH = one_piece_shaft(**TUBE, c_bearing=500.0, shear=False)
+TWO_PIECE = load_driveline(example_path("two_piece_propshaft"))
+HINGED = load_driveline(example_path("two_piece_propshaft_hinged"))
+ENDS = dataclasses.replace(DEFAULT, left="pinned", right="clamped")
+ANISOTROPIC = dataclasses.replace(DEFAULT, bearings=[Bearing(0, 1e7, 3e6, cxx=300.0), Bearing(1, 2e7, cxx=100.0)])
+CROSS_COUPLED = dataclasses.replace(DEFAULT, bearings=[
+    Bearing(0, 1e7, 2e6, cxx=300.0, cyy=100.0, kxy=1e5, kyx=-2e5, cxy=10.0, cyx=30.0), Bearing(1, 1e7, 2e6, cxx=300.0)])
+
+
+def equal_segments(count: int) -> Driveline:
+    """The default tube cut into ``count`` equal Timoshenko segments on damped bearings."""
+    segment = ShaftSegment(1.4 / count, 0.0762, 0.0729, shear=True)
+    return Driveline([segment] * count, [], [Bearing(0, 1e7, cxx=500.0), Bearing(count, 1e7, cxx=500.0)])
+
+
+# the two-piece shaft with damped bearings and unbalances of its own, one at a node, one in a segment
+OWN_UNBALANCES = loads_driveline(example_path("two_piece_propshaft").read_text().replace(
+    "stiffness = 1.0e7", "stiffness = 1.0e7\ndamping = 800.0").replace("stiffness = 1.0e6", "stiffness = 1.0e6\ndamping = 200.0")
+    + "\n[[unbalances]]\nnode = 1\namount = 5e-5\n\n[[unbalances]]\nposition = 1.2\namount = 1e-4\nphase = 2.0\n")
+SEGMENTS_20 = equal_segments(20)  # 84 first-order unknowns in the mode table: numpy's dense eig
+SEGMENTS_60 = equal_segments(60)  # 244 > DENSE_SIZE: ARPACK in Python, the dense solver in C
+
+NATURAL = {"default": DEFAULT, "rayleigh": RAYLEIGH, "two_piece": TWO_PIECE, "hinged": HINGED, "ends": ENDS,
+           "anisotropic": ANISOTROPIC}
+OUTPUTS = {**NATURAL, "cross_coupled": CROSS_COUPLED, "own_unbalances": OWN_UNBALANCES, "segments_20": SEGMENTS_20,
+           "segments_60": SEGMENTS_60}
+OMEGA_MAX = 1500.0
+
+
+@pytest.fixture(scope="module")
+def library(tmp_path_factory):
+    lib = compile_rotor(tmp_path_factory.mktemp("damped"), ["fem", "damped", "spline"])
+    driveline_p = ctypes.POINTER(CDriveline)
+    lib.fe_natural_frequencies.argtypes = [driveline_p, ctypes.c_int, ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
+                                           ctypes.POINTER(ctypes.c_int), ctypes.c_char_p, ctypes.c_size_t]
+    lib.fe_natural_frequencies.restype = ctypes.c_int
+    lib.unbalance_outputs_new.argtypes = [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double, ctypes.c_double,
+                                          ctypes.c_char_p, ctypes.c_size_t]
+    lib.unbalance_outputs_new.restype = ctypes.c_void_p
+    lib.unbalance_outputs_evaluate.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.POINTER(ctypes.c_double)]
+    lib.unbalance_outputs_evaluate.restype = None
+    lib.unbalance_outputs_free.argtypes = [ctypes.c_void_p]
+    lib.unbalance_outputs_free.restype = None
+    lib.free.argtypes = [ctypes.c_void_p]  # libc's, through the library's dependencies
+    return lib
+
+
+def natural_frequencies(lib, d: Driveline, elements: int = model.FE_ELEMENTS) -> np.ndarray:
+    c = c_driveline(d)
+    values, count, error = ctypes.POINTER(ctypes.c_double)(), ctypes.c_int(), ctypes.create_string_buffer(512)
+    assert lib.fe_natural_frequencies(ctypes.byref(c), elements, ctypes.byref(values), ctypes.byref(count), error,
+                                      512) == 0, error.value
+    out = np.array(values[:count.value])
+    lib.free(ctypes.cast(values, ctypes.c_void_p))
+    return out
+
+
+def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds) -> np.ndarray:
+    """The C UnbalanceOutputs' evaluate at ``speeds`` (rows: response, force, damping ratio)."""
+    c = c_driveline(d)
+    _, pointer = kept = unbalances(items)
+    error = ctypes.create_string_buffer(512)
+    handle = lib.unbalance_outputs_new(ctypes.byref(c), pointer, len(items), fraction, omega_max, error, 512)
+    assert handle, error.value
+    try:
+        out = (ctypes.c_double * 3)()
+        rows = []
+        for speed in speeds:
+            lib.unbalance_outputs_evaluate(handle, speed, out)
+            rows.append(list(out))
+    finally:
+        lib.unbalance_outputs_free(handle)
+    del kept
+    return np.array(rows)
+
+
+def excitation(d: Driveline) -> tuple[Unbalance, ...]:
+    """As the FMU: a layout's own unbalances, else 1e-4 kg m at the middle."""
+    return tuple(d.unbalances) or (Unbalance(0.5 * d.length, 1e-4),)
+
+
+def spread(d: Driveline) -> float:
+    """max|lam| / min|lam| of the mode table's first-order eigenproblem at standstill."""
+    rotor = DampedRotor(d, elements_by_length(d, TABLE_ELEMENTS))
+    upper, stiffness, damping, _ = rotor._dense_blocks
+    size = np.abs(np.linalg.eigvals(np.block([[upper], [stiffness, damping]])))
+    return float(size.max() / size.min())
+
+
+@pytest.mark.parametrize("name", NATURAL)
+def test_natural_frequencies_match_the_python_check(library, name):
+    d = NATURAL[name]
+    expected = np.sort(model.natural_frequencies(d))
+    got = natural_frequencies(library, d)
+    assert got.size == expected.size
+    np.testing.assert_allclose(np.sort(got), expected, rtol=FREQUENCY_RTOL, atol=0.0)
+
+
+def test_natural_frequencies_take_each_plane_of_anisotropic_bearings(library):
+    """Two planes: the kxx frequencies first, each plane ascending (Python's set of planes has no order)."""
+    got = natural_frequencies(library, ANISOTROPIC)
+    half = got.size // 2
+    for k in (lambda b: b.kxx, lambda b: b.k_yy):
+        plane = dataclasses.replace(ANISOTROPIC, bearings=[Bearing(b.node, k(b)) for b in ANISOTROPIC.bearings])
+        expected = model.natural_frequencies(plane)
+        part, got = got[:half], got[half:]
+        np.testing.assert_allclose(part, expected, rtol=FREQUENCY_RTOL)
+
+
+@pytest.mark.parametrize("name", OUTPUTS)
+def test_unbalance_outputs_match_the_python_model(library, name):
+    d = OUTPUTS[name]
+    items = excitation(d)
+    speeds = np.linspace(0.0, OMEGA_MAX, 101)
+    python = UnbalanceOutputs.build(d, items, 0.5, OMEGA_MAX)
+    expected = np.array([python.evaluate(speed) for speed in speeds])
+    got = outputs(library, d, items, 0.5, OMEGA_MAX, speeds)
+    assert np.all(np.isfinite(got)) and np.all(got[0, :2] == 0.0)
+    for column in (0, 1):
+        scale = np.max(np.abs(expected[:, column]))
+        assert np.max(np.abs(got[:, column] - expected[:, column])) <= RESPONSE_RTOL * scale
+    zeta = np.max(np.abs(got[:, 2] - expected[:, 2]))
+    assert zeta <= ZETA_UNITS * EPS * spread(d), f"damping ratios differ by {zeta:.3g}"
+
+
+def test_the_mode_table_above_the_dense_size_is_arpacks_selection(library):
+    """The 60-segment shaft's mode table exceeds DENSE_SIZE in Python, where ARPACK finds the modes."""
+    rotor = DampedRotor(SEGMENTS_60, elements_by_length(SEGMENTS_60, TABLE_ELEMENTS))
+    assert 2 * rotor.M.shape[0] > DENSE_SIZE
+
+
+def test_response_position_and_omega_max_are_honoured(library):
+    d = OWN_UNBALANCES
+    speeds = np.linspace(0.0, 900.0, 37)
+    python = UnbalanceOutputs.build(d, d.unbalances, 0.83, 900.0)
+    expected = np.array([python.evaluate(speed) for speed in speeds])
+    got = outputs(library, d, d.unbalances, 0.83, 900.0, speeds)
+    for column in (0, 1):
+        assert np.max(np.abs(got[:, column] - expected[:, column])) <= RESPONSE_RTOL * np.max(expected[:, column])
+    assert np.max(np.abs(got[:, 2] - expected[:, 2])) <= ZETA_UNITS * EPS * spread(d)
+
+
+def test_speed_zero_gives_no_response_and_the_tabulated_damping(library):
+    got = outputs(library, DEFAULT, excitation(DEFAULT), 0.5, OMEGA_MAX, [0.0])
+    python = UnbalanceOutputs.build(DEFAULT, excitation(DEFAULT), 0.5, OMEGA_MAX).evaluate(0.0)
+    assert got[0, 0] == 0.0 and got[0, 1] == 0.0
+    assert got[0, 2] == pytest.approx(python[2], rel=1e-9)
+
+
+@pytest.mark.parametrize("omega_max", [0.0, -5.0, float("nan"), float("inf")])
+def test_refusals_are_worded_as_pythons(library, omega_max):
+    """Equal or falling knots, which CubicSpline refuses; knots that are not finite, which numpy's eig
+    refuses."""
+    with pytest.raises(ValueError) as refused:
+        UnbalanceOutputs.build(DEFAULT, excitation(DEFAULT), 0.5, omega_max)
+    c = c_driveline(DEFAULT)
+    _, pointer = kept = unbalances(excitation(DEFAULT))
+    error = ctypes.create_string_buffer(512)
+    assert not library.unbalance_outputs_new(ctypes.byref(c), pointer, 1, 0.5, omega_max, error, 512)
+    assert error.value.decode() == str(refused.value)
+    del kept
