@@ -195,75 +195,14 @@ static int python_divide(double x, double y, double *out, char *error)
     return 0;
 }
 
-/* math.fsum (exact partial sums, rounded once); -1 with Python's message on its failures. */
-static int python_fsum(const double *values, int n, double *sum, char *error)
+/* math.fsum; -1 with Python's message on its failures. */
+static int fsum(const double *values, int n, double *sum, char *error)
 {
-    double partials[128], special = 0.0, infinities = 0.0, x, y, high, low = 0.0, twice, rounded;
-    int used = 0, kept, i, j;
-    for (i = 0; i < n; i++) {
-        double original = values[i];
-        x = original;
-        kept = 0;
-        for (j = 0; j < used; j++) {
-            y = partials[j];
-            if (fabs(x) < fabs(y)) {
-                double swap = x;
-                x = y;
-                y = swap;
-            }
-            high = x + y;
-            low = y - (high - x);
-            if (low != 0.0) {
-                partials[kept++] = low;
-            }
-            x = high;
-        }
-        used = kept;
-        if (x != 0.0) {
-            if (!isfinite(x)) {
-                if (isfinite(original)) {
-                    snprintf(error, ERROR_SIZE, "intermediate overflow in fsum");
-                    return -1;
-                }
-                if (isinf(original)) {
-                    infinities += original;
-                }
-                special += original;
-                used = 0;
-            } else if (used < (int)(sizeof partials / sizeof partials[0])) {
-                partials[used++] = x;
-            }
-        }
+    const char *failure = python_fsum(values, n, sum);
+    if (failure != NULL) {
+        snprintf(error, ERROR_SIZE, "%s", failure);
+        return -1;
     }
-    if (special != 0.0 || isnan(special)) {
-        if (isnan(infinities)) {
-            snprintf(error, ERROR_SIZE, "-inf + inf in fsum");
-            return -1;
-        }
-        *sum = special;
-        return 0;
-    }
-    high = 0.0;
-    if (used > 0) {
-        high = partials[--used];
-        while (used > 0) {
-            x = high;
-            y = partials[--used];
-            high = x + y;
-            low = y - (high - x);
-            if (low != 0.0) {
-                break;
-            }
-        }
-        if (used > 0 && ((low < 0.0 && partials[used - 1] < 0.0) || (low > 0.0 && partials[used - 1] > 0.0))) {
-            twice = low * 2.0;
-            rounded = high + twice;
-            if (twice == rounded - high) {
-                high = rounded;
-            }
-        }
-    }
-    *sum = high;
     return 0;
 }
 
@@ -459,7 +398,7 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
             terms[n++] = s->length * root;
         }
     }
-    if (failed || python_fsum(terms, n, &kappa, error)) {
+    if (failed || fsum(terms, n, &kappa, error)) {
         free(terms);
         return -1;
     }
@@ -472,7 +411,7 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
             terms[n++] = sqrt(2.0 * orders[i] * omega_max);
         }
     }
-    failed = python_fsum(terms, n, &scanned, error);
+    failed = fsum(terms, n, &scanned, error);
     free(terms);
     if (failed) {
         return -1;

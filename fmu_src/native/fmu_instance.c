@@ -266,26 +266,21 @@ static void input_errors(const ModelData *data, Messages *out)
     }
 }
 
-typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_OVERFLOW, SUM_OPPOSITE_INFINITIES } SumOutcome;
-
-/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it):
- * exact partial sums (Shewchuk), an OverflowError when a partial sum of finite values
- * overflows, a ValueError when +inf and -inf meet, else a finite or non-finite sum. */
-static SumOutcome fsum_outcome(const double values[], int count)
+/* Python's math.fsum: exact partial sums (Shewchuk), rounded once; the text of Python's exception
+ * when a partial sum of finite values overflows (OverflowError) or +inf and -inf meet
+ * (ValueError), else NULL with the sum in ``*sum``. Each value adds at most one partial: exact for
+ * up to FSUM_VALUES values (the Real outputs, a layout's segments). */
+#define FSUM_VALUES 256
+const char *python_fsum(const double values[], int count, double *sum)
 {
-    double partials[MODEL_VARIABLE_COUNT + 1], special = 0.0, infinities = 0.0, magnitude = 0.0;
+    double partials[FSUM_VALUES], special = 0.0, infinities = 0.0, high = 0.0, low = 0.0, x, y;
     int used = 0, i, j;
     for (i = 0; i < count; i++) {
-        magnitude += fabs(values[i]);
-    }
-    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
-        return SUM_FINITE;
-    }
-    for (i = 0; i < count; i++) {
-        double x = values[i], original = values[i];
+        double original = values[i];
         int kept = 0;
+        x = original;
         for (j = 0; j < used; j++) {
-            double y = partials[j], high, low;
+            y = partials[j];
             if (fabs(x) < fabs(y)) {
                 double swap = x;
                 x = y;
@@ -302,22 +297,69 @@ static SumOutcome fsum_outcome(const double values[], int count)
         if (x != 0.0) {
             if (!isfinite(x)) {
                 if (isfinite(original)) {
-                    return SUM_OVERFLOW;
+                    return "intermediate overflow in fsum";
                 }
                 if (isinf(original)) {
                     infinities += original;
                 }
                 special += original;
                 used = 0;
-            } else {
+            } else if (used < (int)(sizeof partials / sizeof partials[0])) {
                 partials[used++] = x;
             }
         }
     }
     if (special != 0.0 || isnan(special)) {
-        return isnan(infinities) ? SUM_OPPOSITE_INFINITIES : SUM_NOT_FINITE;
+        if (isnan(infinities)) {
+            return "-inf + inf in fsum";
+        }
+        *sum = special;
+        return NULL;
     }
-    return SUM_FINITE;
+    high = 0.0;
+    if (used > 0) { /* add the partials from the top until the sum is inexact, then round half even */
+        high = partials[--used];
+        while (used > 0) {
+            x = high;
+            y = partials[--used];
+            high = x + y;
+            low = y - (high - x);
+            if (low != 0.0) {
+                break;
+            }
+        }
+        if (used > 0 && ((low < 0.0 && partials[used - 1] < 0.0) || (low > 0.0 && partials[used - 1] > 0.0))) {
+            y = low * 2.0;
+            x = high + y;
+            if (y == x - high) {
+                high = x;
+            }
+        }
+    }
+    *sum = high;
+    return NULL;
+}
+
+typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_OVERFLOW, SUM_OPPOSITE_INFINITIES } SumOutcome;
+
+/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it);
+ * exactly only where a partial sum could come near overflow. */
+static SumOutcome fsum_outcome(const double values[], int count)
+{
+    double magnitude = 0.0, sum = 0.0;
+    const char *failure;
+    int i;
+    for (i = 0; i < count; i++) {
+        magnitude += fabs(values[i]);
+    }
+    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
+        return SUM_FINITE;
+    }
+    failure = python_fsum(values, count, &sum);
+    if (failure != NULL) {
+        return failure[0] == 'i' ? SUM_OVERFLOW : SUM_OPPOSITE_INFINITIES;
+    }
+    return isfinite(sum) ? SUM_FINITE : SUM_NOT_FINITE;
 }
 
 /* SteppedModel.output_errors; an arithmetic failure of the sum itself becomes ``failure``. */
@@ -1250,6 +1292,9 @@ char *resource_folder_of_uri(const char *uri)
         if (*path != '/') {
             return NULL;
         }
+    }
+    if (path[0] == '/' && path[1] != '\0' && path[2] == ':') { /* file:///C:/...: a drive letter */
+        path++;
     }
     length = strlen(path);
     folder = malloc(length + 1);

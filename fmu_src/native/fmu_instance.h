@@ -22,7 +22,7 @@
 #endif
 
 #define FMU_PI 3.14159265358979323846
-#define FMU_MESSAGE_SIZE 400
+#define FMU_MESSAGE_SIZE 1024 /* a message names a layout file by its absolute path: room for a long one */
 #define FMU_MAX_MESSAGES 48
 /* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
  * five-number warm start); a new count needs a new STATE_FORMAT (fmu_instance.c). */
@@ -184,6 +184,9 @@ void messages_add(Messages *out, const char *first, ...);
 /* Adds generated message ``message`` (a MESSAGE_* of model_variables.h) with its variable's value. */
 void messages_add_extra(Messages *out, const ModelData *data, int message);
 #endif
+/* Python's math.fsum of ``count`` values into ``*sum``: NULL, or the text of the exception Python
+ * raises ("intermediate overflow in fsum", "-inf + inf in fsum"). */
+const char *python_fsum(const double values[], int count, double *sum);
 /* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
 void python_float_repr(double value, char *out, size_t size);
 
