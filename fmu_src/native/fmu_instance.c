@@ -546,8 +546,10 @@ static int copy_strings(char *const from[MODEL_VARIABLE_COUNT], char *to[MODEL_V
 {
     int i;
     for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
-        const char *text = from != NULL ? from[i] : model_variables[i].start_string;
         to[i] = NULL;
+    }
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        const char *text = from != NULL ? from[i] : model_variables[i].start_string;
         if (model_variables[i].type == VAR_STRING) {
             to[i] = copy_text(text != NULL ? text : "", text != NULL ? strlen(text) : 0);
             if (to[i] == NULL) {
