@@ -175,18 +175,25 @@ def test_every_mode_matches_the_python_fmu(native_dir, fmu_path, name, parameter
 
 
 @pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")
-def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
-    """A state stored half way through an exact run with friction, restored from its bytes into an
-    instance whose solver was warm-started elsewhere, continues bit for bit."""
-    path, parameters = _native(native_dir, "TripodCoupling", fmi), {"kinematics": 1, "mu": 0.05}
-    case = scenario(MODELS["TripodCoupling"].spec)
+def _half_way_state(path: Path, parameters: dict) -> tuple[float, bytes, np.ndarray]:
+    """The standard scenario with ``parameters``: the time and serialized state half way, and the
+    second half run on from there."""
+    case = scenario(MODELS[read_model_description(str(path)).modelName].spec)
     with FmuInstance(path) as fmu:
         fmu.initialize({**parameters, **case.input_values(0.0)})
         fmu.run(case.stop_time / 2, case.step_size, case.signals())
         middle, state = fmu.time, fmu.get_state()
         serialized = fmu.serialize_state(state)
         fmu.free_state(state)
-        reference = fmu.run(case.stop_time, case.step_size, case.signals())
+        return middle, serialized, fmu.run(case.stop_time, case.step_size, case.signals())
+
+
+def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
+    """A state stored half way through an exact run with friction, restored from its bytes into an
+    instance whose solver was warm-started elsewhere, continues bit for bit."""
+    path, parameters = _native(native_dir, "TripodCoupling", fmi), {"kinematics": 1, "mu": 0.05}
+    case = scenario(MODELS["TripodCoupling"].spec)
+    middle, serialized, reference = _half_way_state(path, parameters)
     with FmuInstance(path) as other:
         other.initialize({**parameters, "beta": 0.2, "phi_in_start": 1.0})
         other.run(case.stop_time / 3, case.step_size)
@@ -562,13 +569,8 @@ def test_critical_speeds_strings_are_part_of_the_state(native_dir, name, fmi):
     """A state saved with other strings, serialized and restored into another instance, brings
     them back and continues bit for bit (the analysis is rebuilt for the restored parameters)."""
     path, case = _native(native_dir, name, fmi), scenario(MODELS[name].spec)
-    with FmuInstance(path) as fmu:
-        fmu.initialize({"layout": "two_piece_propshaft", "orders": "1,2,6", "shear": False, **case.input_values(0.0)})
-        fmu.run(case.stop_time / 2, case.step_size, case.signals())
-        middle, state = fmu.time, fmu.get_state()
-        serialized = fmu.serialize_state(state)
-        fmu.free_state(state)
-        reference = fmu.run(case.stop_time, case.step_size, case.signals())
+    middle, serialized, reference = _half_way_state(path, {"layout": "two_piece_propshaft", "orders": "1,2,6",
+                                                           "shear": False})
     with FmuInstance(path) as other:
         other.initialize({"orders": "3"})
         other.run(case.stop_time / 4, case.step_size)
