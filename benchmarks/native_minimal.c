@@ -24,4 +24,4 @@ static const char *copy_first_input(ModelData *data, double time)
     return NULL;
 }
 
-const ModelHooks model_hooks = {NULL, copy_first_input, NULL, NULL, NULL, NULL};
+const ModelHooks model_hooks = {NULL, copy_first_input, NULL, NULL, NULL, NULL, NULL};

@@ -12,6 +12,7 @@ import copy
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, ClassVar
 
 from .variables import ModelSpec, Relation, Variable
@@ -102,6 +103,10 @@ class SteppedModel(ABC):
     #: for its message; the first value named is the one the message shows. The native build cuts
     #: the messages from the check run on these values, so their wording exists once.
     extra_parameter_probes: ClassVar[dict[str, dict[str, float]]] = {}
+
+    #: Files a native FMU of the model ships in its ``resources/`` folder, by their path here (the
+    #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.
+    resource_files: ClassVar[tuple[Path, ...]] = ()
 
     def extra_input_errors(self) -> list[str]:
         """Input checks the spec cannot declare, run once the declared ones pass."""

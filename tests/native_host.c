@@ -1,9 +1,11 @@
 /* A minimal co-simulation host with no Python in the process, for the native FMUs' tests.
  *
- * Usage: native_host LIBRARY FMI_VERSION(2|3) TOKEN SCENARIO
+ * Usage: native_host LIBRARY FMI_VERSION(2|3) TOKEN SCENARIO [RESOURCES]
  *
+ * RESOURCES is the FMU's resources folder (handed over as a file URI in FMI 2.0, a path in 3.0).
  * SCENARIO is a text file: "inputs N vr...", "outputs M vr...", "parameters P (vr value)...",
- * "integers Q (vr value)..." (Real and Integer parameters, set in initialisation mode), "steps K h",
+ * "integers Q (vr value)...", "booleans B (vr 0|1)...", "strings S (vr text)..." (parameters set in
+ * initialisation mode; a text has no blanks; each is read back), "tolerance x", "steps K h",
  * then K + 1 rows "t u_1..u_N y_1..y_M": the inputs at t_k and the outputs a reference FMU gave at
  * t_k (row 0: after initialisation). The host loads the FMU's shared library (dlopen), runs two instances
  * side by side (the second must repeat the first bit for bit), stores, serializes and restores
@@ -11,7 +13,7 @@
  * input to NaN (or steps by 0 if there is no input) and expects a refused step (Discard, a logged
  * reason, outputs unchanged).
  * It prints the largest deviation from the reference, relative to each output's largest
- * magnitude, and exits 0 when every check held and the deviation is at most 1e-12.
+ * magnitude, and exits 0 when every check held and the deviation is at most the tolerance.
  */
 #include <dlfcn.h>
 #include <math.h>
@@ -24,18 +26,21 @@
 #include "fmi3FunctionTypes.h"
 
 #define MAX_SIGNALS 64
-#define TOLERANCE 1e-12
+#define MAX_TEXT 4096
 
 typedef struct {
-    int inputs, outputs, steps, parameters, integers;
-    unsigned int input_vr[MAX_SIGNALS], output_vr[MAX_SIGNALS], parameter_vr[MAX_SIGNALS], integer_vr[MAX_SIGNALS];
+    int inputs, outputs, steps, parameters, integers, booleans, strings;
+    unsigned int input_vr[MAX_SIGNALS], output_vr[MAX_SIGNALS], parameter_vr[MAX_SIGNALS], integer_vr[MAX_SIGNALS],
+        boolean_vr[MAX_SIGNALS], string_vr[MAX_SIGNALS];
     double parameter[MAX_SIGNALS];
-    int integer[MAX_SIGNALS];
-    double step_size;
+    int integer[MAX_SIGNALS], boolean[MAX_SIGNALS];
+    char *string[MAX_SIGNALS];
+    double step_size, tolerance;
     double *time, *input, *expected; /* rows of the scenario */
 } Scenario;
 
 static int messages_logged = 0;
+static const char *resources = NULL; /* the FMU's resources folder, if given */
 
 static int fail(const char *what)
 {
@@ -65,6 +70,9 @@ typedef struct {
     int (*initialize)(void *instance);
     int (*set)(void *instance, const unsigned int vr[], size_t n, const double values[]);
     int (*set_integer)(void *instance, const unsigned int vr[], size_t n, const int values[]);
+    int (*set_boolean)(void *instance, const unsigned int vr[], size_t n, const int values[]);
+    /* sets the strings and reads them back: 1 when they arrived as set */
+    int (*set_string)(void *instance, const unsigned int vr[], size_t n, char *const values[]);
     int (*get)(void *instance, const unsigned int vr[], size_t n, double values[]);
     int (*step)(void *instance, double time, double step_size);
     int (*store)(void *instance, void **state);          /* get, serialize, deserialize: the copy */
@@ -82,6 +90,9 @@ static struct {
     fmi2ExitInitializationModeTYPE *ExitInitializationMode;
     fmi2SetRealTYPE *SetReal;
     fmi2SetIntegerTYPE *SetInteger;
+    fmi2SetBooleanTYPE *SetBoolean;
+    fmi2SetStringTYPE *SetString;
+    fmi2GetStringTYPE *GetString;
     fmi2GetRealTYPE *GetReal;
     fmi2DoStepTYPE *DoStep;
     fmi2TerminateTYPE *Terminate;
@@ -110,7 +121,18 @@ static const fmi2CallbackFunctions callbacks2 = {logger2, calloc, free, NULL, NU
 
 static void *instantiate2(const char *name, const char *token)
 {
-    return f2.Instantiate(name, fmi2CoSimulation, token, "", &callbacks2, fmi2False, fmi2True);
+    char uri[4096 + 16] = "file://";
+    size_t at = strlen(uri), i;
+    for (i = 0; resources != NULL && resources[i] != '\0' && at + 4 < sizeof uri; i++) {
+        if (resources[i] == '%' || resources[i] == ' ') { /* the characters a URI must escape here */
+            at += (size_t)sprintf(uri + at, "%%%02X", (unsigned)(unsigned char)resources[i]);
+        } else {
+            uri[at++] = resources[i];
+        }
+    }
+    uri[at] = '\0';
+    return f2.Instantiate(name, fmi2CoSimulation, token, resources != NULL ? uri : "", &callbacks2, fmi2False,
+                          fmi2True);
 }
 
 static int initialize2(void *instance)
@@ -127,6 +149,27 @@ static int set2(void *instance, const unsigned int vr[], size_t n, const double 
 static int set_integer2(void *instance, const unsigned int vr[], size_t n, const int values[])
 {
     return f2.SetInteger(instance, vr, n, values) == fmi2OK;
+}
+
+static int set_boolean2(void *instance, const unsigned int vr[], size_t n, const int values[])
+{
+    return f2.SetBoolean(instance, vr, n, values) == fmi2OK;
+}
+
+static int set_string2(void *instance, const unsigned int vr[], size_t n, char *const values[])
+{
+    fmi2String read[MAX_SIGNALS];
+    size_t i;
+    if (f2.SetString(instance, vr, n, (const fmi2String *)values) != fmi2OK ||
+        f2.GetString(instance, vr, n, read) != fmi2OK) {
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        if (read[i] == NULL || read[i] == values[i] || strcmp(read[i], values[i]) != 0) { /* a copy, equal */
+            return 0;
+        }
+    }
+    return 1;
 }
 
 static int get2(void *instance, const unsigned int vr[], size_t n, double values[])
@@ -176,13 +219,15 @@ static int exit_initialization2(void *instance)
 
 static int load2(Host *host)
 {
-    static const Host fmi2 = {instantiate2, initialize2, set2, set_integer2, get2, step2, store2, restore2, release2, finish2};
+    static const Host fmi2 = {instantiate2, initialize2, set2, set_integer2, set_boolean2, set_string2, get2, step2,
+                              store2, restore2, release2, finish2};
     *host = fmi2;
     return load("fmi2Instantiate", &f2.Instantiate) && load("fmi2FreeInstance", &f2.FreeInstance) &&
            load("fmi2SetupExperiment", &f2.SetupExperiment) &&
            load("fmi2EnterInitializationMode", &f2.EnterInitializationMode) &&
            load("fmi2ExitInitializationMode", &f2.ExitInitializationMode) && load("fmi2SetReal", &f2.SetReal) &&
-           load("fmi2SetInteger", &f2.SetInteger) &&
+           load("fmi2SetInteger", &f2.SetInteger) && load("fmi2SetBoolean", &f2.SetBoolean) &&
+           load("fmi2SetString", &f2.SetString) && load("fmi2GetString", &f2.GetString) &&
            load("fmi2GetReal", &f2.GetReal) && load("fmi2DoStep", &f2.DoStep) && load("fmi2Terminate", &f2.Terminate) &&
            load("fmi2GetFMUstate", &f2.GetFMUstate) && load("fmi2SetFMUstate", &f2.SetFMUstate) &&
            load("fmi2FreeFMUstate", &f2.FreeFMUstate) &&
@@ -199,6 +244,9 @@ static struct {
     fmi3ExitInitializationModeTYPE *ExitInitializationMode;
     fmi3SetFloat64TYPE *SetFloat64;
     fmi3SetInt32TYPE *SetInt32;
+    fmi3SetBooleanTYPE *SetBoolean;
+    fmi3SetStringTYPE *SetString;
+    fmi3GetStringTYPE *GetString;
     fmi3GetFloat64TYPE *GetFloat64;
     fmi3DoStepTYPE *DoStep;
     fmi3TerminateTYPE *Terminate;
@@ -219,7 +267,7 @@ static void logger3(fmi3InstanceEnvironment environment, fmi3Status status, fmi3
 
 static void *instantiate3(const char *name, const char *token)
 {
-    return f3.InstantiateCoSimulation(name, token, "", fmi3False, fmi3True, fmi3False, fmi3False, NULL, 0, NULL,
+    return f3.InstantiateCoSimulation(name, token, resources, fmi3False, fmi3True, fmi3False, fmi3False, NULL, 0, NULL,
                                       logger3, NULL);
 }
 
@@ -236,6 +284,32 @@ static int set3(void *instance, const unsigned int vr[], size_t n, const double 
 static int set_integer3(void *instance, const unsigned int vr[], size_t n, const int values[])
 {
     return f3.SetInt32(instance, vr, n, values, n) == fmi3OK;
+}
+
+static int set_boolean3(void *instance, const unsigned int vr[], size_t n, const int values[])
+{
+    fmi3Boolean truth[MAX_SIGNALS];
+    size_t i;
+    for (i = 0; i < n; i++) {
+        truth[i] = values[i] != 0;
+    }
+    return f3.SetBoolean(instance, vr, n, truth, n) == fmi3OK;
+}
+
+static int set_string3(void *instance, const unsigned int vr[], size_t n, char *const values[])
+{
+    fmi3String read[MAX_SIGNALS];
+    size_t i;
+    if (f3.SetString(instance, vr, n, (const fmi3String *)values, n) != fmi3OK ||
+        f3.GetString(instance, vr, n, read, n) != fmi3OK) {
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        if (read[i] == NULL || read[i] == values[i] || strcmp(read[i], values[i]) != 0) { /* a copy, equal */
+            return 0;
+        }
+    }
+    return 1;
 }
 
 static int get3(void *instance, const unsigned int vr[], size_t n, double values[])
@@ -291,13 +365,15 @@ static int exit_initialization3(void *instance)
 
 static int load3(Host *host)
 {
-    static const Host fmi3 = {instantiate3, initialize3, set3, set_integer3, get3, step3, store3, restore3, release3, finish3};
+    static const Host fmi3 = {instantiate3, initialize3, set3, set_integer3, set_boolean3, set_string3, get3, step3,
+                              store3, restore3, release3, finish3};
     *host = fmi3;
     return load("fmi3InstantiateCoSimulation", &f3.InstantiateCoSimulation) &&
            load("fmi3FreeInstance", &f3.FreeInstance) &&
            load("fmi3EnterInitializationMode", &f3.EnterInitializationMode) &&
            load("fmi3ExitInitializationMode", &f3.ExitInitializationMode) && load("fmi3SetFloat64", &f3.SetFloat64) &&
-           load("fmi3SetInt32", &f3.SetInt32) &&
+           load("fmi3SetInt32", &f3.SetInt32) && load("fmi3SetBoolean", &f3.SetBoolean) &&
+           load("fmi3SetString", &f3.SetString) && load("fmi3GetString", &f3.GetString) &&
            load("fmi3GetFloat64", &f3.GetFloat64) && load("fmi3DoStep", &f3.DoStep) &&
            load("fmi3Terminate", &f3.Terminate) && load("fmi3GetFMUState", &f3.GetFMUState) &&
            load("fmi3SetFMUState", &f3.SetFMUState) && load("fmi3FreeFMUState", &f3.FreeFMUState) &&
@@ -331,6 +407,16 @@ static int read_scenario(const char *path, Scenario *s)
     for (i = 0; ok && i < s->integers; i++) {
         ok = fscanf(file, "%u %d", &s->integer_vr[i], &s->integer[i]) == 2;
     }
+    ok = ok && fscanf(file, " booleans %d", &s->booleans) == 1 && s->booleans >= 0 && s->booleans <= MAX_SIGNALS;
+    for (i = 0; ok && i < s->booleans; i++) {
+        ok = fscanf(file, "%u %d", &s->boolean_vr[i], &s->boolean[i]) == 2;
+    }
+    ok = ok && fscanf(file, " strings %d", &s->strings) == 1 && s->strings >= 0 && s->strings <= MAX_SIGNALS;
+    for (i = 0; ok && i < s->strings; i++) {
+        s->string[i] = malloc(MAX_TEXT);
+        ok = s->string[i] != NULL && fscanf(file, "%u %4095s", &s->string_vr[i], s->string[i]) == 2;
+    }
+    ok = ok && fscanf(file, " tolerance %lf", &s->tolerance) == 1;
     ok = ok && fscanf(file, " steps %d %lf", &s->steps, &s->step_size) == 2 && s->steps > 1 && s->steps < 1000000;
     if (ok) {
         s->time = malloc(sizeof(double) * (size_t)(s->steps + 1));
@@ -381,10 +467,14 @@ int main(int argc, char **argv)
     double *outputs, *replay, deviation = 0.0, before[MAX_SIGNALS], after[MAX_SIGNALS], bad = NAN;
     int half, i, k, failed = 0, logged;
     memset(&s, 0, sizeof s);
-    if (argc != 5 || (strcmp(argv[2], "2") != 0 && strcmp(argv[2], "3") != 0)) {
-        return fail("usage: native_host LIBRARY 2|3 TOKEN SCENARIO");
+    if (argc < 5 || argc > 6 || (strcmp(argv[2], "2") != 0 && strcmp(argv[2], "3") != 0)) {
+        return fail("usage: native_host LIBRARY 2|3 TOKEN SCENARIO [RESOURCES]");
     }
+    resources = argc == 6 ? argv[5] : NULL;
     if (!read_scenario(argv[4], &s)) {
+        for (i = 0; i < MAX_SIGNALS; i++) {
+            free(s.string[i]);
+        }
         return fail("unreadable scenario");
     }
     library = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
@@ -401,6 +491,10 @@ int main(int argc, char **argv)
         !host.set(b, s.parameter_vr, (size_t)s.parameters, s.parameter) ||
         !host.set_integer(a, s.integer_vr, (size_t)s.integers, s.integer) ||
         !host.set_integer(b, s.integer_vr, (size_t)s.integers, s.integer) ||
+        !host.set_boolean(a, s.boolean_vr, (size_t)s.booleans, s.boolean) ||
+        !host.set_boolean(b, s.boolean_vr, (size_t)s.booleans, s.boolean) ||
+        !host.set_string(a, s.string_vr, (size_t)s.strings, s.string) ||
+        !host.set_string(b, s.string_vr, (size_t)s.strings, s.string) ||
         !(argv[2][0] == '2' ? exit_initialization2(a) && exit_initialization2(b)
                             : exit_initialization3(a) && exit_initialization3(b)) ||
         !host.get(a, s.output_vr, (size_t)s.outputs, outputs)) {
@@ -441,7 +535,10 @@ int main(int argc, char **argv)
     free(s.time);
     free(s.input);
     free(s.expected);
+    for (i = 0; i < MAX_SIGNALS; i++) {
+        free(s.string[i]);
+    }
     printf("steps %d, outputs %d, largest relative deviation %.3g, checks %s\n", s.steps, s.outputs, deviation,
            failed ? "failed" : "passed");
-    return failed || !(deviation <= TOLERANCE);
+    return failed || !(deviation <= s.tolerance);
 }

@@ -32,16 +32,28 @@ VERSIONS = ("2", "3")
 # Both sides evaluate the same formulas in float64, but numpy's and libm's sin, cos, atan2 may
 # differ in the last bit: outputs must agree within this fraction of each signal's largest magnitude.
 TOLERANCE = 1e-12
+# The critical speeds come from root searches that stop within a tolerance of their own.
+SIGNAL_TOLERANCE = {"omega_crit_1": 1e-10, "omega_crit_2": 1e-10, "omega_crit_3": 1e-10}
 
 
 def _native(native_dir: Path, name: str, fmi: str) -> Path:
     return native.fmu_path(native_dir, name, fmi)
 
 
+def _deviations(reference: np.ndarray, other: np.ndarray) -> dict[str, float]:
+    """Largest difference of each output, relative to that output's largest magnitude."""
+    return {n: float(np.abs(reference[n] - other[n]).max() / (np.abs(reference[n]).max() or 1.0))
+            for n in reference.dtype.names}
+
+
 def _deviation(reference: np.ndarray, other: np.ndarray) -> float:
     """Largest difference of any output, relative to that output's largest magnitude."""
-    return max(float(np.abs(reference[n] - other[n]).max() / (np.abs(reference[n]).max() or 1.0))
-               for n in reference.dtype.names)
+    return max(_deviations(reference, other).values())
+
+
+def _beyond_tolerance(reference: np.ndarray, other: np.ndarray) -> dict[str, float]:
+    """The outputs that differ by more than their tolerance (:data:`SIGNAL_TOLERANCE`, else TOLERANCE)."""
+    return {n: d for n, d in _deviations(reference, other).items() if not d <= SIGNAL_TOLERANCE.get(n, TOLERANCE)}
 
 
 def _standard_run(path: Path, name: str, **open_options) -> np.ndarray:
@@ -52,7 +64,13 @@ def _standard_run(path: Path, name: str, **open_options) -> np.ndarray:
 
 
 def test_the_models_without_a_c_port_are_skipped(native_dir):
-    assert NATIVE == [name for name in ("TripodCoupling", "CardanJoint", "UniversalReducer", "SpeedSource") if name in MODELS]
+    """CriticalSpeeds is native once its rotor library (every module rotor.h lists) is there."""
+    ported = ("TripodCoupling", "CardanJoint", "UniversalReducer", "SpeedSource")
+    assert native.library_modules("CriticalSpeeds") == sorted(
+        ["layout.c", "pyrepr.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c", "damped.c"])
+    complete = all((native.library_folder("CriticalSpeeds") / module).exists()
+                   for module in native.library_modules("CriticalSpeeds"))
+    assert NATIVE == [name for name in MODELS if name in ported or (name == "CriticalSpeeds" and complete)]
     built = {path.relative_to(native_dir).as_posix() for path in native_dir.rglob("*.fmu")}
     assert built == {f"{native.SUBDIR[fmi]}/{name}.fmu" for name in NATIVE for fmi in VERSIONS}
 
@@ -83,10 +101,14 @@ def _fields(item: object) -> dict:
     return {slot: getattr(item, slot) for slot in type(item).__slots__ if slot != "__weakref__"} if item else {}
 
 
-def _value(text: str | None) -> float | None:
+def _value(text: str | None) -> float | str | None:
     """A start, min or max as written: "0" and "0.0" are one value, and pythonfmu writes starts
-    with 16 significant digits where the native description has the spec's repr (17 at most)."""
-    return None if text is None else float(f"{float(text):.15g}")
+    with 16 significant digits where the native description has the spec's repr (17 at most);
+    a String's or Boolean's start as it is."""
+    try:
+        return None if text is None else float(f"{float(text):.15g}")
+    except ValueError:
+        return text
 
 
 def _described(path: Path) -> dict:
@@ -121,7 +143,7 @@ def test_description_is_the_python_fmus(native_dir, fmu_path, name, fmi):
 
 @pytest.mark.parametrize("name", NATIVE)
 def test_standard_scenario_matches_the_python_fmu(native_dir, fmu_path, name, fmi):
-    assert _deviation(_standard_run(fmu_path(name, fmi), name), _standard_run(_native(native_dir, name, fmi), name)) <= TOLERANCE
+    assert _beyond_tolerance(_standard_run(fmu_path(name, fmi), name), _standard_run(_native(native_dir, name, fmi), name)) == {}
 
 
 MODES = {  # parameters of the modes the standard scenario (spec start values) leaves out
@@ -153,18 +175,25 @@ def test_every_mode_matches_the_python_fmu(native_dir, fmu_path, name, parameter
 
 
 @pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")
-def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
-    """A state stored half way through an exact run with friction, restored from its bytes into an
-    instance whose solver was warm-started elsewhere, continues bit for bit."""
-    path, parameters = _native(native_dir, "TripodCoupling", fmi), {"kinematics": 1, "mu": 0.05}
-    case = scenario(MODELS["TripodCoupling"].spec)
+def _half_way_state(path: Path, parameters: dict) -> tuple[float, bytes, np.ndarray]:
+    """The standard scenario with ``parameters``: the time and serialized state half way, and the
+    second half run on from there."""
+    case = scenario(MODELS[read_model_description(str(path)).modelName].spec)
     with FmuInstance(path) as fmu:
         fmu.initialize({**parameters, **case.input_values(0.0)})
         fmu.run(case.stop_time / 2, case.step_size, case.signals())
         middle, state = fmu.time, fmu.get_state()
         serialized = fmu.serialize_state(state)
         fmu.free_state(state)
-        reference = fmu.run(case.stop_time, case.step_size, case.signals())
+        return middle, serialized, fmu.run(case.stop_time, case.step_size, case.signals())
+
+
+def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
+    """A state stored half way through an exact run with friction, restored from its bytes into an
+    instance whose solver was warm-started elsewhere, continues bit for bit."""
+    path, parameters = _native(native_dir, "TripodCoupling", fmi), {"kinematics": 1, "mu": 0.05}
+    case = scenario(MODELS["TripodCoupling"].spec)
+    middle, serialized, reference = _half_way_state(path, parameters)
     with FmuInstance(path) as other:
         other.initialize({**parameters, "beta": 0.2, "phi_in_start": 1.0})
         other.run(case.stop_time / 3, case.step_size)
@@ -440,3 +469,177 @@ def test_instances_are_independent(open_native, name, fmi):
 @pytest.mark.parametrize("name", NATIVE)
 def test_reset_returns_to_the_start_values(open_native, name, fmi):
     behaviour.test_reset_returns_to_the_start_values(name, fmi, open_native)
+
+
+# -- CriticalSpeeds: String and Boolean parameters, shipped resources, the analysis ------------------------
+# Parametrized by the model's name, so that they count as slow (tests/conftest.py) and are left
+# out, with nothing to run, while the rotor library is incomplete.
+
+CRITICAL = [name for name in NATIVE if name == "CriticalSpeeds"]
+SHIPPED_LAYOUTS = ("two_piece_propshaft", "two_piece_propshaft_hinged")
+
+
+def _ramp(t: float) -> float:
+    return 1450.0 * t
+
+
+def _critical_run(path: Path, parameters: dict, changes: dict | None = None, ramp: bool = False) -> np.ndarray:
+    """The standard scenario (or a speed ramp to 1450 rad/s) with ``parameters``; ``changes`` set half way."""
+    case = scenario(MODELS["CriticalSpeeds"].spec)
+    signals = {"omega": _ramp} if ramp else case.signals()
+    with FmuInstance(path) as fmu:
+        fmu.initialize({**parameters, **({"omega": 0.0} if ramp else case.input_values(0.0))})
+        first = fmu.run(case.stop_time / 2, case.step_size, signals)
+        fmu.set(changes or {})
+        second = fmu.run(case.stop_time, case.step_size, signals)
+    return np.concatenate([first, second[1:]])
+
+
+def _layout_file(folder: Path) -> Path:
+    """A layout of the test's own: the shipped two-piece shaft with a longer rear tube, in a folder
+    whose name needs escaping in a URI."""
+    text = MODELS["CriticalSpeeds"].resource_files[0].read_text()
+    target = folder / "own layouts" / "longer rear tube.toml"
+    target.parent.mkdir()
+    target.write_text(text.replace("length = 0.80", "length = 0.95", 1))
+    return target
+
+
+CRITICAL_MODES = [
+    *({"layout": name} for name in SHIPPED_LAYOUTS),
+    {"shear": False},
+    {"orders": "2, 3", "band": 0.3, "c_bearing": 2000.0},
+]
+
+
+@pytest.mark.parametrize("name", CRITICAL)
+@pytest.mark.parametrize("parameters", CRITICAL_MODES, ids=lambda p: ",".join(f"{k}={v}" for k, v in p.items()))
+def test_critical_speeds_modes_match_the_python_fmu(native_dir, fmu_path, name, parameters, fmi):
+    """Each shipped layout (found in the resources folder), the Rayleigh beam (shear false), other
+    orders and damping: the standard scenario as the Python FMU's."""
+    reference = _critical_run(fmu_path(name, fmi), parameters)
+    assert _beyond_tolerance(reference, _critical_run(_native(native_dir, name, fmi), parameters)) == {}
+
+
+@pytest.mark.parametrize("name", CRITICAL)
+def test_critical_speeds_layout_file_orders_change_and_ramp_match_the_python_fmu(native_dir, fmu_path, tmp_path, name,
+                                                                                  fmi):
+    """A layout file the test writes, orders changed mid-run (re-analysed at the next step), a speed
+    ramp through the resonances."""
+    layout = str(_layout_file(tmp_path))
+    for parameters, changes, ramp in (({"layout": layout}, {"orders": "1,2,3,6"}, False),
+                                      ({}, {"orders": "1,2,3,6", "shear": False}, True),
+                                      ({"layout": "two_piece_propshaft"}, {"layout": layout}, True)):
+        reference = _critical_run(fmu_path(name, fmi), parameters, changes, ramp)
+        native_run = _critical_run(_native(native_dir, name, fmi), parameters, changes, ramp)
+        assert _beyond_tolerance(reference, native_run) == {}, (parameters, changes, ramp)
+
+
+def _refusals(path: Path, parameters: dict) -> list[str]:
+    with FmuInstance(path) as fmu:
+        fmu.initialize(parameters)
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1e-3)
+    return refused.value.messages
+
+
+@pytest.mark.parametrize("name", CRITICAL)
+def test_critical_speeds_refuses_like_the_python_fmu(native_dir, fmu_path, tmp_path, name, fmi):
+    """Bad orders, bad layout values and files, the work limit, the plausibility check: refused with
+    the Python FMU's words."""
+    (tmp_path / "folder.toml").mkdir()
+    (tmp_path / "garbage.toml").write_text("[[segments]\nlength = = 1\n")
+    (tmp_path / "empty.toml").write_text("")
+    cases = [
+        {"orders": "1,x"}, {"orders": "0"}, {"orders": ""}, {"orders": "1, 2,,3"}, {"orders": ",".join(["1"] * 17)},
+        {"orders": "99999999999999999999"}, {"orders": "\u00e9" * 30}, {"orders": "\u0661"}, {"orders": "\u00a02 , 101"},
+        {"layout": "no_such_example"}, {"layout": "../../../etc/passwd"}, {"layout": "x" * 300 + ".toml"},
+        {"layout": str(tmp_path / "missing.toml")}, {"layout": str(tmp_path / "folder.toml")},
+        {"layout": str(tmp_path / "garbage.toml")}, {"layout": str(tmp_path / "empty.toml")},
+        {"L_shaft": 100.0}, {"omega_max": 1e300}, {"density": 1e308}, {"E": 1e-300}, {"E": 1e180},
+        {"D_outer": 1e200, "D_inner": 0.0}, {"orders": "1,2", "D_outer": 1e-100, "D_inner": 0.0},
+    ]
+    for parameters in cases:
+        expected = _refusals(fmu_path(name, fmi), parameters)
+        assert _refusals(_native(native_dir, name, fmi), parameters) == expected, parameters
+
+
+@pytest.mark.parametrize("name", CRITICAL)
+def test_critical_speeds_strings_are_part_of_the_state(native_dir, name, fmi):
+    """A state saved with other strings, serialized and restored into another instance, brings
+    them back and continues bit for bit (the analysis is rebuilt for the restored parameters)."""
+    path, case = _native(native_dir, name, fmi), scenario(MODELS[name].spec)
+    middle, serialized, reference = _half_way_state(path, {"layout": "two_piece_propshaft", "orders": "1,2,6",
+                                                           "shear": False})
+    with FmuInstance(path) as other:
+        other.initialize({"orders": "3"})
+        other.run(case.stop_time / 4, case.step_size)
+        restored = other.deserialize_state(serialized)
+        other.set_state(restored)
+        other.free_state(restored)
+        assert other.get(["layout", "orders", "shear"]) == ["two_piece_propshaft", "1,2,6", False]
+        other.time = middle
+        assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
+
+
+@pytest.mark.parametrize("name", CRITICAL)
+def test_critical_speeds_state_with_a_bad_string_length_is_refused(native_dir, name, fmi):
+    """Serialized bytes whose string length runs beyond the bytes (checksum made right) are refused
+    without reading beyond them."""
+    with FmuInstance(_native(native_dir, name, fmi)) as fmu:
+        fmu.initialize({"orders": "1,2"})
+        state = fmu.get_state()
+        serialized = bytearray(fmu.serialize_state(state))
+        fmu.free_state(state)
+        # the last string (orders, "1,2") sits just before the checksum: its length word before it
+        at = len(serialized) - 8 - 3 - 4
+        assert int.from_bytes(serialized[at:at + 4], "little") == 3
+        for length in (4, 2**31, 2**32 - 1):
+            corrupt = serialized.copy()
+            corrupt[at:at + 4] = length.to_bytes(4, "little")
+            checksum = 14695981039346656037
+            for byte in corrupt[:-8]:
+                checksum = ((checksum ^ byte) * 1099511628211) % 2**64
+            corrupt[-8:] = checksum.to_bytes(8, "little")
+            assert _error(fmu.deserialize_state, bytes(corrupt)) == 3
+            assert "impossible values" in fmu.log[-1].message
+            fmu.reset()
+
+
+@pytest.mark.parametrize("name", CRITICAL)
+def test_critical_speeds_string_limit_and_lifetime(native_dir, name, fmi):
+    """A layout of 10^5 characters is refused by the set itself (Error, model_adapter's limit and
+    wording); a string read stays valid and is the FMU's own copy."""
+    path = _native(native_dir, name, fmi)
+    with FmuInstance(path) as fmu:
+        fmu.initialize()
+        assert _error(fmu.fmu.setString, [fmu.variables["layout"].valueReference], ["1," * 50000]) == 3
+        assert fmu.log[-1].message.endswith("layout is 100000 characters long (at most 4096)")
+        fmu.reset()
+        fmu.initialize({"orders": "1," * 2047 + "2"})  # 4096 characters: accepted, refused by the analysis
+        with pytest.raises(StepRefused, match="more than 16 orders"):
+            fmu.step(1e-3)
+        fmu.set({"orders": "2,3"})
+        first = fmu.get(["orders"])
+        fmu.step(1e-3)
+        assert first == fmu.get(["orders"]) == ["2,3"]
+
+
+@pytest.mark.parametrize("name", CRITICAL)
+def test_critical_speeds_without_resources_refuses_a_shipped_name(native_dir, tmp_path, name, fmi):
+    """The resources folder is found where the FMU was extracted, in a folder whose URI needs
+    percent-escapes; without it a shipped name is not found, with the loader's words, and the
+    one-piece tube needs none."""
+    path = _native(native_dir, name, fmi)
+    unzipdir = Path(extract(str(path), unzipdir=str(tmp_path / "an FMU's folder %41 #1")))
+    with FmuInstance(path, unzipdir=str(unzipdir)) as fmu:
+        fmu.initialize({"layout": "two_piece_propshaft_hinged"})
+        fmu.step(1e-3)
+    shutil.rmtree(unzipdir / "resources")
+    with FmuInstance(path, unzipdir=str(unzipdir)) as fmu:
+        fmu.initialize({"layout": "two_piece_propshaft"})
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1e-3)
+        assert refused.value.messages == ["driveline: no shipped example named 'two_piece_propshaft'"]
+        fmu.set({"layout": ""})
+        fmu.step(1e-3)

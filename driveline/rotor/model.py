@@ -174,6 +174,8 @@ class CriticalSpeedsModel(SteppedModel):
 
     spec = SPEC
     derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts", "_unbalance")
+    resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
+                           for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None

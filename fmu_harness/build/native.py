@@ -1,7 +1,9 @@
 """Native (C) co-simulation FMUs, FMI 2.0 and 3.0, generated from the same specs as the Python FMUs.
 
-A model is native when ``fmu_src/native/<model_in_snake_case>.c`` ports its physics; the
-others are skipped. For each native model and FMI version this module
+A model is native when ``fmu_src/native/<model_in_snake_case>.c`` ports its physics and, if it
+has a library folder ``fmu_src/native/<model_in_snake_case>/``, every module the folder's headers
+list is there (:func:`library_modules`); the others are skipped. For each native model and FMI
+version this module
 
 * generates ``model_variables.h``/``.c`` from the spec: the variable table (value reference =
   position in the spec, as in the Python FMUs) and the range checks' messages, cut from
@@ -12,7 +14,9 @@ others are skipped. For each native model and FMI version this module
   host can swap one FMU for the other, plus the sources the FMU carries (FMI 2.0 ``SourceFiles``,
   FMI 3.0 ``sources/buildDescription.xml``);
 * compiles the shared library with the machine's C compiler (``cc``, or ``$CC``) and the FMI
-  headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU.
+  headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its sources
+  (the library folder's as ``<folder>/<file>``) and the resource files its model class declares
+  (``SteppedModel.resource_files``, into ``resources/``).
 
 FMI 2.0 FMUs land in ``<dest>/native/``, FMI 3.0 ones in ``<dest>/native/fmi3/``.
 """
@@ -61,9 +65,32 @@ def model_source(name: str) -> Path:
     return MODEL_SOURCES / f"{snake_case(name)}.c"
 
 
+def library_folder(name: str) -> Path:
+    """The folder of a model's C library (its modules and headers), if it has one."""
+    return MODEL_SOURCES / snake_case(name)
+
+
+_MODULE_LINE = re.compile(r"^\s*\*\s+(\w+\.c)\s", re.MULTILINE)
+
+
+def library_modules(name: str) -> list[str]:
+    """The modules of a model's library folder, as its headers list them: a comment line
+    `` *   transfer.c   what it holds`` per module (rotor.h). None for a model without a folder."""
+    folder = library_folder(name)
+    return sorted({module for header in folder.glob("*.h") for module in _MODULE_LINE.findall(header.read_text())})
+
+
+def has_c_port(name: str) -> bool:
+    """The model file exists and, with a library folder, every module its headers list."""
+    if not model_source(name).exists():
+        return False
+    folder = library_folder(name)
+    return not folder.is_dir() or all((folder / module).is_file() for module in library_modules(name))
+
+
 def native_models() -> list[str]:
-    """The catalog models with a C port, in catalog order."""
-    return [name for name in MODELS if model_source(name).exists()]
+    """The catalog models with a (complete) C port, in catalog order."""
+    return [name for name in MODELS if has_c_port(name)]
 
 
 def fmu_path(dest: Path, name: str, fmi: str = "2") -> Path:
@@ -155,8 +182,17 @@ def _display(variable: Variable) -> tuple[float, float]:
 
 
 def _table_entry(variable: Variable) -> str:
+    if variable.type in ("Boolean", "String"):  # no bounds: only a start value
+        start = "NULL" if variable.type == "Boolean" else _c_string(variable.start)
+        number = float(bool(variable.start)) if variable.type == "Boolean" else 0.0
+        return (
+            f"    {{{_c_string(variable.name)}, VAR_{variable.type.upper()}, CAUSALITY_{variable.causality.upper()}, "
+            f"{int(variable.effective_variability == 'tunable')}, {_c_double(number)},\n"
+            f"     0, 0, 0, 0, 0.0, 0.0, 1.0, 0.0,\n     {_NO_MESSAGE},\n     {_NO_MESSAGE},\n     {_NO_MESSAGE},\n"
+            f"     {start}}},"
+        )
     if variable.type not in ("Real", "Integer"):
-        raise ValueError(f"{variable.name}: the native FMUs hold Real and Integer variables only")
+        raise ValueError(f"{variable.name}: the native FMUs hold Real, Integer, Boolean and String variables only")
     below = (lambda x: x - 1) if variable.type == "Integer" else (lambda x: math.nextafter(x, -math.inf))
     above = (lambda x: x + 1) if variable.type == "Integer" else (lambda x: math.nextafter(x, math.inf))
     has_min, has_max = variable.min is not None, variable.max is not None
@@ -172,7 +208,7 @@ def _table_entry(variable: Variable) -> str:
         f"{int(variable.effective_variability == 'tunable')}, {_c_double(float(variable.start))},\n"
         f"     {int(has_min)}, {int(has_max)}, {int(variable.min_exclusive)}, {int(variable.max_exclusive)}, "
         f"{_c_double(variable.min if has_min else 0.0)}, {_c_double(variable.max if has_max else 0.0)}, "
-        f"{_c_double(factor)}, {_c_double(offset)},\n     " + ",\n     ".join(messages) + "},"
+        f"{_c_double(factor)}, {_c_double(offset)},\n     " + ",\n     ".join(messages) + ",\n     NULL},"
     )
 
 
@@ -228,6 +264,7 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_NAME {_c_string(spec.name)}
 #define MODEL_TOKEN {_c_string(token)}
 #define MODEL_VARIABLE_COUNT {len(spec.variables)}
+#define MODEL_STRING_COUNT {sum(v.type == "String" for v in spec.variables)}
 #define MODEL_RELATION_COUNT {len(spec.relations)}
 #define MODEL_EXTRA_MESSAGE_COUNT {len(probes)}
 
@@ -269,8 +306,13 @@ const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT] = {{
 # -- model description ----------------------------------------------------------------------------
 
 
-def _number(value: float | int) -> str:
+def _number(value: float | int | bool | str) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
     return repr(float(value)) if isinstance(value, float) else str(value)
+
+
+_FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
 
 
 def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.Element:
@@ -308,8 +350,12 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
         attributes = {"name": v.name, "valueReference": str(reference), "causality": v.causality,
                       "variability": v.effective_variability}
         start = {} if v.causality == "output" else {"start": _number(v.start)}
-        if fmi3:
-            ET.SubElement(variables, "Float64" if v.type == "Real" else "Int32", {**attributes, **start})
+        if fmi3 and v.type == "String":  # FMI 3.0: a String's start is an element
+            element = ET.SubElement(variables, "String", attributes)
+            if start:
+                ET.SubElement(element, "Start", value=start["start"])
+        elif fmi3:
+            ET.SubElement(variables, _FMI3_TYPES[v.type], {**attributes, **start})
         else:
             ET.SubElement(ET.SubElement(variables, "ScalarVariable", attributes), v.type, start)
     if fmi3:
@@ -344,12 +390,28 @@ def compiler() -> str:
     return found
 
 
+def _library_sources(name: str) -> dict[str, bytes]:
+    """The model's library folder (``critical_speeds/rotor.h`` and the like), by relative path."""
+    folder = library_folder(name)
+    if not folder.is_dir():
+        return {}
+    return {f"{folder.name}/{path.name}": path.read_bytes() for path in sorted(folder.iterdir())
+            if path.suffix in (".c", ".h") and path.is_file()}
+
+
+def resource_files(name: str) -> dict[str, bytes]:
+    """The resource files the model class declares, by their name in the FMU's ``resources/``."""
+    return {Path(path).name: Path(path).read_bytes() for path in MODELS[name].resource_files}
+
+
 def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
     """Every source file the FMU carries, by name, with the token computed from all of them."""
     files = {source: (NATIVE_SRC / source).read_bytes() for source in (*SHARED_SOURCES, LAYER[fmi])}
     files[model_file.name] = model_file.read_bytes()
+    files.update(_library_sources(name))
     untokened = variable_table(MODELS[name], "")
-    digest = hashlib.sha256(repr((name, fmi, sorted(files.items()), sorted(untokened.items()))).encode())
+    digest = hashlib.sha256(repr((name, fmi, sorted(files.items()), sorted(untokened.items()),
+                                  sorted(resource_files(name).items()))).encode())
     token = str(uuid.uuid5(TOKEN_NAMESPACE, digest.hexdigest()))
     files.update({key: text.encode() for key, text in variable_table(MODELS[name], token).items()})
     files["token"] = token.encode()
@@ -371,6 +433,7 @@ def build(name: str, dest: Path, fmi: str = "2", model_file: Path | None = None)
         sources = Path(work) / "sources"
         sources.mkdir()
         for source, data in files.items():
+            (sources / source).parent.mkdir(parents=True, exist_ok=True)
             (sources / source).write_bytes(data)
         library = Path(work) / f"{name}.so"
         command = [compiler(), *CFLAGS, "-shared", "-I", str(sources), "-I", str(fmi_headers()),
@@ -382,6 +445,7 @@ def build(name: str, dest: Path, fmi: str = "2", model_file: Path | None = None)
             "modelDescription.xml": model_description(spec, fmi, token, compiled),
             f"binaries/{platform}/{name}.so": library.read_bytes(),
             **{f"sources/{source}": data for source, data in files.items()},
+            **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
         }
         if fmi == "3":
             members["sources/buildDescription.xml"] = build_description(name, compiled)
@@ -393,5 +457,5 @@ def build(name: str, dest: Path, fmi: str = "2", model_file: Path | None = None)
 
 def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] = ("2", "3")) -> list[Path]:
     """The native FMUs of ``names`` (default: every model with a C port) that have one."""
-    chosen = [name for name in (names or native_models()) if model_source(name).exists()]
+    chosen = [name for name in (names or native_models()) if has_c_port(name)]
     return [build(name, dest, version) for version in fmi for name in chosen]

@@ -48,4 +48,4 @@ static const char *evaluate(ModelData *data, double input_time)
 
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {reset_internal, NULL, start, advance, NULL, NULL};
+const ModelHooks model_hooks = {reset_internal, NULL, start, advance, NULL, NULL, NULL};

@@ -6,6 +6,7 @@
  * the host may correct its inputs and step again (fmi2Terminated stays false). Messages reach
  * the logger as data: its format argument is always "%s".
  */
+#include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
@@ -30,12 +31,13 @@ const char *fmi2GetVersion(void)
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
-                              fmi2String fmuResourceLocation UNUSED, const fmi2CallbackFunctions *functions,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
                               fmi2Boolean visible UNUSED, fmi2Boolean loggingOn UNUSED)
 {
     void (*logger)(void) = functions != NULL ? (void (*)(void))functions->logger : NULL;
     void *environment = functions != NULL ? functions->componentEnvironment : NULL;
-    /* fmuResourceLocation: these models need no resources */
+    char *resources;
+    Instance *instance;
     if (fmuType != fmi2CoSimulation) {
         if (logger != NULL) {
             ((fmi2CallbackLogger)logger)(environment, instanceName ? instanceName : "", fmi2Error, "logStatusError",
@@ -43,7 +45,11 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         }
         return NULL;
     }
-    return instance_new(instanceName, fmuGUID, "fmi2", emit, logger, environment);
+    /* a file URI gives the resources folder; NULL or another scheme: none */
+    resources = resource_folder_of_uri(fmuResourceLocation);
+    instance = instance_new(instanceName, fmuGUID, "fmi2", emit, logger, environment, resources);
+    free(resources);
+    return instance;
 }
 
 void fmi2FreeInstance(fmi2Component c)
@@ -90,11 +96,11 @@ ON_INSTANCE(fmi2, instance_get_real(instance, "GetReal", vr, nvr, value))
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[])
 ON_INSTANCE(fmi2, instance_get_integer(instance, "GetInteger", vr, nvr, value))
 
-fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[] UNUSED)
-ON_INSTANCE(fmi2, instance_no_variables_of(instance, "GetBoolean", vr, nvr, "Boolean", 0))
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[])
+ON_INSTANCE(fmi2, instance_get_boolean(instance, "GetBoolean", vr, nvr, value, sizeof(fmi2Boolean)))
 
-fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[] UNUSED)
-ON_INSTANCE(fmi2, instance_no_variables_of(instance, "GetString", vr, nvr, "String", 0))
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[])
+ON_INSTANCE(fmi2, instance_get_string(instance, "GetString", vr, nvr, value))
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[])
 ON_INSTANCE(fmi2, instance_set_real(instance, "SetReal", vr, nvr, value))
@@ -102,12 +108,11 @@ ON_INSTANCE(fmi2, instance_set_real(instance, "SetReal", vr, nvr, value))
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[])
 ON_INSTANCE(fmi2, instance_set_integer(instance, "SetInteger", vr, nvr, value))
 
-fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
-                          const fmi2Boolean value[] UNUSED)
-ON_INSTANCE(fmi2, instance_no_variables_of(instance, "SetBoolean", vr, nvr, "Boolean", 1))
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[])
+ON_INSTANCE(fmi2, instance_set_boolean(instance, "SetBoolean", vr, nvr, value, sizeof(fmi2Boolean)))
 
-fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[] UNUSED)
-ON_INSTANCE(fmi2, instance_no_variables_of(instance, "SetString", vr, nvr, "String", 1))
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[])
+ON_INSTANCE(fmi2, instance_set_string(instance, "SetString", vr, nvr, value))
 
 FMU_STATE_FUNCTIONS(fmi2, fmi2Component, FMUstate, DeSerialize)
 

@@ -55,7 +55,7 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName UNUSED, fmi3St
 }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
-                                         fmi3String resourcePath UNUSED, fmi3Boolean visible UNUSED,
+                                         fmi3String resourcePath, fmi3Boolean visible UNUSED,
                                          fmi3Boolean loggingOn UNUSED,
                                          fmi3Boolean eventModeUsed UNUSED, fmi3Boolean earlyReturnAllowed UNUSED,
                                          const fmi3ValueReference requiredIntermediateVariables[] UNUSED,
@@ -64,10 +64,10 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3LogMessageCallback logMessage,
                                          fmi3IntermediateUpdateCallback intermediateUpdate UNUSED)
 {
-    /* resourcePath: these models need no resources; eventModeUsed: they have no clocks or events;
-     * loggingOn: every message has status Error and is always logged */
+    /* resourcePath: the resources folder (a path; NULL: none); eventModeUsed: these models have no
+     * clocks or events; loggingOn: every message has status Error and is always logged */
     return instance_new(instanceName, instantiationToken, "fmi3", emit, (void (*)(void))logMessage,
-                        instanceEnvironment);
+                        instanceEnvironment, resourcePath);
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName UNUSED, fmi3String instantiationToken UNUSED,
@@ -157,8 +157,26 @@ NO_VARIABLES_OF(UInt16, fmi3UInt16)
 NO_VARIABLES_OF(UInt32, fmi3UInt32)
 NO_VARIABLES_OF(Int64, fmi3Int64)
 NO_VARIABLES_OF(UInt64, fmi3UInt64)
-NO_VARIABLES_OF(Boolean, fmi3Boolean)
-NO_VARIABLES_OF(String, fmi3String)
+
+fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[],
+                          size_t nValues)
+ON_INSTANCE(fmi3, counts_match(instance, "GetBoolean", nvr, nValues)
+                  ? instance_get_boolean(instance, "GetBoolean", vr, nvr, values, sizeof(fmi3Boolean)) : STATUS_ERROR)
+
+fmi3Status fmi3SetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[],
+                          size_t nValues)
+ON_INSTANCE(fmi3, counts_match(instance, "SetBoolean", nvr, nValues)
+                  ? instance_set_boolean(instance, "SetBoolean", vr, nvr, values, sizeof(fmi3Boolean)) : STATUS_ERROR)
+
+fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],
+                         size_t nValues)
+ON_INSTANCE(fmi3, counts_match(instance, "GetString", nvr, nValues)
+                  ? instance_get_string(instance, "GetString", vr, nvr, values) : STATUS_ERROR)
+
+fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3String values[],
+                         size_t nValues)
+ON_INSTANCE(fmi3, counts_match(instance, "SetString", nvr, nValues)
+                  ? instance_set_string(instance, "SetString", vr, nvr, values) : STATUS_ERROR)
 
 fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, size_t valueSizes[] UNUSED,
                          fmi3Binary values[] UNUSED, size_t nValues UNUSED)

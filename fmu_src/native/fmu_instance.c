@@ -180,8 +180,9 @@ static void add_message(Messages *out, const MessageTemplate *message, const Var
 
 static double value_of(const ModelData *data, int variable)
 {
-    return model_variables[variable].type == VAR_INTEGER ? (double)data->int_value[variable]
-                                                         : data->real_value[variable];
+    VariableType type = model_variables[variable].type;
+    return type == VAR_INTEGER || type == VAR_BOOLEAN ? (double)data->int_value[variable]
+                                                      : data->real_value[variable];
 }
 
 #if MODEL_EXTRA_MESSAGE_COUNT > 0
@@ -265,26 +266,21 @@ static void input_errors(const ModelData *data, Messages *out)
     }
 }
 
-typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_OVERFLOW, SUM_OPPOSITE_INFINITIES } SumOutcome;
-
-/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it):
- * exact partial sums (Shewchuk), an OverflowError when a partial sum of finite values
- * overflows, a ValueError when +inf and -inf meet, else a finite or non-finite sum. */
-static SumOutcome fsum_outcome(const double values[], int count)
+/* Python's math.fsum: exact partial sums (Shewchuk), rounded once; the text of Python's exception
+ * when a partial sum of finite values overflows (OverflowError) or +inf and -inf meet
+ * (ValueError), else NULL with the sum in ``*sum``. Each value adds at most one partial: exact for
+ * up to FSUM_VALUES values (the Real outputs, a layout's segments). */
+#define FSUM_VALUES 256
+const char *python_fsum(const double values[], int count, double *sum)
 {
-    double partials[MODEL_VARIABLE_COUNT + 1], special = 0.0, infinities = 0.0, magnitude = 0.0;
+    double partials[FSUM_VALUES], special = 0.0, infinities = 0.0, high = 0.0, low = 0.0, x, y;
     int used = 0, i, j;
     for (i = 0; i < count; i++) {
-        magnitude += fabs(values[i]);
-    }
-    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
-        return SUM_FINITE;
-    }
-    for (i = 0; i < count; i++) {
-        double x = values[i], original = values[i];
+        double original = values[i];
         int kept = 0;
+        x = original;
         for (j = 0; j < used; j++) {
-            double y = partials[j], high, low;
+            y = partials[j];
             if (fabs(x) < fabs(y)) {
                 double swap = x;
                 x = y;
@@ -301,22 +297,69 @@ static SumOutcome fsum_outcome(const double values[], int count)
         if (x != 0.0) {
             if (!isfinite(x)) {
                 if (isfinite(original)) {
-                    return SUM_OVERFLOW;
+                    return "intermediate overflow in fsum";
                 }
                 if (isinf(original)) {
                     infinities += original;
                 }
                 special += original;
                 used = 0;
-            } else {
+            } else if (used < (int)(sizeof partials / sizeof partials[0])) {
                 partials[used++] = x;
             }
         }
     }
     if (special != 0.0 || isnan(special)) {
-        return isnan(infinities) ? SUM_OPPOSITE_INFINITIES : SUM_NOT_FINITE;
+        if (isnan(infinities)) {
+            return "-inf + inf in fsum";
+        }
+        *sum = special;
+        return NULL;
     }
-    return SUM_FINITE;
+    high = 0.0;
+    if (used > 0) { /* add the partials from the top until the sum is inexact, then round half even */
+        high = partials[--used];
+        while (used > 0) {
+            x = high;
+            y = partials[--used];
+            high = x + y;
+            low = y - (high - x);
+            if (low != 0.0) {
+                break;
+            }
+        }
+        if (used > 0 && ((low < 0.0 && partials[used - 1] < 0.0) || (low > 0.0 && partials[used - 1] > 0.0))) {
+            y = low * 2.0;
+            x = high + y;
+            if (y == x - high) {
+                high = x;
+            }
+        }
+    }
+    *sum = high;
+    return NULL;
+}
+
+typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_OVERFLOW, SUM_OPPOSITE_INFINITIES } SumOutcome;
+
+/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it);
+ * exactly only where a partial sum could come near overflow. */
+static SumOutcome fsum_outcome(const double values[], int count)
+{
+    double magnitude = 0.0, sum = 0.0;
+    const char *failure;
+    int i;
+    for (i = 0; i < count; i++) {
+        magnitude += fabs(values[i]);
+    }
+    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
+        return SUM_FINITE;
+    }
+    failure = python_fsum(values, count, &sum);
+    if (failure != NULL) {
+        return failure[0] == 'i' ? SUM_OVERFLOW : SUM_OPPOSITE_INFINITIES;
+    }
+    return isfinite(sum) ? SUM_FINITE : SUM_NOT_FINITE;
 }
 
 /* SteppedModel.output_errors; an arithmetic failure of the sum itself becomes ``failure``. */
@@ -477,14 +520,72 @@ int instance_allows(Instance *instance, unsigned allowed, const char *function)
 
 /* ---- life cycle ------------------------------------------------------------------------------ */
 
-Status instance_reset(Instance *instance)
+/* A copy of ``text`` (``length`` bytes), or NULL without memory. */
+static char *copy_text(const char *text, size_t length)
+{
+    char *copy = malloc(length + 1);
+    if (copy != NULL) {
+        memcpy(copy, text, length);
+        copy[length] = '\0';
+    }
+    return copy;
+}
+
+static void free_strings(char *strings[MODEL_VARIABLE_COUNT])
 {
     int i;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        free(strings[i]);
+        strings[i] = NULL;
+    }
+}
+
+/* Copies of the String variables of ``from`` (their start values where ``from`` is NULL) into
+ * ``to``; 0 (nothing allocated) without memory. */
+static int copy_strings(char *const from[MODEL_VARIABLE_COUNT], char *to[MODEL_VARIABLE_COUNT])
+{
+    int i;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        to[i] = NULL;
+    }
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        const char *text = from != NULL ? from[i] : model_variables[i].start_string;
+        if (model_variables[i].type == VAR_STRING) {
+            to[i] = copy_text(text != NULL ? text : "", text != NULL ? strlen(text) : 0);
+            if (to[i] == NULL) {
+                free_strings(to);
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+/* Drops the model's derived data (rebuilt at the next check). */
+static void clear_cache(Instance *instance)
+{
+    if (instance->cache.derived != NULL && model_hooks.free_derived != NULL) {
+        model_hooks.free_derived(instance->cache.derived);
+    }
+    instance->cache.derived = NULL;
+}
+
+Status instance_reset(Instance *instance)
+{
+    char *strings[MODEL_VARIABLE_COUNT];
+    int i;
+    if (!copy_strings(NULL, strings)) {
+        return instance_fail(instance, instance->fmi_prefix, "Reset: out of memory", (const char *)NULL);
+    }
+    free_strings(instance->data.string_value);
+    clear_cache(instance);
     memset(&instance->data, 0, sizeof instance->data);
     for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
         instance->data.real_value[i] = model_variables[i].start;
         instance->data.int_value[i] = (int32_t)model_variables[i].start;
+        instance->data.string_value[i] = strings[i];
     }
+    instance->data.cache = &instance->cache;
     if (model_hooks.reset_internal != NULL) {
         model_hooks.reset_internal(&instance->data);
     }
@@ -548,7 +649,8 @@ Status instance_do_step(Instance *instance, double current_time, double step_siz
 
 static const char *type_name(VariableType type)
 {
-    return type == VAR_REAL ? "Real" : "Integer";
+    static const char *const names[] = {"Real", "Integer", "Boolean", "String"};
+    return names[type];
 }
 
 static int is_time(const Instance *instance, uint32_t reference)
@@ -568,7 +670,10 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
     } else if (v == NULL) {
         problem = " is unknown";
     } else if (v->type != type) {
-        problem = type == VAR_REAL ? " is not of type Real" : " is not of type Integer";
+        problem = type == VAR_REAL      ? " is not of type Real"
+                  : type == VAR_INTEGER ? " is not of type Integer"
+                  : type == VAR_BOOLEAN ? " is not of type Boolean"
+                                        : " is not of type String";
     } else if (setting && v->causality == CAUSALITY_OUTPUT) {
         problem = " is an output and cannot be set";
     } else if (setting && instance->mode == MODE_STEP && v->causality == CAUSALITY_PARAMETER && !v->tunable) {
@@ -656,6 +761,113 @@ Status instance_get_integer(Instance *instance, const char *function, const uint
     return STATUS_OK;
 }
 
+static int boolean_at(const void *values, size_t size, size_t i)
+{
+    const unsigned char *bytes = (const unsigned char *)values + i * size;
+    size_t k;
+    for (k = 0; k < size; k++) {
+        if (bytes[k] != 0) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+Status instance_set_boolean(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                            const void *value, size_t size)
+{
+    size_t i;
+    if (!all_accessible(instance, function, vr, n, value, VAR_BOOLEAN, 1)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        instance->data.int_value[vr[i]] = boolean_at(value, size, i);
+    }
+    return STATUS_OK;
+}
+
+Status instance_get_boolean(Instance *instance, const char *function, const uint32_t vr[], size_t n, void *value,
+                            size_t size)
+{
+    size_t i;
+    if (!all_accessible(instance, function, vr, n, value, VAR_BOOLEAN, 0)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        unsigned char *at = (unsigned char *)value + i * size;
+        int truth = instance->data.int_value[vr[i]] != 0;
+        if (size == sizeof(int)) {
+            memcpy(at, &truth, sizeof truth);
+        } else {
+            memset(at, 0, size);
+            at[0] = (unsigned char)truth;
+        }
+    }
+    return STATUS_OK;
+}
+
+/* Characters (code points, as Python's len()) of the UTF-8 ``text`` of ``length`` bytes. */
+static size_t characters(const char *text, size_t length)
+{
+    size_t count = 0, at;
+    for (at = 0; at < length; at++) {
+        count += ((unsigned char)text[at] & 0xC0u) != 0x80u;
+    }
+    return count;
+}
+
+Status instance_set_string(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                           const char *const value[])
+{
+    char *copies[MODEL_VARIABLE_COUNT] = {NULL};
+    char number[24], limit[24];
+    size_t i, count;
+    if (!all_accessible(instance, function, vr, n, value, VAR_STRING, 1)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        if (value[i] == NULL) {
+            return instance_fail(instance, instance->fmi_prefix, function, ": null string for ",
+                                 model_variables[vr[i]].name, (const char *)NULL);
+        }
+        count = characters(value[i], strlen(value[i]));
+        if (count > FMU_MAX_STRING) { /* model_adapter's refusal */
+            snprintf(number, sizeof number, "%lu", (unsigned long)count);
+            snprintf(limit, sizeof limit, "%d", FMU_MAX_STRING);
+            return instance_fail(instance, instance->fmi_prefix, function, ": ", model_variables[vr[i]].name, " is ",
+                                 number, " characters long (at most ", limit, ")", (const char *)NULL);
+        }
+    }
+    for (i = 0; i < n; i++) { /* all or nothing: a later copy may fail for memory */
+        free(copies[vr[i]]);
+        copies[vr[i]] = copy_text(value[i], strlen(value[i]));
+        if (copies[vr[i]] == NULL) {
+            free_strings(copies);
+            return instance_fail(instance, instance->fmi_prefix, function, ": out of memory", (const char *)NULL);
+        }
+    }
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (copies[i] != NULL) {
+            free(instance->data.string_value[i]);
+            instance->data.string_value[i] = copies[i];
+        }
+    }
+    return STATUS_OK;
+}
+
+Status instance_get_string(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                           const char *value[])
+{
+    size_t i;
+    if (!all_accessible(instance, function, vr, n, value, VAR_STRING, 0)) {
+        return STATUS_ERROR;
+    }
+    for (i = 0; i < n; i++) {
+        value[i] = instance->data.string_value[vr[i]];
+    }
+    return STATUS_OK;
+}
+
 Status instance_no_variables_of(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                                 const char *type, int setting)
 {
@@ -712,9 +924,10 @@ Status instance_unsupported(Instance *instance, const char *function)
 /* ---- FMU state ---------------------------------------------------------------------------- */
 
 #define STATE_TAG 0x4452564C53544154ull /* marks a live StoredState */
-#define STATE_FORMAT 2u /* 2: six internal slots (1 had four) */
+#define STATE_FORMAT 3u /* 3: String values (2: six internal slots; 1 had four) */
 static const char STATE_MAGIC[8] = {'D', 'R', 'V', 'L', 'S', 'T', 'A', 'T'};
 
+/* A stored state owns the copies of its strings; its ``data.cache`` is NULL. */
 struct StoredState {
     uint64_t tag;
     Mode mode;
@@ -748,36 +961,64 @@ static StoredState *state_slot(Instance *instance, const char *function, void *g
     return slot;
 }
 
+/* Stores ``data`` (whose strings become the state's) in ``slot``, dropping what it held. */
+static void store(StoredState *slot, Mode mode, double start_time, const ModelData *data)
+{
+    if (slot->tag == STATE_TAG) {
+        free_strings(slot->data.string_value);
+    }
+    slot->tag = STATE_TAG;
+    slot->mode = mode;
+    slot->start_time = start_time;
+    slot->data = *data;
+    slot->data.cache = NULL;
+}
+
 Status state_get(Instance *instance, const char *function, void **state)
 {
     StoredState *stored;
+    ModelData data;
     if (!instance_allows(instance, ANY_MODE & ~MODE_BIT(MODE_ERROR), function)) {
         return STATUS_ERROR;
     }
     if (state == NULL) {
         return instance_fail(instance, instance->fmi_prefix, function, ": null state pointer", (const char *)NULL);
     }
+    data = instance->data;
+    if (!copy_strings(instance->data.string_value, data.string_value)) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": out of memory", (const char *)NULL);
+    }
     stored = state_slot(instance, function, *state);
     if (stored == NULL) {
+        free_strings(data.string_value);
         return STATUS_ERROR;
     }
-    stored->tag = STATE_TAG;
-    stored->mode = instance->mode;
-    stored->start_time = instance->start_time;
-    stored->data = instance->data;
+    store(stored, instance->mode, instance->start_time, &data);
     *state = stored;
     return STATUS_OK;
 }
 
+/* The model's derived data stays: the model rebuilds it at the next check if the restored
+ * parameters differ from those it was built for. */
 Status state_set(Instance *instance, const char *function, const void *state)
 {
     const StoredState *stored = live_state(instance, function, state);
+    char *strings[MODEL_VARIABLE_COUNT];
+    int i;
     if (stored == NULL) {
         return STATUS_ERROR;
     }
+    if (!copy_strings(stored->data.string_value, strings)) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": out of memory", (const char *)NULL);
+    }
+    free_strings(instance->data.string_value);
     instance->mode = stored->mode;
     instance->start_time = stored->start_time;
     instance->data = stored->data;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        instance->data.string_value[i] = strings[i];
+    }
+    instance->data.cache = &instance->cache;
     return STATUS_OK;
 }
 
@@ -791,6 +1032,7 @@ Status state_free(Instance *instance, const char *function, void **state)
         return STATUS_ERROR;
     }
     stored = *state;
+    free_strings(stored->data.string_value);
     stored->tag = 0;
     free(stored);
     *state = NULL;
@@ -798,26 +1040,44 @@ Status state_free(Instance *instance, const char *function, void **state)
 }
 
 /* Serialized layout: magic, format, byte-order mark, token length and token, variable and slot
- * counts, mode, start time, time, initialized, Real values, Integer values, internal slots,
- * then an FNV-1a checksum of everything before it. */
+ * counts, mode, start time, time, initialized, Real values, Integer and Boolean values, internal
+ * slots, each String variable's length (uint32) and bytes in value reference order, then an
+ * FNV-1a checksum of everything before it. */
 static size_t token_length(void)
 {
     return strlen(MODEL_TOKEN);
 }
 
-static size_t state_serialized_size(void)
+/* The size of everything but the strings' lengths and bytes. */
+static size_t fixed_serialized_size(void)
 {
     return sizeof STATE_MAGIC + 5 * sizeof(uint32_t) + token_length() + 2 * sizeof(int32_t) + 2 * sizeof(double) +
            MODEL_VARIABLE_COUNT * (sizeof(double) + sizeof(int32_t)) + FMU_INTERNAL_SLOTS * sizeof(double) +
            sizeof(uint64_t);
 }
 
-Status state_size(Instance *instance, const char *function, size_t *size)
+static size_t state_serialized_size(const StoredState *stored)
 {
+    size_t size = fixed_serialized_size();
+    int i;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (model_variables[i].type == VAR_STRING) {
+            size += sizeof(uint32_t) + strlen(stored->data.string_value[i]);
+        }
+    }
+    return size;
+}
+
+Status state_size(Instance *instance, const char *function, const void *state, size_t *size)
+{
+    const StoredState *stored = live_state(instance, function, state);
+    if (stored == NULL) {
+        return STATUS_ERROR;
+    }
     if (size == NULL) {
         return instance_fail(instance, instance->fmi_prefix, function, ": null size pointer", (const char *)NULL);
     }
-    *size = state_serialized_size();
+    *size = state_serialized_size(stored);
     return STATUS_OK;
 }
 
@@ -861,13 +1121,14 @@ Status state_serialize(Instance *instance, const char *function, const void *sta
 {
     const StoredState *stored = live_state(instance, function, state);
     Cursor cursor = {NULL, NULL, 0};
-    uint32_t words[4], slots = FMU_INTERNAL_SLOTS;
+    uint32_t words[4], slots = FMU_INTERNAL_SLOTS, length;
     int32_t mode, initialized;
     uint64_t sum;
+    int i;
     if (stored == NULL) {
         return STATUS_ERROR;
     }
-    if (bytes == NULL || size < state_serialized_size()) {
+    if (bytes == NULL || size < state_serialized_size(stored)) {
         return instance_fail(instance, instance->fmi_prefix, function, ": the buffer is smaller than the state size",
                              (const char *)NULL);
     }
@@ -886,6 +1147,13 @@ Status state_serialize(Instance *instance, const char *function, const void *sta
     put(&cursor, stored->data.real_value, sizeof stored->data.real_value);
     put(&cursor, stored->data.int_value, sizeof stored->data.int_value);
     put(&cursor, stored->data.internal, sizeof stored->data.internal);
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (model_variables[i].type == VAR_STRING) {
+            length = (uint32_t)strlen(stored->data.string_value[i]);
+            put(&cursor, &length, sizeof length);
+            put(&cursor, stored->data.string_value[i], length);
+        }
+    }
     sum = checksum(bytes, cursor.at);
     put(&cursor, &sum, sizeof sum);
     return STATUS_OK;
@@ -896,13 +1164,56 @@ static Status refuse_bytes(Instance *instance, const char *function, const char 
     return instance_fail(instance, instance->fmi_prefix, function, ": refused: ", why, (const char *)NULL);
 }
 
+/* The String values of a serialized state from ``cursor`` up to ``end`` (the checksum) into
+ * ``strings``: 1, or 0 (nothing allocated) when a length runs beyond the bytes or the limit, a
+ * string holds a NUL, or the bytes do not end where the strings do; -1 without memory. */
+static int take_strings(Cursor *cursor, size_t end, char *strings[MODEL_VARIABLE_COUNT])
+{
+    uint32_t length;
+    int i;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        strings[i] = NULL;
+    }
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (model_variables[i].type != VAR_STRING) {
+            continue;
+        }
+        if (end - cursor->at < sizeof length) {
+            free_strings(strings);
+            return 0;
+        }
+        take(cursor, &length, sizeof length);
+        if (length > FMU_MAX_STRING_BYTES || length > end - cursor->at ||
+            memchr(cursor->read + cursor->at, '\0', length) != NULL ||
+            characters(cursor->read + cursor->at, length) > FMU_MAX_STRING) {
+            free_strings(strings);
+            return 0;
+        }
+        strings[i] = copy_text(cursor->read + cursor->at, length);
+        if (strings[i] == NULL) {
+            free_strings(strings);
+            return -1;
+        }
+        cursor->at += length;
+    }
+    if (cursor->at != end) {
+        free_strings(strings);
+        return 0;
+    }
+    return 1;
+}
+
 Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state)
 {
     Cursor cursor = {NULL, NULL, 0};
     uint32_t words[4], expected[4], slots;
     int32_t mode, initialized;
     uint64_t sum;
-    StoredState decoded, *target;
+    StoredState *target;
+    ModelData decoded;
+    Mode decoded_mode;
+    double decoded_start;
+    int taken;
     if (state == NULL || (bytes == NULL && size > 0)) {
         return instance_fail(instance, instance->fmi_prefix, function, ": null argument", (const char *)NULL);
     }
@@ -916,7 +1227,8 @@ Status state_deserialize(Instance *instance, const char *function, const char *b
     if (words[0] != expected[0] || words[1] != expected[1]) {
         return refuse_bytes(instance, function, "the state was written by another format version or platform");
     }
-    if (words[2] != expected[2] || words[3] != expected[3] || size != state_serialized_size() ||
+    if (words[2] != expected[2] || words[3] != expected[3] || size < fixed_serialized_size() ||
+        (MODEL_STRING_COUNT == 0 && size != fixed_serialized_size()) ||
         memcmp(bytes + cursor.at, MODEL_TOKEN, token_length()) != 0) {
         return refuse_bytes(instance, function,
                             "the state belongs to another model or build (instantiation token differs)");
@@ -934,43 +1246,107 @@ Status state_deserialize(Instance *instance, const char *function, const char *b
         initialized > 1) {
         return refuse_bytes(instance, function, "the state holds impossible values");
     }
-    take(&cursor, &decoded.start_time, sizeof(double));
-    take(&cursor, &decoded.data.time, sizeof(double));
-    take(&cursor, decoded.data.real_value, sizeof decoded.data.real_value);
-    take(&cursor, decoded.data.int_value, sizeof decoded.data.int_value);
-    take(&cursor, decoded.data.internal, sizeof decoded.data.internal);
-    decoded.mode = (Mode)mode;
-    decoded.data.initialized = initialized;
-    decoded.tag = STATE_TAG;
+    take(&cursor, &decoded_start, sizeof(double));
+    take(&cursor, &decoded.time, sizeof(double));
+    take(&cursor, decoded.real_value, sizeof decoded.real_value);
+    take(&cursor, decoded.int_value, sizeof decoded.int_value);
+    take(&cursor, decoded.internal, sizeof decoded.internal);
+    taken = take_strings(&cursor, size - sizeof sum, decoded.string_value);
+    if (taken < 0) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": out of memory", (const char *)NULL);
+    }
+    if (taken == 0) {
+        return refuse_bytes(instance, function, "the state holds impossible values");
+    }
+    decoded_mode = (Mode)mode;
+    decoded.initialized = initialized;
     target = state_slot(instance, function, *state);
     if (target == NULL) {
+        free_strings(decoded.string_value);
         return STATUS_ERROR;
     }
-    *target = decoded;
+    store(target, decoded_mode, decoded_start, &decoded);
     *state = target;
     return STATUS_OK;
 }
 
 /* ---- instances ------------------------------------------------------------------------------ */
 
+static int hex_digit(char c)
+{
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+}
+
+char *resource_folder_of_uri(const char *uri)
+{
+    const char *path;
+    char *folder;
+    size_t at = 0, length;
+    if (uri == NULL || strncmp(uri, "file:", 5) != 0) {
+        return NULL;
+    }
+    path = uri + 5;
+    if (strncmp(path, "//", 2) == 0) { /* file://host/path: an empty host or localhost is this machine */
+        path += 2;
+        if (strncmp(path, "localhost", 9) == 0) {
+            path += 9;
+        }
+        if (*path != '/') {
+            return NULL;
+        }
+    }
+    if (path[0] == '/' && path[1] != '\0' && path[2] == ':') { /* file:///C:/...: a drive letter */
+        path++;
+    }
+    length = strlen(path);
+    folder = malloc(length + 1);
+    if (folder == NULL) {
+        return NULL;
+    }
+    while (*path != '\0') {
+        if (path[0] == '%' && hex_digit(path[1]) >= 0 && hex_digit(path[2]) >= 0) {
+            folder[at++] = (char)(hex_digit(path[1]) * 16 + hex_digit(path[2]));
+            path += 3;
+        } else {
+            folder[at++] = *path++;
+        }
+    }
+    folder[at] = '\0';
+    if (strlen(folder) != at) { /* an escaped NUL: no such folder */
+        free(folder);
+        return NULL;
+    }
+    return folder;
+}
+
+/* A copy of the folder ``path`` without trailing separators (the root stays "/"); NULL for none. */
+static char *resource_folder(const char *path)
+{
+    size_t length;
+    if (path == NULL || *path == '\0') {
+        return NULL;
+    }
+    length = strlen(path);
+    while (length > 1 && (path[length - 1] == '/' || path[length - 1] == '\\')) {
+        length--;
+    }
+    return copy_text(path, length);
+}
+
 Instance *instance_new(const char *name, const char *token, const char *fmi_prefix, Emit emit,
-                       void (*host_logger)(void), void *host_environment)
+                       void (*host_logger)(void), void *host_environment, const char *resources)
 {
     Instance *instance = calloc(1, sizeof *instance);
-    size_t length;
     if (instance == NULL) {
         return NULL;
     }
-    if (name == NULL) {
-        name = "";
-    }
-    length = strlen(name);
-    instance->name = malloc(length + 1);
-    if (instance->name == NULL) {
-        free(instance);
+    instance->name = copy_text(name != NULL ? name : "", name != NULL ? strlen(name) : 0);
+    instance->resources = resource_folder(resources);
+    if (instance->name == NULL || (resources != NULL && *resources != '\0' && instance->resources == NULL)) {
+        instance_free(instance);
         return NULL;
     }
-    memcpy(instance->name, name, length + 1);
+    instance->cache.resources = instance->resources;
     instance->emit = emit;
     instance->host_logger = host_logger;
     instance->host_environment = host_environment;
@@ -981,13 +1357,19 @@ Instance *instance_new(const char *name, const char *token, const char *fmi_pref
         instance_free(instance);
         return NULL;
     }
-    instance_reset(instance);
+    if (instance_reset(instance) != STATUS_OK) {
+        instance_free(instance);
+        return NULL;
+    }
     return instance;
 }
 
 void instance_free(Instance *instance)
 {
     if (instance != NULL) {
+        clear_cache(instance);
+        free_strings(instance->data.string_value);
+        free(instance->resources);
         free(instance->name);
         free(instance);
     }

@@ -22,13 +22,17 @@
 #endif
 
 #define FMU_PI 3.14159265358979323846
-#define FMU_MESSAGE_SIZE 400
+#define FMU_MESSAGE_SIZE 1024 /* a message names a layout file by its absolute path: room for a long one */
 #define FMU_MAX_MESSAGES 48
 /* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
  * five-number warm start); a new count needs a new STATE_FORMAT (fmu_instance.c). */
 #define FMU_INTERNAL_SLOTS 6
+/* Longest String value accepted, in characters (code points; model_adapter.MAX_STRING), and so
+ * in bytes of UTF-8 at most four times that. */
+#define FMU_MAX_STRING 4096
+#define FMU_MAX_STRING_BYTES (4 * FMU_MAX_STRING)
 
-typedef enum { VAR_REAL, VAR_INTEGER } VariableType;
+typedef enum { VAR_REAL, VAR_INTEGER, VAR_BOOLEAN, VAR_STRING } VariableType;
 typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT } Causality;
 
 /* A refusal message: text, then the checked value or the bound it broke (as Python's repr(), or
@@ -50,11 +54,12 @@ typedef struct {
     VariableType type;
     Causality causality;
     int tunable;  /* a parameter the host may change after initialisation */
-    double start; /* start value (an Integer's as a double: exact for int32) */
+    double start; /* start value (an Integer's as a double: exact for int32; a Boolean's 0 or 1) */
     int has_min, has_max, min_exclusive, max_exclusive;
     double min, max;
     double display_factor, display_offset; /* display unit (1, 0 without one) */
     MessageTemplate not_finite, outside_min, outside_max;
+    const char *start_string; /* a String's start value, else NULL */
 } VariableInfo;
 
 typedef enum { OP_LT, OP_LE, OP_GT, OP_GE } Operator;
@@ -85,14 +90,29 @@ extern const RelationInfo model_relations[MODEL_RELATION_COUNT];
 extern const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT];
 #endif
 
-/* Everything a step may change: the FMU state. Values are indexed by value reference;
- * an Integer is held in int_value, a Real in real_value. */
+/* What a model keeps beside its variables that is not part of the FMU state (SteppedModel's
+ * derived_state): data derived from the parameters, which the model rebuilds when the parameters
+ * it was built for differ (after a change, a reset or a restored FMU state), and the FMU's
+ * resources folder. One per instance; freed with it and on reset (ModelHooks.free_derived). */
+typedef struct {
+    void *derived;         /* owned by the model; NULL until it builds it */
+    const char *resources; /* the resources folder, a path without a trailing separator; NULL: none */
+} ModelCache;
+
+/* Everything a step may change: the FMU state. Values are indexed by value reference; an
+ * Integer or a Boolean (0 or 1) is held in int_value, a Real in real_value, a String in
+ * string_value (NUL-terminated UTF-8 the instance owns; NULL for the other types). Strings are
+ * parameters: a step never changes them, so a copy of ModelData made around a step may share
+ * them; every other copy (an FMU state) owns copies of its own. ``cache`` points at the
+ * instance's cache, never part of a state. */
 typedef struct {
     double real_value[MODEL_VARIABLE_COUNT];
     int32_t int_value[MODEL_VARIABLE_COUNT];
+    char *string_value[MODEL_VARIABLE_COUNT];
     double internal[FMU_INTERNAL_SLOTS]; /* model-specific internal state */
     double time;
     int initialized;
+    ModelCache *cache;
 } ModelData;
 
 typedef struct {
@@ -118,13 +138,18 @@ struct Instance {
     double start_time;
     ModelData data;
     Messages messages;
+    ModelCache cache;
+    char *resources; /* owned; cache.resources points at it */
 };
 
 /* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
  * The physics returns NULL, or the arithmetic failure as Python names it ("ZeroDivisionError:
  * float division by zero"). A model whose outputs are functions of time alone gives ``at_time``
  * (start: at the start time, step: at its end); the others give ``start`` and ``advance``.
- * A NULL ``reset_internal`` or ``extra_*_errors`` means none. */
+ * A NULL ``reset_internal`` or ``extra_*_errors`` means none. A model with derived data builds it
+ * in ``extra_parameter_errors`` (run before every initialisation and step, once the declared
+ * checks pass) into ``data->cache->derived``, keyed by the parameters it was built for, and gives
+ * ``free_derived``; NULL: the model has none. */
 typedef struct {
     void (*reset_internal)(ModelData *data);
     const char *(*at_time)(ModelData *data, double time);
@@ -132,6 +157,7 @@ typedef struct {
     const char *(*advance)(ModelData *data, double current_time, double step_size);
     void (*extra_parameter_errors)(const ModelData *data, Messages *out);
     void (*extra_input_errors)(const ModelData *data, Messages *out);
+    void (*free_derived)(void *derived);
 } ModelHooks;
 
 extern const ModelHooks model_hooks;
@@ -158,6 +184,9 @@ void messages_add(Messages *out, const char *first, ...);
 /* Adds generated message ``message`` (a MESSAGE_* of model_variables.h) with its variable's value. */
 void messages_add_extra(Messages *out, const ModelData *data, int message);
 #endif
+/* Python's math.fsum of ``count`` values into ``*sum``: NULL, or the text of the exception Python
+ * raises ("intermediate overflow in fsum", "-inf + inf in fsum"). */
+const char *python_fsum(const double values[], int count, double *sum);
 /* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
 void python_float_repr(double value, char *out, size_t size);
 
@@ -178,6 +207,19 @@ Status instance_set_integer(Instance *instance, const char *function, const uint
                             const int32_t value[]);
 Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[]);
 Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[]);
+/* Booleans as the FMI version's type of ``size`` bytes (fmi2Boolean: int, fmi3Boolean: bool):
+ * any non-zero value is true; got as 0 or 1. */
+Status instance_set_boolean(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                            const void *value, size_t size);
+Status instance_get_boolean(Instance *instance, const char *function, const uint32_t vr[], size_t n, void *value,
+                            size_t size);
+/* Strings are copied; a longer one than FMU_MAX_STRING characters, or NULL, is refused (Error)
+ * and nothing is set. A string got stays valid until the next call that may change it (a set,
+ * reset, set FMU state or free). */
+Status instance_set_string(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                           const char *const value[]);
+Status instance_get_string(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                           const char *value[]);
 Status instance_fail(Instance *instance, const char *first, ...);
 /* Get or set of a type the model has no variable of: OK for none, else Error naming the reference. */
 Status instance_no_variables_of(Instance *instance, const char *function, const uint32_t vr[], size_t n,
@@ -210,7 +252,7 @@ typedef struct StoredState StoredState;
 Status state_get(Instance *instance, const char *function, void **state);
 Status state_set(Instance *instance, const char *function, const void *state);
 Status state_free(Instance *instance, const char *function, void **state);
-Status state_size(Instance *instance, const char *function, size_t *size);
+Status state_size(Instance *instance, const char *function, const void *state, size_t *size);
 Status state_serialize(Instance *instance, const char *function, const void *state, char *bytes, size_t size);
 Status state_deserialize(Instance *instance, const char *function, const char *bytes, size_t size, void **state);
 
@@ -224,8 +266,8 @@ Status state_deserialize(Instance *instance, const char *function, const char *b
     ON_INSTANCE(version, state_set(instance, "Set" #State, state))                                             \
     version##Status version##Free##State(Handle c, version##State *state)                                      \
     ON_INSTANCE(version, state_free(instance, "Free" #State, state))                                           \
-    version##Status version##Serialized##State##Size(Handle c, version##State state UNUSED, size_t *size)      \
-    ON_INSTANCE(version, state_size(instance, "Serialized" #State "Size", size))                               \
+    version##Status version##Serialized##State##Size(Handle c, version##State state, size_t *size)             \
+    ON_INSTANCE(version, state_size(instance, "Serialized" #State "Size", state, size))                        \
     version##Status version##Serialize##State(Handle c, version##State state, version##Byte bytes[],           \
                                               size_t size)                                                     \
     ON_INSTANCE(version, state_serialize(instance, "Serialize" #State, state, (char *)bytes, size))            \
@@ -233,8 +275,12 @@ Status state_deserialize(Instance *instance, const char *function, const char *b
                                                 version##State *state)                                         \
     ON_INSTANCE(version, state_deserialize(instance, #Deserialize #State, (const char *)bytes, size, state))
 
+/* ``resources``: the FMU's resources folder as a path (NULL: none); copied. */
 Instance *instance_new(const char *name, const char *token, const char *fmi_prefix, Emit emit,
-                       void (*host_logger)(void), void *host_environment);
+                       void (*host_logger)(void), void *host_environment, const char *resources);
+/* The folder of an FMI 2.0 fmuResourceLocation (a file URI, percent-escapes decoded), newly
+ * allocated; NULL for NULL, a URI of another scheme or no memory. */
+char *resource_folder_of_uri(const char *uri);
 void instance_free(Instance *instance);
 
 #endif

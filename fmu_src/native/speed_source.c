@@ -19,4 +19,4 @@ static const char *evaluate(ModelData *data, double t)
     return NULL;
 }
 
-const ModelHooks model_hooks = {NULL, evaluate, NULL, NULL, NULL, NULL};
+const ModelHooks model_hooks = {NULL, evaluate, NULL, NULL, NULL, NULL, NULL};

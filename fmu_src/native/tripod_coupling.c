@@ -512,4 +512,4 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     }
 }
 
-const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, NULL};
+const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, NULL, NULL};

@@ -63,4 +63,4 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
 
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {NULL, NULL, start, advance, NULL, NULL};
+const ModelHooks model_hooks = {NULL, NULL, start, advance, NULL, NULL, NULL};

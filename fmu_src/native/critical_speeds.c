@@ -1,0 +1,670 @@
+/* CriticalSpeeds: bending critical speeds, whirl frequencies, order resonances and the unbalance
+ * response of a driveline shaft (Hruby, Nahlik 2021; port of driveline/rotor/model.py over the
+ * rotor library, critical_speeds/rotor.h).
+ *
+ * The analysis is the model's derived data (CriticalSpeedsModel.derived_state): built when the
+ * parameters are checked, and only in the parts a change affects, each part kept with the
+ * parameters it was built for (CriticalSpeedsModel._part): the driveline (structure and damping),
+ * the structure (critical speeds, finite-element check), the Campbell table (structure and
+ * omega_max), the order resonances (structure, orders, omega_max) and the unbalance outputs
+ * (structure, damping, unbalance parameters, omega_max). A step only looks values up.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "critical_speeds/rotor.h"
+#include "fmu_instance.h"
+
+#define VALUE(name) (data->real_value[V_##name])
+
+/* driveline/rotor/model.py */
+#define MAX_ORDERS 16
+#define MAX_ORDER 100
+#define MAX_SEARCHED_MODES 250.0
+#define FE_ELEMENTS 4
+#define PLAUSIBLE_DEVIATION 0.02
+#define CAMPBELL_POINTS 41
+#define WHIRL_MODES 2
+#define ERROR_SIZE FMU_MESSAGE_SIZE
+
+/* ---- the parts of the analysis and their keys ------------------------------------------------ */
+
+typedef enum { PART_DRIVELINE, PART_STRUCTURE, PART_WHIRL, PART_RESONANCES, PART_UNBALANCE, PARTS } Part;
+
+/* The parameters each part depends on besides ``layout`` (and ``orders`` for the resonances):
+ * shape = SHAFT_PARAMETERS, damped = shape + DAMPING_PARAMETERS, forced = damped +
+ * UNBALANCE_PARAMETERS; -1 ends a list. */
+#define SHAPE V_L_shaft, V_D_outer, V_D_inner, V_E, V_density, V_m_joint, V_Jp_joint, V_Jd_joint, V_k_bearing, V_shear
+#define KEY_VALUES 16
+static const int PART_VALUES[PARTS][KEY_VALUES] = {
+    {SHAPE, V_c_bearing, -1},
+    {SHAPE, -1},
+    {SHAPE, V_omega_max, -1},
+    {SHAPE, V_omega_max, -1},
+    {SHAPE, V_c_bearing, V_unbalance, V_unbalance_position, V_response_position, V_omega_max, -1},
+};
+
+/* The parameters a part was built for (compared by value, as Python compares the key tuples). */
+typedef struct {
+    int held;
+    char *layout; /* owned */
+    double values[KEY_VALUES];
+    int orders[MAX_ORDERS], n_orders;
+} Key;
+
+typedef struct {
+    Key keys[PARTS];
+    Driveline driveline;
+    /* structure */
+    Chain *chain;
+    double critical[3];
+    int critical_count;
+    double *natural;
+    int natural_count;
+    WhirlTable *whirl;
+    OrderResonance *resonances;
+    int resonance_count;
+    UnbalanceOutputs *unbalance;
+} Analysis;
+
+static double parameter(const ModelData *data, int variable)
+{
+    return model_variables[variable].type == VAR_REAL ? data->real_value[variable] : (double)data->int_value[variable];
+}
+
+static int key_matches(const Key *key, const ModelData *data, Part part, const int *orders, int n_orders)
+{
+    int i;
+    if (!key->held || strcmp(key->layout, data->string_value[V_layout]) != 0) {
+        return 0;
+    }
+    for (i = 0; PART_VALUES[part][i] >= 0; i++) {
+        if (!(key->values[i] == parameter(data, PART_VALUES[part][i]))) {
+            return 0;
+        }
+    }
+    if (part == PART_RESONANCES) {
+        if (key->n_orders != n_orders) {
+            return 0;
+        }
+        for (i = 0; i < n_orders; i++) {
+            if (key->orders[i] != orders[i]) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+/* Records that ``part`` now holds what ``data`` gives; 0 without memory (the part then counts as
+ * not held). */
+static int key_store(Key *key, const ModelData *data, Part part, const int *orders, int n_orders)
+{
+    size_t length = strlen(data->string_value[V_layout]);
+    int i;
+    free(key->layout);
+    key->held = 0;
+    key->layout = malloc(length + 1);
+    if (key->layout == NULL) {
+        return 0;
+    }
+    memcpy(key->layout, data->string_value[V_layout], length + 1);
+    for (i = 0; PART_VALUES[part][i] >= 0; i++) {
+        key->values[i] = parameter(data, PART_VALUES[part][i]);
+    }
+    key->n_orders = part == PART_RESONANCES ? n_orders : 0;
+    for (i = 0; i < key->n_orders; i++) {
+        key->orders[i] = orders[i];
+    }
+    key->held = 1;
+    return 1;
+}
+
+static void drop_part(Analysis *analysis, Part part)
+{
+    Key *key = &analysis->keys[part];
+    free(key->layout);
+    key->layout = NULL;
+    key->held = 0;
+    switch (part) {
+    case PART_DRIVELINE:
+        driveline_free(&analysis->driveline);
+        memset(&analysis->driveline, 0, sizeof analysis->driveline);
+        break;
+    case PART_STRUCTURE:
+        chain_free(analysis->chain);
+        analysis->chain = NULL;
+        free(analysis->natural);
+        analysis->natural = NULL;
+        analysis->natural_count = 0;
+        break;
+    case PART_WHIRL:
+        whirl_table_free(analysis->whirl);
+        analysis->whirl = NULL;
+        break;
+    case PART_RESONANCES:
+        free(analysis->resonances);
+        analysis->resonances = NULL;
+        analysis->resonance_count = 0;
+        break;
+    case PART_UNBALANCE:
+        unbalance_outputs_free(analysis->unbalance);
+        analysis->unbalance = NULL;
+        break;
+    case PARTS:
+        break;
+    }
+}
+
+static void free_analysis(void *derived)
+{
+    Analysis *analysis = derived;
+    int part;
+    if (analysis == NULL) {
+        return;
+    }
+    for (part = 0; part < PARTS; part++) {
+        drop_part(analysis, (Part)part);
+    }
+    free(analysis);
+}
+
+/* ---- Python's arithmetic ----------------------------------------------------------------------- */
+
+/* Python's float ``x ** y``: finite operands with an infinite result raise OverflowError. */
+static int python_pow(double x, double y, double *out, char *error)
+{
+    *out = pow(x, y);
+    if (isinf(*out) && isfinite(x) && isfinite(y)) {
+        snprintf(error, ERROR_SIZE, "(34, 'Numerical result out of range')");
+        return -1;
+    }
+    return 0;
+}
+
+/* Python's float ``x / y``: a zero divisor raises ZeroDivisionError. */
+static int python_divide(double x, double y, double *out, char *error)
+{
+    if (y == 0.0) {
+        snprintf(error, ERROR_SIZE, "float division by zero");
+        return -1;
+    }
+    *out = x / y;
+    return 0;
+}
+
+/* math.fsum; -1 with Python's message on its failures. */
+static int fsum(const double *values, int n, double *sum, char *error)
+{
+    const char *failure = python_fsum(values, n, sum);
+    if (failure != NULL) {
+        snprintf(error, ERROR_SIZE, "%s", failure);
+        return -1;
+    }
+    return 0;
+}
+
+/* Python's format(value, spec) for 'g' specs: C's, but for the spelling of inf and nan. */
+static void python_g(double value, int digits, char *out, size_t size)
+{
+    if (isnan(value)) {
+        snprintf(out, size, "nan");
+    } else if (isinf(value)) {
+        snprintf(out, size, value > 0 ? "inf" : "-inf");
+    } else {
+        snprintf(out, size, "%.*g", digits, value);
+    }
+}
+
+/* The texts of Python's ArithmeticError (ZeroDivisionError, OverflowError) that the core raises;
+ * any other failure is a ValueError. */
+static int arithmetic(const char *message)
+{
+    static const char *const texts[] = {"float division by zero", "division by zero",
+                                        "(34, 'Numerical result out of range')", "math range error",
+                                        "intermediate overflow in fsum", "float modulo", "integer division or modulo by zero"};
+    size_t i;
+    for (i = 0; i < sizeof texts / sizeof texts[0]; i++) {
+        if (strcmp(message, texts[i]) == 0) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* ---- parse_orders ------------------------------------------------------------------------------ */
+
+/* The code point of UTF-8 ``text`` at ``at`` (of ``end``), its byte count in ``*bytes``; a byte
+ * that starts no valid sequence is itself. */
+static unsigned long code_point(const unsigned char *text, size_t at, size_t end, size_t *bytes)
+{
+    unsigned long point = text[at];
+    size_t count = point >= 0xF0u ? 4 : point >= 0xE0u ? 3 : point >= 0xC0u ? 2 : 1, i;
+    if (count == 1 || at + count > end) {
+        *bytes = 1;
+        return point;
+    }
+    point &= 0x3Fu >> (count - 1);
+    for (i = 1; i < count; i++) {
+        if ((text[at + i] & 0xC0u) != 0x80u) {
+            *bytes = 1;
+            return text[at];
+        }
+        point = (point << 6) | (text[at + i] & 0x3Fu);
+    }
+    *bytes = count;
+    return point;
+}
+
+/* str.isspace of one code point */
+static int python_space(unsigned long c)
+{
+    return (c >= 0x09 && c <= 0x0D) || (c >= 0x1C && c <= 0x20) || c == 0x85 || c == 0xA0 || c == 0x1680 ||
+           (c >= 0x2000 && c <= 0x200A) || c == 0x2028 || c == 0x2029 || c == 0x202F || c == 0x205F || c == 0x3000;
+}
+
+/* The start of the last code point before ``end`` (after ``start``). */
+static size_t previous_point(const unsigned char *text, size_t start, size_t end)
+{
+    size_t at = end - 1;
+    while (at > start && end - at < 4 && (text[at] & 0xC0u) == 0x80u) {
+        at--;
+    }
+    return at;
+}
+
+/* parse_orders: "1,2,3,6" -> 1, 2, 3, 6; else -1 with the Python message. */
+static int parse_orders(const char *text, int *orders, int *count, char *error)
+{
+    const unsigned char *bytes = (const unsigned char *)text;
+    size_t length = strlen(text), start = 0, end, at, size, cut;
+    int commas = 0, value;
+    char shown[256], prefix[4 * 20 + 1]; /* repr of 20 characters: 10 bytes each at most */
+    for (at = 0; at < length; at++) {
+        commas += text[at] == ',';
+    }
+    if (commas >= MAX_ORDERS) { /* text.split(",", MAX_ORDERS) gives more than MAX_ORDERS entries */
+        snprintf(error, ERROR_SIZE, "parameter orders lists more than %d orders", MAX_ORDERS);
+        return -1;
+    }
+    *count = 0;
+    while (start <= length) {
+        const char *comma = memchr(text + start, ',', length - start);
+        size_t stop = comma != NULL ? (size_t)(comma - text) : length, first = start, points = 0;
+        int ascii_digits = 1;
+        end = stop;
+        while (first < end && python_space(code_point(bytes, first, end, &size))) { /* str.strip() */
+            first += size;
+        }
+        while (end > first) {
+            size_t last = previous_point(bytes, first, end);
+            if (!python_space(code_point(bytes, last, end, &size)) || last + size != end) {
+                break;
+            }
+            end = last;
+        }
+        value = 0;
+        for (at = first; at < end; at++) {
+            ascii_digits = ascii_digits && text[at] >= '0' && text[at] <= '9';
+            value = ascii_digits && at - first < 3 ? 10 * value + (text[at] - '0') : value;
+        }
+        if (!(ascii_digits && end > first && end - first <= 3 && value >= 1 && value <= MAX_ORDER)) {
+            for (cut = first; cut < end && points < 20; points++) { /* digits[:20] */
+                code_point(bytes, cut, end, &size);
+                cut += size;
+            }
+            memcpy(prefix, text + first, cut - first);
+            prefix[cut - first] = '\0';
+            python_str_repr(prefix, 20, shown, sizeof shown);
+            snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown, MAX_ORDER);
+            return -1;
+        }
+        orders[(*count)++] = value;
+        start = stop + 1;
+    }
+    return 0;
+}
+
+/* A tuple of ints as Python prints it: "(1, 2, 3)", "(1,)". */
+static void orders_tuple(const int *orders, int count, char *out, size_t size)
+{
+    size_t used;
+    int i;
+    snprintf(out, size, "(");
+    for (i = 0; i < count; i++) {
+        used = strlen(out);
+        snprintf(out + used, size - used, i == 0 ? "%d" : ", %d", orders[i]);
+    }
+    used = strlen(out);
+    snprintf(out + used, size - used, count == 1 ? ",)" : ")");
+}
+
+/* ---- the analysis ------------------------------------------------------------------------------ */
+
+/* build_driveline: the one-piece tube of the parameters, or the layout (a file or a shipped name). */
+static int build_driveline(const ModelData *data, Driveline *out, char *error)
+{
+    OnePieceShaft shaft;
+    const char *layout = data->string_value[V_layout];
+    if (layout[0] != '\0') {
+        return driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
+    }
+    shaft.L_shaft = VALUE(L_shaft);
+    shaft.D_outer = VALUE(D_outer);
+    shaft.D_inner = VALUE(D_inner);
+    shaft.E = VALUE(E);
+    shaft.density = VALUE(density);
+    shaft.m_joint = VALUE(m_joint);
+    shaft.Jp_joint = VALUE(Jp_joint);
+    shaft.Jd_joint = VALUE(Jd_joint);
+    shaft.k_bearing = VALUE(k_bearing);
+    shaft.c_bearing = VALUE(c_bearing);
+    shaft.shear = data->int_value[V_shear] != 0;
+    return driveline_one_piece(&shaft, out, error, ERROR_SIZE);
+}
+
+/* searched_modes: bare-shaft bending modes below the frequencies the order-resonance searches scan,
+ * times the stations a determinant evaluation passes. */
+static int searched_modes(const Driveline *driveline, const int *orders, int n_orders, double omega_max, double *work,
+                          char *error)
+{
+    double *terms, kappa, scanned, squared_outer, squared_inner, fourth_outer, fourth_inner, ratio, root;
+    int seen[MAX_ORDER + 1] = {0}, i, n = 0, failed = 0;
+    terms = malloc(((size_t)driveline->n_segments + MAX_ORDERS + 1) * sizeof *terms);
+    if (terms == NULL) {
+        snprintf(error, ERROR_SIZE, "out of memory");
+        return -1;
+    }
+    for (i = 0; i < driveline->n_segments && !failed; i++) {
+        const RotorSegment *s = &driveline->segments[i];
+        double mass_per_length, bending_stiffness;
+        failed = python_pow(s->outer_diameter, 2.0, &squared_outer, error) || /* rho A */
+                 python_pow(s->inner_diameter, 2.0, &squared_inner, error);
+        if (failed) {
+            break;
+        }
+        mass_per_length = s->density * (FMU_PI / 4.0 * (squared_outer - squared_inner));
+        failed = python_pow(s->outer_diameter, 4.0, &fourth_outer, error) || /* E J */
+                 python_pow(s->inner_diameter, 4.0, &fourth_inner, error);
+        if (failed) {
+            break;
+        }
+        bending_stiffness = s->youngs_modulus * (FMU_PI / 64.0 * (fourth_outer - fourth_inner));
+        failed = python_divide(mass_per_length, bending_stiffness, &ratio, error) ||
+                 python_pow(ratio, 0.25, &root, error);
+        if (!failed) {
+            terms[n++] = s->length * root;
+        }
+    }
+    if (failed || fsum(terms, n, &kappa, error)) {
+        free(terms);
+        return -1;
+    }
+    n = 0;
+    seen[1] = 1; /* {1, *orders} */
+    terms[n++] = sqrt(2.0 * 1 * omega_max);
+    for (i = 0; i < n_orders; i++) {
+        if (!seen[orders[i]]) {
+            seen[orders[i]] = 1;
+            terms[n++] = sqrt(2.0 * orders[i] * omega_max);
+        }
+    }
+    failed = fsum(terms, n, &scanned, error);
+    free(terms);
+    if (failed) {
+        return -1;
+    }
+    *work = kappa * scanned / FMU_PI * (driveline->n_segments + 1);
+    return 0;
+}
+
+/* analyse_structure: the chain, the critical speeds (missing ones read as the search limit) and the
+ * finite-element check's natural frequencies. */
+static int analyse_structure(Analysis *analysis, char *error)
+{
+    double spins[3];
+    int count = 0, i;
+    analysis->chain = chain_new(&analysis->driveline, error, ERROR_SIZE);
+    if (analysis->chain == NULL) {
+        return -1;
+    }
+    if (rotor_critical_speeds(analysis->chain, 3, spins, &count, error, ERROR_SIZE)) {
+        return -1;
+    }
+    for (i = 0; i < 3; i++) {
+        analysis->critical[i] = i < count ? spins[i] : ROTOR_SEARCH_LIMIT;
+    }
+    analysis->critical_count = count;
+    return fe_natural_frequencies(&analysis->driveline, FE_ELEMENTS, &analysis->natural, &analysis->natural_count,
+                                  error, ERROR_SIZE);
+}
+
+/* implausibility: the first two whirl frequencies at standstill must each match a natural
+ * frequency of the finite-element check within PLAUSIBLE_DEVIATION. */
+static int implausibility(const Analysis *analysis, char *error)
+{
+    double at_rest[2 * WHIRL_MODES], nearest, deviation, best = 0.0;
+    char frequency_shown[40], nearest_shown[40];
+    int i, j, found;
+    whirl_table_evaluate(analysis->whirl, 0.0, at_rest);
+    for (i = 0; i < WHIRL_MODES; i++) {
+        double frequency = at_rest[i];
+        if (frequency >= ROTOR_SEARCH_LIMIT) {
+            continue;
+        }
+        if (analysis->natural_count == 0) {
+            snprintf(error, ERROR_SIZE, "attempt to get argmin of an empty sequence");
+            return -1;
+        }
+        found = 0;
+        for (j = 0; j < analysis->natural_count; j++) { /* np.argmin: the first smallest (a NaN first) */
+            deviation = fabs(analysis->natural[j] - frequency);
+            if (isnan(deviation)) {
+                found = j;
+                break;
+            }
+            if (j == 0 || deviation < best) {
+                best = deviation;
+                found = j;
+            }
+        }
+        nearest = analysis->natural[found];
+        if (!(fabs(nearest - frequency) <= PLAUSIBLE_DEVIATION * frequency)) {
+            python_g(frequency, 6, frequency_shown, sizeof frequency_shown);
+            python_g(nearest, 6, nearest_shown, sizeof nearest_shown);
+            snprintf(error, ERROR_SIZE,
+                     "the whirl frequency %s rad/s at standstill has no counterpart in the finite-element check "
+                     "(nearest %s rad/s): the parameters are beyond what double precision resolves",
+                     frequency_shown, nearest_shown);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* resonances: every order resonance of ``orders`` (both senses) up to 2 omega_max, or the first
+ * forward one of each order when none lies there. */
+static int resonances(Analysis *analysis, const int *orders, int n_orders, double omega_max, char *error)
+{
+    char tuple[4 * MAX_ORDERS + 8];
+    if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD | WHIRL_BACKWARD, 0, 2.0 * omega_max,
+                               ROTOR_SEARCH_LIMIT, &analysis->resonances, &analysis->resonance_count, error,
+                               ERROR_SIZE)) {
+        return -1;
+    }
+    if (analysis->resonance_count == 0) {
+        free(analysis->resonances);
+        analysis->resonances = NULL;
+        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0, ROTOR_SEARCH_LIMIT,
+                                   &analysis->resonances, &analysis->resonance_count, error, ERROR_SIZE)) {
+            return -1;
+        }
+    }
+    if (analysis->resonance_count == 0) {
+        orders_tuple(orders, n_orders, tuple, sizeof tuple);
+        snprintf(error, ERROR_SIZE, "no order resonance of the orders %s below the search limit 100000 rad/s", tuple);
+        return -1;
+    }
+    return 0;
+}
+
+/* The unbalance outputs: a layout's own unbalances, or the one-piece tube's single unbalance. */
+static int unbalance_outputs(Analysis *analysis, const ModelData *data, char *error)
+{
+    RotorUnbalance single;
+    const RotorUnbalance *unbalances = analysis->driveline.unbalances;
+    int count = analysis->driveline.n_unbalances;
+    char shown[40];
+    if (data->string_value[V_layout][0] == '\0') {
+        single.position = VALUE(unbalance_position) * driveline_length(&analysis->driveline);
+        single.amount = VALUE(unbalance);
+        single.phase = 0.0;
+        if (!isfinite(single.position) || single.position < 0.0) { /* elements._non_negative */
+            python_float_repr(single.position, shown, sizeof shown);
+            snprintf(error, ERROR_SIZE, "position must be a finite number >= 0, got %s", shown);
+            return -1;
+        }
+        unbalances = &single;
+        count = 1;
+    }
+    analysis->unbalance = unbalance_outputs_new(&analysis->driveline, unbalances, count, VALUE(response_position),
+                                                VALUE(omega_max), error, ERROR_SIZE);
+    return analysis->unbalance != NULL ? 0 : -1;
+}
+
+/* One part: kept when its key is unchanged, else dropped and computed anew (kept on success only). */
+static int part(Analysis *analysis, const ModelData *data, Part which, const int *orders, int n_orders, char *error)
+{
+    int failed;
+    if (key_matches(&analysis->keys[which], data, which, orders, n_orders)) {
+        return 0;
+    }
+    drop_part(analysis, which);
+    switch (which) {
+    case PART_DRIVELINE:
+        failed = build_driveline(data, &analysis->driveline, error);
+        break;
+    case PART_STRUCTURE:
+        failed = analyse_structure(analysis, error);
+        break;
+    case PART_WHIRL:
+        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), CAMPBELL_POINTS, WHIRL_MODES, error,
+                                          ERROR_SIZE);
+        failed = analysis->whirl == NULL || implausibility(analysis, error);
+        break;
+    case PART_RESONANCES:
+        failed = resonances(analysis, orders, n_orders, VALUE(omega_max), error);
+        break;
+    default:
+        failed = unbalance_outputs(analysis, data, error);
+        break;
+    }
+    if (!failed && !key_store(&analysis->keys[which], data, which, orders, n_orders)) {
+        snprintf(error, ERROR_SIZE, "out of memory");
+        failed = 1;
+    }
+    if (failed) {
+        drop_part(analysis, which);
+        return -1;
+    }
+    return 0;
+}
+
+/* CriticalSpeedsModel.extra_parameter_errors: analyse what a changed parameter affects. */
+static void extra_parameter_errors(const ModelData *data, Messages *out)
+{
+    ModelCache *cache = data->cache;
+    Analysis *analysis = cache->derived;
+    int orders[MAX_ORDERS], n_orders = 0, failed;
+    double work = 0.0;
+    char error[ERROR_SIZE] = "", shown[40];
+    if (analysis == NULL) {
+        analysis = calloc(1, sizeof *analysis);
+        if (analysis == NULL) {
+            messages_add(out, "driveline: out of memory", (const char *)NULL);
+            return;
+        }
+        cache->derived = analysis;
+    }
+    failed = parse_orders(data->string_value[V_orders], orders, &n_orders, error) ||
+             part(analysis, data, PART_DRIVELINE, orders, n_orders, error) ||
+             searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
+    if (!failed && !(work <= MAX_SEARCHED_MODES)) {
+        python_g(work, 3, shown, sizeof shown);
+        snprintf(error, sizeof error,
+                 "the analysis would scan %s shaft modes, more than the %.0f accepted (shorter or stiffer shaft, "
+                 "fewer or lower orders, or a smaller omega_max)", shown, MAX_SEARCHED_MODES);
+        failed = 1;
+    }
+    failed = failed || part(analysis, data, PART_STRUCTURE, orders, n_orders, error) ||
+             part(analysis, data, PART_WHIRL, orders, n_orders, error) ||
+             part(analysis, data, PART_RESONANCES, orders, n_orders, error) ||
+             part(analysis, data, PART_UNBALANCE, orders, n_orders, error);
+    if (failed) {
+        messages_add(out, "driveline: ", error,
+                     arithmetic(error) ? " (a structural parameter is too large or small to analyse)" : "",
+                     (const char *)NULL);
+    }
+}
+
+/* ---- per step ------------------------------------------------------------------------------------ */
+
+/* CriticalSpeedsModel.evaluate: lookups in the analysis at |omega|. */
+static const char *evaluate(ModelData *data)
+{
+    const Analysis *analysis = data->cache->derived;
+    double speed = fabs(VALUE(omega)), whirl[2 * WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
+    int closest = 0, count = 0, i;
+    if (analysis == NULL || analysis->whirl == NULL || analysis->resonance_count == 0 ||
+        analysis->unbalance == NULL) { /* the parameter check builds it before every step */
+        return "RuntimeError: the driveline was not analysed";
+    }
+    VALUE(omega_crit_1) = analysis->critical[0];
+    VALUE(omega_crit_2) = analysis->critical[1];
+    VALUE(omega_crit_3) = analysis->critical[2];
+    data->int_value[V_critical_speed_count] = analysis->critical_count;
+    whirl_table_evaluate(analysis->whirl, speed, whirl);
+    VALUE(whirl_forward_1) = whirl[0];
+    VALUE(whirl_forward_2) = whirl[1];
+    VALUE(whirl_backward_1) = whirl[2];
+    VALUE(whirl_backward_2) = whirl[3];
+    if (VALUE(omega_crit_1) == 0.0) {
+        return "ZeroDivisionError: float division by zero";
+    }
+    VALUE(speed_ratio) = speed / VALUE(omega_crit_1);
+    for (i = 0; i < analysis->resonance_count; i++) { /* np.argmin of |margins|: the first smallest, a NaN first */
+        double spin = analysis->resonances[i].spin;
+        margin = fabs((speed - spin) / spin);
+        if (i == 0 || (!isnan(smallest) && (isnan(margin) || margin < smallest))) {
+            closest = i;
+            smallest = margin;
+        }
+        count += margin < VALUE(band);
+    }
+    margin = (speed - analysis->resonances[closest].spin) / analysis->resonances[closest].spin;
+    data->int_value[V_resonance_order] = analysis->resonances[closest].order;
+    data->int_value[V_resonance_whirl] = analysis->resonances[closest].whirl;
+    VALUE(resonance_speed) = analysis->resonances[closest].spin;
+    VALUE(resonance_margin) = margin;
+    data->int_value[V_resonance_count] = count;
+    data->int_value[V_resonance_warning] = count > 0;
+    unbalance_outputs_evaluate(analysis->unbalance, speed, unbalance);
+    VALUE(unbalance_response) = unbalance[0];
+    VALUE(bearing_force_max) = unbalance[1];
+    VALUE(damping_ratio) = unbalance[2];
+    return NULL;
+}
+
+static const char *start(ModelData *data, double start_time UNUSED)
+{
+    return evaluate(data);
+}
+
+static const char *advance(ModelData *data, double current_time UNUSED, double step_size UNUSED)
+{
+    return evaluate(data);
+}
+
+const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, NULL, free_analysis};
