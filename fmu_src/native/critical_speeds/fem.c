@@ -401,8 +401,9 @@ static int cholesky(double *m, int n, int *start)
     return 0;
 }
 
-/* a = L^-1 a L^-T for the symmetric ``a`` (both triangles on return); ``first_nonzero`` has n places */
-static void reduce_to_standard(double *a, const double *l, int n, int *first_nonzero)
+/* a = L^-1 a L^-T for the symmetric ``a`` (both triangles on return); row i of L starts at
+ * ``first_nonzero[i]`` (cholesky's envelope) */
+static void reduce_to_standard(double *a, const double *l, int n, const int *first_nonzero)
 {
     /* L^-1 a: forward substitution, a row at a time */
     for (int i = 0; i < n; i++) {
@@ -420,16 +421,7 @@ static void reduce_to_standard(double *a, const double *l, int n, int *first_non
             row[c] /= li[i];
         }
     }
-    /* (L^-1 a) L^-T: the same substitution along each row, from each row of L's first non-zero (the
-     * Cholesky factor of a banded mass matrix is banded) */
-    for (int j = 0; j < n; j++) {
-        const double *lj = l + (size_t)j * (size_t)n;
-        int first = 0;
-        while (first < j && lj[first] == 0.0) {
-            first++;
-        }
-        first_nonzero[j] = first;
-    }
+    /* (L^-1 a) L^-T: the same substitution along each row, from each row of L's first non-zero */
     for (int r = 0; r < n; r++) {
         double *row = a + (size_t)r * (size_t)n;
         for (int j = 0; j < n; j++) {
