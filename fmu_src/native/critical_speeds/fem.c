@@ -364,13 +364,22 @@ out_of_memory:
 }
 
 /* ---- scipy.linalg.eigh(K, M, eigvals_only=True) ---------------------------------------------- */
-/* Cholesky factor M = L L^T in the lower triangle of ``m``; the order of the failing minor, or 0. */
-static int cholesky(double *m, int n)
+/* Cholesky factor M = L L^T in the lower triangle of ``m``; the order of the failing minor, or 0.
+ * L keeps M's envelope: row i from its first non-zero, ``start`` (n places). */
+static int cholesky(double *m, int n, int *start)
 {
+    for (int i = 0; i < n; i++) {
+        const double *row = m + (size_t)i * (size_t)n;
+        int first = 0;
+        while (first < i && row[first] == 0.0) {
+            first++;
+        }
+        start[i] = first;
+    }
     for (int j = 0; j < n; j++) {
         double *row_j = m + (size_t)j * (size_t)n;
         double diagonal = row_j[j];
-        for (int k = 0; k < j; k++) {
+        for (int k = start[j]; k < j; k++) {
             diagonal -= row_j[k] * row_j[k];
         }
         if (!(diagonal > 0.0)) {
@@ -380,7 +389,10 @@ static int cholesky(double *m, int n)
         row_j[j] = diagonal;
         for (int i = j + 1; i < n; i++) {
             double *row_i = m + (size_t)i * (size_t)n, sum = row_i[j];
-            for (int k = 0; k < j; k++) {
+            if (start[i] > j) {
+                continue;
+            }
+            for (int k = start[i] > start[j] ? start[i] : start[j]; k < j; k++) {
                 sum -= row_i[k] * row_j[k];
             }
             row_i[j] = sum / diagonal;
@@ -389,26 +401,33 @@ static int cholesky(double *m, int n)
     return 0;
 }
 
-/* a = L^-1 a L^-T for the symmetric ``a`` (both triangles on return) */
-static void reduce_to_standard(double *a, const double *l, int n)
+/* a = L^-1 a L^-T for the symmetric ``a`` (both triangles on return); row i of L starts at
+ * ``first_nonzero[i]`` (cholesky's envelope) */
+static void reduce_to_standard(double *a, const double *l, int n, const int *first_nonzero)
 {
-    /* rows of L^-1 a: forward substitution down each column */
-    for (int c = 0; c < n; c++) {
-        for (int i = 0; i < n; i++) {
-            double sum = a[(size_t)i * (size_t)n + (size_t)c];
-            for (int k = 0; k < i; k++) {
-                sum -= l[(size_t)i * (size_t)n + (size_t)k] * a[(size_t)k * (size_t)n + (size_t)c];
+    /* L^-1 a: forward substitution, a row at a time */
+    for (int i = 0; i < n; i++) {
+        double *row = a + (size_t)i * (size_t)n;
+        const double *li = l + (size_t)i * (size_t)n;
+        for (int k = 0; k < i; k++) {
+            const double *done = a + (size_t)k * (size_t)n;
+            if (li[k] != 0.0) {
+                for (int c = 0; c < n; c++) {
+                    row[c] -= li[k] * done[c];
+                }
             }
-            a[(size_t)i * (size_t)n + (size_t)c] = sum / l[(size_t)i * (size_t)n + (size_t)i];
+        }
+        for (int c = 0; c < n; c++) {
+            row[c] /= li[i];
         }
     }
-    /* (L^-1 a) L^-T: the same substitution along each row */
+    /* (L^-1 a) L^-T: the same substitution along each row, from each row of L's first non-zero */
     for (int r = 0; r < n; r++) {
         double *row = a + (size_t)r * (size_t)n;
         for (int j = 0; j < n; j++) {
             double sum = row[j];
             const double *lj = l + (size_t)j * (size_t)n;
-            for (int k = 0; k < j; k++) {
+            for (int k = first_nonzero[j]; k < j; k++) {
                 sum -= row[k] * lj[k];
             }
             row[j] = sum / lj[j];
@@ -539,8 +558,14 @@ static int ascending(const void *a, const void *b)
 /* eigh(K, M, eigvals_only=True) ascending into ``values``; K and M are overwritten */
 static int generalized_eigenvalues(double *K, double *M, int n, double *values, char *error, size_t size)
 {
-    int minor = cholesky(M, n);
+    int *first_nonzero = malloc((size_t)(n + 1) * sizeof *first_nonzero);
+    if (!first_nonzero) {
+        set_error(error, size, OUT_OF_MEMORY);
+        return -1;
+    }
+    int minor = cholesky(M, n, first_nonzero);
     if (minor) {
+        free(first_nonzero);
         if (error && size) {
             snprintf(error, size,
                      "The leading minor of order %d of B is not positive definite. The factorization of B could "
@@ -550,10 +575,12 @@ static int generalized_eigenvalues(double *K, double *M, int n, double *values, 
     }
     double *work = malloc(3 * (size_t)(n + 1) * sizeof *work);
     if (!work) {
+        free(first_nonzero);
         set_error(error, size, OUT_OF_MEMORY);
         return -1;
     }
-    reduce_to_standard(K, M, n);
+    reduce_to_standard(K, M, n, first_nonzero);
+    free(first_nonzero);
     double *e = work, *v = work + n + 1, *p = v + n + 1;
     tridiagonalize(K, n, values, e, v, p);
     int status = tridiagonal_eigenvalues(values, e, n);
