@@ -5,6 +5,7 @@ same refusals word for word, and misuse answered with Error (never Fatal, never 
 from __future__ import annotations
 
 import math
+import re
 import shutil
 import subprocess
 import zipfile
@@ -32,8 +33,16 @@ VERSIONS = ("2", "3")
 # Both sides evaluate the same formulas in float64, but numpy's and libm's sin, cos, atan2 may
 # differ in the last bit: outputs must agree within this fraction of each signal's largest magnitude.
 TOLERANCE = 1e-12
-# The critical speeds come from root searches that stop within a tolerance of their own.
-SIGNAL_TOLERANCE = {"omega_crit_1": 1e-10, "omega_crit_2": 1e-10, "omega_crit_3": 1e-10}
+# The critical speeds come from root searches that stop within a tolerance of their own. The damping
+# ratio is the small real part of an eigenvalue, which a backward-stable eigensolver fixes to about
+# eps max|lambda| only, where max|lambda| is the finite-element model's highest mode, 100 to 1000
+# times the first: 1e-10 to 1e-9 of zeta's own size (measured between the two implementations: 6.8e-11
+# in the standard scenario, 1.5e-9 in the property test; numpy's own error against a 40-digit
+# reference is of the same order). The unbalance response and the bearing force carry the banded
+# solve's rounding amplified by the resonance, up to 1 / (2 zeta) = 330 (measured up to 2.6e-12 here,
+# 1.1e-10 at 0.07 % from the resonance in the rotor library's own test).
+SIGNAL_TOLERANCE = {"omega_crit_1": 1e-10, "omega_crit_2": 1e-10, "omega_crit_3": 1e-10, "damping_ratio": 1e-8,
+                    "unbalance_response": 1e-9, "bearing_force_max": 1e-9}
 
 
 def _native(native_dir: Path, name: str, fmi: str) -> Path:
@@ -326,7 +335,8 @@ def test_random_runs_match_the_core_and_refuse_alike(native_dir, name, fmi):
         if core_rows:
             reference, values = np.array(core_rows, dtype=float), np.array(native_rows, dtype=float)
             scale = np.abs(reference).max(axis=0)
-            assert np.all(np.abs(values - reference) <= TOLERANCE * scale), (values - reference) / scale
+            tolerance = np.array([SIGNAL_TOLERANCE.get(v.name, TOLERANCE) for v in MODELS[name].spec.of("output")])
+            assert np.all(np.abs(values - reference) <= tolerance * scale), (values - reference) / scale
 
     try:
         check()
@@ -560,8 +570,20 @@ def test_critical_speeds_refuses_like_the_python_fmu(native_dir, fmu_path, tmp_p
         {"D_outer": 1e200, "D_inner": 0.0}, {"orders": "1,2", "D_outer": 1e-100, "D_inner": 0.0},
     ]
     for parameters in cases:
-        expected = _refusals(fmu_path(name, fmi), parameters)
-        assert _refusals(_native(native_dir, name, fmi), parameters) == expected, parameters
+        expected = [_up_to_the_toml_reason(m) for m in _refusals(fmu_path(name, fmi), parameters)]
+        found = [_up_to_the_toml_reason(m) for m in _refusals(_native(native_dir, name, fmi), parameters)]
+        assert found == expected, parameters
+
+
+def _up_to_the_toml_reason(message: str) -> str:
+    """A message up to the reason of a malformed TOML text, which tomllib words in its own way, and
+    without the nearest finite-element frequency of a failed plausibility check: that check fails
+    where the eigenproblem is beyond double precision, and its lowest eigenvalues are round-off."""
+    message = re.sub(r"\(nearest \S+ rad/s\)", "(nearest ... rad/s)", message)
+    return message[:message.index(MALFORMED) + len(MALFORMED)] if MALFORMED in message else message
+
+
+MALFORMED = "malformed TOML: "
 
 
 @pytest.mark.parametrize("name", CRITICAL)

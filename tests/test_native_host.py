@@ -37,9 +37,10 @@ def host(tmp_path_factory: pytest.TempPathFactory) -> Path:
 # found in the resources folder the host hands over.
 MODES = {"TripodCoupling": [{"kinematics": 1, "mu": 0.05}, {"kinematics": 1, "seed_reactions": 1}],
          "CriticalSpeeds": [{"layout": "two_piece_propshaft"}, {"orders": "1,2,3,6", "shear": False}]}
-#: Largest deviation from the Python FMU, relative to each output's largest magnitude: the critical
-#: speeds and what derives from them come from root searches, 1e-10 (tests/test_native_fmus.py).
-TOLERANCES = {"CriticalSpeeds": 1e-10}
+#: Largest deviation from the Python FMU, relative to each output's largest magnitude: the damping
+#: ratio's eigenvalue real part and the response near a resonance, 1e-9 (why: SIGNAL_TOLERANCE of
+#: tests/test_native_fmus.py).
+TOLERANCES = {"CriticalSpeeds": 1e-9}
 RUNS = [(name, parameters) for name in native.native_models() for parameters in ({}, *MODES.get(name, ()))]
 
 

@@ -139,6 +139,9 @@ class DampedRotor:
         fe = fem.assemble_damped(driveline, elements_per_segment)
         self._fe = fe
         self.doubled = bool(np.any(fe.K_b) or np.any(fe.C_b))
+        # no damping and a symmetric bearing stiffness: a conservative gyroscopic system, whose
+        # eigenvalues are imaginary (the eigensolver's real parts are round-off, about 1e-13 |lam|)
+        self.conservative = not (np.any(fe.C) or np.any(fe.C_b)) and all(b.kxy == b.kyx for b in driveline.bearings)
         n = fe.M.shape[0]
         if self.doubled:
             self.K = np.block([[fe.K, fe.K_b], [fe.K_b.conj(), fe.K.conj()]])
@@ -260,6 +263,8 @@ class DampedRotor:
             nu, vectors = eigs(operator, k=count, which="LM") if self.doubled else (
                 eigs(operator, k=count, which="LM", return_eigenvectors=False), None)
             lam = SHIFT + 1.0 / nu
+        if self.conservative:
+            lam = 1j * lam.imag
         whirling = np.isfinite(lam) & (np.abs(lam.imag) > 1e-9 * np.max(np.abs(lam)))  # not overdamped or static
         if not self.doubled:  # u = p exp(lam t): Im lam < 0 whirls backward
             out = [DampedMode(complex(v.real, abs(v.imag)), float(v.imag > 0)) for v in lam[whirling]]

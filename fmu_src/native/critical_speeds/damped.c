@@ -415,6 +415,7 @@ static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
 typedef struct {
     FeModel fe;                /* fem.assemble_damped's mesh and real K, M, G (bearings left out) */
     int n, doubled, size;      /* p unknowns; [p, q] when doubled; size = n or 2 n */
+    int conservative;          /* no damping, symmetric bearing stiffness: imaginary eigenvalues */
     cplx *K, *C, *G;           /* K2, C2, Gv (size x size); NULL once the rotor only solves */
     Band band;                 /* the interleaved order [p0, q0, p1, q1, ...] */
     cplx *banded[4];           /* k, c, g, m in band storage */
@@ -487,13 +488,17 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
         Ca[at] += c[2];
         Cb[at] += c[3];
     }
+    int damped = 0, symmetric = 1;
     for (int i = 0; i < nb; i++) {
         int row = rotor->bearing_rows[i];
+        symmetric &= d->bearings[i].kxy == d->bearings[i].kyx;
         if (row >= 0) {
             size_t at = (size_t)row * (size_t)n + (size_t)row;
             doubled |= Kb[at] != 0.0 || Cb[at] != 0.0;
+            damped |= Ca[at] != 0.0 || Cb[at] != 0.0;
         }
     }
+    rotor->conservative = !damped && symmetric;
     /* the translation rows of the beam nodes (np.unique of the elements' U dofs) */
     int count = 0;
     for (int e = 0; e <= fe->n_elements; e++) {
@@ -814,6 +819,11 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
             index[best] = t;
         }
         count = wanted;
+    }
+    if (rotor->conservative) { /* the eigensolver's real parts are round-off (DampedRotor.modes) */
+        for (int k = 0; k < count; k++) {
+            dense->lambda[index[k]] = make_complex(0.0, cimag(dense->lambda[index[k]]));
+        }
     }
     double largest = 0.0;
     for (int k = 0; k < count; k++) {

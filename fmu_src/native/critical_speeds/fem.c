@@ -464,8 +464,7 @@ static void tridiagonalize(double *a, int n, double *d, double *e, double *v, do
         double alpha = v[0] >= 0.0 ? -sqrt(norm2) : sqrt(norm2);
         e[k] = alpha * scale;
         v[0] -= alpha;
-        double vv = norm2 - 2.0 * alpha * (v[0] + alpha) + alpha * alpha; /* |x - alpha e1|^2 */
-        vv = 0.0;
+        double vv = 0.0; /* |x - alpha e1|^2 */
         for (int i = 0; i < m; i++) {
             vv += v[i] * v[i];
         }
@@ -583,7 +582,25 @@ static int generalized_eigenvalues(double *K, double *M, int n, double *values, 
     free(first_nonzero);
     double *e = work, *v = work + n + 1, *p = v + n + 1;
     tridiagonalize(K, n, values, e, v, p);
+    /* scaled by a power of two (exact) to order one: the shifts' squares neither overflow nor underflow */
+    double largest = 0.0;
+    for (int i = 0; i < n; i++) {
+        largest = fmax(largest, fmax(fabs(values[i]), i + 1 < n ? fabs(e[i]) : 0.0));
+    }
+    int exponent = 0;
+    if (largest > 0.0 && isfinite(largest)) {
+        frexp(largest, &exponent);
+    }
+    for (int i = 0; i < n; i++) {
+        values[i] = ldexp(values[i], -exponent);
+        if (i + 1 < n) {
+            e[i] = ldexp(e[i], -exponent);
+        }
+    }
     int status = tridiagonal_eigenvalues(values, e, n);
+    for (int i = 0; i < n; i++) {
+        values[i] = ldexp(values[i], exponent);
+    }
     free(work);
     if (status) {
         set_error(error, size, "the eigenvalue iteration did not converge");
