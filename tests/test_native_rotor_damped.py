@@ -75,7 +75,7 @@ OMEGA_MAX = 1500.0
 
 @pytest.fixture(scope="module")
 def library(tmp_path_factory):
-    lib = compile_rotor(tmp_path_factory.mktemp("damped"), ["fem", "damped", "spline"])
+    lib = compile_rotor(tmp_path_factory.mktemp("damped"), ["fem", "damped", "spline", "layout", "pyrepr"])
     driveline_p = ctypes.POINTER(CDriveline)
     lib.fe_natural_frequencies.argtypes = [driveline_p, ctypes.c_int, ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
                                            ctypes.POINTER(ctypes.c_int), ctypes.c_char_p, ctypes.c_size_t]

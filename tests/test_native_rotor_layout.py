@@ -73,7 +73,7 @@ def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
                                             ctypes.c_size_t]
     library.python_str_repr_n.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_size_t, ctypes.c_char_p,
                                           ctypes.c_size_t]
-    library.pyrepr_float.argtypes = [ctypes.c_double, ctypes.c_char_p, ctypes.c_size_t]
+    library.python_float_repr.argtypes = [ctypes.c_double, ctypes.c_char_p, ctypes.c_size_t]
     return library
 
 
@@ -688,11 +688,11 @@ def test_python_str_repr(lib):
 
 def float_repr(lib, value: float) -> str:
     out = ctypes.create_string_buffer(64)
-    lib.pyrepr_float(value, out, 64)
+    lib.python_float_repr(value, out, 64)
     return out.value.decode()
 
 
-def test_pyrepr_float(lib):
+def test_python_float_repr(lib):
     rng = random.Random(11)
     values = [0.0, -0.0, math.inf, -math.inf, math.nan, 5e-324, 1.7976931348623157e308, 2.2250738585072014e-308,
               0.1, 0.3, 1 / 3, 1e16, 1e15, 9999999999999998.0, 1e-4, 1e-5, 0.0001234, 123.0, 1e22, 1e23, 2.0 ** 63,

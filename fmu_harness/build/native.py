@@ -48,7 +48,7 @@ from .model_description import complete_fmi2, complete_fmi3
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
 MODEL_SOURCES = NATIVE_SRC
-SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c")
+SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c", "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-fPIC", "-O2", "-fvisibility=hidden")

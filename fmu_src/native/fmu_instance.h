@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "model_variables.h"
+#include "python_numbers.h"
 
 /* Marks a parameter the standard's signature has and this implementation does not need. */
 #if defined(__GNUC__) || defined(__clang__)
@@ -184,11 +185,6 @@ void messages_add(Messages *out, const char *first, ...);
 /* Adds generated message ``message`` (a MESSAGE_* of model_variables.h) with its variable's value. */
 void messages_add_extra(Messages *out, const ModelData *data, int message);
 #endif
-/* Python's math.fsum of ``count`` values into ``*sum``: NULL, or the text of the exception Python
- * raises ("intermediate overflow in fsum", "-inf + inf in fsum"). */
-const char *python_fsum(const double values[], int count, double *sum);
-/* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
-void python_float_repr(double value, char *out, size_t size);
 
 /* ---- life cycle (used by the FMI layers) -------------------------------------------- */
 Status instance_reset(Instance *instance);

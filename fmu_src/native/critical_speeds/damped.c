@@ -880,60 +880,14 @@ struct UnbalanceOutputs {
     int *pivots;
 };
 
-/* repr() of a finite float: the shortest digits that read back to it, in Python's layout */
-static void float_repr(double value, char *out, size_t size)
-{
-    if (!isfinite(value)) {
-        snprintf(out, size, "%s", isnan(value) ? "nan" : value > 0 ? "inf" : "-inf");
-        return;
-    }
-    char digits[40];
-    int precision = 1;
-    for (; precision < 17; precision++) {
-        snprintf(digits, sizeof digits, "%.*e", precision - 1, value);
-        if (strtod(digits, NULL) == value) {
-            break;
-        }
-    }
-    snprintf(digits, sizeof digits, "%.*e", precision - 1, value);
-    char *e = strchr(digits, 'e');
-    int exponent = atoi(e + 1);
-    *e = '\0';
-    char mantissa[24];
-    const char *sign = digits[0] == '-' ? "-" : "";
-    int count = 0;
-    for (const char *c = digits + (*sign ? 1 : 0); *c && count < 20; c++) {
-        if (*c != '.') {
-            mantissa[count++] = *c;
-        }
-    }
-    mantissa[count] = '\0';
-    if (exponent < -4 || exponent >= 16) {
-        snprintf(out, size, "%s%c%s%s%se%c%02d", sign, mantissa[0], count > 1 ? "." : "", mantissa + 1, "",
-                 exponent < 0 ? '-' : '+', abs(exponent));
-    } else if (exponent < 0) {
-        snprintf(out, size, "%s0.%0*d%s", sign, -exponent - 1, 0, mantissa);
-        if (exponent == -1) {
-            snprintf(out, size, "%s0.%s", sign, mantissa);
-        }
-    } else if (count <= exponent + 1) {
-        snprintf(out, size, "%s%s%0*d.0", sign, mantissa, exponent + 1 - count, 0);
-        if (count == exponent + 1) {
-            snprintf(out, size, "%s%s.0", sign, mantissa);
-        }
-    } else {
-        snprintf(out, size, "%s%.*s.%s", sign, exponent + 1, mantissa, mantissa + exponent + 1);
-    }
-}
-
 /* DampedRotor.shape_rows for one position: ``row`` (rotor.n) */
 static int shape_row(const Rotor *rotor, double z, double length, cplx *row, char *error, size_t size)
 {
     const FeModel *fe = &rotor->fe;
     if (!isfinite(z) || z < 0.0 || z > length * (1 + 1e-12)) {
         char shown[40], at[40];
-        float_repr(length, shown, sizeof shown);
-        float_repr(z, at, sizeof at);
+        python_float_repr(length, shown, sizeof shown);
+        python_float_repr(z, at, sizeof at);
         if (error && size) {
             snprintf(error, size, "positions must lie on the shaft, 0 to %s m, got [%s]", shown, at);
         }
@@ -1062,7 +1016,7 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         return NULL;
     }
     /* DampedRotor.load: the unbalances' phasors times their shape rows */
-    double length = fe_driveline_length(d);
+    double length = driveline_length(d);
     for (int u = 0; u < n_unbalances; u++) {
         if (shape_row(rotor, unbalances[u].position, length, rows, error, size)) {
             free(rows);

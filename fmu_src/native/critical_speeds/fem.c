@@ -18,65 +18,10 @@ static void set_error(char *error, size_t size, const char *message)
     }
 }
 
-/* math.fsum: the correctly rounded sum (partials of the exact sum, as Python's) */
-static double exact_sum(const double *values, int count, int stride)
-{
-    double partials[64];
-    int used = 0;
-    for (int k = 0; k < count; k++) {
-        double x = values[(size_t)k * (size_t)stride];
-        int kept = 0;
-        for (int j = 0; j < used; j++) {
-            double y = partials[j];
-            if (fabs(x) < fabs(y)) {
-                double t = x;
-                x = y;
-                y = t;
-            }
-            double hi = x + y;
-            double lo = y - (hi - x);
-            if (lo != 0.0 && kept < 63) {
-                partials[kept++] = lo;
-            }
-            x = hi;
-        }
-        partials[kept] = x;
-        used = kept + 1;
-    }
-    if (used == 0) {
-        return 0.0;
-    }
-    int n = used - 1;
-    double hi = partials[n], lo = 0.0;
-    while (n > 0) {
-        double x = hi, y = partials[--n];
-        hi = x + y;
-        lo = y - (hi - x);
-        if (lo != 0.0) {
-            break;
-        }
-    }
-    /* half-way cases: round as the exact sum would */
-    if (n > 0 && ((lo < 0.0 && partials[n - 1] < 0.0) || (lo > 0.0 && partials[n - 1] > 0.0))) {
-        double y = 2.0 * lo, x = hi + y;
-        if (y == x - hi) {
-            hi = x;
-        }
-    }
-    return hi;
-}
-
-/* Driveline.length */
-double fe_driveline_length(const Driveline *driveline)
-{
-    return exact_sum(&driveline->segments[0].length, driveline->n_segments,
-                     (int)(sizeof(RotorSegment) / sizeof(double)));
-}
-
 /* fem.elements_by_length */
 void fe_elements_by_length(const Driveline *driveline, int most, int *counts)
 {
-    double half = 0.5 * fe_driveline_length(driveline);
+    double half = 0.5 * driveline_length(driveline);
     for (int k = 0; k < driveline->n_segments; k++) {
         double share = ceil(most * driveline->segments[k].length / half - 1e-9);
         int count = share >= most ? most : (int)share;

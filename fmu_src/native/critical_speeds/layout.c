@@ -60,7 +60,7 @@ static void put_str_repr(Text *text, const char *bytes, size_t count)
 static void put_float(Text *text, double value)
 {
     char shown[40];
-    pyrepr_float(value, shown, sizeof shown);
+    python_float_repr(value, shown, sizeof shown);
     put(text, shown);
 }
 
@@ -1318,56 +1318,10 @@ static int check_unbalance(const Loader *loader, const RotorUnbalance *u)
     return 0;
 }
 
-/* math.fsum (Shewchuk's partials, then the half-even correction of CPython's msum); 0 with the
- * sum, -1 on an intermediate overflow. */
-static int exact_length(const RotorSegment *segments, int n, double *sum)
+/* Driveline.length: math.fsum of the segment lengths; NULL, or the text of Python's exception */
+static const char *segments_length(const Driveline *d, double *sum)
 {
-    double partials[64], hi = 0.0, lo = 0.0;
-    size_t count = 0, j, kept;
-    int i;
-    for (i = 0; i < n; i++) {
-        double x = segments[i].length;
-        for (j = 0, kept = 0; j < count; j++) {
-            double y = partials[j], high, low;
-            if (fabs(x) < fabs(y)) {
-                double t = x;
-                x = y;
-                y = t;
-            }
-            high = x + y;
-            low = y - (high - x);
-            if (low != 0.0) {
-                partials[kept++] = low;
-            }
-            x = high;
-        }
-        count = kept;
-        if (!isfinite(x)) {
-            return -1;
-        }
-        if (x != 0.0 && count < sizeof partials / sizeof partials[0]) {
-            partials[count++] = x;
-        }
-    }
-    if (count > 0) {
-        hi = partials[--count];
-        while (count > 0) {
-            double x = hi, y = partials[--count];
-            hi = x + y;
-            lo = y - (hi - x);
-            if (lo != 0.0) {
-                break;
-            }
-        }
-        if (count > 0 && ((lo < 0.0 && partials[count - 1] < 0.0) || (lo > 0.0 && partials[count - 1] > 0.0))) {
-            double y = lo * 2.0, x = hi + y;
-            if (y == x - hi) {
-                hi = x;
-            }
-        }
-    }
-    *sum = hi;
-    return 0;
+    return python_fsum_strided(&d->segments[0].length, d->n_segments, sizeof(RotorSegment) / sizeof(double), sum);
 }
 
 /* Driveline.__post_init__'s checks on the nodes and the unbalances. */
@@ -1399,13 +1353,17 @@ static int check_driveline(const Loader *loader, const Driveline *d)
                         n_nodes - 2);
         }
     }
-    if (exact_length(d->segments, d->n_segments, &length) != 0) {
-        return fail(loader->error, loader->size, "intermediate overflow in fsum");
+    const char *failure = segments_length(d, &length);
+    if (failure != NULL) {
+        return fail(loader->error, loader->size, "%s", failure);
     }
     for (i = 0; i < d->n_unbalances; i++) {
         if (d->unbalances[i].position > length) {
-            return fail(loader->error, loader->size, "unbalances[%d].position = %g m lies beyond the right end (%g m)",
-                        i, d->unbalances[i].position, length);
+            char position[32], end[32];
+            python_float_repr(d->unbalances[i].position, position, sizeof position);
+            python_float_repr(length, end, sizeof end);
+            return fail(loader->error, loader->size, "unbalances[%d].position = %s m lies beyond the right end (%s m)",
+                        i, position, end);
         }
     }
     return 0;
@@ -2376,7 +2334,7 @@ int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error,
 double driveline_length(const Driveline *driveline)
 {
     double sum;
-    return exact_length(driveline->segments, driveline->n_segments, &sum) == 0 ? sum : HUGE_VAL;
+    return segments_length(driveline, &sum) == NULL ? sum : HUGE_VAL;
 }
 
 /* Driveline.is_isotropic (the chain's: every bearing with kxx == kyy) */

@@ -53,77 +53,11 @@ static void set_error(char *error, size_t size, const char *text)
     }
 }
 
-/* repr() of a Python float: the shortest digits that read back, fixed for 1e-4 <= |v| < 1e16 */
-static void float_repr(double v, char *out, size_t size)
-{
-    char digits[40], text[48];
-    int precision, exponent, n, i;
-    char *mantissa_end;
-    if (isnan(v)) {
-        snprintf(out, size, "nan");
-        return;
-    }
-    if (isinf(v)) {
-        snprintf(out, size, v > 0 ? "inf" : "-inf");
-        return;
-    }
-    for (precision = 1; precision <= 17; precision++) {
-        snprintf(text, sizeof text, "%.*e", precision - 1, v);
-        if (strtod(text, NULL) == v) {
-            break;
-        }
-    }
-    mantissa_end = strchr(text, 'e');
-    exponent = atoi(mantissa_end + 1);
-    n = 0;
-    for (i = 0; text + i < mantissa_end; i++) { /* the significant digits, sign and point dropped */
-        if (text[i] >= '0' && text[i] <= '9') {
-            digits[n++] = text[i];
-        }
-    }
-    while (n > 1 && digits[n - 1] == '0') {
-        n--;
-    }
-    digits[n] = '\0';
-    if (exponent < -4 || exponent >= 16) {
-        snprintf(out, size, "%s%c%s%se%c%02d", signbit(v) ? "-" : "", digits[0], n > 1 ? "." : "", digits + 1,
-                 exponent < 0 ? '-' : '+', abs(exponent));
-        return;
-    }
-    i = 0;
-    if (signbit(v)) {
-        text[i++] = '-';
-    }
-    if (exponent < 0) { /* 0.000ddd */
-        text[i++] = '0';
-        text[i++] = '.';
-        for (precision = 0; precision < -exponent - 1; precision++) {
-            text[i++] = '0';
-        }
-        for (precision = 0; precision < n; precision++) {
-            text[i++] = digits[precision];
-        }
-    } else { /* ddd.ddd, at least one digit after the point */
-        for (precision = 0; precision <= exponent; precision++) {
-            text[i++] = precision < n ? digits[precision] : '0';
-        }
-        text[i++] = '.';
-        if (n <= exponent + 1) {
-            text[i++] = '0';
-        }
-        for (precision = exponent + 1; precision < n; precision++) {
-            text[i++] = digits[precision];
-        }
-    }
-    text[i] = '\0';
-    snprintf(out, size, "%s", text);
-}
-
 /* driveline._speed's message */
 static int speed_error(const char *name, double value, char *error, size_t size)
 {
     char text[64];
-    float_repr(value, text, sizeof text);
+    python_float_repr(value, text, sizeof text);
     if (error != NULL && size > 0) {
         snprintf(error, size, "%s must be a finite speed > 0 rad/s, got %s", name, text);
     }

@@ -19,6 +19,8 @@
 
 #include <stddef.h>
 
+#include "../python_numbers.h"
+
 /* ---- limits and constants (the modules of driveline/rotor/) -------------------------------- */
 #define ROTOR_SEARCH_LIMIT 1.0e5     /* driveline.SEARCH_LIMIT [rad/s] */
 #define ROTOR_EXCITED_SHARE 0.01     /* driveline.EXCITED_SHARE */
@@ -99,8 +101,6 @@ int driveline_isotropic(const Driveline *driveline);
 void python_str_repr(const char *text, size_t max_chars, char *out, size_t size);
 /* The same for ``length`` bytes (the text may hold NUL characters). */
 void python_str_repr_n(const char *text, size_t length, size_t max_chars, char *out, size_t size);
-/* repr() of a Python float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05", "1e+16". */
-void pyrepr_float(double value, char *out, size_t size);
 /* Appends ``count`` bytes to the text of ``*used`` bytes in ``out`` (``size`` bytes), cut to fit,
  * always terminated; ``*used`` grows by what was written. */
 void text_append(char *out, size_t size, size_t *used, const char *bytes, size_t count);
@@ -201,8 +201,6 @@ void fe_elements_by_length(const Driveline *driveline, int most, int *counts);
 int fe_model_build(const Driveline *driveline, const int *counts, int with_bearings, FeModel *model, char *error,
                    size_t size);
 void fe_model_free(FeModel *model);
-/* math.fsum of the segment lengths (Driveline.length) */
-double fe_driveline_length(const Driveline *driveline);
 
 /* model.natural_frequencies: sqrt|eigenvalues| of the undamped FE model with ``elements``
  * elements per segment (both planes for anisotropic bearings: the kxx plane first, each plane
