@@ -17,6 +17,8 @@ from driveline.catalog import MODELS
 from fmu_harness import importers, system
 from fmu_harness.build import fmu_path, native
 
+import test_native_fmus as native_fmus
+
 SSD = {"ssd": system.SSD, "ssv": system.SSV}
 PACKAGES = ("driveline_ssp", "native_ssp")
 
@@ -100,11 +102,14 @@ def test_native_package_holds_the_native_fmu_of_each_model_that_has_one(native_s
 
 
 def test_the_master_runs_the_native_variant_like_the_python_system(fmu_dir, native_dir, master_result):
-    """Within 1e-12 of each output's largest magnitude, the native FMUs' own promise (measured:
-    bit for bit)."""
+    """Within the native FMUs' own promise of each output's largest magnitude (tests/test_native_fmus.py:
+    1e-12, the watcher's eigenvalue-conditioned outputs 1e-9 and 1e-8; measured: bit for bit but the
+    tripod's theta, 1.4e-16, and the watcher's damping ratio, 6.9e-11)."""
     result = system.simulate(system.driveline(), fmu_dir, natives=native_dir)
     deviation = _deviation(result, master_result)
-    assert max(deviation.values()) <= 1e-12, deviation
+    beyond = {name: d for name, d in deviation.items()
+              if not d <= native_fmus.SIGNAL_TOLERANCE.get(name.rpartition(".")[2], native_fmus.TOLERANCE)}
+    assert beyond == {}, deviation
 
 
 def test_the_master_feeds_the_coupling_with_the_source_speed(master_result):
