@@ -12,10 +12,9 @@ import pytest
 
 from driveline.rotor import Bearing, Driveline, example_path, load_driveline, one_piece_shaft
 from driveline.rotor.campbell import whirl_branches
-from driveline.rotor.elements import Hinge
 from driveline.rotor.model import CAMPBELL_POINTS, WHIRL_MODES, analyse_structure, whirl_table
 
-from native_rotor import ROTOR_SOURCES, compile_rotor
+from native_rotor import CHAIN_SIGNATURES, DOUBLE_P, ROTOR_SOURCES, c_driveline, compile_rotor, declare
 
 #: Agreement of every whirl frequency, relative to the largest magnitude of its column over the speeds
 #: compared. The C port evaluates the same determinant at the same points, follows the same branches
@@ -30,81 +29,21 @@ RTOL = 1e-12
 SPEEDS = 200
 
 
-class Segment(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in ("length", "outer_diameter", "inner_diameter",
-                                                     "youngs_modulus", "density", "poisson_ratio")] + \
-               [(name, ctypes.c_int) for name in ("rotary_inertia", "gyroscopic", "shear")]
-
-
-class Mass(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int), ("mass", ctypes.c_double), ("polar_inertia", ctypes.c_double),
-                ("diametral_inertia", ctypes.c_double)]
-
-
-class CBearing(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int)] + [(name, ctypes.c_double) for name in
-                                           ("kxx", "kyy", "cxx", "cyy", "kxy", "kyx", "cxy", "cyx")]
-
-
-class CHinge(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int), ("bending_stiffness", ctypes.c_double)]
-
-
-class CUnbalance(ctypes.Structure):
-    _fields_ = [("position", ctypes.c_double), ("amount", ctypes.c_double), ("phase", ctypes.c_double)]
-
-
-class CDriveline(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_int) for name in ("n_segments", "n_masses", "n_bearings", "n_hinges",
-                                                  "n_unbalances")] + \
-               [("segments", ctypes.POINTER(Segment)), ("masses", ctypes.POINTER(Mass)),
-                ("bearings", ctypes.POINTER(CBearing)), ("hinges", ctypes.POINTER(CHinge)),
-                ("unbalances", ctypes.POINTER(CUnbalance)), ("left", ctypes.c_int), ("right", ctypes.c_int)]
-
-
-ENDS = {"free": 0, "pinned": 1, "clamped": 2}
-
-
-def c_driveline(d: Driveline) -> tuple[CDriveline, list]:
-    """The C driveline of ``d`` and the arrays it points into (keep them alive with it)."""
-    assert all(isinstance(j, Hinge) for j in d.joints)
-    segments = (Segment * len(d.segments))(*[
-        Segment(s.length, s.outer_diameter, s.inner_diameter, s.youngs_modulus, s.density, s.poisson_ratio,
-                int(s.rotary_inertia), int(s.gyroscopic), int(s.shear)) for s in d.segments])
-    masses = (Mass * max(len(d.masses), 1))(*[
-        Mass(m.node, m.mass, m.polar_inertia, m.diametral_inertia) for m in d.masses])
-    bearings = (CBearing * max(len(d.bearings), 1))(*[
-        CBearing(b.node, b.kxx, b.kxx if b.kyy is None else b.kyy, b.cxx, b.cxx if b.cyy is None else b.cyy,
-                 b.kxy, b.kyx, b.cxy, b.cyx) for b in d.bearings])
-    hinges = (CHinge * max(len(d.joints), 1))(*[CHinge(h.node, h.bending_stiffness) for h in d.joints])
-    unbalances = (CUnbalance * max(len(d.unbalances), 1))(*[
-        CUnbalance(u.position, u.amount, u.phase) for u in d.unbalances])
-    ends = [ENDS[str(getattr(end, "value", end))] for end in (d.left, d.right)]
-    out = CDriveline(len(d.segments), len(d.masses), len(d.bearings), len(d.joints), len(d.unbalances),
-                     segments, masses, bearings, hinges, unbalances, *ends)
-    return out, [segments, masses, bearings, hinges, unbalances]
-
-
 @pytest.fixture(scope="module")
 def library(tmp_path_factory):
     missing = [m for m in ("transfer", "roots") if not (ROTOR_SOURCES / f"{m}.c").is_file()]
     if missing:
         pytest.skip(f"the rotor library has no {' or '.join(missing)} module yet")
     lib = compile_rotor(tmp_path_factory.mktemp("campbell"), ["transfer", "roots", "spline", "campbell"])
-    lib.chain_new.argtypes = [ctypes.POINTER(CDriveline), ctypes.c_char_p, ctypes.c_size_t]
-    lib.chain_new.restype = ctypes.c_void_p
-    lib.chain_free.argtypes = [ctypes.c_void_p]
-    lib.chain_free.restype = None
-    lib.whirl_table_new.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_int, ctypes.c_int, ctypes.c_char_p,
-                                    ctypes.c_size_t]
-    lib.whirl_table_new.restype = ctypes.c_void_p
-    lib.whirl_table_evaluate.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.POINTER(ctypes.c_double)]
-    lib.whirl_table_evaluate.restype = None
-    lib.whirl_table_knots.argtypes = [ctypes.c_void_p]
-    lib.whirl_table_knots.restype = ctypes.c_int
-    lib.whirl_table_free.argtypes = [ctypes.c_void_p]
-    lib.whirl_table_free.restype = None
-    return lib
+    table = ctypes.c_void_p
+    return declare(lib, {
+        **CHAIN_SIGNATURES,
+        "whirl_table_new": (table, [ctypes.c_void_p, ctypes.c_double, ctypes.c_int, ctypes.c_int, ctypes.c_char_p,
+                                    ctypes.c_size_t]),
+        "whirl_table_evaluate": (None, [table, ctypes.c_double, DOUBLE_P]),
+        "whirl_table_knots": (ctypes.c_int, [table]),
+        "whirl_table_free": (None, [table]),
+    })
 
 
 class NativeTable:
@@ -113,7 +52,7 @@ class NativeTable:
     def __init__(self, lib, d: Driveline, omega_max: float, n_modes: int = WHIRL_MODES,
                  points: int = CAMPBELL_POINTS) -> None:
         self._lib, self._n = lib, n_modes
-        driveline, self._keep = c_driveline(d)
+        self._driveline = driveline = c_driveline(d)
         error = ctypes.create_string_buffer(512)
         self._chain = lib.chain_new(ctypes.byref(driveline), error, len(error))
         assert self._chain, error.value.decode()

@@ -21,8 +21,7 @@ from driveline.rotor.fem import elements_by_length
 from driveline.rotor.loader import example_path, load_driveline, loads_driveline
 from driveline.rotor.unbalance_outputs import TABLE_ELEMENTS, UnbalanceOutputs
 
-from native_rotor import compile_rotor
-from native_rotor_driveline import CDriveline, c_driveline, unbalances
+from native_rotor import DOUBLE_P, CDriveline, P, c_driveline, compile_rotor, declare, unbalances
 
 EPS = np.finfo(float).eps
 #: Natural frequencies, relative: scipy's and the C Cholesky reduction both lose the lowest
@@ -76,17 +75,15 @@ OMEGA_MAX = 1500.0
 @pytest.fixture(scope="module")
 def library(tmp_path_factory):
     lib = compile_rotor(tmp_path_factory.mktemp("damped"), ["fem", "damped", "spline", "layout", "pyrepr"])
-    driveline_p = ctypes.POINTER(CDriveline)
-    lib.fe_natural_frequencies.argtypes = [driveline_p, ctypes.c_int, ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
-                                           ctypes.POINTER(ctypes.c_int), ctypes.c_char_p, ctypes.c_size_t]
-    lib.fe_natural_frequencies.restype = ctypes.c_int
-    lib.unbalance_outputs_new.argtypes = [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double, ctypes.c_double,
-                                          ctypes.c_char_p, ctypes.c_size_t]
-    lib.unbalance_outputs_new.restype = ctypes.c_void_p
-    lib.unbalance_outputs_evaluate.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.POINTER(ctypes.c_double)]
-    lib.unbalance_outputs_evaluate.restype = None
-    lib.unbalance_outputs_free.argtypes = [ctypes.c_void_p]
-    lib.unbalance_outputs_free.restype = None
+    driveline_p, outputs_p, error, size = P(CDriveline), ctypes.c_void_p, ctypes.c_char_p, ctypes.c_size_t
+    declare(lib, {
+        "fe_natural_frequencies": (ctypes.c_int, [driveline_p, ctypes.c_int, P(DOUBLE_P), P(ctypes.c_int), error,
+                                                  size]),
+        "unbalance_outputs_new": (outputs_p, [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double,
+                                              ctypes.c_double, error, size]),
+        "unbalance_outputs_evaluate": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
+        "unbalance_outputs_free": (None, [outputs_p]),
+    })
     lib.free.argtypes = [ctypes.c_void_p]  # libc's, through the library's dependencies
     return lib
 
@@ -104,9 +101,9 @@ def natural_frequencies(lib, d: Driveline, elements: int = model.FE_ELEMENTS) ->
 def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds) -> np.ndarray:
     """The C UnbalanceOutputs' evaluate at ``speeds`` (rows: response, force, damping ratio)."""
     c = c_driveline(d)
-    _, pointer = kept = unbalances(items)
+    excited = unbalances(items)
     error = ctypes.create_string_buffer(512)
-    handle = lib.unbalance_outputs_new(ctypes.byref(c), pointer, len(items), fraction, omega_max, error, 512)
+    handle = lib.unbalance_outputs_new(ctypes.byref(c), excited, len(items), fraction, omega_max, error, 512)
     assert handle, error.value
     try:
         out = (ctypes.c_double * 3)()
@@ -116,7 +113,6 @@ def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds)
             rows.append(list(out))
     finally:
         lib.unbalance_outputs_free(handle)
-    del kept
     return np.array(rows)
 
 
@@ -200,8 +196,7 @@ def test_refusals_are_worded_as_pythons(library, omega_max):
     with pytest.raises(ValueError) as refused:
         UnbalanceOutputs.build(DEFAULT, excitation(DEFAULT), 0.5, omega_max)
     c = c_driveline(DEFAULT)
-    _, pointer = kept = unbalances(excitation(DEFAULT))
+    excited = unbalances(excitation(DEFAULT))
     error = ctypes.create_string_buffer(512)
-    assert not library.unbalance_outputs_new(ctypes.byref(c), pointer, 1, 0.5, omega_max, error, 512)
+    assert not library.unbalance_outputs_new(ctypes.byref(c), excited, 1, 0.5, omega_max, error, 512)
     assert error.value.decode() == str(refused.value)
-    del kept

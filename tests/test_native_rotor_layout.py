@@ -16,82 +16,42 @@ from driveline.rotor import loader
 from driveline.rotor.loader import load_driveline, loads_driveline, one_piece_shaft
 from driveline.rotor.model import build_driveline
 
-from native_rotor import compile_rotor
+from native_rotor import (CDriveline, OnePieceShaft, P, RotorBearing, RotorHinge, RotorMass, RotorSegment,
+                          RotorUnbalance, compile_rotor, declare)
 
 DATA = Path(loader.__file__).parent / "data"
 ERROR_SIZE = 8192
 
 
-class Segment(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in
-                ("length", "outer_diameter", "inner_diameter", "youngs_modulus", "density", "poisson_ratio")] + [
-        (name, ctypes.c_int) for name in ("rotary_inertia", "gyroscopic", "shear")]
-
-
-class Mass(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int)] + [(name, ctypes.c_double) for name in
-                                            ("mass", "polar_inertia", "diametral_inertia")]
-
-
-class Bearing(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int)] + [(name, ctypes.c_double) for name in
-                                            ("kxx", "kyy", "cxx", "cyy", "kxy", "kyx", "cxy", "cyx")]
-
-
-class Hinge(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int), ("bending_stiffness", ctypes.c_double)]
-
-
-class Unbalance(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in ("position", "amount", "phase")]
-
-
-class Driveline(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_int) for name in
-                ("n_segments", "n_masses", "n_bearings", "n_hinges", "n_unbalances")] + [
-        ("segments", ctypes.POINTER(Segment)), ("masses", ctypes.POINTER(Mass)),
-        ("bearings", ctypes.POINTER(Bearing)), ("hinges", ctypes.POINTER(Hinge)),
-        ("unbalances", ctypes.POINTER(Unbalance)), ("left", ctypes.c_int), ("right", ctypes.c_int)]
-
-
-class OnePiece(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in
-                ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", "Jp_joint", "Jd_joint", "k_bearing",
-                 "c_bearing")] + [("shear", ctypes.c_int)]
-
-
 @pytest.fixture(scope="module")
 def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
     library = compile_rotor(tmp_path_factory.mktemp("layout"), ["layout", "pyrepr"])
-    library.driveline_length.restype = ctypes.c_double
-    library.driveline_length.argtypes = [ctypes.POINTER(Driveline)]
-    library.driveline_from_text.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p,
-                                            ctypes.POINTER(Driveline), ctypes.c_char_p, ctypes.c_size_t]
-    library.driveline_from_layout.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(Driveline),
-                                              ctypes.c_char_p, ctypes.c_size_t]
-    library.driveline_one_piece.argtypes = [ctypes.POINTER(OnePiece), ctypes.POINTER(Driveline), ctypes.c_char_p,
-                                            ctypes.c_size_t]
-    library.python_str_repr_n.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_size_t, ctypes.c_char_p,
-                                          ctypes.c_size_t]
-    library.python_float_repr.argtypes = [ctypes.c_double, ctypes.c_char_p, ctypes.c_size_t]
-    return library
+    driveline_p, error, size = P(CDriveline), ctypes.c_char_p, ctypes.c_size_t
+    return declare(library, {
+        "driveline_length": (ctypes.c_double, [driveline_p]),
+        "driveline_from_text": (ctypes.c_int, [ctypes.c_char_p, size, ctypes.c_char_p, driveline_p, error, size]),
+        "driveline_from_layout": (ctypes.c_int, [ctypes.c_char_p, ctypes.c_char_p, driveline_p, error, size]),
+        "driveline_one_piece": (ctypes.c_int, [P(OnePieceShaft), driveline_p, error, size]),
+        "python_str_repr_n": (None, [ctypes.c_char_p, size, size, ctypes.c_char_p, size]),
+        "python_float_repr": (None, [ctypes.c_double, ctypes.c_char_p, size]),
+    })
 
 
 def bits(value: float) -> bytes:
     return struct.pack("<d", value)
 
 
-def native_fields(lib: ctypes.CDLL, d: Driveline) -> dict:
+def native_fields(lib: ctypes.CDLL, d: CDriveline) -> dict:
     """The driveline's fields, the numbers as their bits."""
     def rows(pointer, count, names):
         return [tuple(bits(v) if isinstance(v, float) else v for v in (getattr(pointer[i], n) for n in names))
                 for i in range(count)]
     return {
-        "segments": rows(d.segments, d.n_segments, [f[0] for f in Segment._fields_]),
-        "masses": rows(d.masses, d.n_masses, [f[0] for f in Mass._fields_]),
-        "bearings": rows(d.bearings, d.n_bearings, [f[0] for f in Bearing._fields_]),
-        "hinges": rows(d.hinges, d.n_hinges, [f[0] for f in Hinge._fields_]),
-        "unbalances": rows(d.unbalances, d.n_unbalances, [f[0] for f in Unbalance._fields_]),
+        "segments": rows(d.segments, d.n_segments, [f[0] for f in RotorSegment._fields_]),
+        "masses": rows(d.masses, d.n_masses, [f[0] for f in RotorMass._fields_]),
+        "bearings": rows(d.bearings, d.n_bearings, [f[0] for f in RotorBearing._fields_]),
+        "hinges": rows(d.hinges, d.n_hinges, [f[0] for f in RotorHinge._fields_]),
+        "unbalances": rows(d.unbalances, d.n_unbalances, [f[0] for f in RotorUnbalance._fields_]),
         "ends": (d.left, d.right),
         "isotropic": bool(lib.driveline_isotropic(ctypes.byref(d))),
     }
@@ -115,7 +75,7 @@ def python_fields(drv) -> dict:
 
 def native_result(lib: ctypes.CDLL, call, *args):
     """(fields, length) or the message of a native call."""
-    d, error = Driveline(), ctypes.create_string_buffer(ERROR_SIZE)
+    d, error = CDriveline(), ctypes.create_string_buffer(ERROR_SIZE)
     status = call(*args, ctypes.byref(d), error, ERROR_SIZE)
     if status != 0:
         assert not d.segments and d.n_segments == 0
@@ -714,7 +674,7 @@ def test_one_piece_shaft(lib):
     cases += [{**good, "D_inner": 0.08}, {**good, "D_inner": 0.1}, {**good, "E": -0.0}]
     for params in cases:
         for shear in (True, False):
-            native = native_result(lib, lib.driveline_one_piece, ctypes.byref(OnePiece(**params, shear=shear)))
+            native = native_result(lib, lib.driveline_one_piece, ctypes.byref(OnePieceShaft(**params, shear=shear)))
             same(native, python_result(lambda: one_piece_shaft(**params, shear=shear)))
 
 

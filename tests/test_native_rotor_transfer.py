@@ -3,7 +3,7 @@ the Python core (``driveline.rotor.transfer``, ``roots``, ``driveline``).
 
 The library is compiled on its own (:mod:`native_rotor`) and called through ctypes; the ``Driveline``
 structure of ``rotor.h`` is filled from a Python :class:`~driveline.rotor.Driveline` through ctypes
-structures that mirror the header (the arrays are kept alive by :class:`NativeChain`).
+structures that mirror the header (:func:`native_rotor.c_driveline`).
 
 Tolerances, and why:
 
@@ -40,41 +40,7 @@ from driveline.rotor.driveline import Driveline
 from driveline.rotor.elements import Bearing, ConcentratedMass, Hinge, ShaftSegment
 from driveline.rotor.loader import example_path, one_piece_shaft
 
-from native_rotor import compile_rotor
-
-P = ctypes.POINTER
-DOUBLE_P = P(ctypes.c_double)
-
-
-class CSegment(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in
-                ("length", "outer_diameter", "inner_diameter", "youngs_modulus", "density", "poisson_ratio")] + [
-        (name, ctypes.c_int) for name in ("rotary_inertia", "gyroscopic", "shear")]
-
-
-class CMass(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int)] + [(name, ctypes.c_double) for name in
-                                           ("mass", "polar_inertia", "diametral_inertia")]
-
-
-class CBearing(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int)] + [(name, ctypes.c_double) for name in
-                                           ("kxx", "kyy", "cxx", "cyy", "kxy", "kyx", "cxy", "cyx")]
-
-
-class CHinge(ctypes.Structure):
-    _fields_ = [("node", ctypes.c_int), ("bending_stiffness", ctypes.c_double)]
-
-
-class CUnbalance(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_double) for name in ("position", "amount", "phase")]
-
-
-class CDriveline(ctypes.Structure):
-    _fields_ = [(name, ctypes.c_int) for name in
-                ("n_segments", "n_masses", "n_bearings", "n_hinges", "n_unbalances")] + [
-        ("segments", P(CSegment)), ("masses", P(CMass)), ("bearings", P(CBearing)), ("hinges", P(CHinge)),
-        ("unbalances", P(CUnbalance)), ("left", ctypes.c_int), ("right", ctypes.c_int)]
+from native_rotor import CHAIN_SIGNATURES, DOUBLE_P, P, c_array, c_driveline, compile_rotor, declare
 
 
 class CLine(ctypes.Structure):
@@ -89,7 +55,6 @@ class COrderResonance(ctypes.Structure):
     _fields_ = [("order", ctypes.c_int), ("whirl", ctypes.c_int), ("spin", ctypes.c_double)]
 
 
-END_CONDITIONS = {"free": 0, "pinned": 1, "clamped": 2}
 WHIRL_BITS = {"forward": 1, "backward": 2}
 ERROR_SIZE = 512
 
@@ -97,8 +62,7 @@ ERROR_SIZE = 512
 def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
     chain, size, error = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_char_p
     signatures = {
-        "chain_new": (chain, [P(CDriveline), error, size]),
-        "chain_free": (None, [chain]),
+        **CHAIN_SIGNATURES,
         "chain_isotropic": (ctypes.c_int, [chain]),
         "chain_kappa": (ctypes.c_double, [chain]),
         "chain_freedoms": (ctypes.c_int, [chain]),
@@ -114,19 +78,12 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
                                                   P(ctypes.c_int), error, size]),
         "rotor_critical_speeds": (ctypes.c_int, [chain, ctypes.c_int, DOUBLE_P, P(ctypes.c_int), error, size]),
     }
-    for name, (restype, argtypes) in signatures.items():
-        function = getattr(lib, name)
-        function.restype, function.argtypes = restype, argtypes
-    return lib
+    return declare(lib, signatures)
 
 
 LIBC = ctypes.CDLL(None)
 LIBC.free.argtypes = [ctypes.c_void_p]
 LIBC.free.restype = None
-
-
-def _array(kind: type, items: list) -> ctypes.Array:
-    return (kind * max(len(items), 1))(*items)
 
 
 class NativeChain:
@@ -135,18 +92,7 @@ class NativeChain:
 
     def __init__(self, lib: ctypes.CDLL, driveline: Driveline) -> None:
         self.lib = lib
-        self.arrays = (
-            _array(CSegment, [CSegment(s.length, s.outer_diameter, s.inner_diameter, s.youngs_modulus, s.density,
-                                       s.poisson_ratio, s.rotary_inertia, s.gyroscopic, s.shear)
-                              for s in driveline.segments]),
-            _array(CMass, [CMass(m.node, m.mass, m.polar_inertia, m.diametral_inertia) for m in driveline.masses]),
-            _array(CBearing, [CBearing(b.node, b.kxx, b.k_yy, b.cxx, b.c_yy, b.kxy, b.kyx, b.cxy, b.cyx)
-                              for b in driveline.bearings]),
-            _array(CHinge, [CHinge(h.node, h.bending_stiffness) for h in driveline.joints]),
-        )
-        counts = (len(driveline.segments), len(driveline.masses), len(driveline.bearings), len(driveline.joints))
-        self.struct = CDriveline(*counts, 0, *self.arrays, None, END_CONDITIONS[driveline.left.value],
-                                 END_CONDITIONS[driveline.right.value])
+        self.struct = c_driveline(driveline)
         error = ctypes.create_string_buffer(ERROR_SIZE)
         self.pointer = lib.chain_new(ctypes.byref(self.struct), error, ERROR_SIZE)
         if not self.pointer:
@@ -177,21 +123,21 @@ class NativeChain:
     def line_roots(self, lines, n, x_max, limit=1e5, coarse=None) -> list[np.ndarray]:
         m = len(lines)
         roots = (CRoots * m)()
-        flags = None if coarse is None else _array(ctypes.c_ubyte, [int(bool(c)) for c in coarse])
-        self._call("rotor_line_roots", _array(CLine, [CLine(*line) for line in lines]), m, 0 if n is None else n,
+        flags = None if coarse is None else c_array(ctypes.c_ubyte, [int(bool(c)) for c in coarse])
+        self._call("rotor_line_roots", c_array(CLine, [CLine(*line) for line in lines]), m, 0 if n is None else n,
                    0.0 if x_max is None else x_max, limit, flags, roots)
         return self._roots(roots, m)
 
     def roots_by_whirl(self, cases, n, x_max, limit=1e5) -> list[dict[str, np.ndarray]]:
         m = len(cases)
         forward, backward = (CRoots * m)(), (CRoots * m)()
-        self._call("rotor_roots_by_whirl", _array(CLine, [CLine(*case) for case in cases]), m,
+        self._call("rotor_roots_by_whirl", c_array(CLine, [CLine(*case) for case in cases]), m,
                    0 if n is None else n, 0.0 if x_max is None else x_max, limit, forward, backward)
         return [{"forward": f, "backward": b} for f, b in zip(self._roots(forward, m), self._roots(backward, m))]
 
     def order_resonances(self, orders, whirls, n, spin_max, limit=1e5) -> list[tuple[int, str, float]]:
         found, count = P(COrderResonance)(), ctypes.c_int()
-        self._call("rotor_order_resonances", _array(ctypes.c_int, list(orders)), len(orders),
+        self._call("rotor_order_resonances", c_array(ctypes.c_int, list(orders)), len(orders),
                    sum(WHIRL_BITS[w] for w in whirls), 0 if n is None else n, 0.0 if spin_max is None else spin_max,
                    limit, ctypes.byref(found), ctypes.byref(count))
         out = [(found[i].order, "forward" if found[i].whirl == 1 else "backward", found[i].spin)
