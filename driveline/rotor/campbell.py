@@ -55,7 +55,9 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
 
     Where a branch's cubic spline errs by more than ``SPLINE_RTOL`` at the middle between
     two speeds (estimated by a Newton step on the determinant there), that middle is
-    added to the speeds, up to ``REFINEMENTS`` times. Anisotropic drivelines (whose whirl
+    added to the speeds, up to ``REFINEMENTS`` times. Branches missing at some speed (crossing
+    the search bound) are not refined: the search is widened, up to ``SEARCH_LIMIT``, where
+    they are returned unrefined with their NaN. Anisotropic drivelines (whose whirl
     sense is read from mode shapes) give the sorted Campbell table, one column per rank.
     """
     sp = np.asarray(spins, dtype=float)
@@ -71,8 +73,8 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
         for round_ in range(REFINEMENTS + 1):
             branches = [_follow(knots, roots, slopes, n_modes)
                         for roots, slopes in zip(found, _slopes(driveline, knots, found))]
-            if round_ == REFINEMENTS or knots.size > MAX_KNOTS:
-                break
+            if round_ == REFINEMENTS or knots.size > MAX_KNOTS or not _complete(branches):
+                break  # a branch crossing x_hi has no spline to refine: widen the search first
             rough = np.flatnonzero(_spline_error(driveline, knots, branches) > SPLINE_RTOL)
             if not rough.size:
                 break
@@ -82,9 +84,14 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
             knots = np.insert(knots, rough + 1, middles)
             found = [_insert(old, rough + 1, new) for old, new in zip(found, added)]
         enough = min(r.size for roots in found for r in roots) >= n_modes
-        if x_hi >= SEARCH_LIMIT or (enough and not any(np.isnan(b).any() for b in branches)):
+        if x_hi >= SEARCH_LIMIT or (enough and _complete(branches)):
             return WhirlBranches(knots, *branches)
         x_hi = min(4.0 * x_hi, SEARCH_LIMIT)
+
+
+def _complete(branches: list[FloatArray]) -> bool:
+    """No branch missing at any speed (none crosses the search bound)."""
+    return not any(np.isnan(table).any() for table in branches)
 
 
 def _insert(roots: list[FloatArray], at: NDArray[np.intp], new: list[FloatArray]) -> list[FloatArray]:

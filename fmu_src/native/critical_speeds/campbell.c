@@ -344,7 +344,8 @@ static double *side_by_side(const Branches branches[2], int speeds, int pad, dou
 /* campbell._spline_error: the relative error of the branches' splines at the middle of every knot
  * interval (largest of all branches) by one Newton step on the determinant there, zero within NOISE
  * times the same step at the interval's ends; ``error_of`` has count - 1 entries. A branch missing at
- * some speed fails with the message of scipy's CubicSpline, as the Python one does. */
+ * some speed fails with the message of scipy's CubicSpline, as the Python one would (whirl_branches
+ * refines complete branches only). */
 static int spline_error(const Chain *chain, const Found *found, const Branches branches[2], double *error_of,
                         char *error, size_t size)
 {
@@ -480,6 +481,19 @@ static int follow_both(const Chain *chain, const Found *found, int n_modes, Bran
     return status;
 }
 
+/* No branch of either sense missing at any of the ``knots`` speeds (none crosses the search bound). */
+static int branches_complete(const Branches branches[2], int knots)
+{
+    for (int s = 0; s < 2; ++s) {
+        for (size_t v = 0; v < (size_t)knots * (size_t)branches[s].columns; ++v) {
+            if (isnan(branches[s].value[v])) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
 /* One round of refinement (the body of whirl_branches' inner loop after _follow): the middles of the
  * intervals whose splines err searched and inserted; *refined 0 when no interval errs. */
 static int refine(const Chain *chain, Found *found, const Branches branches[2], double x_hi, int *refined,
@@ -544,8 +558,8 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
                 found_free(found);
                 return -1;
             }
-            if (round == REFINEMENTS || found->count > MAX_KNOTS) {
-                break;
+            if (round == REFINEMENTS || found->count > MAX_KNOTS || !branches_complete(branches, found->count)) {
+                break; /* a branch crossing x_hi has no spline to refine: widen the search first */
             }
             if (refine(chain, found, branches, x_hi, &refined, error, size)) {
                 branches_free(branches);
@@ -557,16 +571,13 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
             }
             branches_free(branches);
         }
-        int enough = 1, complete = 1;
+        int enough = 1;
         for (int s = 0; s < 2; ++s) {
             for (int i = 0; i < found->count; ++i) {
                 enough = enough && found->roots[s][i].count >= n_modes;
             }
-            for (size_t v = 0; v < (size_t)found->count * (size_t)branches[s].columns; ++v) {
-                complete = complete && !isnan(branches[s].value[v]);
-            }
         }
-        if (x_hi >= ROTOR_SEARCH_LIMIT || (enough && complete)) {
+        if (x_hi >= ROTOR_SEARCH_LIMIT || (enough && branches_complete(branches, found->count))) {
             return 0;
         }
         branches_free(branches);
