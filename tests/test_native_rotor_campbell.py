@@ -101,7 +101,7 @@ def gyroscopic() -> Driveline:
 
 def beyond_the_limit() -> Driveline:
     """tests/test_rotor_campbell.py's short shaft on stiff bearings: up to 20000 rad/s a forward branch
-    leaves the search limit, and is missing."""
+    leaves the search limit between the first speeds, the complete branches are refined."""
     return one_piece_shaft(0.5, 0.0762, 0.0729, 2.1e11, 7850.0, 10.0, 1.0, 0.1, 1e9)
 
 
