@@ -93,6 +93,18 @@ def anisotropic() -> Driveline:
     return dataclasses.replace(d, bearings=[Bearing(b.node, b.kxx, 0.2 * b.kxx) for b in d.bearings])
 
 
+def gyroscopic() -> Driveline:
+    """tests/test_rotor_campbell.py's joints of large polar inertia: up to 10000 rad/s a forward branch
+    leaves the first search bound, which is widened."""
+    return one_piece_shaft(1.4, 0.0762, 0.0729, 2.1e11, 7850.0, 2.5, 2.0, 0.1, 1e7)
+
+
+def beyond_the_limit() -> Driveline:
+    """tests/test_rotor_campbell.py's short shaft on stiff bearings: up to 20000 rad/s a forward branch
+    leaves the search limit between the first speeds, the complete branches are refined."""
+    return one_piece_shaft(0.5, 0.0762, 0.0729, 2.1e11, 7850.0, 10.0, 1.0, 0.1, 1e9)
+
+
 CASES = {
     "tube-1500": (tube, 1500.0),
     "tube-6000": (tube, 6000.0),
@@ -102,6 +114,8 @@ CASES = {
     "two-piece-hinged": (lambda: load_driveline(example_path("two_piece_propshaft_hinged")), 1500.0),
     "crossing": (crossing, 1500.0),
     "anisotropic": (anisotropic, 1500.0),
+    "gyroscopic-10000": (gyroscopic, 10000.0),
+    "beyond-the-limit-20000": (beyond_the_limit, 20000.0),
 }
 
 

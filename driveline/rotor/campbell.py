@@ -55,7 +55,10 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
 
     Where a branch's cubic spline errs by more than ``SPLINE_RTOL`` at the middle between
     two speeds (estimated by a Newton step on the determinant there), that middle is
-    added to the speeds, up to ``REFINEMENTS`` times. Anisotropic drivelines (whose whirl
+    added to the speeds, up to ``REFINEMENTS`` times. A branch missing at some speed (crossing
+    the search bound) widens the search, up to ``SEARCH_LIMIT``; the rounds to be widened are not
+    refined. At the final bound the complete branches are refined and the missing one is returned
+    with its NaN, its spline error left out. Anisotropic drivelines (whose whirl
     sense is read from mode shapes) give the sorted Campbell table, one column per rank.
     """
     sp = np.asarray(spins, dtype=float)
@@ -71,8 +74,10 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
         for round_ in range(REFINEMENTS + 1):
             branches = [_follow(knots, roots, slopes, n_modes)
                         for roots, slopes in zip(found, _slopes(driveline, knots, found))]
-            if round_ == REFINEMENTS or knots.size > MAX_KNOTS:
-                break
+            enough = min(r.size for roots in found for r in roots) >= n_modes
+            final = x_hi >= SEARCH_LIMIT or (enough and _complete(branches))
+            if round_ == REFINEMENTS or knots.size > MAX_KNOTS or not final:
+                break  # a round to be widened restarts from ``sp``: refining it is wasted
             rough = np.flatnonzero(_spline_error(driveline, knots, branches) > SPLINE_RTOL)
             if not rough.size:
                 break
@@ -81,10 +86,14 @@ def whirl_branches(driveline: Driveline, spins: ArrayLike, n_modes: int) -> Whir
             added = _roots_over_speeds(driveline, middles, x_hi, np.stack([counts[rough], counts[rough + 1]], axis=1))
             knots = np.insert(knots, rough + 1, middles)
             found = [_insert(old, rough + 1, new) for old, new in zip(found, added)]
-        enough = min(r.size for roots in found for r in roots) >= n_modes
-        if x_hi >= SEARCH_LIMIT or (enough and not any(np.isnan(b).any() for b in branches)):
+        if final:
             return WhirlBranches(knots, *branches)
         x_hi = min(4.0 * x_hi, SEARCH_LIMIT)
+
+
+def _complete(branches: list[FloatArray]) -> bool:
+    """No branch missing at any speed (none crosses the search bound)."""
+    return not any(np.isnan(table).any() for table in branches)
 
 
 def _insert(roots: list[FloatArray], at: NDArray[np.intp], new: list[FloatArray]) -> list[FloatArray]:
@@ -140,10 +149,14 @@ def _spline_error(driveline: Driveline, knots: FloatArray, branches: list[FloatA
     """Relative error of the branches' cubic splines at the middle of every knot interval (largest of
     all branches), estimated by one Newton step ``f / f_w`` on the determinant there. The same step
     at the interval's ends, where the splines hold the roots, is the round-off of the estimate:
-    an error within ``NOISE`` times that counts as zero."""
+    an error within ``NOISE`` times that counts as zero. A branch missing at some speed (NaN) has
+    no spline and contributes no error."""
+    complete = [table[:, ~np.isnan(table).any(axis=0)] for table in branches]
+    if not any(table.shape[1] for table in complete):
+        return np.zeros(knots.size - 1)
     at = np.concatenate([0.5 * (knots[:-1] + knots[1:]), knots])
-    w = np.hstack([CubicSpline(knots, table)(at) for table in branches])
-    sign = np.repeat([1.0, -1.0], [table.shape[1] for table in branches])
+    w = np.hstack([CubicSpline(knots, table)(at) for table in complete if table.shape[1]])
+    sign = np.repeat([1.0, -1.0], [table.shape[1] for table in complete])
     spin = np.broadcast_to(at[:, None], w.shape)
     h = SLOPE_STEP * w
     f = driveline.determinant(sign * np.stack([w, w + h, w - h]), np.stack([spin] * 3))

@@ -344,7 +344,7 @@ static double *side_by_side(const Branches branches[2], int speeds, int pad, dou
 /* campbell._spline_error: the relative error of the branches' splines at the middle of every knot
  * interval (largest of all branches) by one Newton step on the determinant there, zero within NOISE
  * times the same step at the interval's ends; ``error_of`` has count - 1 entries. A branch missing at
- * some speed fails with the message of scipy's CubicSpline, as the Python one does. */
+ * some speed (NaN) has no spline and contributes no error. */
 static int spline_error(const Chain *chain, const Found *found, const Branches branches[2], double *error_of,
                         char *error, size_t size)
 {
@@ -360,12 +360,28 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
     if (!table) {
         return out_of_memory(error, size);
     }
-    for (size_t v = 0; v < (size_t)knots * (size_t)m; ++v) {
-        if (isnan(table[v])) {
-            free(table);
-            snprintf(error, size, "`y` must contain only finite values.");
-            return -1;
+    int kept = 0, kept_forward = 0;
+    for (int c = 0; c < m; ++c) { /* the complete columns, in their order, moved to the left */
+        int complete = 1;
+        for (int i = 0; i < knots && complete; ++i) {
+            complete = !isnan(table[(size_t)i * m + c]);
         }
+        if (complete) {
+            for (int i = 0; i < knots; ++i) {
+                table[(size_t)i * m + kept] = table[(size_t)i * m + c];
+            }
+            kept_forward += c < forward;
+            ++kept;
+        }
+    }
+    for (int i = 0; i < knots; ++i) { /* rows of ``kept`` columns */
+        memmove(table + (size_t)i * kept, table + (size_t)i * m, (size_t)kept * sizeof *table);
+    }
+    m = kept;
+    forward = kept_forward;
+    if (m == 0) {
+        free(table);
+        return 0;
     }
     if (cubic_spline_build(&spline, knots, found->spin, m, table)) {
         free(table);
@@ -480,6 +496,19 @@ static int follow_both(const Chain *chain, const Found *found, int n_modes, Bran
     return status;
 }
 
+/* No branch of either sense missing at any of the ``knots`` speeds (none crosses the search bound). */
+static int branches_complete(const Branches branches[2], int knots)
+{
+    for (int s = 0; s < 2; ++s) {
+        for (size_t v = 0; v < (size_t)knots * (size_t)branches[s].columns; ++v) {
+            if (isnan(branches[s].value[v])) {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
 /* One round of refinement (the body of whirl_branches' inner loop after _follow): the middles of the
  * intervals whose splines err searched and inserted; *refined 0 when no interval errs. */
 static int refine(const Chain *chain, Found *found, const Branches branches[2], double x_hi, int *refined,
@@ -535,6 +564,7 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
     double reach = (n_modes + 2) * PI / chain_kappa(chain);
     double x_hi = fmin(reach * reach, ROTOR_SEARCH_LIMIT);
     for (;;) {
+        int final = 0;
         if (roots_over_speeds(chain, spins, points, x_hi, NULL, found, error, size)) {
             return -1;
         }
@@ -544,8 +574,15 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
                 found_free(found);
                 return -1;
             }
-            if (round == REFINEMENTS || found->count > MAX_KNOTS) {
-                break;
+            int enough = 1;
+            for (int s = 0; s < 2; ++s) {
+                for (int i = 0; i < found->count; ++i) {
+                    enough = enough && found->roots[s][i].count >= n_modes;
+                }
+            }
+            final = x_hi >= ROTOR_SEARCH_LIMIT || (enough && branches_complete(branches, found->count));
+            if (round == REFINEMENTS || found->count > MAX_KNOTS || !final) {
+                break; /* a round to be widened restarts from ``spins``: refining it is wasted */
             }
             if (refine(chain, found, branches, x_hi, &refined, error, size)) {
                 branches_free(branches);
@@ -557,16 +594,7 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
             }
             branches_free(branches);
         }
-        int enough = 1, complete = 1;
-        for (int s = 0; s < 2; ++s) {
-            for (int i = 0; i < found->count; ++i) {
-                enough = enough && found->roots[s][i].count >= n_modes;
-            }
-            for (size_t v = 0; v < (size_t)found->count * (size_t)branches[s].columns; ++v) {
-                complete = complete && !isnan(branches[s].value[v]);
-            }
-        }
-        if (x_hi >= ROTOR_SEARCH_LIMIT || (enough && complete)) {
+        if (final) {
             return 0;
         }
         branches_free(branches);
