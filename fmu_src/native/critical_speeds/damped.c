@@ -413,7 +413,10 @@ static void band_substitute(Band band, const cplx *ab, const int *pivots, cplx *
             b[pivots[j]] = t;
         }
         for (int i = j + 1; i <= last; i++) {
-            b[i] -= mul(AB(band, ab, i, j), b[j]);
+            cplx factor = AB(band, ab, i, j);
+            if (factor != 0.0) {
+                b[i] -= mul(factor, b[j]);
+            }
         }
     }
     for (int i = n - 1; i >= 0; i--) {
