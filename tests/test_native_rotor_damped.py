@@ -1,7 +1,7 @@
 """The native rotor library's finite elements (``fem.c``, ``damped.c``) against the Python core:
 the plausibility check's natural frequencies (model.natural_frequencies, scipy's eigh) and the
 FMU's unbalance outputs (UnbalanceOutputs.build and evaluate: numpy's eig, ARPACK above
-DENSE_SIZE, LAPACK's banded solve).
+DENSE_SIZE, LAPACK's banded solve; in C the dense solver, shift-invert Arnoldi above DENSE_SIZE).
 
 Both sides round differently (their own eigensolvers and factorisations), so they agree to the
 rounding level of each problem, which the tolerances below state and bound.
@@ -14,12 +14,14 @@ import dataclasses
 
 import numpy as np
 import pytest
+from scipy.interpolate import CubicSpline
 
-from driveline.rotor import Bearing, Driveline, ShaftSegment, Unbalance, model, one_piece_shaft
+from driveline.rotor import Bearing, ConcentratedMass, Driveline, ShaftSegment, Unbalance, model, one_piece_shaft
 from driveline.rotor.damped import DENSE_SIZE, DampedRotor
+from driveline.rotor.driveline import EXCITED_SHARE
 from driveline.rotor.fem import elements_by_length
 from driveline.rotor.loader import example_path, load_driveline, loads_driveline
-from driveline.rotor.unbalance_outputs import TABLE_ELEMENTS, UnbalanceOutputs
+from driveline.rotor.unbalance_outputs import DAMPED_MODES, FE_ELEMENTS, TABLE_ELEMENTS, UnbalanceOutputs
 
 from native_rotor import DOUBLE_P, CDriveline, P, c_driveline, compile_rotor, declare, unbalances
 
@@ -36,8 +38,9 @@ RESPONSE_RTOL = 1e-9
 #: table's first-order eigenproblem: an eigensolver determines Re(lam) only to about eps ||A||, and
 #: zeta = -Re(lam) / |lam| (numpy's own errors against a 30-digit reference reach 2e-13 on the
 #: 20-segment shaft, 2e-13 on the default tube's zeta = 0.0016 mode). Measured differences: at most
-#: 16 units on the one- and two-piece layouts, 51 on the 20-segment shaft, 103 against ARPACK on the
-#: 60-segment one (2.6e-11 absolute).
+#: 16 units on the one- and two-piece layouts, 51 on the 20-segment shaft; the C Arnoldi against
+#: ARPACK 14 on the 60-segment shafts, 12 on the 100-segment ones (5e-12 absolute). The tabulated damped
+#: frequencies, relative, in the same units (Im(lam) is as uncertain as Re(lam)): measured at most 30.
 ZETA_UNITS = 200.0
 
 TUBE = dict(L_shaft=1.4, D_outer=0.0762, D_inner=0.0729, E=2.1e11, density=7850.0, m_joint=2.5, Jp_joint=0.004,
@@ -52,10 +55,14 @@ CROSS_COUPLED = dataclasses.replace(DEFAULT, bearings=[
     Bearing(0, 1e7, 2e6, cxx=300.0, cyy=100.0, kxy=1e5, kyx=-2e5, cxy=10.0, cyx=30.0), Bearing(1, 1e7, 2e6, cxx=300.0)])
 
 
-def equal_segments(count: int) -> Driveline:
-    """The default tube cut into ``count`` equal Timoshenko segments on damped bearings."""
+def equal_segments(count: int, anisotropic: bool = False, masses: bool = False) -> Driveline:
+    """The default tube cut into ``count`` equal Timoshenko segments on damped bearings (``anisotropic``:
+    kxx != kyy, the doubled system), with ``masses``: a small concentrated mass at every third inner node."""
     segment = ShaftSegment(1.4 / count, 0.0762, 0.0729, shear=True)
-    return Driveline([segment] * count, [], [Bearing(0, 1e7, cxx=500.0), Bearing(count, 1e7, cxx=500.0)])
+    bearings = ([Bearing(0, 1e7, 3e6, cxx=300.0), Bearing(count, 2e7, cxx=100.0)] if anisotropic
+                else [Bearing(0, 1e7, cxx=500.0), Bearing(count, 1e7, cxx=500.0)])
+    points = [ConcentratedMass(k, 0.02, 1e-5, 5e-6) for k in range(1, count, 3)] if masses else []
+    return Driveline([segment] * count, points, bearings)
 
 
 # the two-piece shaft with damped bearings and unbalances of its own, one at a node, one in a segment
@@ -63,12 +70,15 @@ OWN_UNBALANCES = loads_driveline(example_path("two_piece_propshaft").read_text()
     "stiffness = 1.0e7", "stiffness = 1.0e7\ndamping = 800.0").replace("stiffness = 1.0e6", "stiffness = 1.0e6\ndamping = 200.0")
     + "\n[[unbalances]]\nnode = 1\namount = 5e-5\n\n[[unbalances]]\nposition = 1.2\namount = 1e-4\nphase = 2.0\n")
 SEGMENTS_20 = equal_segments(20)  # 84 first-order unknowns in the mode table: numpy's dense eig
-SEGMENTS_60 = equal_segments(60)  # 244 > DENSE_SIZE: ARPACK in Python, the dense solver in C
+SEGMENTS_60 = equal_segments(60)  # 244 > DENSE_SIZE: ARPACK in Python, shift-invert Arnoldi in C
+# the damped modes by Arnoldi on both sides: 488, 404 and 808 first-order unknowns in the mode table
+ARNOLDI = {"segments_60_anisotropic": equal_segments(60, True), "segments_100": equal_segments(100),
+           "segments_100_anisotropic": equal_segments(100, True)}
 
 NATURAL = {"default": DEFAULT, "rayleigh": RAYLEIGH, "two_piece": TWO_PIECE, "hinged": HINGED, "ends": ENDS,
            "anisotropic": ANISOTROPIC}
 OUTPUTS = {**NATURAL, "cross_coupled": CROSS_COUPLED, "own_unbalances": OWN_UNBALANCES, "segments_20": SEGMENTS_20,
-           "segments_60": SEGMENTS_60}
+           "segments_60": SEGMENTS_60, **ARNOLDI}
 OMEGA_MAX = 1500.0
 
 
@@ -82,6 +92,7 @@ def library(tmp_path_factory):
         "unbalance_outputs_new": (outputs_p, [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double,
                                               ctypes.c_double, error, size]),
         "unbalance_outputs_evaluate": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
+        "unbalance_outputs_modes": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
         "unbalance_outputs_free": (None, [outputs_p]),
     })
     lib.free.argtypes = [ctypes.c_void_p]  # libc's, through the library's dependencies
@@ -98,19 +109,21 @@ def natural_frequencies(lib, d: Driveline, elements: int = model.FE_ELEMENTS) ->
     return out
 
 
-def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds) -> np.ndarray:
-    """The C UnbalanceOutputs' evaluate at ``speeds`` (rows: response, force, damping ratio)."""
+def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds, table: bool = False) -> np.ndarray:
+    """The C UnbalanceOutputs' evaluate at ``speeds`` (rows: response, force, damping ratio), with ``table``
+    also its mode table (the damped frequencies, then the damping ratios)."""
     c = c_driveline(d)
     excited = unbalances(items)
     error = ctypes.create_string_buffer(512)
     handle = lib.unbalance_outputs_new(ctypes.byref(c), excited, len(items), fraction, omega_max, error, 512)
     assert handle, error.value
     try:
-        out = (ctypes.c_double * 3)()
+        out, modes = (ctypes.c_double * 3)(), (ctypes.c_double * (2 * DAMPED_MODES))()
         rows = []
         for speed in speeds:
             lib.unbalance_outputs_evaluate(handle, speed, out)
-            rows.append(list(out))
+            lib.unbalance_outputs_modes(handle, speed, modes)
+            rows.append(list(out) + (list(modes) if table else []))
     finally:
         lib.unbalance_outputs_free(handle)
     return np.array(rows)
@@ -153,22 +166,64 @@ def test_natural_frequencies_take_each_plane_of_anisotropic_bearings(library):
 def test_unbalance_outputs_match_the_python_model(library, name):
     d = OUTPUTS[name]
     items = excitation(d)
-    speeds = np.linspace(0.0, OMEGA_MAX, 101)
+    speeds = np.linspace(0.0, OMEGA_MAX, 101 if name not in ARNOLDI else 51)
     python = UnbalanceOutputs.build(d, items, 0.5, OMEGA_MAX)
     expected = np.array([python.evaluate(speed) for speed in speeds])
-    got = outputs(library, d, items, 0.5, OMEGA_MAX, speeds)
+    got = outputs(library, d, items, 0.5, OMEGA_MAX, speeds, table=True)
     assert np.all(np.isfinite(got)) and np.all(got[0, :2] == 0.0)
     for column in (0, 1):
         scale = np.max(np.abs(expected[:, column]))
         assert np.max(np.abs(got[:, column] - expected[:, column])) <= RESPONSE_RTOL * scale
+    bound = ZETA_UNITS * EPS * spread(d)
     zeta = np.max(np.abs(got[:, 2] - expected[:, 2]))
-    assert zeta <= ZETA_UNITS * EPS * spread(d), f"damping ratios differ by {zeta:.3g}"
+    assert zeta <= bound, f"damping ratios differ by {zeta:.3g}"
+    # the mode table itself: the damped frequencies (relative) and damping ratios of the modes the FMU uses
+    table = python.modes(speeds)
+    frequencies = np.max(np.abs(got[:, 3:3 + DAMPED_MODES] / table[:, :DAMPED_MODES] - 1.0))
+    assert frequencies <= bound, f"damped frequencies differ by {frequencies:.3g}"
+    zeta = np.max(np.abs(got[:, 3 + DAMPED_MODES:] - table[:, DAMPED_MODES:]))
+    assert zeta <= bound, f"tabulated damping ratios differ by {zeta:.3g}"
 
 
 def test_the_mode_table_above_the_dense_size_is_arpacks_selection(library):
-    """The 60-segment shaft's mode table exceeds DENSE_SIZE in Python, where ARPACK finds the modes."""
-    rotor = DampedRotor(SEGMENTS_60, elements_by_length(SEGMENTS_60, TABLE_ELEMENTS))
-    assert 2 * rotor.M.shape[0] > DENSE_SIZE
+    """The 60-segment shafts' mode tables exceed DENSE_SIZE in Python, where ARPACK finds the modes."""
+    for d in (SEGMENTS_60, ARNOLDI["segments_60_anisotropic"]):
+        rotor = DampedRotor(d, elements_by_length(d, TABLE_ELEMENTS))
+        assert 2 * rotor.M.shape[0] > DENSE_SIZE
+
+
+def test_a_layout_cut_by_many_point_elements_stays_fast(library):
+    """300 segments cut by 99 concentrated masses: 1204 first-order unknowns, where the dense eigensolver
+    took a minute and a half for the mode table (now well under a second); the Arnoldi mode table agrees with ARPACK's at three of its speeds (DampedRotor.modes
+    as UnbalanceOutputs.build calls it) and the response with Python's banded solve."""
+    d = equal_segments(300, masses=True)
+    items = excitation(d)
+    rotor = DampedRotor(d, elements_by_length(d, TABLE_ELEMENTS))
+    assert elements_by_length(d, FE_ELEMENTS) == elements_by_length(d, TABLE_ELEMENTS)  # one model serves both
+    knots = np.linspace(0.0, OMEGA_MAX, 11)[[0, 5, 10]]
+    table, smallest = [], np.inf
+    for spin in knots:
+        modes = rotor.modes(spin, 4 * DAMPED_MODES)
+        smallest = min(smallest, *(abs(m.eigenvalue) for m in modes)) if spin == 0.0 else smallest
+        excited = [m for m in modes if m.forward_share >= EXCITED_SHARE]
+        assert len(excited) >= DAMPED_MODES
+        table.append([m.frequency for m in excited[:DAMPED_MODES]] + [m.damping_ratio for m in excited[:DAMPED_MODES]])
+    table = np.array(table)
+    speeds = np.array([*knots, 333.0, 1234.5])
+    got = outputs(library, d, items, 0.5, OMEGA_MAX, speeds, table=True)
+    python = UnbalanceOutputs(rotor, rotor.load(items), rotor.shape_rows([0.5 * d.length]), CubicSpline(knots, table))
+    expected = np.array([python.evaluate(speed)[:2] for speed in speeds])
+    for column in (0, 1):
+        assert np.max(np.abs(got[:, column] - expected[:, column])) <= RESPONSE_RTOL * np.max(expected[:, column])
+    # ZETA_UNITS with max|lam| bounded by the 1-norm of B^-1 A (a dense eigensolver would take seconds
+    # here), about 10 times max|lam| on the 60- and 100-segment shafts: the bound is 2.5e-9, the
+    # measured differences 2.1e-11 (frequencies, relative) and 1.1e-12 (damping ratios)
+    upper, stiffness, damping, _ = rotor._dense_blocks
+    largest = np.max(np.sum(np.abs(upper), axis=0) + np.sum(np.abs(np.hstack([stiffness, damping])), axis=0))
+    bound = ZETA_UNITS * EPS * largest / smallest
+    frequencies = np.max(np.abs(got[:3, 3:3 + DAMPED_MODES] / table[:, :DAMPED_MODES] - 1.0))
+    zeta = np.max(np.abs(got[:3, 3 + DAMPED_MODES:] - table[:, DAMPED_MODES:]))
+    assert frequencies <= bound and zeta <= bound, (frequencies, zeta, bound)
 
 
 def test_response_position_and_omega_max_are_honoured(library):

@@ -1,5 +1,6 @@
 /* Damped finite-element model of a driveline (damped.DampedRotor) and what the FMU reports of it
- * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver, the synchronous
+ * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver up to DENSE_SIZE
+ * first-order unknowns and by shift-invert Arnoldi on a banded factorisation above, the synchronous
  * unbalance response from a banded complex LU solve. */
 #include "rotor.h"
 
@@ -358,8 +359,9 @@ typedef struct {
 
 #define AB(band, ab, i, j) (ab)[(size_t)(j) * (size_t)(band).rows + (size_t)((band).kl + (band).ku + (i) - (j))]
 
-/* Solves ab x = b in place (ab factorised, ``pivots`` n); -1 on an exactly zero pivot (singular) */
-static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
+/* LU factors of ab in place with partial pivoting (``pivots`` n, the row swapped with each row as
+ * it is eliminated); -1 on an exactly zero pivot (singular) */
+static int band_factor(Band band, cplx *ab, int *pivots)
 {
     int n = band.n, kl = band.kl, width = kl + band.ku;
     for (int j = 0; j < n; j++) {
@@ -383,9 +385,6 @@ static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
                 AB(band, ab, j, c) = AB(band, ab, pivot, c);
                 AB(band, ab, pivot, c) = t;
             }
-            cplx t = b[j];
-            b[j] = b[pivot];
-            b[pivot] = t;
         }
         cplx diagonal = AB(band, ab, j, j);
         for (int i = j + 1; i <= last; i++) {
@@ -397,7 +396,27 @@ static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
             for (int c = j + 1; c <= end; c++) {
                 AB(band, ab, i, c) -= mul(factor, AB(band, ab, j, c));
             }
-            b[i] -= mul(factor, b[j]);
+        }
+    }
+    return 0;
+}
+
+/* b <- ab^-1 b in place, ab factorised by band_factor */
+static void band_substitute(Band band, const cplx *ab, const int *pivots, cplx *b)
+{
+    int n = band.n, kl = band.kl, width = kl + band.ku;
+    for (int j = 0; j < n; j++) {
+        int last = j + kl < n ? j + kl : n - 1;
+        if (pivots[j] != j) {
+            cplx t = b[j];
+            b[j] = b[pivots[j]];
+            b[pivots[j]] = t;
+        }
+        for (int i = j + 1; i <= last; i++) {
+            cplx factor = AB(band, ab, i, j);
+            if (factor != 0.0) {
+                b[i] -= mul(factor, b[j]);
+            }
         }
     }
     for (int i = n - 1; i >= 0; i--) {
@@ -408,6 +427,15 @@ static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
         }
         b[i] = sum / AB(band, ab, i, i);
     }
+}
+
+/* Solves ab x = b in place (ab factorised, ``pivots`` n); -1 on an exactly zero pivot (singular) */
+static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
+{
+    if (band_factor(band, ab, pivots)) {
+        return -1;
+    }
+    band_substitute(band, ab, pivots, b);
     return 0;
 }
 
@@ -618,6 +646,284 @@ static int by_frequency(const void *a, const void *b)
     return (x->place > y->place) - (x->place < y->place);
 }
 
+/* ---- shift-invert Arnoldi (DampedRotor.modes above DENSE_SIZE) ------------------------------
+ * The eigenvalues nu of (A - SHIFT B)^-1 B are 1 / (lam - SHIFT): the largest |nu| are the lam nearest
+ * SHIFT. With y = [y1, y2] and v = [v1, v2] (x and x'/s blocks, each in the interleaved order),
+ * (A - SHIFT B) y = B v reads -SHIFT y1 + s y2 = v1 and -K2 y1 / s - (C2 + spin Gv + SHIFT M2) y2 = M2 v2,
+ * so that Q(SHIFT) y1 = -s M2 v2 - (C2 + spin Gv + SHIFT M2) v1 with the banded
+ * Q(SHIFT) = K2 + SHIFT (C2 + spin Gv) + SHIFT^2 M2, and y2 = (v1 + SHIFT y1) / s. */
+/* most Krylov vectors: memory 2 size (KRYLOV_CAP + 1) complex numbers */
+#define KRYLOV_CAP 400
+/* a Ritz value has converged when its residual estimate is below this times the largest |nu| */
+#define RITZ_TOLERANCE (64.0 * DBL_EPSILON)
+
+typedef struct {
+    int cap, steps;        /* most Krylov vectors (0: the dense path); vectors of the last run */
+    cplx *q, *coupling;    /* Q(SHIFT) factorised and C2 + spin Gv + SHIFT M2, band storage */
+    int *pivots, *place;   /* Q's row swaps; place[order[i]] = i */
+    cplx *basis;           /* cap + 1 orthonormal vectors of 2 size */
+    cplx *hess;            /* (cap + 1) x cap Hessenberg matrix of the Arnoldi relation, by rows */
+    cplx *small, *work, *lu, *ritz, *z, *multiplier; /* the leading steps x steps part and its work */
+    unsigned char *swapped;
+    int *rank;             /* the Ritz values by descending |nu| (the first ones wanted) */
+} Krylov;
+
+static void krylov_free(Krylov *krylov)
+{
+    void *all[] = {krylov->q, krylov->coupling, krylov->pivots, krylov->place, krylov->basis, krylov->hess,
+                   krylov->small, krylov->work, krylov->lu, krylov->ritz, krylov->z, krylov->multiplier,
+                   krylov->swapped, krylov->rank};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
+        free(all[i]);
+    }
+    memset(krylov, 0, sizeof *krylov);
+}
+
+static int krylov_init(Krylov *krylov, const Rotor *rotor)
+{
+    memset(krylov, 0, sizeof *krylov);
+    int m = rotor->size, order = 2 * m, cap = order < KRYLOV_CAP ? order : KRYLOV_CAP;
+    size_t cells = (size_t)rotor->band.rows * (size_t)m, square = (size_t)cap * (size_t)cap;
+    krylov->cap = cap;
+    krylov->q = malloc(cells * sizeof(cplx));
+    krylov->coupling = malloc(cells * sizeof(cplx));
+    krylov->pivots = malloc((size_t)m * sizeof(int));
+    krylov->place = malloc((size_t)m * sizeof(int));
+    krylov->basis = malloc(((size_t)cap + 1) * (size_t)order * sizeof(cplx));
+    krylov->hess = malloc(((size_t)cap + 1) * (size_t)cap * sizeof(cplx));
+    krylov->small = malloc(square * sizeof(cplx));
+    krylov->work = malloc(square * sizeof(cplx));
+    krylov->lu = malloc(square * sizeof(cplx));
+    krylov->ritz = malloc((size_t)cap * sizeof(cplx));
+    krylov->z = malloc((size_t)cap * sizeof(cplx));
+    krylov->multiplier = malloc((size_t)cap * sizeof(cplx));
+    krylov->swapped = malloc((size_t)cap);
+    krylov->rank = malloc((size_t)cap * sizeof(int));
+    if (!krylov->q || !krylov->coupling || !krylov->pivots || !krylov->place || !krylov->basis || !krylov->hess ||
+        !krylov->small || !krylov->work || !krylov->lu || !krylov->ritz || !krylov->z || !krylov->multiplier ||
+        !krylov->swapped || !krylov->rank) {
+        krylov_free(krylov);
+        return -1;
+    }
+    for (int i = 0; i < m; i++) {
+        krylov->place[rotor->order[i]] = i;
+    }
+    return 0;
+}
+
+/* y = (A - SHIFT B)^-1 B v (2 size each, blocks in the interleaved order) */
+static void krylov_apply(const Rotor *rotor, const Krylov *krylov, const cplx *v, cplx *y)
+{
+    Band band = rotor->band;
+    int m = rotor->size;
+    double s = rotor->scale;
+    const cplx *v1 = v, *v2 = v + m, *mass = rotor->banded[3];
+    cplx *y1 = y, *y2 = y + m;
+    for (int i = 0; i < m; i++) {
+        y1[i] = 0.0;
+    }
+    for (int j = 0; j < m; j++) { /* -s M2 v2 - (C2 + spin Gv + SHIFT M2) v1, column by column */
+        int first = j - band.ku > 0 ? j - band.ku : 0, last = j + band.kl < m ? j + band.kl : m - 1;
+        cplx a = -s * v2[j], b = v1[j];
+        for (int i = first; i <= last; i++) {
+            y1[i] += mul(AB(band, mass, i, j), a) - mul(AB(band, krylov->coupling, i, j), b);
+        }
+    }
+    band_substitute(band, krylov->q, krylov->pivots, y1);
+    for (int i = 0; i < m; i++) {
+        y2[i] = (v1[i] + SHIFT * y1[i]) / s;
+    }
+}
+
+static double vector_norm(const cplx *x, int n)
+{
+    double scale = 0.0;
+    for (int i = 0; i < n; i++) {
+        scale = fmax(scale, cabs1(x[i]));
+    }
+    if (!(scale > 0.0) || !isfinite(scale)) {
+        return scale;
+    }
+    double sum = 0.0;
+    for (int i = 0; i < n; i++) {
+        double re = creal(x[i]) / scale, im = cimag(x[i]) / scale;
+        sum += re * re + im * im;
+    }
+    return scale * sqrt(sum);
+}
+
+/* w minus its projection on the first ``count`` basis vectors, twice (classical Gram-Schmidt with one
+ * reorthogonalisation); the coefficients added to ``column`` (stride ``stride``) unless it is NULL */
+static void orthogonalize(const cplx *basis, int count, int order, cplx *w, cplx *column, int stride)
+{
+    for (int pass = 0; pass < 2; pass++) {
+        for (int j = 0; j < count; j++) {
+            const cplx *v = basis + (size_t)j * (size_t)order;
+            cplx c = 0.0;
+            for (int i = 0; i < order; i++) {
+                c += mul_conj(v[i], w[i]);
+            }
+            for (int i = 0; i < order; i++) {
+                w[i] -= mul(c, v[i]);
+            }
+            if (column) {
+                column[(size_t)j * (size_t)stride] += c;
+            }
+        }
+    }
+}
+
+/* A unit start vector, orthogonal to the first ``count`` basis vectors, from a fixed pseudo-random sequence */
+static void start_vector(const cplx *basis, int count, int order, unsigned long *seed, cplx *w)
+{
+    for (int attempt = 0; attempt < 3; attempt++) {
+        for (int i = 0; i < order; i++) {
+            double part[2];
+            for (int k = 0; k < 2; k++) { /* a 32-bit linear congruential sequence */
+                *seed = (*seed * 1664525UL + 1013904223UL) & 0xffffffffUL;
+                part[k] = (double)*seed / 4294967296.0 - 0.5;
+            }
+            w[i] = make_complex(part[0], part[1]);
+        }
+        orthogonalize(basis, count, order, w, NULL, 0);
+        double norm = vector_norm(w, order);
+        if (norm > 0.0) {
+            for (int i = 0; i < order; i++) {
+                w[i] /= norm;
+            }
+            return;
+        }
+    }
+}
+
+/* The Ritz values of the first ``steps`` vectors (into ritz, ranked by descending |nu|): 1 when the
+ * ``wanted`` largest have converged, 0 when not yet, -1 when the small eigenproblem fails */
+static int krylov_converged(Krylov *krylov, int steps, int order, int wanted)
+{
+    int cap = krylov->cap;
+    for (int i = 0; i < steps; i++) {
+        for (int j = 0; j < steps; j++) {
+            krylov->small[(size_t)i * (size_t)steps + (size_t)j] = krylov->hess[(size_t)i * (size_t)cap + (size_t)j];
+        }
+    }
+    memcpy(krylov->work, krylov->small, (size_t)steps * (size_t)steps * sizeof(cplx));
+    if (hessenberg_eigenvalues(krylov->work, steps, krylov->ritz)) {
+        return -1;
+    }
+    int *rank = krylov->rank;
+    for (int i = 0; i < steps; i++) {
+        rank[i] = i;
+    }
+    for (int k = 0; k < wanted; k++) { /* partial selection by descending |nu| */
+        int best = k;
+        for (int i = k + 1; i < steps; i++) {
+            if (cabs(krylov->ritz[rank[i]]) > cabs(krylov->ritz[rank[best]])) {
+                best = i;
+            }
+        }
+        int t = rank[k];
+        rank[k] = rank[best];
+        rank[best] = t;
+    }
+    if (steps == order) { /* the whole space: the Ritz values are the eigenvalues */
+        return 1;
+    }
+    double beta = cabs(krylov->hess[(size_t)steps * (size_t)cap + (size_t)(steps - 1)]);
+    double bound = RITZ_TOLERANCE * cabs(krylov->ritz[rank[0]]);
+    for (int k = 0; k < wanted; k++) { /* |h_{m+1,m} e_m^T z| with z a unit eigenvector of H */
+        inverse_iteration(krylov->small, steps, krylov->ritz[rank[k]], krylov->lu, krylov->multiplier,
+                          krylov->swapped, krylov->z);
+        double norm = vector_norm(krylov->z, steps);
+        if (!(beta * cabs(krylov->z[steps - 1]) <= bound * norm)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* The ``wanted`` eigenvalues lam nearest SHIFT at ``spin`` into ``lambda`` (ranked by descending
+ * |nu|); afterwards ritz[rank[k]] is the Ritz value of lambda[k] and small the Hessenberg matrix */
+static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wanted, cplx *lambda, char *error,
+                        size_t size)
+{
+    int m = rotor->size, order = 2 * m, cap = krylov->cap;
+    if (!isfinite(spin)) {
+        set_error(error, size, "Array must not contain infs or NaNs");
+        return -1;
+    }
+    size_t cells = (size_t)rotor->band.rows * (size_t)m;
+    for (size_t i = 0; i < cells; i++) {
+        krylov->coupling[i] = rotor->banded[1][i] + spin * rotor->banded[2][i] + SHIFT * rotor->banded[3][i];
+        krylov->q[i] = rotor->banded[0][i] + SHIFT * krylov->coupling[i];
+    }
+    if (band_factor(rotor->band, krylov->q, krylov->pivots)) {
+        set_error(error, size, "the damped model is singular at the Arnoldi shift");
+        return -1;
+    }
+    memset(krylov->hess, 0, ((size_t)cap + 1) * (size_t)cap * sizeof(cplx));
+    unsigned long seed = 20240601UL;
+    start_vector(krylov->basis, 0, order, &seed, krylov->basis);
+    int steps = 0, next = wanted + 8, status = 0;
+    while (status == 0) {
+        cplx *w = krylov->basis + (size_t)(steps + 1) * (size_t)order;
+        krylov_apply(rotor, krylov, krylov->basis + (size_t)steps * (size_t)order, w);
+        double before = vector_norm(w, order);
+        if (!isfinite(before)) {
+            set_error(error, size, "the Arnoldi iteration met infs or NaNs");
+            return -1;
+        }
+        orthogonalize(krylov->basis, steps + 1, order, w, krylov->hess + steps, cap);
+        double beta = vector_norm(w, order);
+        steps++;
+        if (beta > 1e-12 * before) {
+            krylov->hess[(size_t)steps * (size_t)cap + (size_t)(steps - 1)] = beta;
+            for (int i = 0; i < order; i++) {
+                w[i] /= beta;
+            }
+        } else if (steps < order) { /* an invariant subspace: go on with a new direction */
+            start_vector(krylov->basis, steps, order, &seed, w);
+        }
+        if (steps == order || steps == cap || steps >= next) {
+            status = krylov_converged(krylov, steps, order, wanted < steps ? wanted : steps);
+            if (status < 0) {
+                set_error(error, size, "Eigenvalues did not converge");
+                return -1;
+            }
+            if (status == 0 && steps == cap) {
+                if (error && size) {
+                    snprintf(error, size, "the damped modes did not converge in %d Arnoldi vectors", cap);
+                }
+                return -1;
+            }
+            next = steps + (steps / 8 > 4 ? steps / 8 : 4);
+        }
+    }
+    krylov->steps = steps;
+    for (int k = 0; k < wanted; k++) {
+        lambda[k] = SHIFT + 1.0 / krylov->ritz[krylov->rank[k]];
+    }
+    return 0;
+}
+
+/* The forward and backward sums sum |p_U|^2, sum |q_U|^2 of the Ritz vector of lambda[k] */
+static void krylov_shares(const Rotor *rotor, Krylov *krylov, int k, double *forward, double *backward)
+{
+    int steps = krylov->steps, order = 2 * rotor->size;
+    inverse_iteration(krylov->small, steps, krylov->ritz[krylov->rank[k]], krylov->lu, krylov->multiplier,
+                      krylov->swapped, krylov->z);
+    *forward = *backward = 0.0;
+    for (int t = 0; t < rotor->n_translations; t++) { /* x = y1 = V z at the rows of p_U and q_U */
+        int rows[2] = {krylov->place[rotor->translations[t]], krylov->place[rotor->n + rotor->translations[t]]};
+        for (int half = 0; half < 2; half++) {
+            cplx x = 0.0;
+            for (int j = 0; j < steps; j++) {
+                x += mul(krylov->basis[(size_t)j * (size_t)order + (size_t)rows[half]], krylov->z[j]);
+            }
+            *(half ? backward : forward) += creal(x) * creal(x) + cimag(x) * cimag(x);
+        }
+    }
+}
+
 /* The dense work of DampedRotor.modes: the blocks of B^-1 A without the spin (_dense_blocks) and
  * the eigen solver's arrays, for a 2 size first-order system. */
 typedef struct {
@@ -628,6 +934,7 @@ typedef struct {
     unsigned char *swapped;
     Mode *modes;
     int *index;
+    Krylov krylov;                     /* above DENSE_SIZE (krylov.cap > 0): none of the dense arrays */
 } Dense;
 
 static void dense_free(Dense *dense)
@@ -638,6 +945,7 @@ static void dense_free(Dense *dense)
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
         free(all[i]);
     }
+    krylov_free(&dense->krylov);
     memset(dense, 0, sizeof *dense);
 }
 
@@ -716,6 +1024,18 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
     size_t block = (size_t)m * (size_t)m, full = (size_t)order * (size_t)order;
     dense->size = m;
     dense->order = order;
+    if (order > DENSE_SIZE) { /* shift-invert Arnoldi: the banded matrices and O(order KRYLOV_CAP) work */
+        int cap = order < KRYLOV_CAP ? order : KRYLOV_CAP;
+        dense->lambda = malloc((size_t)cap * sizeof(cplx));
+        dense->modes = malloc((size_t)cap * sizeof(Mode));
+        dense->index = malloc((size_t)cap * sizeof(int));
+        if (!dense->lambda || !dense->modes || !dense->index || krylov_init(&dense->krylov, rotor)) {
+            dense_free(dense);
+            set_error(error, size, OUT_OF_MEMORY);
+            return -1;
+        }
+        return 0;
+    }
     dense->stiffness = malloc(block * sizeof(cplx));
     dense->damping = malloc(block * sizeof(cplx));
     dense->gyro = malloc(block * sizeof(cplx));
@@ -766,9 +1086,8 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
     return 0;
 }
 
-/* DampedRotor.modes(spin, n): the first ``n`` damped modes into ``out`` (n), their number in *found */
-static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mode *out, int *found, char *error,
-                       size_t size)
+/* All eigenvalues of the first-order system at ``spin`` (numpy.linalg.eig) into dense->lambda */
+static int dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char *error, size_t size)
 {
     int m = dense->size, order = dense->order;
     cplx *a = dense->a;
@@ -800,25 +1119,29 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
         set_error(error, size, "Eigenvalues did not converge");
         return -1;
     }
-    /* above DENSE_SIZE Python takes the 2 n + EXTRA_EIGENVALUES nearest SHIFT (shift-invert Arnoldi) */
-    int count = order, *index = dense->index;
-    for (int i = 0; i < order; i++) {
-        index[i] = i;
-    }
-    if (order > DENSE_SIZE && 2 * n + EXTRA_EIGENVALUES < order) {
-        int wanted = 2 * n + EXTRA_EIGENVALUES;
-        for (int k = 0; k < wanted; k++) { /* partial selection by |lambda - SHIFT| */
-            int best = k;
-            for (int i = k + 1; i < order; i++) {
-                if (cabs(dense->lambda[index[i]] - SHIFT) < cabs(dense->lambda[index[best]] - SHIFT)) {
-                    best = i;
-                }
-            }
-            int t = index[k];
-            index[k] = index[best];
-            index[best] = t;
+    return 0;
+}
+
+/* DampedRotor.modes(spin, n): the first ``n`` damped modes into ``out`` (n), their number in *found */
+static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mode *out, int *found, char *error,
+                       size_t size)
+{
+    int order = dense->order, count, *index = dense->index;
+    if (dense->krylov.cap) { /* above DENSE_SIZE: the 2 n + EXTRA_EIGENVALUES nearest SHIFT by Arnoldi */
+        count = 2 * n + EXTRA_EIGENVALUES < dense->krylov.cap ? 2 * n + EXTRA_EIGENVALUES : dense->krylov.cap;
+        if (krylov_modes(rotor, &dense->krylov, spin, count, dense->lambda, error, size)) {
+            return -1;
         }
-        count = wanted;
+        for (int i = 0; i < count; i++) {
+            index[i] = i;
+        }
+    } else if (dense_eigenvalues(rotor, dense, spin, error, size)) {
+        return -1;
+    } else {
+        count = order;
+        for (int i = 0; i < order; i++) {
+            index[i] = i;
+        }
     }
     if (rotor->conservative) { /* the eigensolver's real parts are round-off (DampedRotor.modes) */
         for (int k = 0; k < count; k++) {
@@ -854,14 +1177,18 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
     for (int k = 0; k < take; k++) {
         out[k] = dense->modes[k];
         if (rotor->doubled) { /* the forward share sum |p_U|^2 / sum (|p_U|^2 + |q_U|^2) of its eigenvector */
-            cplx value = out[k].eigenvalue;
-            inverse_iteration(dense->saved, order, value, dense->h, dense->multiplier, dense->swapped, dense->x);
-            back_transform(a, order, dense->tau, dense->d, dense->x);
             double forward = 0.0, backward = 0.0;
-            for (int t = 0; t < rotor->n_translations; t++) {
-                cplx p = dense->x[rotor->translations[t]], q = dense->x[rotor->n + rotor->translations[t]];
-                forward += creal(p) * creal(p) + cimag(p) * cimag(p);
-                backward += creal(q) * creal(q) + cimag(q) * cimag(q);
+            if (dense->krylov.cap) { /* its Ritz vector */
+                krylov_shares(rotor, &dense->krylov, out[k].place, &forward, &backward);
+            } else {
+                inverse_iteration(dense->saved, order, out[k].eigenvalue, dense->h, dense->multiplier, dense->swapped,
+                                  dense->x);
+                back_transform(dense->a, order, dense->tau, dense->d, dense->x);
+                for (int t = 0; t < rotor->n_translations; t++) {
+                    cplx p = dense->x[rotor->translations[t]], q = dense->x[rotor->n + rotor->translations[t]];
+                    forward += creal(p) * creal(p) + cimag(p) * cimag(p);
+                    backward += creal(q) * creal(q) + cimag(q) * cimag(q);
+                }
             }
             out[k].forward_share = forward / (forward + backward);
         }
@@ -1049,6 +1376,11 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         return NULL;
     }
     return outputs;
+}
+
+void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed, double out[2 * DAMPED_MODES])
+{
+    cubic_spline_evaluate(&outputs->modes, speed, out);
 }
 
 /* UnbalanceOutputs.evaluate (DampedRotor.solve, components and bearing_forces at one speed) */

@@ -209,14 +209,19 @@ int fe_natural_frequencies(const Driveline *driveline, int elements, double **fr
                            size_t size);
 
 typedef struct UnbalanceOutputs UnbalanceOutputs;
-/* unbalance_outputs.UnbalanceOutputs.build; the mode table from the dense eigensolver at every size
- * (Python: ARPACK above DENSE_SIZE first-order unknowns, whose selection it reproduces) */
+/* unbalance_outputs.UnbalanceOutputs.build; the mode table from the dense eigensolver up to DENSE_SIZE
+ * first-order unknowns, above from shift-invert Arnoldi (as Python) on one banded factorisation per
+ * speed: O(unknowns (band^2 + vectors^2)) with at most 400 Krylov vectors, an error if the wanted
+ * eigenvalues have not converged by then */
 UnbalanceOutputs *unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
                                         double response_fraction, double omega_max, char *error, size_t size);
 /* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio (an exactly singular
  * dynamic stiffness: infinite response and force). It allocates nothing: the object holds the
  * solve's work arrays, so one object is evaluated by one caller at a time. */
 void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3]);
+/* UnbalanceOutputs.modes(speed): the tabulated damped frequencies of the DAMPED_MODES (4) modes, then
+ * their damping ratios (out has 8 places) */
+void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed, double out[8]);
 void unbalance_outputs_free(UnbalanceOutputs *outputs);
 
 #endif
