@@ -52,6 +52,19 @@ static cplx mul_conj(cplx a, cplx b)
     return make_complex(creal(a) * creal(b) + cimag(a) * cimag(b), creal(a) * cimag(b) - cimag(a) * creal(b));
 }
 
+/* 1 / d without overflow or a library call (Smith's division; LAPACK's gbtf2 scales a column by the
+ * pivot's reciprocal too) */
+static cplx reciprocal(cplx d)
+{
+    double re = creal(d), im = cimag(d);
+    if (fabs(re) >= fabs(im)) {
+        double ratio = im / re, denominator = re + im * ratio;
+        return make_complex(1.0 / denominator, -ratio / denominator);
+    }
+    double ratio = re / im, denominator = re * ratio + im;
+    return make_complex(ratio / denominator, -1.0 / denominator);
+}
+
 static double cabs1(cplx z)
 {
     return fabs(creal(z)) + fabs(cimag(z));
@@ -363,7 +376,7 @@ typedef struct {
  * it is eliminated); -1 on an exactly zero pivot (singular) */
 static int band_factor(Band band, cplx *ab, int *pivots)
 {
-    int n = band.n, kl = band.kl, width = kl + band.ku;
+    int n = band.n, kl = band.kl, ju = 0; /* ju: the last column U reaches so far (LAPACK's gbtf2) */
     for (int j = 0; j < n; j++) {
         int last = j + kl < n ? j + kl : n - 1, pivot = j;
         double best = cabs1(AB(band, ab, j, j));
@@ -378,7 +391,9 @@ static int band_factor(Band band, cplx *ab, int *pivots)
         if (AB(band, ab, pivot, j) == 0.0) {
             return -1;
         }
-        int end = j + width < n ? j + width : n - 1;
+        int reach = pivot + band.ku < n ? pivot + band.ku : n - 1, end;
+        ju = reach > ju ? reach : ju;
+        end = ju;
         if (pivot != j) {
             for (int c = j; c <= end; c++) {
                 cplx t = AB(band, ab, j, c);
@@ -386,9 +401,9 @@ static int band_factor(Band band, cplx *ab, int *pivots)
                 AB(band, ab, pivot, c) = t;
             }
         }
-        cplx diagonal = AB(band, ab, j, j);
+        cplx inverse = reciprocal(AB(band, ab, j, j));
         for (int i = j + 1; i <= last; i++) {
-            cplx factor = AB(band, ab, i, j) / diagonal;
+            cplx factor = mul(AB(band, ab, i, j), inverse);
             AB(band, ab, i, j) = factor;
             if (factor == 0.0) {
                 continue;
@@ -423,9 +438,12 @@ static void band_substitute(Band band, const cplx *ab, const int *pivots, cplx *
         int end = i + width < n ? i + width : n - 1;
         cplx sum = b[i];
         for (int c = i + 1; c <= end; c++) {
-            sum -= mul(AB(band, ab, i, c), b[c]);
+            cplx u = AB(band, ab, i, c);
+            if (u != 0.0) { /* beyond the columns pivoting reached, U is zero */
+                sum -= mul(u, b[c]);
+            }
         }
-        b[i] = sum / AB(band, ab, i, i);
+        b[i] = mul(sum, reciprocal(AB(band, ab, i, i)));
     }
 }
 
