@@ -33,12 +33,18 @@ def package_root(name: str) -> Path:
     return location.parent.parent if location.name == "__init__.py" else location.parent
 
 
+#: Sub-folders that hold no data of the Python FMUs: ``fmu_src/native/`` holds the native FMUs' C
+#: sources (85 kB more in every Python FMU, and with them a Python FMU of FMI 2.0 followed by one
+#: of FMI 3.0 in one process was seen to corrupt the heap of the wrappers' shared host).
+NOT_DATA = ("__pycache__", "native")
+
+
 def data_files(package: Path) -> list[Path]:
     """Files in the sub-folders of ``package`` that are not packages themselves (e.g. ``data/``)."""
     return sorted(
         path
         for folder in package.iterdir()
-        if folder.is_dir() and folder.name != "__pycache__" and not (folder / "__init__.py").exists()
+        if folder.is_dir() and folder.name not in NOT_DATA and not (folder / "__init__.py").exists()
         for path in folder.rglob("*")
         if path.is_file() and "__pycache__" not in path.parts
     )
