@@ -572,6 +572,19 @@ static int part(Analysis *analysis, const ModelData *data, Part which, const int
     return 0;
 }
 
+/* Whether every part holds for these parameters: the last analysis succeeded for exactly them, work
+ * check included (Python: key == _analysed_for), so a step has nothing to check or build. */
+static int analysed_for(const Analysis *analysis, const ModelData *data, const int *orders, int n_orders)
+{
+    int which;
+    for (which = 0; which < PARTS; which++) {
+        if (!key_matches(&analysis->keys[which], data, (Part)which, orders, n_orders)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* CriticalSpeedsModel.extra_parameter_errors: analyse what a changed parameter affects. */
 static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
@@ -588,8 +601,11 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
         }
         cache->derived = analysis;
     }
-    failed = parse_orders(data->string_value[V_orders], orders, &n_orders, error) ||
-             part(analysis, data, PART_DRIVELINE, orders, n_orders, error) ||
+    failed = parse_orders(data->string_value[V_orders], orders, &n_orders, error);
+    if (!failed && analysed_for(analysis, data, orders, n_orders)) {
+        return;
+    }
+    failed = failed || part(analysis, data, PART_DRIVELINE, orders, n_orders, error) ||
              searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
     if (!failed && !(work <= MAX_SEARCHED_MODES)) {
         python_g(work, 3, shown, sizeof shown);
