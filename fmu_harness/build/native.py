@@ -41,7 +41,7 @@ import fmpy
 import fmu_src
 from driveline import __version__
 from driveline.catalog import MODELS
-from driveline.model import SteppedModel
+from driveline.model import TIME_TOLERANCE, SteppedModel
 from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
 from .model_description import complete_fmi2, complete_fmi3
@@ -267,6 +267,8 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_STRING_COUNT {sum(v.type == "String" for v in spec.variables)}
 #define MODEL_RELATION_COUNT {len(spec.relations)}
 #define MODEL_EXTRA_MESSAGE_COUNT {len(probes)}
+/* driveline.model.TIME_TOLERANCE: how far, relative to the time reached, a step may start before it */
+#define MODEL_TIME_TOLERANCE {_c_double(TIME_TOLERANCE)}
 
 /* value references */
 enum {{
