@@ -113,6 +113,10 @@ class SteppedModel(ABC):
     #: the messages from the check run on these values, so their wording exists once.
     extra_parameter_probes: ClassVar[dict[str, dict[str, float]]] = {}
 
+    #: Constants the native port of the model shares with it (``#define`` name and value, a
+    #: string as a C string), generated into its variable header so they are written once.
+    native_constants: ClassVar[dict[str, str | int | float]] = {}
+
     #: Files a native FMU of the model ships in its ``resources/`` folder, by their path here (the
     #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.
     resource_files: ClassVar[tuple[Path, ...]] = ()

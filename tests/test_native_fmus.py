@@ -75,8 +75,10 @@ def _standard_run(path: Path, name: str, **open_options) -> np.ndarray:
 def test_the_models_without_a_c_port_are_skipped(native_dir):
     """CriticalSpeeds is native once its rotor library (every module rotor.h lists) is there."""
     ported = ("TripodCoupling", "CardanJoint", "UniversalReducer", "SpeedSource")
-    assert native.library_modules("CriticalSpeeds") == sorted(
-        ["layout.c", "pyrepr.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c", "damped.c"])
+    folder = native.library_folder("CriticalSpeeds")
+    assert native.library_modules("CriticalSpeeds") == sorted(path.name for path in folder.glob("*.c"))
+    assert {"layout.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c", "damped.c"} <= set(
+        native.library_modules("CriticalSpeeds"))
     complete = all((native.library_folder("CriticalSpeeds") / module).exists()
                    for module in native.library_modules("CriticalSpeeds"))
     assert NATIVE == [name for name in MODELS if name in ported or (name == "CriticalSpeeds" and complete)]

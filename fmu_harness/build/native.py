@@ -255,6 +255,9 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
     spec = model.spec
     probes = model.extra_parameter_probes
     names = "\n".join(f"    V_{v.name} = {index}," for index, v in enumerate(spec.variables))
+    derivatives = input_derivatives(spec)
+    constants = "".join(f"#define {name} {_c_string(value) if isinstance(value, str) else value}\n"
+                        for name, value in model.native_constants.items())
     extra_enum = "" if not probes else "\n/* messages of the model's own checks */\nenum {\n" + "".join(
         f"    MESSAGE_{name} = {index},\n" for index, name in enumerate(probes)) + "};\n"
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
@@ -269,7 +272,8 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_EXTRA_MESSAGE_COUNT {len(probes)}
 /* driveline.model.TIME_TOLERANCE: how far, relative to the time reached, a step may start before it */
 #define MODEL_TIME_TOLERANCE {_c_double(TIME_TOLERANCE)}
-
+#define MODEL_INPUT_DERIVATIVE_COUNT {len(derivatives)}
+{constants}
 /* value references */
 enum {{
 {names}
@@ -302,7 +306,26 @@ const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT] = {{
 {extra}
 }};
 """
+    if derivatives:
+        table = "\n".join(f"    {{V_{of}, {order}, V_{target}}}," for of, order, target in derivatives)
+        source += f"""
+const InputDerivative model_input_derivatives[MODEL_INPUT_DERIVATIVE_COUNT] = {{
+{table}
+}};
+"""
     return {"model_variables.h": header, "model_variables.c": source}
+
+
+def input_derivatives(spec: ModelSpec) -> list[tuple[str, int, str]]:
+    """``(input, order, variable)``: the inputs that hold an input's time derivatives, by order."""
+    found = []
+    for variable in spec.of("input"):
+        base, order = variable.name, 0
+        while spec[base].derivative is not None:
+            base, order = spec[base].derivative, order + 1
+        if order:
+            found.append((base, order, variable.name))
+    return found
 
 
 # -- model description ----------------------------------------------------------------------------
@@ -332,7 +355,8 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
         "modelIdentifier": spec.name, "needsExecutionTool": "false", "canHandleVariableCommunicationStepSize": "true",
         "canBeInstantiatedOnlyOncePerProcess": "false", f"canGetAndSetFMU{state}": "true",
         f"canSerializeFMU{state}": "true",
-        **({} if fmi3 else {"canInterpolateInputs": "false", "canNotUseMemoryManagementFunctions": "true"}),
+        **({} if fmi3 else {"canInterpolateInputs": "true" if input_derivatives(spec) else "false",
+                             "canNotUseMemoryManagementFunctions": "true"}),
     })
     if not fmi3:
         files = ET.SubElement(cosimulation, "SourceFiles")

@@ -123,9 +123,9 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         const fmi2Real dvKnown[] UNUSED, fmi2Real dvUnknown[] UNUSED)
 ON_INSTANCE(fmi2, instance_unsupported(instance, "GetDirectionalDerivative"))
 
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
-                                       const fmi2Integer order[] UNUSED, const fmi2Real value[] UNUSED)
-ON_INSTANCE(fmi2, instance_unsupported(instance, "SetRealInputDerivatives"))
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[])
+ON_INSTANCE(fmi2, instance_set_input_derivatives(instance, "SetRealInputDerivatives", vr, nvr, order, value))
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                         const fmi2Integer order[] UNUSED, fmi2Real value[] UNUSED)

@@ -584,6 +584,44 @@ Status instance_set_real(Instance *instance, const char *function, const uint32_
     return STATUS_OK;
 }
 
+Status instance_set_input_derivatives(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                                      const int32_t order[], const double value[])
+{
+#if MODEL_INPUT_DERIVATIVE_COUNT > 0
+    uint32_t target[MODEL_INPUT_DERIVATIVE_COUNT];
+    size_t i;
+    int k;
+    if (n > 0 && (vr == NULL || order == NULL || value == NULL)) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": a NULL array", (const char *)NULL);
+    }
+    if (n > MODEL_INPUT_DERIVATIVE_COUNT) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": more derivatives than the model's inputs hold",
+                             (const char *)NULL);
+    }
+    for (i = 0; i < n; i++) {
+        for (k = 0; k < MODEL_INPUT_DERIVATIVE_COUNT; k++) {
+            const InputDerivative *d = &model_input_derivatives[k];
+            if ((uint32_t)d->input == vr[i] && d->order == order[i]) {
+                target[i] = (uint32_t)d->target;
+                break;
+            }
+        }
+        if (k == MODEL_INPUT_DERIVATIVE_COUNT) {
+            return instance_fail(instance, instance->fmi_prefix, function,
+                                 ": no input holds that derivative (input and order: see the model's inputs "
+                                 "with a derivative)", (const char *)NULL);
+        }
+    }
+    return instance_set_real(instance, function, target, n, value);
+#else
+    (void)vr;
+    (void)n;
+    (void)order;
+    (void)value;
+    return instance_unsupported(instance, function);
+#endif
+}
+
 Status instance_set_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                             const int32_t value[])
 {
