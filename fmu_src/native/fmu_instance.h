@@ -22,7 +22,6 @@
 #define UNUSED
 #endif
 
-#define FMU_PI 3.14159265358979323846
 #define FMU_MESSAGE_SIZE 1024 /* a message names a layout file by its absolute path: room for a long one */
 #define FMU_MAX_MESSAGES 48
 /* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
@@ -172,6 +171,9 @@ typedef struct {
 } ModelHooks;
 
 extern const ModelHooks model_hooks;
+
+/* A Real variable of the model by its name, in a hook whose ModelData is ``data`` */
+#define VALUE(name) (data->real_value[V_##name])
 
 /* ``start`` and ``advance`` of a model driven by an input shaft (DrivenShaftModel in
  * driveline/model.py): phi_in starts at phi_in_start and integrates the held omega_in exactly;
