@@ -162,17 +162,22 @@ MODES = {  # parameters of the modes the standard scenario (spec start values) l
         {"kinematics": 1, "mu": 0.02, "v_slip": 1e-2, "seed_reactions": 1, "phi_in_start": 0.4},
         {"seed_reactions": 1},
         {"kinematics": 1, "beta_max": math.radians(60.0), "r": 0.07},
+        {"kinematics": 1, "mu": 0.05, "T_load": -500.0},  # coast
+        {"kinematics": 1, "beta_dot": 2.0, "beta_ddot": -40.0},
+        {"beta_dot": 2.0, "beta_ddot": -40.0},
+        {"kinematics": 1, "beta_rate": 1},  # rates from the scenario's beta samples
     ],
 }
 
 
 def _mode_run(path: Path, name: str, parameters: dict) -> np.ndarray:
-    """The standard scenario with ``parameters``, a load and a speed rate on top of the spec's start values."""
+    """The standard scenario with ``parameters``, a load and a speed rate on top of the spec's start
+    values (``parameters`` may hold inputs too, held over the run)."""
     case = scenario(MODELS[name].spec)
+    held = {"T_load": 500.0, "alpha_in": 800.0, **{k: v for k, v in parameters.items() if k in case.signals()}}
     with FmuInstance(path) as fmu:
-        fmu.initialize({**parameters, **case.input_values(0.0), "T_load": 500.0, "alpha_in": 800.0})
-        return fmu.run(case.stop_time, case.step_size, {k: v for k, v in case.signals().items()
-                                                        if k not in ("T_load", "alpha_in")})
+        fmu.initialize({**parameters, **case.input_values(0.0), **held})
+        return fmu.run(case.stop_time, case.step_size, {k: v for k, v in case.signals().items() if k not in held})
 
 
 @pytest.mark.parametrize("name, parameters", [(name, p) for name, modes in MODES.items() if name in NATIVE
