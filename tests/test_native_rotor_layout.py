@@ -568,6 +568,7 @@ def test_file_checks(lib, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "dir.toml").mkdir()
     os.mkfifo(tmp_path / "fifo.toml")
+    os.symlink(os.devnull, tmp_path / "device.toml")  # a character device: refused unread
     (tmp_path / "big.toml").write_text(ONE + "#" * (64 * 1024))
     (tmp_path / "limit.toml").write_text(ONE + "#" * (64 * 1024 - len(ONE) - 1) + "\n")
     bad_bytes = {
@@ -585,7 +586,7 @@ def test_file_checks(lib, tmp_path, monkeypatch):
     (tmp_path / "sub" / "good.toml").write_text(ONE)
     (tmp_path / "sub" / "bad.toml").write_text(ONE + "[[masses]]\nnode = 7\nmass = 1\n")
     (tmp_path / "sub" / "malformed.toml").write_text(ONE + "x = \n")
-    layouts = ["missing.toml", "dir.toml", "fifo.toml", "big.toml", "limit.toml", *bad_bytes, "a" * 295 + ".toml",
+    layouts = ["missing.toml", "dir.toml", "fifo.toml", "device.toml", "big.toml", "limit.toml", *bad_bytes, "a" * 295 + ".toml",
                "./sub//good.toml", "sub/./bad.TOML".replace("TOML", "toml"), ".//sub/../sub/malformed.toml",
                str(tmp_path) + "//sub/./good.toml", "sub/nothing/../good.toml", "SUB.TOML",
                "/" + str(tmp_path) + "/sub/bad.toml", "//" + str(tmp_path) + "/sub/bad.toml"]

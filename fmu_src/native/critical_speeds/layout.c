@@ -6,12 +6,9 @@
  * and sign, 0x, 0o, 0b; beyond 64 bits refused), floats (exponent, inf, nan, _), booleans, arrays
  * and inline tables. Datetimes are refused as malformed. Everything the reader builds lives in one
  * arena, freed at once. */
-#define _POSIX_C_SOURCE 200809L
-
 #include "rotor.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <limits.h>
 #include <locale.h>
 #include <math.h>
@@ -21,10 +18,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
-
-#ifndef O_NOCTTY
-#define O_NOCTTY 0
+#ifdef _WIN32
+#include <direct.h> /* _getcwd */
+#else
+#include <unistd.h> /* getcwd */
 #endif
 
 #define NODE_SNAP 1e-9 /* loader.NODE_SNAP */
@@ -2048,13 +2045,67 @@ int driveline_from_text(const char *text, size_t length, const char *source, Dri
     return status;
 }
 
+/* ---- what ISO C cannot ask the operating system ------------------------------------------ */
+/* Standard C has neither the working directory nor a file's type, and opening a FIFO with fopen
+ * blocks until a writer comes: these two calls, with the C library each platform has, are all the
+ * loader asks of the system beyond stdio. */
+
+/* The working directory into ``out`` (``room`` bytes); NULL with errno (ERANGE: too small). */
+static char *working_directory(char *out, size_t room)
+{
+#ifdef _WIN32
+    return _getcwd(out, room > INT_MAX ? INT_MAX : (int)room);
+#else
+    return getcwd(out, room);
+#endif
+}
+
+/* 1 when ``path`` names a regular file, 0 when it names something else (a directory, a FIFO, a
+ * device), -1 with errno when it names nothing that can be looked at. */
+static int regular_file(const char *path)
+{
+#ifdef _WIN32
+    struct _stat64 info;
+    if (_stat64(path, &info) != 0) {
+        return -1;
+    }
+    return (info.st_mode & _S_IFMT) == _S_IFREG;
+#else
+    struct stat info;
+    if (stat(path, &info) != 0) {
+        return -1;
+    }
+    return S_ISREG(info.st_mode) != 0;
+#endif
+}
+
+/* os.strerror */
+static void error_text(int err, char *out, size_t size)
+{
+    const char *text = strerror(err);
+    if (text != NULL) {
+        snprintf(out, size, "%s", text);
+    } else {
+        snprintf(out, size, "error %d", err);
+    }
+}
+
+#ifdef _WIN32
+#define SEPARATOR "\\"
+#define IS_ABSOLUTE(path) ((path)[0] == '/' || (path)[0] == '\\' || ((path)[0] != '\0' && (path)[1] == ':'))
+#else
+#define SEPARATOR "/"
+#define IS_ABSOLUTE(path) ((path)[0] == '/')
+#endif
+
 /* pathlib's Path(path).absolute(): the working directory before a relative path, "//" and "."
- * parts dropped (a leading "//" kept), ".." kept. Owned (free()); NULL with errno. */
+ * parts dropped (a leading "//" kept), ".." kept (on Windows only the working directory put
+ * before a relative path). Owned (free()); NULL with errno. */
 static char *absolute_path(const char *path)
 {
     char *joined, *out, *cwd = NULL;
     size_t n, used = 0, at, root;
-    if (path[0] != '/') {
+    if (!IS_ABSOLUTE(path)) {
         size_t room = 256;
         for (;;) {
             char *grown = realloc(cwd, room);
@@ -2064,7 +2115,7 @@ static char *absolute_path(const char *path)
                 return NULL;
             }
             cwd = grown;
-            if (getcwd(cwd, room) != NULL) {
+            if (working_directory(cwd, room) != NULL) {
                 break;
             }
             if (errno != ERANGE) {
@@ -2084,8 +2135,12 @@ static char *absolute_path(const char *path)
         errno = ENOMEM;
         return NULL;
     }
-    snprintf(joined, n, "%s%s%s", cwd != NULL ? cwd : "", cwd != NULL ? "/" : "", path);
+    snprintf(joined, n, "%s%s%s", cwd != NULL ? cwd : "", cwd != NULL ? SEPARATOR : "", path);
     free(cwd);
+#ifdef _WIN32
+    free(out);
+    return joined;
+#endif
     out[used++] = '/';
     if (joined[0] == '/' && joined[1] == '/' && joined[2] != '/') {
         out[used++] = '/';
@@ -2115,50 +2170,42 @@ static char *absolute_path(const char *path)
     return out;
 }
 
-/* loader._read_regular_file: open without blocking, refuse what is not a regular file before reading,
- * read at most MAX_FILE_BYTES + 1 bytes. ``*data`` owned (free()). */
+/* loader._read_regular_file: refuse what is not a regular file before opening it (a FIFO would block
+ * fopen), read at most MAX_FILE_BYTES + 1 bytes. ``*data`` owned (free()). */
 static int read_regular_file(const char *path, char **data, size_t *length, char *error, size_t size)
 {
     char reason[128];
-    struct stat info;
     size_t used = 0;
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY), err = 0;
+    int err = 0, regular;
+    FILE *file = NULL;
     *data = NULL;
-    if (fd < 0) {
-        err = errno;
-    } else if (fstat(fd, &info) != 0) {
-        err = errno;
-    } else if (!S_ISREG(info.st_mode)) {
-        close(fd);
+    errno = 0;
+    regular = regular_file(path);
+    if (regular == 0) {
         return fail(error, size, "driveline file %r is not a regular file", path);
+    }
+    if (regular < 0 || (file = fopen(path, "rb")) == NULL) {
+        err = errno != 0 ? errno : EINVAL;
     } else if ((*data = malloc(LAYOUT_MAX_FILE_BYTES + 1)) == NULL) {
-        close(fd);
+        fclose(file);
         return fail(error, size, "out of memory");
     } else {
         while (used <= LAYOUT_MAX_FILE_BYTES) {
-            ssize_t got = read(fd, *data + used, LAYOUT_MAX_FILE_BYTES + 1 - used);
-            if (got < 0 && errno == EINTR) {
-                continue;
-            }
-            if (got < 0) {
-                err = errno;
-                break;
-            }
+            size_t got = fread(*data + used, 1, LAYOUT_MAX_FILE_BYTES + 1 - used, file);
             if (got == 0) {
                 break;
             }
-            used += (size_t)got;
+            used += got;
         }
-    }
-    if (fd >= 0) {
-        close(fd);
+        if (ferror(file)) {
+            err = errno != 0 ? errno : EIO;
+        }
+        fclose(file);
     }
     if (err != 0) {
         free(*data);
         *data = NULL;
-        if (strerror_r(err, reason, sizeof reason) != 0) {
-            snprintf(reason, sizeof reason, "error %d", err);
-        }
+        error_text(err, reason, sizeof reason);
         return fail(error, size, "cannot read driveline file %r: %s", path, reason);
     }
     if (used > LAYOUT_MAX_FILE_BYTES) {
@@ -2184,10 +2231,7 @@ static int load_driveline(const char *path, Driveline *out, char *error, size_t 
     }
     if (p == NULL) { /* the working directory is gone (os.getcwd's OSError) */
         char reason_text[128];
-        int err = errno;
-        if (strerror_r(err, reason_text, sizeof reason_text) != 0) {
-            snprintf(reason_text, sizeof reason_text, "error %d", err);
-        }
+        error_text(errno, reason_text, sizeof reason_text);
         return fail(error, size, "cannot read driveline file %r: %s", path, reason_text);
     }
     if (read_regular_file(p, &data, &length, error, size) != 0) {
@@ -2226,7 +2270,6 @@ int driveline_from_layout(const char *layout, const char *resources, Driveline *
 {
     size_t n = strlen(layout), i;
     char *path;
-    struct stat info;
     int status;
     memset(out, 0, sizeof *out);
     if (size > 0) {
@@ -2259,7 +2302,7 @@ int driveline_from_layout(const char *layout, const char *resources, Driveline *
         return fail(error, size, "out of memory");
     }
     sprintf(path, "%s/%s.toml", resources, layout);
-    if (stat(path, &info) != 0 || !S_ISREG(info.st_mode)) {
+    if (regular_file(path) != 1) {
         free(path);
         return fail(error, size, "no shipped example named %r", layout);
     }
