@@ -597,14 +597,14 @@ def test_critical_speeds_strings_are_part_of_the_state(native_dir, name, fmi):
     them back and continues bit for bit (the analysis is rebuilt for the restored parameters)."""
     path, case = _native(native_dir, name, fmi), scenario(MODELS[name].spec)
     middle, serialized, reference = _half_way_state(path, {"layout": "two_piece_propshaft", "orders": "1,2,6",
-                                                           "shear": False})
+                                                           "band": 0.2})
     with FmuInstance(path) as other:
         other.initialize({"orders": "3"})
         other.run(case.stop_time / 4, case.step_size)
         restored = other.deserialize_state(serialized)
         other.set_state(restored)
         other.free_state(restored)
-        assert other.get(["layout", "orders", "shear"]) == ["two_piece_propshaft", "1,2,6", False]
+        assert other.get(["layout", "orders", "band"]) == ["two_piece_propshaft", "1,2,6", 0.2]
         other.time = middle
         assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
 

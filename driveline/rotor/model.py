@@ -130,6 +130,11 @@ SHEAR_CONFLICT = ("shear = False conflicts with the layout, whose segments keep 
                   "shear applies to the one-piece tube")
 
 
+def load_layout(layout: str) -> Driveline:
+    """The described layout: a file (a path ending in '.toml', any case) or a shipped name."""
+    return load_driveline(Path(layout) if layout.lower().endswith(".toml") else example_path(layout))
+
+
 def build_driveline(layout: str, shaft: dict[str, float]) -> Driveline:
     """The one-piece tube of ``shaft``, or the described layout (file or shipped name). Refused
     (ValueError) when the supports leave it a mechanism (:mod:`.mechanism`) or when ``shaft``'s
@@ -137,8 +142,8 @@ def build_driveline(layout: str, shaft: dict[str, float]) -> Driveline:
     if not layout:
         driveline = one_piece_shaft(**shaft)
     else:
-        driveline = load_driveline(Path(layout) if layout.lower().endswith(".toml") else example_path(layout))
-        if not shaft["shear"] and any(segment.shear for segment in driveline.segments):
+        driveline = load_layout(layout)
+        if not shaft.get("shear", True) and any(segment.shear for segment in driveline.segments):
             raise ValueError(SHEAR_CONFLICT)
     reason = mechanism_error(driveline)
     if reason is not None:
