@@ -670,3 +670,21 @@ def test_critical_speeds_without_resources_refuses_a_shipped_name(native_dir, tm
         assert refused.value.messages == ["driveline: no shipped example named 'two_piece_propshaft'"]
         fmu.set({"layout": ""})
         fmu.step(1e-3)
+
+
+@pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")
+def test_a_bend_extrapolated_beyond_its_range_is_refused_alike(native_dir, fmu_path, fmi):
+    """beta + beta_dot h leaving [0, beta_max] refuses the step, with the same words in both families,
+    and the model stays as before the step."""
+    messages = []
+    for path in (fmu_path("TripodCoupling", fmi), _native(native_dir, "TripodCoupling", fmi)):
+        with FmuInstance(path) as fmu:
+            fmu.initialize({"beta": 0.78, "beta_dot": 1.0})
+            before = fmu.get(["phi_in", "Rx_in"])
+            with pytest.raises(StepRefused) as refused:
+                fmu.step(0.01)
+            assert fmu.get(["phi_in", "Rx_in"]) == before
+            messages.append(refused.value.messages)
+            fmu.set({"beta_dot": -1.0})
+            fmu.step(0.01)
+    assert messages[0] == messages[1] and "beta extrapolated to the end of the step" in messages[0][0]
