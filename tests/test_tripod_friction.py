@@ -167,7 +167,8 @@ def test_efficiency_in_drive_coast_and_between(tripod_fmu):
     -500 N.m gave 1.019-1.022 with the drive formula), 0 while both shafts feed the friction."""
     period = 2 * math.pi / OMEGA
     result = simulate(tripod_fmu, 2 * period, period / 240,
-                      inputs={"omega_in": OMEGA, "beta": math.radians(25.0), "T_load": lambda t: 500.0 - 500.0 * t / period},
+                      inputs={"omega_in": OMEGA, "beta": math.radians(25.0),
+                              "T_load": lambda t: 500.0 - 500.0 * t / period},
                       start_values={"kinematics": 1, "mu": MU})
     load = 500.0 - 500.0 * np.maximum(result["time"] - period / 240, 0.0) / period  # held over each step
     load[0] = 500.0
