@@ -8,6 +8,7 @@ import math
 import re
 import shutil
 import subprocess
+import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
@@ -23,7 +24,7 @@ import test_fmu_behaviour as behaviour
 import test_fmus_common as common
 from driveline.catalog import MODELS
 from fmu_harness import interop
-from fmu_harness.build import native
+from fmu_harness.build import native, toolchain
 from fmu_harness.runner import FmuInstance, StepRefused
 from fmu_harness.scenario import scenario
 from test_fmu_properties import Run, _runs, run_alongside_the_core
@@ -215,19 +216,59 @@ def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
         assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
 
 
+#: A C program that loads a shared library (every symbol bound at once) and links no libm itself:
+#: a library that needs libm and does not say so fails to load in it.
+LOADER = """#include <dlfcn.h>
+#include <stdio.h>
+int main(int argc, char **argv)
+{
+    void *library = argc == 2 ? dlopen(argv[1], RTLD_NOW | RTLD_LOCAL) : NULL;
+    if (library == NULL) {
+        fprintf(stderr, "%s\\n", dlerror());
+        return 1;
+    }
+    return dlclose(library);
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def loader(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("loader")
+    (folder / "loader.c").write_text(LOADER)
+    subprocess.run([*toolchain.host_compiler(), "-std=c99", "-Wall", "-Werror", str(folder / "loader.c"), "-o",
+                    str(folder / "loader"), "-ldl"], check=True, capture_output=True, text=True)
+    return folder / "loader"
+
+
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="rebuilding from the carried sources needs cmake")
 @pytest.mark.parametrize("name", NATIVE)
-def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, name, fmi):
-    """What a Windows or macOS user does: fmpy's build_platform_binary (CMake) from the FMU's
-    sources alone; the rebuilt binary gives the shipped one's results bit for bit."""
+def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, loader, name, fmi):
+    """What a user of another platform does: fmpy's build_platform_binary (CMake) from the FMU's
+    sources alone, with the documented options (libm, which the FMU's FMI 3.0 build description
+    names); the rebuilt binary loads in a program that has not loaded libm, and gives the shipped
+    one's results bit for bit."""
     from fmpy.build import build_platform_binary
 
     unzipdir = Path(extract(str(_native(native_dir, name, fmi)), unzipdir=str(tmp_path / "fmu")))
     shutil.rmtree(unzipdir / "binaries")
     (tmp_path / "build").mkdir()
-    build_platform_binary(unzipdir, build_dir=tmp_path / "build")
+    build_platform_binary(unzipdir, build_dir=tmp_path / "build", cmake_options=dict(native.REBUILD_CMAKE_OPTIONS))
+    loaded = subprocess.run([str(loader), str(native.host_library(unzipdir, name, fmi))], capture_output=True, text=True)
+    assert loaded.returncode == 0, loaded.stderr
+    if fmi == "3":
+        libraries = ET.parse(unzipdir / "sources" / "buildDescription.xml").getroot().iter("Library")
+        assert [library.get("name") for library in libraries] == ["m"]
     rebuilt = _standard_run(_native(native_dir, name, fmi), name, unzipdir=str(unzipdir))
     assert rebuilt.tobytes() == _standard_run(_native(native_dir, name, fmi), name).tobytes()
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_fmu_carries_its_documentation_and_licence(native_dir, name, fmi):
+    with zipfile.ZipFile(_native(native_dir, name, fmi)) as archive:
+        page = archive.read(f"documentation/{native.snake_case(name)}.md").decode()
+        assert page.startswith("# ") and "## Variables" in page
+        assert archive.read("documentation/licenses/LICENSE.txt").decode().startswith("MIT License")
 
 
 # -- refusals: the Python FMUs' tests, run on the native FMUs ----------------------------------------
