@@ -20,7 +20,7 @@ from test_native_host import HOST_SOURCE, RUNS, TOLERANCES, _host_command
 from fmu_harness.build import native, toolchain
 
 VERSIONS = ("2", "3")
-EMULATED = {"x86_64-windows": "wine (Debian: apt-get install wine64)",
+EMULATED = {"x86_64-windows": "wine (Debian: apt-get install wine wine64)",
             "aarch64-linux": "qemu-aarch64 (Debian: apt-get install qemu-user) and the aarch64 C library "
                              "(Debian: apt-get install libc6-arm64-cross)"}
 
