@@ -28,8 +28,10 @@ P = ctypes.POINTER
 DOUBLE_P = P(ctypes.c_double)
 
 
-#: The modules a module calls into besides itself (the layout reader's parts with the loader).
-NEEDS = {"layout": ("layout_file", "toml", "messages", "arena")}
+#: The modules a module calls into besides itself (the layout reader's parts with the loader, the
+#: linear algebra with the damped model, the shaft elements with both models).
+NEEDS = {"layout": ("layout_file", "toml", "messages", "arena"), "damped": ("linalg",), "transfer": ("elements",),
+         "fem": ("elements",)}
 
 
 def compile_rotor(folder: Path, modules: list[str], shims: list[Path] = ()) -> ctypes.CDLL:

@@ -38,7 +38,7 @@ import fmpy
 import fmu_src
 from driveline import __version__
 from driveline.catalog import MODELS
-from driveline.model import SteppedModel
+from driveline.model import TIME_TOLERANCE, SteppedModel
 from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
 from . import toolchain
@@ -282,6 +282,8 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_STRING_COUNT {sum(v.type == "String" for v in spec.variables)}
 #define MODEL_RELATION_COUNT {len(spec.relations)}
 #define MODEL_EXTRA_MESSAGE_COUNT {len(probes)}
+/* driveline.model.TIME_TOLERANCE: how far, relative to the time reached, a step may start before it */
+#define MODEL_TIME_TOLERANCE {_c_double(TIME_TOLERANCE)}
 #define MODEL_INPUT_DERIVATIVE_COUNT {len(derivatives)}
 {constants}
 /* the FMU's token (FMI 2.0 GUID, FMI 3.0 instantiation token): the FMI version's, in model_variables.c */
