@@ -224,7 +224,6 @@ def test_bad_input_is_refused_with_a_reason_and_the_run_can_go_on(tripod_fmu, va
         assert refused.value.status == "Discard"
         assert any(name in message for message in refused.value.messages)
         assert fmu.get(["phi_in", "phi_out"]) == before  # the refused step left no trace
-        fmu.time -= 1e-3  # the host retries the same step with a good input
         fmu.set({"beta": 0.3, "omega_in": OMEGA, "T_load": 100.0, "alpha_in": 0.0})
         fmu.step(1e-3)
         assert fmu.get(["phi_in"])[0] == pytest.approx(2 * OMEGA * 1e-3, rel=1e-12)

@@ -17,7 +17,6 @@
 #include "critical_speeds/rotor.h"
 #include "fmu_instance.h"
 
-#define VALUE(name) (data->real_value[V_##name])
 
 /* driveline/rotor/model.py */
 #define MAX_ORDERS 16
@@ -714,4 +713,5 @@ static const char *advance(ModelData *data, double current_time UNUSED, double s
     return evaluate(data);
 }
 
-const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, NULL, free_analysis};
+const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors,
+                                .free_derived = free_analysis};

@@ -22,7 +22,6 @@
 #define UNUSED
 #endif
 
-#define FMU_PI 3.14159265358979323846
 #define FMU_MESSAGE_SIZE 1024 /* a message names a layout file by its absolute path: room for a long one */
 #define FMU_MAX_MESSAGES 48
 /* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
@@ -145,10 +144,12 @@ struct Instance {
     const char *fmi_prefix;   /* "fmi2" or "fmi3", for misuse messages */
     Mode mode;
     double start_time;
+    int terminated; /* the last step was refused: the same call is refused again (fmi2Terminated) */
     ModelData data;
     Messages messages;
     ModelCache cache;
     char *resources; /* owned; cache.resources points at it */
+    char refusal[FMU_MESSAGE_SIZE]; /* the first reason of the last refusal or misuse: a repeat is not logged */
 };
 
 /* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
@@ -170,6 +171,9 @@ typedef struct {
 } ModelHooks;
 
 extern const ModelHooks model_hooks;
+
+/* A Real variable of the model by its name, in a hook whose ModelData is ``data`` */
+#define VALUE(name) (data->real_value[V_##name])
 
 /* ``start`` and ``advance`` of a model driven by an input shaft (DrivenShaftModel in
  * driveline/model.py): phi_in starts at phi_in_start and integrates the held omega_in exactly;

@@ -13,7 +13,6 @@
 
 #include "fmu_instance.h"
 
-#define VALUE(name) (data->real_value[V_##name])
 #define INTEGER(name) (data->int_value[V_##name])
 /* the exact solver's warm start (plane_solver.Solution): a flag, then phi_in, x, y, dx/dphi, dy/dphi */
 #define HAS_SOLUTION (data->internal[0])
@@ -591,4 +590,4 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     }
 }
 
-const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, NULL, NULL};
+const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors};

@@ -2,8 +2,9 @@
  * stays the readable reference; every function names the Python function it ports).
  *
  * One header for the library's modules, one module per concern:
- *   layout.c     the driveline (segments, point elements, unbalances), the one-piece tube and the
- *                TOML-subset layout reader with the Python loader's messages and work limits
+ *   layout.c     the driveline (segments, point elements, unbalances) of a layout read by the
+ *                TOML-subset reader (toml.h), checked with the Python loader's messages and work
+ *                limits; the one-piece tube
  *   pyrepr.c     Python's repr() of the values the messages show
  *   mechanism.c  whether the supports hold the shaft still (no zero-frequency mechanism mode)
  *   transfer.c   element transfer matrices and the scaled frequency determinant (seed Eqs. 16-31)
