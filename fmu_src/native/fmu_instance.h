@@ -144,10 +144,12 @@ struct Instance {
     const char *fmi_prefix;   /* "fmi2" or "fmi3", for misuse messages */
     Mode mode;
     double start_time;
+    int terminated; /* the last step was refused: the same call is refused again (fmi2Terminated) */
     ModelData data;
     Messages messages;
     ModelCache cache;
     char *resources; /* owned; cache.resources points at it */
+    char refusal[FMU_MESSAGE_SIZE]; /* the first reason of the last refusal or misuse: a repeat is not logged */
 };
 
 /* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
