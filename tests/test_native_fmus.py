@@ -165,17 +165,22 @@ MODES = {  # parameters of the modes the standard scenario (spec start values) l
         {"kinematics": 1, "mu": 0.02, "v_slip": 1e-2, "seed_reactions": 1, "phi_in_start": 0.4},
         {"seed_reactions": 1},
         {"kinematics": 1, "beta_max": math.radians(60.0), "r": 0.07},
+        {"kinematics": 1, "mu": 0.05, "T_load": -500.0},  # coast
+        {"kinematics": 1, "beta_dot": 2.0, "beta_ddot": -40.0},
+        {"beta_dot": 2.0, "beta_ddot": -40.0},
+        {"kinematics": 1, "beta_rate": 1},  # rates from the scenario's beta samples
     ],
 }
 
 
 def _mode_run(path: Path, name: str, parameters: dict) -> np.ndarray:
-    """The standard scenario with ``parameters``, a load and a speed rate on top of the spec's start values."""
+    """The standard scenario with ``parameters``, a load and a speed rate on top of the spec's start
+    values (``parameters`` may hold inputs too, held over the run)."""
     case = scenario(MODELS[name].spec)
+    held = {"T_load": 500.0, "alpha_in": 800.0, **{k: v for k, v in parameters.items() if k in case.signals()}}
     with FmuInstance(path) as fmu:
-        fmu.initialize({**parameters, **case.input_values(0.0), "T_load": 500.0, "alpha_in": 800.0})
-        return fmu.run(case.stop_time, case.step_size, {k: v for k, v in case.signals().items()
-                                                        if k not in ("T_load", "alpha_in")})
+        fmu.initialize({**parameters, **case.input_values(0.0), **held})
+        return fmu.run(case.stop_time, case.step_size, {k: v for k, v in case.signals().items() if k not in held})
 
 
 @pytest.mark.parametrize("name, parameters", [(name, p) for name, modes in MODES.items() if name in NATIVE
@@ -644,14 +649,14 @@ def test_critical_speeds_strings_are_part_of_the_state(native_dir, name, fmi):
     them back and continues bit for bit (the analysis is rebuilt for the restored parameters)."""
     path, case = _native(native_dir, name, fmi), scenario(MODELS[name].spec)
     middle, serialized, reference = _half_way_state(path, {"layout": "two_piece_propshaft", "orders": "1,2,6",
-                                                           "shear": False})
+                                                           "band": 0.2})
     with FmuInstance(path) as other:
         other.initialize({"orders": "3"})
         other.run(case.stop_time / 4, case.step_size)
         restored = other.deserialize_state(serialized)
         other.set_state(restored)
         other.free_state(restored)
-        assert other.get(["layout", "orders", "shear"]) == ["two_piece_propshaft", "1,2,6", False]
+        assert other.get(["layout", "orders", "band"]) == ["two_piece_propshaft", "1,2,6", 0.2]
         other.time = middle
         assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
 
@@ -717,3 +722,21 @@ def test_critical_speeds_without_resources_refuses_a_shipped_name(native_dir, tm
         assert refused.value.messages == ["driveline: no shipped example named 'two_piece_propshaft'"]
         fmu.set({"layout": ""})
         fmu.step(1e-3)
+
+
+@pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")
+def test_a_bend_extrapolated_beyond_its_range_is_refused_alike(native_dir, fmu_path, fmi):
+    """beta + beta_dot h leaving [0, beta_max] refuses the step, with the same words in both families,
+    and the model stays as before the step."""
+    messages = []
+    for path in (fmu_path("TripodCoupling", fmi), _native(native_dir, "TripodCoupling", fmi)):
+        with FmuInstance(path) as fmu:
+            fmu.initialize({"beta": 0.78, "beta_dot": 1.0})
+            before = fmu.get(["phi_in", "Rx_in"])
+            with pytest.raises(StepRefused) as refused:
+                fmu.step(0.01)
+            assert fmu.get(["phi_in", "Rx_in"]) == before
+            messages.append(refused.value.messages)
+            fmu.set({"beta_dot": -1.0})
+            fmu.step(0.01)
+    assert messages[0] == messages[1] and "beta extrapolated to the end of the step" in messages[0][0]

@@ -6,6 +6,7 @@
  *                TOML-subset reader (toml.h), checked with the Python loader's messages and work
  *                limits; the one-piece tube
  *   pyrepr.c     Python's repr() of the values the messages show
+ *   mechanism.c  whether the supports hold the shaft still (no zero-frequency mechanism mode)
  *   transfer.c   element transfer matrices and the scaled frequency determinant (seed Eqs. 16-31)
  *   roots.c      the batched bracketing root search and the searches along lines (w, spin)
  *   spline.c     not-a-knot cubic splines (scipy's CubicSpline default)
@@ -74,6 +75,12 @@ typedef struct {
     RotorUnbalance *unbalances;
     EndCondition left, right;
 } Driveline;
+
+/* mechanism.mechanism_error: MECHANISM_NONE when the supports hold the driveline still,
+ * MECHANISM_HINGE_FOLDS with the index (in ``hinges``) and node of the hinge that folds, or
+ * MECHANISM_RIGID_BODY when the whole shaft moves rigidly; -1: out of memory. */
+enum { MECHANISM_NONE = 0, MECHANISM_HINGE_FOLDS = 1, MECHANISM_RIGID_BODY = 2 };
+int driveline_mechanism(const Driveline *driveline, int *hinge_index, int *hinge_node);
 
 /* The parameters of loader.one_piece_shaft (the FMU's one-piece tube). */
 typedef struct {
