@@ -13,10 +13,10 @@ version this module
   (:mod:`model_description`: units, display units, min/max, descriptions, model structure), so a
   host can swap one FMU for the other, plus the sources the FMU carries (FMI 2.0 ``SourceFiles``,
   FMI 3.0 ``sources/buildDescription.xml``);
-* compiles the shared library with the machine's C compiler (``cc``, or ``$CC``) and the FMI
-  headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its sources
-  (the library folder's as ``<folder>/<file>``) and the resource files its model class declares
-  (``SteppedModel.resource_files``, into ``resources/``).
+* compiles the shared library for each platform (:mod:`.toolchain`: zig, five platforms) with
+  the FMI headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its
+  sources (the library folder's as ``<folder>/<file>``), the resource files its model class
+  declares (``SteppedModel.resource_files``, into ``resources/``), its doc page and the licence.
 
 FMI 2.0 FMUs land in ``<dest>/native/``, FMI 3.0 ones in ``<dest>/native/fmi3/``.
 """
