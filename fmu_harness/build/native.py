@@ -41,23 +41,17 @@ from driveline.catalog import MODELS
 from driveline.model import TIME_TOLERANCE, SteppedModel
 from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
-from . import toolchain
+from . import documentation, toolchain
+from .documentation import snake_case
 from .model_description import complete_fmi2, complete_fmi3
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
-DOCS = NATIVE_SRC.parent / "docs"  # the repository's docs/ (a link, so that the wheel carries them)
-LICENSE = NATIVE_SRC.parent / "LICENSE"
 MODEL_SOURCES = NATIVE_SRC
 SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c", "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
-
-
-def snake_case(name: str) -> str:
-    """``CardanJoint`` -> ``cardan_joint``: the model file's name."""
-    return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
 
 
 def model_source(name: str) -> Path:
@@ -483,8 +477,7 @@ def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain
         **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": library.read_bytes() for p, library in binaries.items()},
         **{f"sources/{source}": data for source, data in sources.items()},
         **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
-        f"documentation/{snake_case(name)}.md": (DOCS / f"{snake_case(name)}.md").read_bytes(),
-        "documentation/licenses/LICENSE.txt": LICENSE.read_bytes(),
+        **documentation.members(name),
     }
     if fmi == "3":
         members["sources/buildDescription.xml"] = build_description(name, compiled)
