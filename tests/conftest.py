@@ -47,6 +47,8 @@ SLOW = (
     "tests/test_critical_speeds_model.py::test_shear_parameter_selects_the_beam_theory",
     "tests/test_critical_speeds_model.py::test_shipped_layout_by_name",
     "tests/test_host_environment.py",
+    "tests/test_install.py::test_installed_wheel_builds_every_fmu_and_both_systems",
+    "tests/test_install.py::test_wheel_carries_what_the_native_build_needs",
     "tests/test_interop.py",
     "tests/test_packaging.py::test_different_fmus_alive_at_once_in_one_host",
     "tests/test_packaging.py::test_markers_follow_what_the_tests_use",

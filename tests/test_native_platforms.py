@@ -15,6 +15,7 @@ from pathlib import Path
 
 import lief
 import pytest
+from fmpy.validation import validate_fmu
 from test_native_host import HOST_SOURCE, RUNS, TOLERANCES, _host_command
 
 from fmu_harness.build import native, toolchain
@@ -46,6 +47,7 @@ def _binary(release_dir: Path, name: str, fmi: str, platform: toolchain.Platform
 def test_every_native_fmu_carries_the_five_platforms(release_dir, name, fmi):
     expected = {f"binaries/{p.folder(fmi)}/{name}{p.suffix}" for p in toolchain.PLATFORMS}
     assert set(_members(release_dir, name, fmi)) == expected
+    assert validate_fmu(str(native.fmu_path(release_dir, name, fmi))) == []
 
 
 def _glibc_versions(binary: lief.ELF.Binary) -> set[tuple[int, ...]]:

@@ -13,10 +13,10 @@ version this module
   (:mod:`model_description`: units, display units, min/max, descriptions, model structure), so a
   host can swap one FMU for the other, plus the sources the FMU carries (FMI 2.0 ``SourceFiles``,
   FMI 3.0 ``sources/buildDescription.xml``);
-* compiles the shared library with the machine's C compiler (``cc``, or ``$CC``) and the FMI
-  headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its sources
-  (the library folder's as ``<folder>/<file>``) and the resource files its model class declares
-  (``SteppedModel.resource_files``, into ``resources/``).
+* compiles the shared library for each platform (:mod:`.toolchain`: zig, five platforms) with
+  the FMI headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its
+  sources (the library folder's as ``<folder>/<file>``), the resource files its model class
+  declares (``SteppedModel.resource_files``, into ``resources/``), its doc page and the licence.
 
 FMI 2.0 FMUs land in ``<dest>/native/``, FMI 3.0 ones in ``<dest>/native/fmi3/``.
 """
@@ -41,25 +41,19 @@ from driveline.catalog import MODELS
 from driveline.model import TIME_TOLERANCE, SteppedModel
 from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
-from . import toolchain
+from . import documentation, toolchain
+from .documentation import snake_case
 from .model_description import complete_fmi2, complete_fmi3
 from .native_constants import HEADER as CONSTANTS_HEADER
 from .native_constants import constants_header
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
-DOCS = NATIVE_SRC.parent / "docs"  # the repository's docs/ (a link, so that the wheel carries them)
-LICENSE = NATIVE_SRC.parent / "LICENSE"
 MODEL_SOURCES = NATIVE_SRC
 SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c", "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
-
-
-def snake_case(name: str) -> str:
-    """``CardanJoint`` -> ``cardan_joint``: the model file's name."""
-    return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
 
 
 def model_source(name: str) -> Path:
@@ -486,8 +480,7 @@ def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain
         **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": library.read_bytes() for p, library in binaries.items()},
         **{f"sources/{source}": data for source, data in sources.items()},
         **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
-        f"documentation/{snake_case(name)}.md": (DOCS / f"{snake_case(name)}.md").read_bytes(),
-        "documentation/licenses/LICENSE.txt": LICENSE.read_bytes(),
+        **documentation.members(name),
     }
     if fmi == "3":
         members["sources/buildDescription.xml"] = build_description(name, compiled)

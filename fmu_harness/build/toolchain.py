@@ -85,10 +85,15 @@ def host_compiler() -> list[str]:
         return shlex.split(os.environ["CC"])
     if (found := zig()) is not None:
         return [str(found), "cc"]
-    system = shutil.which("cc") or shutil.which("gcc")
+    system = system_compiler()
     if system is None:
         raise NoCompiler(NO_COMPILER)
     return [system]
+
+
+def system_compiler() -> str | None:
+    """The machine's own C compiler on the PATH, if any."""
+    return shutil.which("cc") or shutil.which("gcc")
 
 
 def release_available() -> bool:
