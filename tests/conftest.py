@@ -29,12 +29,12 @@ from fmpy import extract
 
 from driveline.catalog import MODELS
 from fmu_harness import build
-from fmu_harness.build import native
+from fmu_harness.build import native, toolchain
 from fmu_harness.runner import FmuInstance
 
 FmuPath = Callable[..., Path]
 
-FMU_FIXTURES = {"fmu_store", "native_dir"}
+FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir"}
 IMPORTER_MODULES = ("fmu_harness.importers", "fmu_harness.interop")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
@@ -48,9 +48,12 @@ SLOW = (
     "tests/test_critical_speeds_model.py::test_shear_parameter_selects_the_beam_theory",
     "tests/test_critical_speeds_model.py::test_shipped_layout_by_name",
     "tests/test_host_environment.py",
+    "tests/test_install.py::test_installed_wheel_builds_every_fmu_and_both_systems",
+    "tests/test_install.py::test_wheel_carries_what_the_native_build_needs",
     "tests/test_interop.py",
     "tests/test_packaging.py::test_different_fmus_alive_at_once_in_one_host",
     "tests/test_packaging.py::test_markers_follow_what_the_tests_use",
+    "tests/test_native_platforms.py",
     "tests/test_robustness.py",
     "tests/test_rotor_hinge.py::test_fmu_analyses_a_hinged_layout",
     "tests/test_rotor_hinge.py::test_hinged_two_piece_matches_finite_elements",
@@ -110,9 +113,20 @@ def fmu_path(fmu_store: Path, pytestconfig: pytest.Config) -> FmuPath:
 
 @pytest.fixture(scope="session")
 def native_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A folder holding the freshly built native FMUs (``native/``, ``native/fmi3/``)."""
+    """A folder holding the freshly built native FMUs (``native/``, ``native/fmi3/``), with the
+    binary of this machine's platform alone."""
     dest = tmp_path_factory.mktemp("native_models")
-    native.build_all(dest)
+    native.build_all(dest, release=False)
+    return dest
+
+
+@pytest.fixture(scope="session")
+def release_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The native FMUs as released: a binary for each of the five platforms (needs ziglang)."""
+    if not toolchain.release_available():
+        pytest.skip("the five-platform build needs ziglang (pip install ziglang)")
+    dest = tmp_path_factory.mktemp("release_models")
+    native.build_all(dest, release=True)
     return dest
 
 

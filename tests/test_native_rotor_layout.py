@@ -14,7 +14,7 @@ import pytest
 
 from driveline.rotor import loader
 from driveline.rotor.loader import load_driveline, loads_driveline, one_piece_shaft
-from driveline.rotor.model import build_driveline
+from driveline.rotor.model import load_layout
 
 from native_rotor import (CDriveline, OnePieceShaft, P, RotorBearing, RotorHinge, RotorMass, RotorSegment,
                           RotorUnbalance, compile_rotor, declare)
@@ -592,7 +592,7 @@ def test_file_checks(lib, tmp_path, monkeypatch):
                "/" + str(tmp_path) + "/sub/bad.toml", "//" + str(tmp_path) + "/sub/bad.toml"]
     messages = []
     for layout in layouts:
-        python = python_result(build_driveline, layout, {})
+        python = python_result(load_layout, layout)
         native = from_layout(lib, layout)
         same(native, python)
         messages.append(python)
@@ -608,7 +608,7 @@ def test_file_checks(lib, tmp_path, monkeypatch):
 def test_shipped_names(lib, tmp_path):
     for name in ("two_piece_propshaft", "two_piece_propshaft_hinged", "../../../etc/passwd", "%s%n", "a" * 64,
                  "a" * 65, "b" * 100, "no_such_layout", "with space", "é", "x\ny", "it's", "two_piece_propshaft.tom"):
-        same(from_layout(lib, name), python_result(build_driveline, name, {}))
+        same(from_layout(lib, name), python_result(load_layout, name))
     # a layout folder of the FMU's own: the shipped name looks there only
     (tmp_path / "mine.toml").write_text(ONE)
     assert not isinstance(from_layout(lib, "mine", tmp_path), str)

@@ -17,15 +17,6 @@
 #include "critical_speeds/rotor.h"
 #include "fmu_instance.h"
 
-
-/* driveline/rotor/model.py */
-#define MAX_ORDERS 16
-#define MAX_ORDER 100
-#define MAX_SEARCHED_MODES 250.0
-#define FE_ELEMENTS 4
-#define PLAUSIBLE_DEVIATION 0.02
-#define CAMPBELL_POINTS 41
-#define WHIRL_MODES 2
 #define ERROR_SIZE FMU_MESSAGE_SIZE
 
 /* ---- the parts of the analysis and their keys ------------------------------------------------ */
@@ -50,7 +41,7 @@ typedef struct {
     int held;
     char *layout; /* owned */
     double values[KEY_VALUES];
-    int orders[MAX_ORDERS], n_orders;
+    int orders[ROTOR_MODEL_MAX_ORDERS], n_orders;
 } Key;
 
 typedef struct {
@@ -284,8 +275,8 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
     for (at = 0; at < length; at++) {
         commas += text[at] == ',';
     }
-    if (commas >= MAX_ORDERS) { /* text.split(",", MAX_ORDERS) gives more than MAX_ORDERS entries */
-        snprintf(error, ERROR_SIZE, "parameter orders lists more than %d orders", MAX_ORDERS);
+    if (commas >= ROTOR_MODEL_MAX_ORDERS) { /* text.split(",", ROTOR_MODEL_MAX_ORDERS) gives more than ROTOR_MODEL_MAX_ORDERS entries */
+        snprintf(error, ERROR_SIZE, "parameter orders lists more than %d orders", ROTOR_MODEL_MAX_ORDERS);
         return -1;
     }
     *count = 0;
@@ -309,7 +300,7 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
             ascii_digits = ascii_digits && text[at] >= '0' && text[at] <= '9';
             value = ascii_digits && at - first < 3 ? 10 * value + (text[at] - '0') : value;
         }
-        if (!(ascii_digits && end > first && end - first <= 3 && value >= 1 && value <= MAX_ORDER)) {
+        if (!(ascii_digits && end > first && end - first <= 3 && value >= 1 && value <= ROTOR_MODEL_MAX_ORDER)) {
             for (cut = first; cut < end && points < 20; points++) { /* digits[:20] */
                 code_point(bytes, cut, end, &size);
                 cut += size;
@@ -317,7 +308,7 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
             memcpy(prefix, text + first, cut - first);
             prefix[cut - first] = '\0';
             python_str_repr(prefix, 20, shown, sizeof shown);
-            snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown, MAX_ORDER);
+            snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown, ROTOR_MODEL_MAX_ORDER);
             return -1;
         }
         orders[(*count)++] = value;
@@ -342,14 +333,45 @@ static void orders_tuple(const int *orders, int count, char *out, size_t size)
 
 /* ---- the analysis ------------------------------------------------------------------------------ */
 
-/* build_driveline: the one-piece tube of the parameters, or the layout (a file or a shipped name). */
+static int build_one_piece(const ModelData *data, Driveline *out, char *error);
+
+/* build_driveline: the one-piece tube of the parameters, or the layout (a file or a shipped name);
+ * refused when shear = false meets a layout segment with shear, or when the supports leave the
+ * shaft a mechanism (mechanism.py). */
 static int build_driveline(const ModelData *data, Driveline *out, char *error)
 {
-    OnePieceShaft shaft;
     const char *layout = data->string_value[V_layout];
+    int failed, hinge = 0, node = 0, i;
     if (layout[0] != '\0') {
-        return driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
+        failed = driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
+        for (i = 0; !failed && !data->int_value[V_shear] && i < out->n_segments; i++) {
+            if (out->segments[i].shear) {
+                snprintf(error, ERROR_SIZE, "%s", SHEAR_CONFLICT);
+                failed = -1;
+            }
+        }
+    } else {
+        failed = build_one_piece(data, out, error);
     }
+    switch (failed ? MECHANISM_NONE : driveline_mechanism(out, &hinge, &node)) {
+    case MECHANISM_NONE:
+        return failed;
+    case MECHANISM_HINGE_FOLDS:
+        snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node);
+        return -1;
+    case MECHANISM_RIGID_BODY:
+        snprintf(error, ERROR_SIZE, "%s", MECHANISM_RIGID);
+        return -1;
+    default:
+        snprintf(error, ERROR_SIZE, "out of memory");
+        return -1;
+    }
+}
+
+/* loader.one_piece_shaft of the parameters. */
+static int build_one_piece(const ModelData *data, Driveline *out, char *error)
+{
+    OnePieceShaft shaft;
     shaft.L_shaft = VALUE(L_shaft);
     shaft.D_outer = VALUE(D_outer);
     shaft.D_inner = VALUE(D_inner);
@@ -370,8 +392,8 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
                           char *error)
 {
     double *terms, kappa, scanned, squared_outer, squared_inner, fourth_outer, fourth_inner, ratio, root;
-    int seen[MAX_ORDER + 1] = {0}, i, n = 0, failed = 0;
-    terms = malloc(((size_t)driveline->n_segments + MAX_ORDERS + 1) * sizeof *terms);
+    int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, i, n = 0, failed = 0;
+    terms = malloc(((size_t)driveline->n_segments + ROTOR_MODEL_MAX_ORDERS + 1) * sizeof *terms);
     if (terms == NULL) {
         snprintf(error, ERROR_SIZE, "out of memory");
         return -1;
@@ -524,24 +546,24 @@ static int analyse_structure(Analysis *analysis, char *error)
         return -1;
     }
     for (i = 0; i < 3; i++) {
-        analysis->critical[i] = i < count ? spins[i] : ROTOR_SEARCH_LIMIT;
+        analysis->critical[i] = i < count ? spins[i] : ROTOR_DRIVELINE_SEARCH_LIMIT;
     }
     analysis->critical_count = count;
-    return fe_natural_frequencies(&analysis->driveline, FE_ELEMENTS, &analysis->natural, &analysis->natural_count,
+    return fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural, &analysis->natural_count,
                                   error, ERROR_SIZE);
 }
 
 /* implausibility: the first two whirl frequencies at standstill must each match a natural
- * frequency of the finite-element check within PLAUSIBLE_DEVIATION. */
+ * frequency of the finite-element check within ROTOR_MODEL_PLAUSIBLE_DEVIATION. */
 static int implausibility(const Analysis *analysis, char *error)
 {
-    double at_rest[2 * WHIRL_MODES], nearest, deviation, best = 0.0;
+    double at_rest[2 * ROTOR_MODEL_WHIRL_MODES], nearest, deviation, best = 0.0;
     char frequency_shown[40], nearest_shown[40];
     int i, j, found;
     whirl_table_evaluate(analysis->whirl, 0.0, at_rest);
-    for (i = 0; i < WHIRL_MODES; i++) {
+    for (i = 0; i < ROTOR_MODEL_WHIRL_MODES; i++) {
         double frequency = at_rest[i];
-        if (frequency >= ROTOR_SEARCH_LIMIT) {
+        if (frequency >= ROTOR_DRIVELINE_SEARCH_LIMIT) {
             continue;
         }
         if (analysis->natural_count == 0) {
@@ -561,7 +583,7 @@ static int implausibility(const Analysis *analysis, char *error)
             }
         }
         nearest = analysis->natural[found];
-        if (!(fabs(nearest - frequency) <= PLAUSIBLE_DEVIATION * frequency)) {
+        if (!(fabs(nearest - frequency) <= ROTOR_MODEL_PLAUSIBLE_DEVIATION * frequency)) {
             python_g(frequency, 6, frequency_shown, sizeof frequency_shown);
             python_g(nearest, 6, nearest_shown, sizeof nearest_shown);
             snprintf(error, ERROR_SIZE,
@@ -578,16 +600,16 @@ static int implausibility(const Analysis *analysis, char *error)
  * forward one of each order when none lies there. */
 static int resonances(Analysis *analysis, const int *orders, int n_orders, double omega_max, char *error)
 {
-    char tuple[4 * MAX_ORDERS + 8];
+    char tuple[4 * ROTOR_MODEL_MAX_ORDERS + 8];
     if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD | WHIRL_BACKWARD, 0, 2.0 * omega_max,
-                               ROTOR_SEARCH_LIMIT, &analysis->resonances, &analysis->resonance_count, error,
+                               ROTOR_DRIVELINE_SEARCH_LIMIT, &analysis->resonances, &analysis->resonance_count, error,
                                ERROR_SIZE)) {
         return -1;
     }
     if (analysis->resonance_count == 0) {
         free(analysis->resonances);
         analysis->resonances = NULL;
-        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0, ROTOR_SEARCH_LIMIT,
+        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT,
                                    &analysis->resonances, &analysis->resonance_count, error, ERROR_SIZE)) {
             return -1;
         }
@@ -640,7 +662,7 @@ static int part(Analysis *analysis, const ModelData *data, Part which, const int
         failed = analyse_structure(analysis, error);
         break;
     case PART_WHIRL:
-        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), CAMPBELL_POINTS, WHIRL_MODES, error,
+        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS, ROTOR_MODEL_WHIRL_MODES, error,
                                           ERROR_SIZE);
         failed = analysis->whirl == NULL || implausibility(analysis, error);
         break;
@@ -680,7 +702,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
     ModelCache *cache = data->cache;
     Analysis *analysis = cache->derived;
-    int orders[MAX_ORDERS], n_orders = 0, failed;
+    int orders[ROTOR_MODEL_MAX_ORDERS], n_orders = 0, failed;
     double work = 0.0;
     char error[ERROR_SIZE] = "", shown[40];
     if (analysis == NULL) {
@@ -697,11 +719,11 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     }
     failed = failed || part(analysis, data, PART_DRIVELINE, orders, n_orders, error) ||
              searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
-    if (!failed && !(work <= MAX_SEARCHED_MODES)) {
+    if (!failed && !(work <= ROTOR_MODEL_MAX_SEARCHED_MODES)) {
         python_g(work, 3, shown, sizeof shown);
         snprintf(error, sizeof error,
                  "the analysis would scan %s shaft modes, more than the %.0f accepted (shorter or stiffer shaft, "
-                 "fewer or lower orders, or a smaller omega_max)", shown, MAX_SEARCHED_MODES);
+                 "fewer or lower orders, or a smaller omega_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);
         failed = 1;
     }
     failed = failed || work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), error) ||
@@ -722,7 +744,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
 static const char *evaluate(ModelData *data)
 {
     const Analysis *analysis = data->cache->derived;
-    double speed = fabs(VALUE(omega)), whirl[2 * WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
+    double speed = fabs(VALUE(omega)), whirl[2 * ROTOR_MODEL_WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
     int closest = 0, count = 0, i;
     if (analysis == NULL || analysis->whirl == NULL || analysis->resonance_count == 0 ||
         analysis->unbalance == NULL) { /* the parameter check builds it before every step */

@@ -13,6 +13,15 @@
 #include "fmi2Functions.h"
 #include "fmu_instance.h"
 
+/* FMI2_FUNCTION_PREFIX prefixes the entry points (several FMUs linked into one program), as the
+ * standard's fmi2Functions.h does; some copies of that header (fmpy's) leave it out. */
+#ifdef FMI2_FUNCTION_PREFIX
+#undef fmi2FullName
+#define fmi2PrefixPaste(a, b) a##b
+#define fmi2PrefixName(a, b) fmi2PrefixPaste(a, b)
+#define fmi2FullName(name) fmi2PrefixName(FMI2_FUNCTION_PREFIX, name)
+#endif
+
 static void emit(const Instance *instance, Status status, const char *category, const char *message)
 {
     fmi2CallbackLogger logger = (fmi2CallbackLogger)instance->host_logger;
