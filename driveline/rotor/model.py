@@ -195,11 +195,10 @@ class CriticalSpeedsModel(SteppedModel):
 
     spec = SPEC
     derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts", "_unbalance")
-    native_constants = NATIVE_CONSTANTS
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
     native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d"),
-                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT}
+                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT, **NATIVE_CONSTANTS}
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None

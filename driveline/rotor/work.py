@@ -43,12 +43,9 @@ STAGES = ("critical speeds", "order resonances", "Campbell table", "FE check", "
 #: What the refusal suggests, after the estimates.
 ADVICE = "(fewer stations or segments, fewer or lower orders)"
 
-#: The constants the C port of :func:`estimate` reads (``CriticalSpeedsModel.native_constants``).
-NATIVE_CONSTANTS = {"WORK_MAX_SECONDS": MAX_ANALYSIS_SECONDS, "WORK_RATE_SEARCH": RATE_SEARCH,
-                    "WORK_RATE_DENSE": RATE_DENSE, "WORK_RATE_BANDED": RATE_BANDED, "WORK_MAX_KNOTS": MAX_KNOTS,
-                    "WORK_DAMPING_POINTS": DAMPING_POINTS, "WORK_TABLE_ELEMENTS": TABLE_ELEMENTS,
-                    "WORK_RESPONSE_ELEMENTS": FE_ELEMENTS, "WORK_POINTS_PER_ROOT": POINTS_PER_ROOT,
-                    "WORK_ADVICE": ADVICE,
+#: The texts the C port of :func:`estimate` reads (``CriticalSpeedsModel.native_constants``); its
+#: numbers come from the shared constants header (``fmu_harness.build.native_constants``).
+NATIVE_CONSTANTS = {"WORK_ADVICE": ADVICE, "WORK_STAGE_COUNT": len(STAGES),
                     **{f"WORK_STAGE_{i}": name for i, name in enumerate(STAGES)}}
 
 
