@@ -29,6 +29,7 @@ from .loader import example_path, load_driveline, one_piece_shaft
 from .mechanism import MECHANISM_HINGE, MECHANISM_RIGID, mechanism_error
 from .spec import SPEC
 from .unbalance_outputs import UnbalanceOutputs
+from .work import NATIVE_CONSTANTS, estimate
 
 #: Orders watched at most, and the highest order (joints excite low orders: 1, 2, 3, 6).
 MAX_ORDERS = 16
@@ -194,6 +195,7 @@ class CriticalSpeedsModel(SteppedModel):
 
     spec = SPEC
     derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts", "_unbalance")
+    native_constants = NATIVE_CONSTANTS
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
     native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d"),
@@ -238,6 +240,9 @@ class CriticalSpeedsModel(SteppedModel):
                 raise ValueError(f"the analysis would scan {work:.3g} shaft modes, more than the "
                                  f"{MAX_SEARCHED_MODES:.0f} accepted (shorter or stiffer shaft, fewer or "
                                  "lower orders, or a smaller omega_max)")
+            refusal = estimate(driveline, orders, self.omega_max, CAMPBELL_POINTS, FE_ELEMENTS).refusal()
+            if refusal is not None:
+                raise ValueError(refusal)
             structure = self._part("structure", shape, lambda: analyse_structure(driveline))
             whirl = self._part("whirl", (shape, self.omega_max), lambda: whirl_table(structure, self.omega_max))
             found = self._part("resonances", (shape, orders, self.omega_max),

@@ -44,6 +44,8 @@ from driveline.variables import UNITS, ModelSpec, Relation, Variable
 from . import documentation, toolchain
 from .documentation import snake_case
 from .model_description import complete_fmi2, complete_fmi3
+from .native_constants import HEADER as CONSTANTS_HEADER
+from .native_constants import constants_header
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
 MODEL_SOURCES = NATIVE_SRC
@@ -445,6 +447,7 @@ def resource_files(name: str) -> dict[str, bytes]:
 def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
     """Every source file the FMU carries, by name, with the token computed from all of them."""
     files = {source: (NATIVE_SRC / source).read_bytes() for source in (*SHARED_SOURCES, LAYER[fmi])}
+    files[CONSTANTS_HEADER] = constants_header().encode()
     files[model_file.name] = model_file.read_bytes()
     files.update(_library_sources(name))
     untokened = variable_table(MODELS[name], "")
