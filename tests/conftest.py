@@ -54,6 +54,7 @@ SLOW = (
     "tests/test_packaging.py::test_different_fmus_alive_at_once_in_one_host",
     "tests/test_packaging.py::test_markers_follow_what_the_tests_use",
     "tests/test_native_platforms.py",
+    "tests/test_native_static_link.py",
     "tests/test_robustness.py",
     "tests/test_rotor_hinge.py::test_fmu_analyses_a_hinged_layout",
     "tests/test_rotor_hinge.py::test_hinged_two_piece_matches_finite_elements",
