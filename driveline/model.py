@@ -163,9 +163,11 @@ class SteppedModel(ABC):
             return [f"{what} could not be checked ({type(error).__name__}: {error})"]
 
     def output_errors(self) -> list[str]:
+        """Outputs that are not finite, then outputs beyond their declared bounds (a physical bound
+        the model's equations no longer describe): the step is not taken."""
         values = [getattr(self, name) for name in self._real_outputs]
         if math.isfinite(math.fsum(values)):
-            return []
+            return [e for v in self.spec.of("output") if (e := self._range_error(v))]
         return [
             f"output {name} is not finite ({value!r}); the step was not taken"
             for name, value in zip(self._real_outputs, values)

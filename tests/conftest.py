@@ -40,6 +40,7 @@ VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
 SLOW = (
     "tests/test_tripod_moving_bearing.py",
+    "tests/test_analysis_work.py::test_the_worst_inputs_the_limits_allow_stay_within_the_budgets",
     "tests/test_coupling_comparison.py::test_two_cardan_joints_cancel_when_phased_and_double_when_not",
     "tests/test_critical_speeds_model.py::test_a_layout_brings_its_own_unbalance_and_damping",
     "tests/test_critical_speeds_model.py::test_analysis_runs_only_when_the_structure_changes",
@@ -53,6 +54,7 @@ SLOW = (
     "tests/test_packaging.py::test_different_fmus_alive_at_once_in_one_host",
     "tests/test_packaging.py::test_markers_follow_what_the_tests_use",
     "tests/test_native_platforms.py",
+    "tests/test_native_static_link.py",
     "tests/test_robustness.py",
     "tests/test_rotor_hinge.py::test_fmu_analyses_a_hinged_layout",
     "tests/test_rotor_hinge.py::test_hinged_two_piece_matches_finite_elements",

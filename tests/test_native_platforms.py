@@ -78,18 +78,28 @@ MACHO_LINKER_SYMBOLS = {"__mh_dylib_header", "___dso_handle"}
 @pytest.mark.parametrize("name", native.native_models())
 @pytest.mark.parametrize("platform", [p for p in toolchain.PLATFORMS if p.system == "darwin"], ids=lambda p: p.tuple)
 def test_macos_binaries_are_dylibs_of_the_right_architecture(release_dir, name, fmi, platform):
-    """macOS binaries cannot run here: a Mach-O dylib of the platform's CPU, for macOS 11 or newer,
-    exporting the FMI functions only, linked against libSystem alone; the arm64 one code-signed
-    (ad hoc), as Apple silicon requires of any code it loads."""
-    binary = lief.MachO.parse(list(_binary(release_dir, name, fmi, platform))).at(0)
-    assert binary.header.file_type == lief.MachO.Header.FILE_TYPE.DYLIB
-    assert binary.header.cpu_type.name == {"x86_64": "X86_64", "aarch64": "ARM64"}[platform.tuple.split("-")[0]]
-    loaded = [c.name for c in binary.commands if c.command == lief.MachO.LoadCommand.TYPE.LOAD_DYLIB]
-    assert loaded == ["/usr/lib/libSystem.B.dylib"]
-    exported = {s.name for s in binary.exported_symbols} - MACHO_LINKER_SYMBOLS
-    assert exported and all(symbol.startswith(f"_fmi{fmi}") for symbol in exported)
-    assert tuple(binary.build_version.minos) <= (11, 0, 0)
-    assert binary.has_code_signature or platform.tuple == "x86_64-darwin"
+    """macOS binaries cannot run here: Mach-O dylibs of the platform's CPU, for macOS 11 or newer,
+    exporting the FMI functions only, linked against libSystem alone; the arm64 ones code-signed
+    (ad hoc), as Apple silicon requires of any code it loads. FMI 2.0's ``darwin64`` is universal
+    (x86_64 and arm64: importers on Apple silicon look there), its arm64 slice the
+    ``aarch64-darwin`` binary."""
+    fat = lief.MachO.parse(list(_binary(release_dir, name, fmi, platform)))
+    slices = [fat.at(index) for index in range(fat.size)]
+    architectures = {"x86_64": ["X86_64"], "aarch64": ["ARM64"]}[platform.tuple.split("-")[0]]
+    if platform.folder(fmi) == "darwin64":
+        architectures = ["X86_64", "ARM64"]
+        arm = _binary(release_dir, name, fmi, toolchain.BY_TUPLE["aarch64-darwin"])
+        offset = fat.at(1).fat_offset
+        assert _binary(release_dir, name, fmi, platform)[offset:offset + len(arm)] == arm
+    assert [binary.header.cpu_type.name for binary in slices] == architectures
+    for binary in slices:
+        assert binary.header.file_type == lief.MachO.Header.FILE_TYPE.DYLIB
+        loaded = [c.name for c in binary.commands if c.command == lief.MachO.LoadCommand.TYPE.LOAD_DYLIB]
+        assert loaded == ["/usr/lib/libSystem.B.dylib"]
+        exported = {s.name for s in binary.exported_symbols} - MACHO_LINKER_SYMBOLS
+        assert exported and all(symbol.startswith(f"_fmi{fmi}") for symbol in exported)
+        assert tuple(binary.build_version.minos) <= (11, 0, 0)
+        assert binary.has_code_signature or binary.header.cpu_type.name == "X86_64"
 
 
 @pytest.mark.parametrize("name", native.native_models())

@@ -29,6 +29,7 @@ from .loader import example_path, load_driveline, one_piece_shaft
 from .mechanism import MECHANISM_HINGE, MECHANISM_RIGID, mechanism_error
 from .spec import SPEC
 from .unbalance_outputs import UnbalanceOutputs
+from .work import NATIVE_CONSTANTS, estimate
 
 #: Orders watched at most, and the highest order (joints excite low orders: 1, 2, 3, 6).
 MAX_ORDERS = 16
@@ -207,7 +208,7 @@ class CriticalSpeedsModel(SteppedModel):
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
     derived_parts = ANALYSIS_PARTS
     native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d"),
-                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT}
+                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT, **NATIVE_CONSTANTS}
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None
@@ -243,6 +244,9 @@ class CriticalSpeedsModel(SteppedModel):
                 raise ValueError(f"the analysis would scan {work:.3g} shaft modes, more than the "
                                  f"{MAX_SEARCHED_MODES:.0f} accepted (shorter or stiffer shaft, fewer or "
                                  "lower orders, or a smaller omega_max)")
+            refusal = estimate(driveline, orders, self.omega_max, CAMPBELL_POINTS, FE_ELEMENTS).refusal()
+            if refusal is not None:
+                raise ValueError(refusal)
             structure = self._part("structure", self._key("structure"), lambda: analyse_structure(driveline))
             whirl = self._part("whirl", self._key("whirl"), lambda: whirl_table(structure, self.omega_max))
             found = self._part("resonances", self._key("resonances", orders),

@@ -488,9 +488,14 @@ def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain
     token = files["token"].decode()
     sources = {source: data for source, data in files.items() if source != "token"}
     compiled = sorted(source for source in sources if source.endswith(".c"))
+    libraries = {p: library.read_bytes() for p, library in binaries.items()}
+    intel, arm = toolchain.BY_TUPLE["x86_64-darwin"], toolchain.BY_TUPLE["aarch64-darwin"]
+    if fmi == "2" and intel in libraries and arm in libraries:
+        # FMI 2.0's darwin64 universal: importers on Apple silicon (fmpy among them) look there
+        libraries[intel] = toolchain.universal([libraries[intel], libraries[arm]])
     members = {
         "modelDescription.xml": model_description(MODELS[name].spec, fmi, token, compiled),
-        **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": library.read_bytes() for p, library in binaries.items()},
+        **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": data for p, data in libraries.items()},
         **{f"sources/{source}": data for source, data in sources.items()},
         **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
         **documentation.members(name),

@@ -24,6 +24,7 @@ SHARED = {
     "driveline.rotor.campbell": ("SLOPE_STEP", "SPLINE_RTOL", "REFINEMENTS", "MAX_KNOTS", "NOISE"),
     "driveline.rotor.damped": ("EXTRA_EIGENVALUES", "DENSE_SIZE", "SHIFT"),
     "driveline.rotor.unbalance_outputs": ("FE_ELEMENTS", "TABLE_ELEMENTS", "DAMPING_POINTS", "DAMPED_MODES"),
+    "driveline.rotor.work": ("MAX_ANALYSIS_SECONDS", "RATE_SEARCH", "RATE_DENSE", "RATE_BANDED"),
     "driveline.rotor.model": ("MAX_ORDERS", "MAX_ORDER", "MAX_SEARCHED_MODES", "FE_ELEMENTS", "PLAUSIBLE_DEVIATION",
                               "CAMPBELL_POINTS", "WHIRL_MODES"),
     "driveline.tripod.spec": ("EXACT",),

@@ -431,6 +431,95 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
     return 0;
 }
 
+/* ---- work.py: the estimate of every stage, before any stage starts ------------------------------ */
+
+/* work._grid: points of one search line up to the bare-shaft phase ``phase``. */
+static double work_grid(double per_pi, double phase)
+{
+    return per_pi * phase / FMU_PI + 8.0;
+}
+
+/* work.estimate, then Work.refusal: 0, or -1 with the refusal (or a failure) in ``error``. */
+static int work_refusal(const Driveline *driveline, const int *orders, int n_orders, double omega_max, char *error)
+{
+    static const char *const names[WORK_STAGE_COUNT] = {WORK_STAGE_0, WORK_STAGE_1, WORK_STAGE_2,
+                                                   WORK_STAGE_3, WORK_STAGE_4, WORK_STAGE_5};
+    double seconds[WORK_STAGE_COUNT], terms[ROTOR_MODEL_MAX_ORDERS + 1], per_pi, kappa, to_limit, resonances, check, total, search;
+    int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, *counts, i, n = 0, stations, planes = 1, isotropic, freedoms, table = 0,
+        response = 0;
+    char shown[40], stage[80];
+    size_t used;
+    Chain *chain = chain_new(driveline, error, ERROR_SIZE);
+    counts = malloc(((size_t)driveline->n_segments + 1) * sizeof *counts);
+    if (chain == NULL || counts == NULL) {
+        chain_free(chain);
+        free(counts);
+        if (chain != NULL) {
+            snprintf(error, ERROR_SIZE, "out of memory");
+        }
+        return -1;
+    }
+    isotropic = chain_isotropic(chain);
+    freedoms = chain_freedoms(chain);
+    kappa = chain_kappa(chain);
+    chain_free(chain);
+    stations = driveline->n_segments + 1 + driveline->n_masses + driveline->n_bearings + driveline->n_hinges;
+    per_pi = (double)(ROTOR_DRIVELINE_POINTS_PER_ROOT * (1 + freedoms) * (isotropic ? 1 : 2));
+    to_limit = work_grid(per_pi, kappa * sqrt(ROTOR_DRIVELINE_SEARCH_LIMIT));
+    seen[1] = 1; /* {1, *orders} */
+    terms[n++] = 2.0 * work_grid(per_pi, kappa * sqrt(2.0 * 1 * omega_max)) +
+                 2.0 * work_grid(per_pi, kappa * sqrt(1 * ROTOR_DRIVELINE_SEARCH_LIMIT));
+    for (i = 0; i < n_orders; i++) {
+        if (!seen[orders[i]]) {
+            seen[orders[i]] = 1;
+            terms[n++] = 2.0 * work_grid(per_pi, kappa * sqrt(2.0 * orders[i] * omega_max)) +
+                         2.0 * work_grid(per_pi, kappa * sqrt(orders[i] * ROTOR_DRIVELINE_SEARCH_LIMIT));
+        }
+    }
+    for (i = 0; i < driveline->n_bearings; i++) {
+        planes = driveline->bearings[i].kxx == driveline->bearings[i].kyy ? planes : 2;
+    }
+    fe_elements_by_length(driveline, ROTOR_UNBALANCE_OUTPUTS_TABLE_ELEMENTS, counts);
+    for (i = 0; i < driveline->n_segments; i++) {
+        table += counts[i];
+    }
+    fe_elements_by_length(driveline, ROTOR_UNBALANCE_OUTPUTS_FE_ELEMENTS, counts);
+    for (i = 0; i < driveline->n_segments; i++) {
+        response += counts[i];
+    }
+    free(counts);
+    if (fsum(terms, n, &resonances, error)) {
+        return -1;
+    }
+    check = planes * pow(2.0 * (ROTOR_MODEL_FE_ELEMENTS * driveline->n_segments + 1 + driveline->n_hinges), 3.0);
+    search = ROTOR_WORK_RATE_SEARCH * stations;
+    seconds[0] = search * (2.0 * to_limit);
+    seconds[1] = search * resonances;
+    seconds[2] = search * (2.0 * 2.0 * (ROTOR_MODEL_CAMPBELL_POINTS + ROTOR_CAMPBELL_MAX_KNOTS) * to_limit);
+    seconds[3] = ROTOR_WORK_RATE_DENSE * check;
+    seconds[4] = ROTOR_WORK_RATE_BANDED * (ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 4.0 * (table + 1));
+    seconds[5] = ROTOR_WORK_RATE_BANDED * (4.0 * (response + 1));
+    if (fsum(seconds, WORK_STAGE_COUNT, &total, error)) {
+        return -1;
+    }
+    if (total <= ROTOR_WORK_MAX_ANALYSIS_SECONDS) {
+        return 0;
+    }
+    python_g(total, 3, shown, sizeof shown);
+    snprintf(error, ERROR_SIZE, "the analysis would take about %s s (", shown);
+    used = strlen(error);
+    for (i = 0; i < WORK_STAGE_COUNT; i++) {
+        python_g(seconds[i], 3, shown, sizeof shown);
+        snprintf(stage, sizeof stage, "%s%s %s s", i ? ", " : "", names[i], shown);
+        text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
+    }
+    python_g(ROTOR_WORK_MAX_ANALYSIS_SECONDS, 6, shown, sizeof shown);
+    snprintf(stage, sizeof stage, "), more than the %s s accepted ", shown);
+    text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
+    text_append(error, ERROR_SIZE, &used, WORK_ADVICE, strlen(WORK_ADVICE));
+    return -1;
+}
+
 /* analyse_structure: the chain, the critical speeds (missing ones read as the search limit) and the
  * finite-element check's natural frequencies. */
 static int analyse_structure(Analysis *analysis, char *error)
@@ -625,7 +714,8 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
                  "fewer or lower orders, or a smaller omega_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);
         failed = 1;
     }
-    failed = failed || part(analysis, data, PART_STRUCTURE, orders, n_orders, error) ||
+    failed = failed || work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), error) ||
+             part(analysis, data, PART_STRUCTURE, orders, n_orders, error) ||
              part(analysis, data, PART_WHIRL, orders, n_orders, error) ||
              part(analysis, data, PART_RESONANCES, orders, n_orders, error) ||
              part(analysis, data, PART_UNBALANCE, orders, n_orders, error);
