@@ -117,6 +117,11 @@ class SteppedModel(ABC):
     #: string as a C string), generated into its variable header so they are written once.
     native_constants: ClassVar[dict[str, str | int | float]] = {}
 
+    #: The parts of the model's derived data and the parameters each is built for: a changed
+    #: parameter redoes the parts that list it and keeps the others. The native build writes the
+    #: table into the model's variable header (``PART_<NAME>``, ``model_part_values``).
+    derived_parts: ClassVar[dict[str, tuple[str, ...]]] = {}
+
     #: Files a native FMU of the model ships in its ``resources/`` folder, by their path here (the
     #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.
     resource_files: ClassVar[tuple[Path, ...]] = ()

@@ -77,3 +77,20 @@ def test_the_check_finds_a_copy():
     assert _value("16u") == 16 and _value("(-1.0)") == -1.0 and _value("FMU_MESSAGE_SIZE") is None
     assert DEFINE.findall("#define SUBGRID 24          /* roots.SUBGRID */") == [("SUBGRID", "24")]
     assert STATIC_CONST.findall("static const double NOISE = 10.0;") == [("NOISE", "10.0")]
+
+
+def test_the_rule_of_which_parameter_redoes_which_analysis_part_is_generated_from_python():
+    """The C model keeps each part of the CriticalSpeeds analysis for the parameters the Python model
+    keys it by (ANALYSIS_PARTS): the table is generated, the C file lists none of its own."""
+    from driveline.catalog import MODELS
+    from driveline.rotor.model import ANALYSIS_PARTS
+
+    model = MODELS["CriticalSpeeds"]
+    assert model.derived_parts is ANALYSIS_PARTS
+    generated = native.variable_table(model, "")
+    rows = re.findall(r"^    \{((?:V_\w+, )*)-1\},$", generated["model_variables.c"], re.MULTILINE)
+    assert [tuple(re.findall(r"V_(\w+)", row)) for row in rows] == list(ANALYSIS_PARTS.values())
+    assert [f"PART_{name.upper()}" for name in ANALYSIS_PARTS] == re.findall(
+        r"^    (PART_\w+),$", generated["model_variables.h"], re.MULTILINE)
+    c_model = (native.NATIVE_SRC / "critical_speeds.c").read_text()
+    assert "model_part_values" in c_model and not re.search(r"\bPART_\w+\s*[,=]", c_model.split("typedef int Part;")[0])

@@ -203,7 +203,10 @@ def test_emulated_binary_reproduces_the_x86_64_binary(hosts, release_dir, fmu_pa
     tolerance = PLATFORM_TOLERANCES.get((platform, name), TOLERANCES.get(name, 1e-12))
     scenario = _with_expected(Path(arguments[3]), reference, tolerance, work / f"{platform}.scenario")
     outputs = work / f"{platform}.txt"
-    done = subprocess.run([*_runner(platform, hosts[platform]), str(library), fmi, arguments[2], str(scenario), arguments[4],
+    # on Windows the resources folder as a Windows path (wine's drive Z: is /): FMI 2.0 hands it
+    # over as file:///Z:/..., FMI 3.0 as Z:/...
+    resources = f"Z:{arguments[4]}" if platform == "x86_64-windows" else arguments[4]
+    done = subprocess.run([*_runner(platform, hosts[platform]), str(library), fmi, arguments[2], str(scenario), resources,
                            str(outputs)], capture_output=True, text=True, timeout=600,
                           env={**os.environ, "WINEDEBUG": "-all"})
     assert done.returncode == 0, done.stdout + done.stderr[-3000:]

@@ -266,7 +266,13 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
     derivatives = input_derivatives(spec)
     constants = "".join(f"#define {name} {_c_string(value) if isinstance(value, str) else value}\n"
                         for name, value in model.native_constants.items())
-    extra_enum = "" if not probes else "\n/* messages of the model's own checks */\nenum {\n" + "".join(
+    parts = model.derived_parts
+    most = max((len(names) for names in parts.values()), default=0)
+    part_enum = "" if not parts else (
+        "\n/* the parts of the derived data (derived_parts): model_part_values lists the parameters each is\n"
+        " * built for, -1 ending a list */\nenum {\n" + "".join(f"    PART_{name.upper()},\n" for name in parts)
+        + f"    PARTS\n}};\n#define PART_MOST_VALUES {most}\nextern const int model_part_values[PARTS][PART_MOST_VALUES + 1];\n")
+    extra_enum = part_enum + "" if not probes else part_enum + "\n/* messages of the model's own checks */\nenum {\n" + "".join(
         f"    MESSAGE_{name} = {index},\n" for index, name in enumerate(probes)) + "};\n"
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
 #ifndef MODEL_VARIABLES_H
@@ -317,6 +323,13 @@ const RelationInfo model_relations[MODEL_RELATION_COUNT] = {{
         source += f"""
 const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT] = {{
 {extra}
+}};
+"""
+    if parts:
+        lists = "\n".join("    {" + ", ".join([*(f"V_{name}" for name in names), "-1"]) + "}," for names in parts.values())
+        source += f"""
+const int model_part_values[PARTS][PART_MOST_VALUES + 1] = {{
+{lists}
 }};
 """
     if derivatives:

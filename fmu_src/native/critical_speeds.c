@@ -21,26 +21,16 @@
 
 /* ---- the parts of the analysis and their keys ------------------------------------------------ */
 
-typedef enum { PART_DRIVELINE, PART_STRUCTURE, PART_WHIRL, PART_RESONANCES, PART_UNBALANCE, PARTS } Part;
-
-/* The parameters each part depends on besides ``layout`` (and ``orders`` for the resonances):
- * shape = SHAFT_PARAMETERS, damped = shape + DAMPING_PARAMETERS, forced = damped +
- * UNBALANCE_PARAMETERS; -1 ends a list. */
-#define SHAPE V_L_shaft, V_D_outer, V_D_inner, V_E, V_density, V_m_joint, V_Jp_joint, V_Jd_joint, V_k_bearing, V_shear
-#define KEY_VALUES 16
-static const int PART_VALUES[PARTS][KEY_VALUES] = {
-    {SHAPE, V_c_bearing, -1},
-    {SHAPE, -1},
-    {SHAPE, V_omega_max, -1},
-    {SHAPE, V_omega_max, -1},
-    {SHAPE, V_c_bearing, V_unbalance, V_unbalance_position, V_response_position, V_omega_max, -1},
-};
+/* A part of the analysis (PART_<NAME>) and the parameters each is built for besides ``layout`` (and
+ * ``orders`` for the resonances): model_part_values, generated from the Python model's
+ * ANALYSIS_PARTS (driveline/rotor/model.py). */
+typedef int Part;
 
 /* The parameters a part was built for (compared by value, as Python compares the key tuples). */
 typedef struct {
     int held;
     char *layout; /* owned */
-    double values[KEY_VALUES];
+    double values[PART_MOST_VALUES];
     int orders[ROTOR_MODEL_MAX_ORDERS], n_orders;
 } Key;
 
@@ -70,8 +60,8 @@ static int key_matches(const Key *key, const ModelData *data, Part part, const i
     if (!key->held || strcmp(key->layout, data->string_value[V_layout]) != 0) {
         return 0;
     }
-    for (i = 0; PART_VALUES[part][i] >= 0; i++) {
-        if (!(key->values[i] == parameter(data, PART_VALUES[part][i]))) {
+    for (i = 0; model_part_values[part][i] >= 0; i++) {
+        if (!(key->values[i] == parameter(data, model_part_values[part][i]))) {
             return 0;
         }
     }
@@ -101,8 +91,8 @@ static int key_store(Key *key, const ModelData *data, Part part, const int *orde
         return 0;
     }
     memcpy(key->layout, data->string_value[V_layout], length + 1);
-    for (i = 0; PART_VALUES[part][i] >= 0; i++) {
-        key->values[i] = parameter(data, PART_VALUES[part][i]);
+    for (i = 0; model_part_values[part][i] >= 0; i++) {
+        key->values[i] = parameter(data, model_part_values[part][i]);
     }
     key->n_orders = part == PART_RESONANCES ? n_orders : 0;
     for (i = 0; i < key->n_orders; i++) {
