@@ -84,8 +84,8 @@ def host_compiler() -> list[str]:
     ``zig cc``, else ``cc``/``gcc``."""
     if os.environ.get("CC"):
         return shlex.split(os.environ["CC"])
-    if (found := zig()) is not None:
-        return [str(found), "cc"]
+    if (found := zig()) is not None:  # the baseline CPU, not this one's (valgrind knows every instruction)
+        return [str(found), "cc", "-mcpu=baseline"]
     system = system_compiler()
     if system is None:
         raise NoCompiler(NO_COMPILER)
