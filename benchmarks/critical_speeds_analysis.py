@@ -121,7 +121,7 @@ def fmu_table() -> None:
         work = Path(folder)
         layout = work / "twenty_segments.toml"
         layout.write_text(TWENTY_SEGMENTS_TOML)
-        families = {"native": native.build(MODEL, work / "models"), "Python": build_fmu(MODEL, work / "models")}
+        families = {"native": native.build(MODEL, work / "models", release=False), "Python": build_fmu(MODEL, work / "models")}
         cases = {"one-piece tube": {}, "two-piece example": {"layout": "two_piece_propshaft"},
                  "20 segments (layout file)": {"layout": str(layout)}}
         print(f"\nInitialisation of the CriticalSpeeds FMUs, FMI 2.0 (CPU time [s]); {machine()}, "

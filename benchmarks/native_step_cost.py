@@ -22,7 +22,7 @@ from fmpy import extract, read_model_description
 from benchmarks.step_cost import VARIANTS, Stepper, best_alternating
 from benchmarks.timing import machine
 from driveline.catalog import MODELS
-from fmu_harness.build import build, native
+from fmu_harness.build import build, native, toolchain
 
 HERE = Path(__file__).resolve().parent
 C_STEPS, C_ROUNDS = 200_000, 7
@@ -30,8 +30,8 @@ C_STEPS, C_ROUNDS = 200_000, 7
 
 def compile_timer(folder: Path) -> Path:
     executable = folder / "native_step_timer"
-    subprocess.run([native.compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2",
-                    "-I", str(native.fmi_headers()), str(HERE / "native_step_timer.c"), "-o", str(executable),
+    subprocess.run([*toolchain.host_compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2",
+                    "-isystem", str(native.fmi_headers()), str(HERE / "native_step_timer.c"), "-o", str(executable),
                     "-ldl"], check=True)
     return executable
 
@@ -45,7 +45,7 @@ def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path, integers: dict[str
     inputs = [v.valueReference for v in description.modelVariables if v.causality == "input" and v.type in real]
     outputs = [v.valueReference for v in description.modelVariables if v.causality == "output" and v.type in real]
     references = {v.name: v.valueReference for v in description.modelVariables}
-    library = next((unzipdir / "binaries").rglob("*.so"))
+    library = native.host_library(unzipdir, description.coSimulation.modelIdentifier, fmi)
     done = subprocess.run([str(timer), str(library), fmi, token, description.defaultExperiment.stepSize,
                            str(C_STEPS), str(C_ROUNDS), " ".join(map(str, inputs)), " ".join(map(str, outputs)),
                            " ".join(f"{references[name]}={value}" for name, value in integers.items())],
@@ -64,8 +64,8 @@ def main() -> None:
         for fmi in ("2", "3"):
             for name in native.native_models():
                 inputs = [v.name for v in MODELS[name].spec.of("input")]
-                fmu = native.build(name, dest, fmi)
-                twin = native.build(name, dest / "twin", fmi, HERE / "native_minimal.c")
+                fmu = native.build(name, dest, fmi, release=False)
+                twin = native.build(name, dest / "twin", fmi, HERE / "native_minimal.c", release=False)
                 python_fmu = build(name, dest / "python", fmi)
                 for variant, values in VARIANTS.get(name, {"default": {}}).items():
                     ours, floor, python = best_alternating([Stepper(path, values, inputs)

@@ -17,6 +17,11 @@ from typing import Any, ClassVar
 
 from .variables import ModelSpec, Relation, Variable
 
+#: How far, relative to the time reached (at least 1 s), a step may start before that time: a host
+#: that adds step sizes and one that multiplies them differ in the last bits. Earlier is time going
+#: backwards, which the adapters refuse as misuse.
+TIME_TOLERANCE = 1e-9
+
 RULES = {"<": "must be below", "<=": "must not exceed", ">": "must exceed", ">=": "must not be below"}
 
 
@@ -43,13 +48,17 @@ class SteppedModel(ABC):
 
     def initialize(self, start_time: float) -> list[str]:
         """Validate parameters and inputs and compute the outputs at ``start_time``."""
+        self.time = start_time
         errors = self.parameter_errors() + self.input_errors()
         if errors:
             return errors
-        self.time = start_time
         errors = self._undoable(lambda: self.start(start_time), "the start values")
         self._initialized = not errors
         return errors
+
+    def goes_back(self, current_time: float) -> bool:
+        """Whether a step from ``current_time`` would start before the time the model reached."""
+        return current_time < self.time - TIME_TOLERANCE * max(1.0, abs(self.time))
 
     def step(self, current_time: float, step_size: float) -> list[str]:
         """Advance from ``current_time`` by ``step_size``; return the reasons for a refusal."""
@@ -103,6 +112,10 @@ class SteppedModel(ABC):
     #: for its message; the first value named is the one the message shows. The native build cuts
     #: the messages from the check run on these values, so their wording exists once.
     extra_parameter_probes: ClassVar[dict[str, dict[str, float]]] = {}
+
+    #: Constants the native port of the model shares with it (``#define`` name and value, a
+    #: string as a C string), generated into its variable header so they are written once.
+    native_constants: ClassVar[dict[str, str | int | float]] = {}
 
     #: Files a native FMU of the model ships in its ``resources/`` folder, by their path here (the
     #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.

@@ -87,6 +87,9 @@ class Variable:
     variability: Variability | None = None
     min_exclusive: bool = False
     max_exclusive: bool = False
+    #: An input that is the time derivative of the input named here (FMI 3.0's ``derivative``
+    #: attribute; the native FMI 2.0 FMUs take it from ``fmi2SetRealInputDerivatives``).
+    derivative: str | None = None
 
     def __post_init__(self) -> None:
         if self.unit is not None and self.unit not in UNITS:

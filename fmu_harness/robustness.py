@@ -76,6 +76,12 @@ class Result:
     seconds: float
 
 
+def _departures(procedure: str, fmi: str) -> tuple[str, ...]:
+    """A bad parameter is refused at initialisation: the wrappers answer OK there (the reasons
+    logged) and refuse later steps with fmi2Discard for fmi2Error."""
+    return _refusing(fmi, STATUS_OK_LOGGED) if procedure == "bad_parameter" else ()
+
+
 def _variables(model: str, causality: str) -> list[str]:
     return [v.name for v in MODELS[model].spec.of(causality) if v.type == "Real"]
 
@@ -91,7 +97,8 @@ def _non_finite(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
                 values = NON_FINITE if slow else (NON_FINITE[index % 3],)
                 index += 1
                 found += [Case("non-finite values", f"{model}.{name} = {v}", procedure,
-                               (str(fmu_path(model, fmi)), name, v), fmi) for v in values]
+                               (str(fmu_path(model, fmi)), name, v), fmi, _departures(procedure, fmi))
+                          for v in values]
     return found
 
 
@@ -106,7 +113,7 @@ def _out_of_range(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
             procedure = "bad_input" if v.causality == "input" else "bad_parameter"
             for beyond in ([v.min - 1.0] if v.min is not None else []) + ([v.max + 1.0] if v.max is not None else []):
                 of_model.append(Case("out-of-range values", f"{model}.{v.name} = {beyond:g}", procedure,
-                                     (str(fmu_path(model, fmi)), v.name, beyond), fmi))
+                                     (str(fmu_path(model, fmi)), v.name, beyond), fmi, _departures(procedure, fmi)))
         found += of_model if slow else of_model[:1]
     return found
 
@@ -118,7 +125,8 @@ def _step_sizes(fmu_path: FmuPath, fmi: str, slow: bool) -> list[Case]:
 
 
 MISUSE = ("step before initialisation", "step in initialisation mode", "step after terminate",
-          "set after terminate", "nan time", "-inf time", "unknown value reference", "string on a real",
+          "set after terminate", "nan time", "-inf time", "time going backwards", "unknown value reference",
+          "string on a real",
           "set an output", "fixed parameter after initialisation", "enter initialisation twice", "wrong guid",
           "nan start time")
 
@@ -181,8 +189,8 @@ LAYOUTS = (
 
 def _layouts(fmu_path: FmuPath, fmi: str) -> list[Case]:
     path = str(fmu_path("CriticalSpeeds", fmi))
-    found = [Case("hostile layout values", f"layout {value[:24]!r}", "layout", (path, value, fragment, prepare), fmi)
-             for value, prepare, fragment in LAYOUTS]
+    found = [Case("hostile layout values", f"layout {value[:24]!r}", "layout", (path, value, fragment, prepare), fmi,
+                  _departures("bad_parameter", fmi)) for value, prepare, fragment in LAYOUTS]
     found.append(Case("hostile layout values", "layout of 10^5 characters", "long_string",
                       (path, "layout", 100000), fmi, _refusing(fmi, STATUS_OK_LOGGED)))
     return found
@@ -204,7 +212,23 @@ LIMITS = (
 def _limits(fmu_path: FmuPath, fmi: str) -> list[Case]:
     path = str(fmu_path("CriticalSpeeds", fmi))
     return [Case("work, memory and resolution limits", f"{name} = {str(value)[:24]}", "parameter_limit",
-                 (path, name, value, fragment), fmi) for name, value, fragment in LIMITS]
+                 (path, name, value, fragment), fmi, _departures("bad_parameter", fmi))
+            for name, value, fragment in LIMITS]
+
+
+#: (model, input or tunable parameter, value every later step refuses, fragment of the message)
+PERSISTENT = (
+    ("CardanJoint", "beta", 1.6, "beta"),
+    ("TripodCoupling", "beta", 1.2, "beta"),
+    ("UniversalReducer", "alpha", 4.0, "alpha"),
+    ("CriticalSpeeds", "layout", "nosuch", "no shipped example named 'nosuch'"),
+)
+
+
+def _persistent(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    return [Case("refusals that end a run", f"{model}.{name} = {value!r}", "persistent_refusal",
+                 (str(fmu_path(model, fmi)), name, value, fragment), fmi)
+            for model, name, value, fragment in PERSISTENT]
 
 
 def _start_time(fmu_path: FmuPath, fmi: str) -> list[Case]:
@@ -257,7 +281,8 @@ def cases(fmu_path: FmuPath, slow: bool = False, versions: Iterable[str] = ("2",
         found += (_non_finite(fmu_path, fmi, slow) + _out_of_range(fmu_path, fmi, slow)
                   + _step_sizes(fmu_path, fmi, slow) + _misuse(fmu_path, fmi) + _states(fmu_path, fmi)
                   + _instances(fmu_path, fmi, slow)
-                  + _layouts(fmu_path, fmi) + _limits(fmu_path, fmi) + _start_time(fmu_path, fmi)
+                  + _layouts(fmu_path, fmi) + _limits(fmu_path, fmi) + _persistent(fmu_path, fmi)
+                  + _start_time(fmu_path, fmi)
                   + (_model_failures(fmu_path, fmi) if family == "python" else []))
         if slow:
             found += _soak(fmu_path, fmi)

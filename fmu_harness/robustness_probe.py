@@ -120,6 +120,27 @@ class Probe:
             self.time += step_size
         return status
 
+    def step_stopping(self, step_size: float) -> tuple[str, bool]:
+        """``(status, stop)`` of a doStep from the current time: ``stop`` is FMI 3.0's
+        terminateSimulation, or FMI 2.0's fmi2Terminated asked for after a Discard, as fmusim and
+        fmpy's ``simulate_fmu`` ask."""
+        if not self.fmi3:
+            status = self.step(step_size)
+            return status, status == "Discard" and bool(self.call("getBooleanStatus", 3)[1])  # fmi2Terminated
+        from ctypes import byref
+
+        from fmpy.fmi3 import fmi3Boolean, fmi3Float64
+
+        event, stop, early, last = fmi3Boolean(False), fmi3Boolean(False), fmi3Boolean(False), fmi3Float64(0.0)
+        try:
+            self.fmu.fmi3DoStep(self.fmu.component, self.time, step_size, fmi3Boolean(True), byref(event), byref(stop),
+                                byref(early), byref(last))
+            status = "OK"
+            self.time += step_size
+        except FMICallException as error:
+            status = STATUS_NAMES[error.status]
+        return status, bool(stop.value)
+
     def errors_logged(self) -> list[str]:
         return [text for status, text in self.log if status == "Error"]
 
@@ -170,13 +191,41 @@ def bad_input(path: str, name: str, value: float) -> None:
     probe.close()
 
 
+def _refused_parameters(probe: Probe, values: dict[str, Any], fragment: str) -> None:
+    """Parameters no input can make valid: exitInitializationMode returns Error (the wrappers: OK)
+    with a message holding ``fragment`` logged, and every step is refused."""
+    shown = ", ".join(f"{name} = {str(value)[:40]!r}" for name, value in values.items())
+    expect(probe.initialize(values), probe.misuse_status(), what=f"exitInitializationMode with {shown}")
+    if not any(fragment in text for text in probe.errors_logged()):
+        raise Wrong("status", f"no message with {fragment!r}: {[t[:120] for t in probe.errors_logged()]}")
+    expect(probe.step(1e-3), probe.refusal(), what=f"doStep with {shown}")
+    probe.close()
+
+
 def bad_parameter(path: str, name: str, value: Any) -> None:
-    """A bad start value of a parameter is logged at initialisation and refuses every step."""
+    """A bad start value of a parameter is refused at initialisation, naming it."""
+    _refused_parameters(Probe(path), {name: value}, name)
+
+
+def persistent_refusal(path: str, name: str, value: Any, fragment: str) -> None:
+    """A master that retries a discarded step at the same time until the FMU asks it to stop
+    (fmusim's FMI 2.0 loop; fmpy's ``simulate_fmu`` asks fmi2Terminated the same way) stops after
+    the first refusal, which is logged once however often the step is repeated."""
     probe = Probe(path)
-    expect(probe.initialize({name: value}), "OK", what="exitInitializationMode")
-    expect(probe.step(1e-3), "Discard", what=f"doStep with {name} = {value!r}")
-    if not any(name in text for text in probe.errors_logged()):
-        raise Wrong("status", f"the refusal does not name {name}: {probe.errors_logged()[:2]}")
+    expect(probe.initialize(), "OK", what="exitInitializationMode")
+    expect(probe.step(1e-3), "OK", what="first doStep")
+    probe.set(name, value)
+    for tries in range(1, 1001):
+        status, stop = probe.step_stopping(1e-3)
+        if status != "Discard" or stop:
+            break
+    expect(status, "Discard", what=f"doStep with {name} = {value!r}")
+    if not stop:
+        raise Wrong("status", f"the FMU did not ask the master to stop after {tries} refused steps")
+    expect(probe.step_stopping(1e-3)[0], "Discard", what="the same step repeated")
+    naming = [text for text in probe.errors_logged() if fragment in text]
+    if len(naming) != 1:
+        raise Wrong("status", f"the refusal was logged {len(naming)} times: {naming[:3]}")
     probe.close()
 
 
@@ -250,9 +299,11 @@ def misuse(path: str, kind: str) -> None:
             expect(probe.set(first_input, 1.0), probe.misuse_status(), what="set after terminate")
             if not probe.errors_logged():
                 raise Wrong("status", "setting after terminate logged no error")
-    elif kind in ("nan time", "-inf time"):
-        time = math.nan if kind == "nan time" else -math.inf
+    elif kind in ("nan time", "-inf time", "time going backwards"):
+        time = {"nan time": math.nan, "-inf time": -math.inf}.get(kind, probe.time - 1e-3)
         expect(probe.step(1e-3, time), probe.refusal(), what=f"doStep at t = {time}")
+        if not probe.errors_logged():
+            raise Wrong("status", f"doStep at t = {time}: no error logged")
     else:
         call = {
             "unknown value reference": lambda: probe.call("getReal", [987654])[0],
@@ -349,28 +400,19 @@ def hostile_file(target: Path, kind: str) -> None:
 
 
 def layout(path: str, value: str, fragment: str, prepare: str = "") -> None:
-    """A hostile ``layout`` is refused (Discard) with a message holding ``fragment``, quickly; the
-    message reaches the logger verbatim (no printf conversion of host text)."""
+    """A hostile ``layout`` is refused at initialisation with a message holding ``fragment``,
+    quickly; the message reaches the logger verbatim (no printf conversion of host text)."""
     folder = Path(extract(path))
     target = folder / value if prepare else Path(value)
     if prepare:
         hostile_file(target, prepare)
-    probe = Probe(path, unzipdir=str(folder))
-    expect(probe.initialize({"layout": str(target) if prepare else value}), "OK")
-    expect(probe.step(1e-3), "Discard", what=f"doStep with layout {value[:40]!r}")
-    if not any(fragment in text for text in probe.errors_logged()):
-        raise Wrong("status", f"no message with {fragment!r}: {[t[:120] for t in probe.errors_logged()]}")
-    probe.close()
+    _refused_parameters(Probe(path, unzipdir=str(folder)), {"layout": str(target) if prepare else value}, fragment)
 
 
 def parameter_limit(path: str, name: str, value: Any, fragment: str) -> None:
-    """A parameter beyond what the analysis can do in bounded time or resolve is refused quickly."""
-    probe = Probe(path)
-    expect(probe.initialize({name: value}), "OK")
-    expect(probe.step(1e-3), "Discard", what=f"doStep with {name} = {value!r}")
-    if not any(fragment in text for text in probe.errors_logged()):
-        raise Wrong("status", f"no message with {fragment!r}: {[t[:120] for t in probe.errors_logged()]}")
-    probe.close()
+    """A parameter beyond what the analysis can do in bounded time or resolve is refused quickly,
+    at initialisation."""
+    _refused_parameters(Probe(path), {name: value}, fragment)
 
 
 def long_string(path: str, name: str, length: int) -> None:

@@ -4,8 +4,8 @@ Shipped inside every FMI 3.0 FMU next to the model's modules and ``model_adapter
 wants an independent variable: ``time``, after the spec's variables. A refused step returns
 ``Fmi3StepResult(status=discard)``: pythonfmu3's native ``fmi3DoStep`` returns that status,
 **fmi3Discard**, with ``lastSuccessfulTime`` = ``currentCommunicationPoint`` and
-``terminateSimulation`` false, so the host may retry the step; misuse and the error state
-return **fmi3Error**. The reasons go to the FMI logger with status fmi3Error (category
+``terminateSimulation`` true (the same step would be refused again: the importer stops; one that
+corrects its inputs may step again); misuse and the error state return **fmi3Error**. The reasons go to the FMI logger with status fmi3Error (category
 ``logStatusError``); pythonfmu3 forwards them whether or not logging was switched on.
 
 pythonfmu3 0.3.4 drops the ``startTime`` of ``fmi3EnterInitializationMode`` (the Python
@@ -50,4 +50,5 @@ class ModelSlave(ModelAdapter, Fmi3Slave):
         if first_step_elsewhere and self.phase is Phase.STEPPING and self.fault is None and current_time - current_time == 0.0:
             self.start_time = current_time
             self.initialize_model()
-        return Fmi3StepResult(status=_STATUS[self.step_outcome(current_time, step_size)])
+        outcome = self.step_outcome(current_time, step_size)
+        return Fmi3StepResult(status=_STATUS[outcome], terminateSimulation=outcome is not StepOutcome.OK)

@@ -100,6 +100,7 @@ class ModelAdapter:
         self.stepped = False
         self.phase = Phase.INSTANTIATED
         self.fault: str | None = None
+        self._refusal: str | None = None  # the first reason of the last refused step
         self._log_texts: dict[str, str] = {}
         self._spec_of_reference: dict[int, Any] = {}
         for variable in spec.variables:
@@ -176,11 +177,16 @@ class ModelAdapter:
             self.phase = Phase.INITIALIZATION
 
     def exit_initialization_mode(self) -> None:
-        """Initialise the model at the start time; bad parameters or inputs are logged here and
-        refuse every step until corrected."""
+        """Initialise the model at the start time. Parameters that no input can make valid enter
+        the error state here (the wrappers can only return OK: the reasons are logged and every
+        step is refused); bad inputs are logged and refuse every step until corrected."""
         if self._in_phase("exitInitializationMode", Phase.INITIALIZATION):
             self.phase = Phase.STEPPING
-            self.initialize_model()
+            errors = self._guarded("exitInitializationMode", self.model.parameter_errors, [])
+            for reason in errors:
+                self._fail("exitInitializationMode", reason)
+            if not errors:
+                self.initialize_model()
 
     def initialize_model(self) -> None:
         self._guarded("exitInitializationMode", lambda: self._report(self.model.initialize(self.start_time)))
@@ -193,18 +199,31 @@ class ModelAdapter:
         """One step of the model: OK, DISCARD (refused, reasons logged) or ERROR (misuse or the
         error state)."""
         if self.fault is not None:
-            self._report([f"doStep: refused in the error state ({self.fault}); reset the instance or restore a state"])
+            refusal = f"doStep: refused in the error state ({self.fault}); reset the instance or restore a state"
+            if refusal != self._refusal:  # logged once, however often a host that ignores it steps again
+                self._refusal = refusal
+                self._report([refusal])
             return StepOutcome.ERROR
         if not self._in_phase("doStep", Phase.STEPPING):
             return StepOutcome.ERROR
         if not _finite(current_time):
             self._fail("doStep", f"currentCommunicationPoint {current_time!r} is not finite")
             return StepOutcome.ERROR
+        if self.model.goes_back(current_time):
+            self._fail("doStep", f"currentCommunicationPoint {current_time!r} is before the time the FMU reached, "
+                                 f"{self.model.time!r}")
+            return StepOutcome.ERROR
         errors = self._guarded("doStep", lambda: self.model.step(current_time, step_size))
         if errors is None:
             return StepOutcome.ERROR
         self.stepped = self.stepped or not errors
-        return StepOutcome.OK if self._report(errors) else StepOutcome.DISCARD
+        if not errors:
+            self._refusal = None
+            return StepOutcome.OK
+        if errors[0] != self._refusal:  # the same step is refused again: its reasons are logged once
+            self._refusal = errors[0]
+            self._report(errors)
+        return StepOutcome.DISCARD
 
     # -- values ------------------------------------------------------------------
     def _variable(self, call: str, reference: int, kind: str):
@@ -289,7 +308,7 @@ class ModelAdapter:
         self.start_time, self.stepped = state.start_time, state.stepped
         if self.phase is not Phase.TERMINATED:
             self.phase = state.phase
-        self.fault = None
+        self.fault = self._refusal = None
 
     @classmethod
     def _fmu_state_to_bytes(cls, state: Any) -> bytes:

@@ -37,12 +37,12 @@ from fmpy import extract
 
 from driveline.catalog import MODELS
 from fmu_harness import build
-from fmu_harness.build import native
+from fmu_harness.build import native, toolchain
 from fmu_harness.runner import FmuInstance
 
 FmuPath = Callable[..., Path]
 
-FMU_FIXTURES = {"fmu_store", "native_dir"}
+FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir"}
 IMPORTER_MODULES = ("fmu_harness.importers", "fmu_harness.interop")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
@@ -112,9 +112,20 @@ def fmu_path(fmu_store: Path, pytestconfig: pytest.Config) -> FmuPath:
 
 @pytest.fixture(scope="session")
 def native_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A folder holding the freshly built native FMUs (``native/``, ``native/fmi3/``)."""
+    """A folder holding the freshly built native FMUs (``native/``, ``native/fmi3/``), with the
+    binary of this machine's platform alone."""
     dest = tmp_path_factory.mktemp("native_models")
-    native.build_all(dest)
+    native.build_all(dest, release=False)
+    return dest
+
+
+@pytest.fixture(scope="session")
+def release_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The native FMUs as released: a binary for each of the five platforms (needs ziglang)."""
+    if not toolchain.release_available():
+        pytest.skip("the five-platform build needs ziglang (pip install ziglang)")
+    dest = tmp_path_factory.mktemp("release_models")
+    native.build_all(dest, release=True)
     return dest
 
 

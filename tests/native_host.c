@@ -1,21 +1,23 @@
 /* A minimal co-simulation host with no Python in the process, for the native FMUs' tests.
  *
- * Usage: native_host LIBRARY FMI_VERSION(2|3) TOKEN SCENARIO [RESOURCES]
+ * Usage: native_host LIBRARY FMI_VERSION(2|3) TOKEN SCENARIO [RESOURCES [OUTPUTS]]
  *
- * RESOURCES is the FMU's resources folder (handed over as a file URI in FMI 2.0, a path in 3.0).
+ * RESOURCES is the FMU's resources folder (handed over as a file URI in FMI 2.0, a path in 3.0;
+ * "-" for none); OUTPUTS, a file the host writes the outputs it got to, one row per time, every
+ * number with 17 significant digits (the reference of a run on another platform).
  * SCENARIO is a text file: "inputs N vr...", "outputs M vr...", "parameters P (vr value)...",
  * "integers Q (vr value)...", "booleans B (vr 0|1)...", "strings S (vr text)..." (parameters set in
  * initialisation mode; a text has no blanks; each is read back), "tolerance x", "steps K h",
  * then K + 1 rows "t u_1..u_N y_1..y_M": the inputs at t_k and the outputs a reference FMU gave at
- * t_k (row 0: after initialisation). The host loads the FMU's shared library (dlopen), runs two instances
+ * t_k (row 0: after initialisation). The host loads the FMU's shared library (dlopen; LoadLibrary in
+ * its Windows build), runs two instances
  * side by side (the second must repeat the first bit for bit), stores, serializes and restores
  * the FMU state half way and replays the second half (bit for bit again), then sets the first
  * input to NaN (or steps by 0 if there is no input) and expects a refused step (Discard, a logged
- * reason, outputs unchanged).
+ * reason, outputs unchanged) that ends fmusim's retry loop (retry_until_stopped) at once, logged once.
  * It prints the largest deviation from the reference, relative to each output's largest
  * magnitude, and exits 0 when every check held and the deviation is at most the tolerance.
  */
-#include <dlfcn.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -48,18 +50,72 @@ static int fail(const char *what)
     return 1;
 }
 
-/* ---- loading ------------------------------------------------------------------------------- */
+/* ---- loading: dlopen, or LoadLibrary on Windows, behind open_library/symbol/close_library ------- */
+
+#ifdef _WIN32
+#include <windows.h>
+
+static HMODULE library;
+
+static int open_library(const char *path)
+{
+    library = LoadLibraryA(path);
+    return library != NULL;
+}
+
+static const char *library_error(void)
+{
+    static char text[64];
+    sprintf(text, "LoadLibrary failed (error %lu)", (unsigned long)GetLastError());
+    return text;
+}
+
+static int symbol(const char *name, void *function_pointer)
+{
+    FARPROC found = GetProcAddress(library, name);
+    memcpy(function_pointer, &found, sizeof found);
+    return found != NULL;
+}
+
+static void close_library(void)
+{
+    FreeLibrary(library);
+}
+#else
+#include <dlfcn.h>
 
 static void *library;
 
+static int open_library(const char *path)
+{
+    library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    return library != NULL;
+}
+
+static const char *library_error(void)
+{
+    return dlerror();
+}
+
+static int symbol(const char *name, void *function_pointer)
+{
+    void *found = dlsym(library, name);
+    memcpy(function_pointer, &found, sizeof found); /* object to function pointer, as POSIX allows */
+    return found != NULL;
+}
+
+static void close_library(void)
+{
+    dlclose(library);
+}
+#endif
+
 static int load(const char *name, void *function_pointer)
 {
-    void *symbol = dlsym(library, name);
-    if (symbol == NULL) {
+    if (!symbol(name, function_pointer)) {
         fprintf(stderr, "native_host: missing symbol %s\n", name);
         return 0;
     }
-    memcpy(function_pointer, &symbol, sizeof symbol); /* object to function pointer, as POSIX allows */
     return 1;
 }
 
@@ -79,6 +135,7 @@ typedef struct {
     int (*restore)(void *instance, void *state);
     void (*release)(void *instance, void **state);
     void (*finish)(void *instance);
+    int (*stops)(void *instance); /* after a Discard: the FMU asks the master to stop */
 } Host;
 
 /* FMI 2.0 */
@@ -95,6 +152,7 @@ static struct {
     fmi2GetStringTYPE *GetString;
     fmi2GetRealTYPE *GetReal;
     fmi2DoStepTYPE *DoStep;
+    fmi2GetBooleanStatusTYPE *GetBooleanStatus;
     fmi2TerminateTYPE *Terminate;
     fmi2GetFMUstateTYPE *GetFMUstate;
     fmi2SetFMUstateTYPE *SetFMUstate;
@@ -217,10 +275,16 @@ static int exit_initialization2(void *instance)
     return f2.ExitInitializationMode(instance) == fmi2OK;
 }
 
+static int stops2(void *instance)
+{
+    fmi2Boolean terminated = fmi2False;
+    return f2.GetBooleanStatus(instance, fmi2Terminated, &terminated) == fmi2OK && terminated;
+}
+
 static int load2(Host *host)
 {
     static const Host fmi2 = {instantiate2, initialize2, set2, set_integer2, set_boolean2, set_string2, get2, step2,
-                              store2, restore2, release2, finish2};
+                              store2, restore2, release2, finish2, stops2};
     *host = fmi2;
     return load("fmi2Instantiate", &f2.Instantiate) && load("fmi2FreeInstance", &f2.FreeInstance) &&
            load("fmi2SetupExperiment", &f2.SetupExperiment) &&
@@ -229,6 +293,7 @@ static int load2(Host *host)
            load("fmi2SetInteger", &f2.SetInteger) && load("fmi2SetBoolean", &f2.SetBoolean) &&
            load("fmi2SetString", &f2.SetString) && load("fmi2GetString", &f2.GetString) &&
            load("fmi2GetReal", &f2.GetReal) && load("fmi2DoStep", &f2.DoStep) && load("fmi2Terminate", &f2.Terminate) &&
+           load("fmi2GetBooleanStatus", &f2.GetBooleanStatus) &&
            load("fmi2GetFMUstate", &f2.GetFMUstate) && load("fmi2SetFMUstate", &f2.SetFMUstate) &&
            load("fmi2FreeFMUstate", &f2.FreeFMUstate) &&
            load("fmi2SerializedFMUstateSize", &f2.SerializedFMUstateSize) &&
@@ -317,15 +382,24 @@ static int get3(void *instance, const unsigned int vr[], size_t n, double values
     return f3.GetFloat64(instance, vr, n, values, n) == fmi3OK;
 }
 
+static int stop_requested = 0; /* terminateSimulation of the last fmi3DoStep */
+
 static int step3(void *instance, double time, double step_size)
 {
     fmi3Boolean event, terminate, early;
     fmi3Float64 last;
     int status = (int)f3.DoStep(instance, time, step_size, fmi3True, &event, &terminate, &early, &last);
-    if (terminate || (status == fmi3Discard && last != time)) {
+    stop_requested = terminate;
+    if ((terminate && status != fmi3Discard) || (status == fmi3Discard && last != time)) {
         return -1;
     }
     return status;
+}
+
+static int stops3(void *instance)
+{
+    (void)instance;
+    return stop_requested;
 }
 
 static int store3(void *instance, void **copy)
@@ -366,7 +440,7 @@ static int exit_initialization3(void *instance)
 static int load3(Host *host)
 {
     static const Host fmi3 = {instantiate3, initialize3, set3, set_integer3, set_boolean3, set_string3, get3, step3,
-                              store3, restore3, release3, finish3};
+                              store3, restore3, release3, finish3, stops3};
     *host = fmi3;
     return load("fmi3InstantiateCoSimulation", &f3.InstantiateCoSimulation) &&
            load("fmi3FreeInstance", &f3.FreeInstance) &&
@@ -437,6 +511,19 @@ static int read_scenario(const char *path, Scenario *s)
     return ok;
 }
 
+/* fmusim's loop on a discarded step (its FMI 2.0 co-simulation; fmpy's simulate_fmu alike): unless
+ * the FMU asks to stop, the step is tried again at the same time. The attempts until the FMU took
+ * the step or asked to stop (at most ``limit``: a master without a limit would never end). */
+static int retry_until_stopped(const Host *host, void *instance, double time, double step_size, int limit)
+{
+    int attempts = 0, status;
+    do {
+        status = host->step(instance, time, step_size);
+        attempts++;
+    } while (status == 2 && !host->stops(instance) && attempts < limit);
+    return status == 2 ? attempts : -1;
+}
+
 /* Steps rows first..last-1 on both instances; the second must agree bit for bit. Records the
  * outputs of instance a into ``outputs`` (row k + 1 after step k). */
 static int run(const Host *host, const Scenario *s, void *a, void *b, int first, int last, double *outputs)
@@ -459,6 +546,19 @@ static int run(const Host *host, const Scenario *s, void *a, void *b, int first,
     return 0;
 }
 
+/* The outputs of every row, "%.17g" (round-trips every double). */
+static int write_outputs(const char *path, const Scenario *s, const double *outputs)
+{
+    FILE *file = fopen(path, "w");
+    int k, i, ok = file != NULL;
+    for (k = 0; ok && k <= s->steps; k++) {
+        for (i = 0; ok && i < s->outputs; i++) {
+            ok = fprintf(file, i + 1 < s->outputs ? "%.17g " : "%.17g\n", outputs[k * s->outputs + i]) > 0;
+        }
+    }
+    return file != NULL && fclose(file) == 0 && ok;
+}
+
 int main(int argc, char **argv)
 {
     Scenario s;
@@ -467,19 +567,21 @@ int main(int argc, char **argv)
     double *outputs, *replay, deviation = 0.0, before[MAX_SIGNALS], after[MAX_SIGNALS], bad = NAN;
     int half, i, k, failed = 0, logged;
     memset(&s, 0, sizeof s);
-    if (argc < 5 || argc > 6 || (strcmp(argv[2], "2") != 0 && strcmp(argv[2], "3") != 0)) {
-        return fail("usage: native_host LIBRARY 2|3 TOKEN SCENARIO [RESOURCES]");
+    if (argc < 5 || argc > 7 || (strcmp(argv[2], "2") != 0 && strcmp(argv[2], "3") != 0)) {
+        return fail("usage: native_host LIBRARY 2|3 TOKEN SCENARIO [RESOURCES [OUTPUTS]]");
     }
-    resources = argc == 6 ? argv[5] : NULL;
+    resources = argc >= 6 && strcmp(argv[5], "-") != 0 ? argv[5] : NULL;
     if (!read_scenario(argv[4], &s)) {
         for (i = 0; i < MAX_SIGNALS; i++) {
             free(s.string[i]);
         }
         return fail("unreadable scenario");
     }
-    library = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
-    if (library == NULL || !(argv[2][0] == '2' ? load2(&host) : load3(&host))) {
-        return fail(library == NULL ? dlerror() : "incomplete FMI library");
+    if (!open_library(argv[1])) {
+        return fail(library_error());
+    }
+    if (!(argv[2][0] == '2' ? load2(&host) : load3(&host))) {
+        return fail("incomplete FMI library");
     }
     outputs = calloc((size_t)(s.steps + 1) * (size_t)s.outputs, sizeof(double));
     replay = calloc((size_t)(s.steps + 1) * (size_t)s.outputs, sizeof(double));
@@ -522,14 +624,18 @@ int main(int argc, char **argv)
     logged = messages_logged;
     if (!failed) {
         failed = !host.get(a, s.output_vr, (size_t)s.outputs, before) || !host.set(a, s.input_vr, s.inputs > 0, &bad) ||
-                 host.step(a, s.time[s.steps], s.inputs > 0 ? s.step_size : 0.0) != 2 || messages_logged == logged ||
+                 retry_until_stopped(&host, a, s.time[s.steps], s.inputs > 0 ? s.step_size : 0.0, 1000) != 1 ||
+                 messages_logged != logged + 1 ||
                  !host.get(a, s.output_vr, (size_t)s.outputs, after) ||
                  memcmp(before, after, sizeof(double) * (size_t)s.outputs) != 0;
+    }
+    if (!failed && argc == 7) {
+        failed = !write_outputs(argv[6], &s, outputs);
     }
     host.release(a, &state);
     host.finish(a);
     host.finish(b);
-    dlclose(library);
+    close_library();
     free(outputs);
     free(replay);
     free(s.time);

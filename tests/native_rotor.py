@@ -19,21 +19,28 @@ from pathlib import Path
 from driveline.rotor import Driveline
 from driveline.rotor.elements import Hinge
 
-from fmu_harness.build import native
+from fmu_harness.build import native, toolchain
 
 ROTOR_SOURCES = native.NATIVE_SRC / "critical_speeds"
-TEST_FLAGS = tuple(flag for flag in native.CFLAGS if not flag.startswith("-fvisibility"))
+TEST_FLAGS = (*(flag for flag in toolchain.CFLAGS if not flag.startswith("-fvisibility")), "-fPIC")
 
 P = ctypes.POINTER
 DOUBLE_P = P(ctypes.c_double)
 
 
+#: The modules a module calls into besides itself (the layout reader's parts with the loader, the
+#: linear algebra with the damped model, the shaft elements with both models).
+NEEDS = {"layout": ("layout_file", "toml", "messages", "arena"), "damped": ("linalg",), "transfer": ("elements",),
+         "fem": ("elements",)}
+
+
 def compile_rotor(folder: Path, modules: list[str], shims: list[Path] = ()) -> ctypes.CDLL:
-    """The shared library of the rotor ``modules`` (``"transfer"`` is ``transfer.c``) and ``shims``,
-    built in ``folder``."""
-    sources = [str(ROTOR_SOURCES / f"{module}.c") for module in modules] + [str(shim) for shim in shims]
+    """The shared library of the rotor ``modules`` (``"transfer"`` is ``transfer.c``) with the modules
+    they need (:data:`NEEDS`) and ``shims``, built in ``folder``."""
+    needed = list(dict.fromkeys(part for module in modules for part in (module, *NEEDS.get(module, ()))))
+    sources = [str(ROTOR_SOURCES / f"{module}.c") for module in needed] + [str(shim) for shim in shims]
     library = folder / f"rotor_{'_'.join(modules)}.so"
-    command = [native.compiler(), *TEST_FLAGS, "-shared", "-I", str(ROTOR_SOURCES), *sources,
+    command = [*toolchain.host_compiler(), *TEST_FLAGS, "-shared", "-I", str(ROTOR_SOURCES), *sources,
                str(native.NATIVE_SRC / "python_numbers.c"), "-o", str(library), "-lm"]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode:

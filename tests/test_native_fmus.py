@@ -8,6 +8,7 @@ import math
 import re
 import shutil
 import subprocess
+import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
@@ -23,10 +24,10 @@ import test_fmu_behaviour as behaviour
 import test_fmus_common as common
 from driveline.catalog import MODELS
 from fmu_harness import interop
-from fmu_harness.build import native
+from fmu_harness.build import native, toolchain
 from fmu_harness.runner import FmuInstance, StepRefused
 from fmu_harness.scenario import scenario
-from test_fmu_properties import Run, _runs, run_alongside_the_core
+from test_fmu_properties import Run, _runs, expect_refused_parameters, run_alongside_the_core
 
 NATIVE = native.native_models()
 VERSIONS = ("2", "3")
@@ -75,8 +76,10 @@ def _standard_run(path: Path, name: str, **open_options) -> np.ndarray:
 def test_the_models_without_a_c_port_are_skipped(native_dir):
     """CriticalSpeeds is native once its rotor library (every module rotor.h lists) is there."""
     ported = ("TripodCoupling", "CardanJoint", "UniversalReducer", "SpeedSource")
-    assert native.library_modules("CriticalSpeeds") == sorted(
-        ["layout.c", "pyrepr.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c", "damped.c"])
+    folder = native.library_folder("CriticalSpeeds")
+    assert native.library_modules("CriticalSpeeds") == sorted(path.name for path in folder.glob("*.c"))
+    assert {"layout.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c", "damped.c"} <= set(
+        native.library_modules("CriticalSpeeds"))
     complete = all((native.library_folder("CriticalSpeeds") / module).exists()
                    for module in native.library_modules("CriticalSpeeds"))
     assert NATIVE == [name for name in MODELS if name in ported or (name == "CriticalSpeeds" and complete)]
@@ -162,17 +165,22 @@ MODES = {  # parameters of the modes the standard scenario (spec start values) l
         {"kinematics": 1, "mu": 0.02, "v_slip": 1e-2, "seed_reactions": 1, "phi_in_start": 0.4},
         {"seed_reactions": 1},
         {"kinematics": 1, "beta_max": math.radians(60.0), "r": 0.07},
+        {"kinematics": 1, "mu": 0.05, "T_load": -500.0},  # coast
+        {"kinematics": 1, "beta_dot": 2.0, "beta_ddot": -40.0},
+        {"beta_dot": 2.0, "beta_ddot": -40.0},
+        {"kinematics": 1, "beta_rate": 1},  # rates from the scenario's beta samples
     ],
 }
 
 
 def _mode_run(path: Path, name: str, parameters: dict) -> np.ndarray:
-    """The standard scenario with ``parameters``, a load and a speed rate on top of the spec's start values."""
+    """The standard scenario with ``parameters``, a load and a speed rate on top of the spec's start
+    values (``parameters`` may hold inputs too, held over the run)."""
     case = scenario(MODELS[name].spec)
+    held = {"T_load": 500.0, "alpha_in": 800.0, **{k: v for k, v in parameters.items() if k in case.signals()}}
     with FmuInstance(path) as fmu:
-        fmu.initialize({**parameters, **case.input_values(0.0), "T_load": 500.0, "alpha_in": 800.0})
-        return fmu.run(case.stop_time, case.step_size, {k: v for k, v in case.signals().items()
-                                                        if k not in ("T_load", "alpha_in")})
+        fmu.initialize({**parameters, **case.input_values(0.0), **held})
+        return fmu.run(case.stop_time, case.step_size, {k: v for k, v in case.signals().items() if k not in held})
 
 
 @pytest.mark.parametrize("name, parameters", [(name, p) for name, modes in MODES.items() if name in NATIVE
@@ -213,19 +221,59 @@ def test_the_exact_solvers_warm_start_is_part_of_the_state(native_dir, fmi):
         assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
 
 
+#: A C program that loads a shared library (every symbol bound at once) and links no libm itself:
+#: a library that needs libm and does not say so fails to load in it.
+LOADER = """#include <dlfcn.h>
+#include <stdio.h>
+int main(int argc, char **argv)
+{
+    void *library = argc == 2 ? dlopen(argv[1], RTLD_NOW | RTLD_LOCAL) : NULL;
+    if (library == NULL) {
+        fprintf(stderr, "%s\\n", dlerror());
+        return 1;
+    }
+    return dlclose(library);
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def loader(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("loader")
+    (folder / "loader.c").write_text(LOADER)
+    subprocess.run([*toolchain.host_compiler(), "-std=c99", "-Wall", "-Werror", str(folder / "loader.c"), "-o",
+                    str(folder / "loader"), "-ldl"], check=True, capture_output=True, text=True)
+    return folder / "loader"
+
+
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="rebuilding from the carried sources needs cmake")
 @pytest.mark.parametrize("name", NATIVE)
-def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, name, fmi):
-    """What a Windows or macOS user does: fmpy's build_platform_binary (CMake) from the FMU's
-    sources alone; the rebuilt binary gives the shipped one's results bit for bit."""
+def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, loader, name, fmi):
+    """What a user of another platform does: fmpy's build_platform_binary (CMake) from the FMU's
+    sources alone, with the documented options (libm, which the FMU's FMI 3.0 build description
+    names); the rebuilt binary loads in a program that has not loaded libm, and gives the shipped
+    one's results bit for bit."""
     from fmpy.build import build_platform_binary
 
     unzipdir = Path(extract(str(_native(native_dir, name, fmi)), unzipdir=str(tmp_path / "fmu")))
     shutil.rmtree(unzipdir / "binaries")
     (tmp_path / "build").mkdir()
-    build_platform_binary(unzipdir, build_dir=tmp_path / "build")
+    build_platform_binary(unzipdir, build_dir=tmp_path / "build", cmake_options=dict(native.REBUILD_CMAKE_OPTIONS))
+    loaded = subprocess.run([str(loader), str(native.host_library(unzipdir, name, fmi))], capture_output=True, text=True)
+    assert loaded.returncode == 0, loaded.stderr
+    if fmi == "3":
+        libraries = ET.parse(unzipdir / "sources" / "buildDescription.xml").getroot().iter("Library")
+        assert [library.get("name") for library in libraries] == ["m"]
     rebuilt = _standard_run(_native(native_dir, name, fmi), name, unzipdir=str(unzipdir))
     assert rebuilt.tobytes() == _standard_run(_native(native_dir, name, fmi), name).tobytes()
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_fmu_carries_its_documentation_and_licence(native_dir, name, fmi):
+    with zipfile.ZipFile(_native(native_dir, name, fmi)) as archive:
+        page = archive.read(f"documentation/{native.snake_case(name)}.md").decode()
+        assert page.startswith("# ") and "## Variables" in page
+        assert archive.read("documentation/licenses/LICENSE.txt").decode().startswith("MIT License")
 
 
 # -- refusals: the Python FMUs' tests, run on the native FMUs ----------------------------------------
@@ -292,6 +340,8 @@ def test_declared_bounds_and_relations_refuse_word_for_word(native_dir, name, va
     errors = core.step(0.0, 1e-3)
     assert errors
     with FmuInstance(_native(native_dir, name, fmi)) as fmu:
+        if core.parameter_errors():
+            return expect_refused_parameters(fmu, values, core.parameter_errors())
         fmu.initialize(values)
         with pytest.raises(StepRefused) as refused:
             fmu.step(1e-3)
@@ -407,18 +457,25 @@ def test_a_wrong_token_is_refused_at_instantiation(native_dir, tmp_path, fmi):
     assert any(b"is not this FMU's" in message for message in logged)
 
 
-def test_a_discarded_step_is_retryable_and_terminated_stays_false(native_dir, fmi):
+def test_a_discarded_step_asks_to_stop_and_a_corrected_one_is_taken(native_dir, fmi):
+    """A refused step would be refused again: fmi2Terminated is true after it (FMI 3.0's
+    terminateSimulation: the robustness suite), so a retrying master stops; the refusal is logged
+    once however often it is repeated; a corrected input steps on."""
     with FmuInstance(_native(native_dir, "CardanJoint", fmi)) as fmu:
         fmu.initialize()
         fmu.set({"beta": math.nan})
-        with pytest.raises(StepRefused) as refused:
-            fmu.step(1e-3)
-        assert refused.value.status == "Discard"
-        if fmi == "2":
-            assert fmu.fmu.getBooleanStatus(3) is False  # fmi2Terminated
-            assert fmu.fmu.getRealStatus(2) == 0.0  # fmi2LastSuccessfulTime
+        for attempt in range(3):
+            with pytest.raises(StepRefused) as refused:
+                fmu.step(1e-3)
+            assert refused.value.status == "Discard"
+            assert len(refused.value.messages) == (1 if attempt == 0 else 0)
+            if fmi == "2":
+                assert fmu.fmu.getBooleanStatus(3) is True  # fmi2Terminated
+                assert fmu.fmu.getRealStatus(2) == 0.0  # fmi2LastSuccessfulTime
         fmu.set({"beta": 0.3})
         fmu.step(1e-3)
+        if fmi == "2":
+            assert fmu.fmu.getBooleanStatus(3) is False
         assert fmu.get(["phi_in"])[0] == pytest.approx(MODELS["CardanJoint"].spec["omega_in"].start * 1e-3, rel=1e-15)
 
 
@@ -592,14 +649,14 @@ def test_critical_speeds_strings_are_part_of_the_state(native_dir, name, fmi):
     them back and continues bit for bit (the analysis is rebuilt for the restored parameters)."""
     path, case = _native(native_dir, name, fmi), scenario(MODELS[name].spec)
     middle, serialized, reference = _half_way_state(path, {"layout": "two_piece_propshaft", "orders": "1,2,6",
-                                                           "shear": False})
+                                                           "band": 0.2})
     with FmuInstance(path) as other:
         other.initialize({"orders": "3"})
         other.run(case.stop_time / 4, case.step_size)
         restored = other.deserialize_state(serialized)
         other.set_state(restored)
         other.free_state(restored)
-        assert other.get(["layout", "orders", "shear"]) == ["two_piece_propshaft", "1,2,6", False]
+        assert other.get(["layout", "orders", "band"]) == ["two_piece_propshaft", "1,2,6", 0.2]
         other.time = middle
         assert other.run(case.stop_time, case.step_size, case.signals()).tobytes() == reference.tobytes()
 
@@ -665,3 +722,21 @@ def test_critical_speeds_without_resources_refuses_a_shipped_name(native_dir, tm
         assert refused.value.messages == ["driveline: no shipped example named 'two_piece_propshaft'"]
         fmu.set({"layout": ""})
         fmu.step(1e-3)
+
+
+@pytest.mark.skipif("TripodCoupling" not in NATIVE, reason="the tripod has no C port")
+def test_a_bend_extrapolated_beyond_its_range_is_refused_alike(native_dir, fmu_path, fmi):
+    """beta + beta_dot h leaving [0, beta_max] refuses the step, with the same words in both families,
+    and the model stays as before the step."""
+    messages = []
+    for path in (fmu_path("TripodCoupling", fmi), _native(native_dir, "TripodCoupling", fmi)):
+        with FmuInstance(path) as fmu:
+            fmu.initialize({"beta": 0.78, "beta_dot": 1.0})
+            before = fmu.get(["phi_in", "Rx_in"])
+            with pytest.raises(StepRefused) as refused:
+                fmu.step(0.01)
+            assert fmu.get(["phi_in", "Rx_in"]) == before
+            messages.append(refused.value.messages)
+            fmu.set({"beta_dot": -1.0})
+            fmu.step(0.01)
+    assert messages[0] == messages[1] and "beta extrapolated to the end of the step" in messages[0][0]

@@ -14,7 +14,7 @@ import pytest
 from fmpy import extract, read_model_description
 
 from driveline.catalog import MODELS
-from fmu_harness.build import native
+from fmu_harness.build import native, toolchain
 from fmu_harness.runner import FmuInstance
 from fmu_harness.scenario import scenario
 
@@ -26,8 +26,8 @@ VALGRIND = ("valgrind", "--error-exitcode=99", "--leak-check=full", "--show-leak
 @pytest.fixture(scope="module")
 def host(tmp_path_factory: pytest.TempPathFactory) -> Path:
     executable = tmp_path_factory.mktemp("host") / "native_host"
-    subprocess.run([native.compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2",
-                    "-I", str(native.fmi_headers()), str(HOST_SOURCE), "-o", str(executable), "-ldl", "-lm"],
+    subprocess.run([*toolchain.host_compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2",
+                    "-isystem", str(native.fmi_headers()), str(HOST_SOURCE), "-o", str(executable), "-ldl", "-lm"],
                    check=True, capture_output=True, text=True)
     return executable
 
@@ -51,7 +51,7 @@ def _host_command(native_dir: Path, fmu_path, name: str, fmi: str, work: Path, p
     unzipdir = Path(extract(str(path), unzipdir=str(work / "fmu")))
     description = read_model_description(str(path))
     token = description.instantiationToken if fmi == "3" else description.guid
-    library = next((unzipdir / "binaries").rglob(f"{name}.so"))
+    library = native.host_library(unzipdir, name, fmi)
     spec = MODELS[name].spec
     case = scenario(spec)
     references = {v.name: v.valueReference for v in description.modelVariables}

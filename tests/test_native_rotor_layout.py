@@ -14,7 +14,7 @@ import pytest
 
 from driveline.rotor import loader
 from driveline.rotor.loader import load_driveline, loads_driveline, one_piece_shaft
-from driveline.rotor.model import build_driveline
+from driveline.rotor.model import load_layout
 
 from native_rotor import (CDriveline, OnePieceShaft, P, RotorBearing, RotorHinge, RotorMass, RotorSegment,
                           RotorUnbalance, compile_rotor, declare)
@@ -568,6 +568,7 @@ def test_file_checks(lib, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "dir.toml").mkdir()
     os.mkfifo(tmp_path / "fifo.toml")
+    os.symlink(os.devnull, tmp_path / "device.toml")  # a character device: refused unread
     (tmp_path / "big.toml").write_text(ONE + "#" * (64 * 1024))
     (tmp_path / "limit.toml").write_text(ONE + "#" * (64 * 1024 - len(ONE) - 1) + "\n")
     bad_bytes = {
@@ -585,13 +586,13 @@ def test_file_checks(lib, tmp_path, monkeypatch):
     (tmp_path / "sub" / "good.toml").write_text(ONE)
     (tmp_path / "sub" / "bad.toml").write_text(ONE + "[[masses]]\nnode = 7\nmass = 1\n")
     (tmp_path / "sub" / "malformed.toml").write_text(ONE + "x = \n")
-    layouts = ["missing.toml", "dir.toml", "fifo.toml", "big.toml", "limit.toml", *bad_bytes, "a" * 295 + ".toml",
+    layouts = ["missing.toml", "dir.toml", "fifo.toml", "device.toml", "big.toml", "limit.toml", *bad_bytes, "a" * 295 + ".toml",
                "./sub//good.toml", "sub/./bad.TOML".replace("TOML", "toml"), ".//sub/../sub/malformed.toml",
                str(tmp_path) + "//sub/./good.toml", "sub/nothing/../good.toml", "SUB.TOML",
                "/" + str(tmp_path) + "/sub/bad.toml", "//" + str(tmp_path) + "/sub/bad.toml"]
     messages = []
     for layout in layouts:
-        python = python_result(build_driveline, layout, {})
+        python = python_result(load_layout, layout)
         native = from_layout(lib, layout)
         same(native, python)
         messages.append(python)
@@ -607,7 +608,7 @@ def test_file_checks(lib, tmp_path, monkeypatch):
 def test_shipped_names(lib, tmp_path):
     for name in ("two_piece_propshaft", "two_piece_propshaft_hinged", "../../../etc/passwd", "%s%n", "a" * 64,
                  "a" * 65, "b" * 100, "no_such_layout", "with space", "é", "x\ny", "it's", "two_piece_propshaft.tom"):
-        same(from_layout(lib, name), python_result(build_driveline, name, {}))
+        same(from_layout(lib, name), python_result(load_layout, name))
     # a layout folder of the FMU's own: the shipped name looks there only
     (tmp_path / "mine.toml").write_text(ONE)
     assert not isinstance(from_layout(lib, "mine", tmp_path), str)

@@ -39,16 +39,33 @@ def test_model_description_carries_units_ranges_and_structure(tripod_fmu):
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
 
 
+def test_rates_are_declared_as_input_derivatives(fmu_path, fmi):
+    """alpha_in, beta_dot and beta_ddot are the derivatives of omega_in, beta and beta_dot (FMI 3.0's
+    derivative attribute; FMI 2.0 has it for states only). They come after every other variable, so
+    the earlier value references (positions) are those of before."""
+    md = read_model_description(str(fmu_path("TripodCoupling", fmi)))
+    variables = {v.name: v for v in md.modelVariables}
+    pairs = {"alpha_in": "omega_in", "beta_dot": "beta", "beta_ddot": "beta_dot"}
+    if fmi == "3":
+        assert {name: variables[name].derivative.name for name in pairs} == pairs
+    names = [v.name for v in md.modelVariables if v.causality != "independent"]
+    assert names[-3:] == ["beta_dot", "beta_ddot", "beta_rate"] and names.index("F_plunger3") == len(names) - 4
+    assert [variables[n].valueReference for n in names] == sorted(variables[n].valueReference for n in names)
+
+
 @pytest.mark.parametrize("kinematics", [0, 1])
 @pytest.mark.parametrize("seed_reactions", [0, 1])
 def test_outputs_match_the_physics_core(tripod_fmu, kinematics, seed_reactions):
-    beta = math.radians(35.0)
+    """On a linear speed ramp (omega_in and its rate alpha_in given at each communication point),
+    phi_in and every output follow the ramp exactly: phi_in = phi_0 + omega t + alpha t^2 / 2."""
+    beta, alpha = math.radians(35.0), 1500.0
     result = simulate(
         tripod_fmu, 0.02, 1e-4,
-        inputs={"omega_in": OMEGA, "beta": beta, "T_load": 250.0, "alpha_in": 1500.0},
+        inputs={"omega_in": lambda t: OMEGA + alpha * t, "beta": beta, "T_load": 250.0, "alpha_in": alpha},
         start_values={"kinematics": kinematics, "phi_in_start": 0.3, "seed_reactions": seed_reactions},
     )
-    phi = 0.3 + OMEGA * result["time"]
+    time = result["time"]
+    phi, omega = 0.3 + OMEGA * time + 0.5 * alpha * time**2, OMEGA + alpha * time
     np.testing.assert_allclose(result["phi_in"], phi, rtol=1e-12)
     if kinematics:
         reference = exact_pose(phi, beta, R, L)
@@ -57,16 +74,16 @@ def test_outputs_match_the_physics_core(tripod_fmu, kinematics, seed_reactions):
         phi_out = phi + closed_form.angle_deviation(phi, beta, R, L)
         ratio = closed_form.speed_ratio(phi, beta, R, L)
     np.testing.assert_allclose(result["phi_out"], phi_out, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(result["omega_out"], OMEGA * ratio, rtol=1e-9)
+    np.testing.assert_allclose(result["omega_out"], omega * ratio, rtol=1e-9)
     np.testing.assert_allclose(result["F_pin"], dynamics.pin_force(250.0, geometry.orbit_radius(beta, R), R), rtol=1e-12)
     np.testing.assert_allclose(result["rho"], geometry.orbit_radius(beta, R), rtol=1e-12)
     # every other output as the vectorised core gives it (the FMU warm-starts a scalar solver)
-    core, _ = coupling_outputs(phi, np.full_like(phi, beta), OMEGA, 250.0, R, L, M, kinematics, None, 1500.0, seed_reactions)
+    core, _ = coupling_outputs(phi, np.full_like(phi, beta), omega, 250.0, R, L, M, kinematics, None, alpha, seed_reactions)
     for name, values in core.items():
         scale = np.abs(values).max()
         np.testing.assert_allclose(result[name], values, rtol=0, atol=1e-7 * scale + 1e-12, err_msg=name)
     if seed_reactions:
-        seed = dynamics.reactions(phi, beta, OMEGA, geometry.orbit_radius(beta, R), L, M)
+        seed = dynamics.reactions(phi, beta, omega, geometry.orbit_radius(beta, R), L, M)
         np.testing.assert_allclose(result["Rz_out"], seed.Rz_out, rtol=1e-9, atol=1e-9)
         np.testing.assert_allclose(result["Ry_in"], seed.Ry_in, rtol=1e-9, atol=1e-12)
 
@@ -76,18 +93,19 @@ def test_power_balance_through_the_fmu(tripod_fmu):
     Newton closure (exact.py), for a speed that rises at alpha_in; omega_spin differs from
     omega_out by the output shaft's cone (geometric phase), about 3 omega_in (1 - cos theta)."""
     beta, T_load, alpha = math.radians(40.0), 500.0, 3000.0
-    result = simulate(tripod_fmu, 0.01, 1e-4, inputs={"omega_in": OMEGA, "beta": beta, "T_load": T_load,
-                                                      "alpha_in": alpha}, start_values={"kinematics": 1})
+    result = simulate(tripod_fmu, 0.01, 1e-4, inputs={"omega_in": lambda t: OMEGA + alpha * t, "beta": beta,
+                                                      "T_load": T_load, "alpha_in": alpha}, start_values={"kinematics": 1})
+    omega = OMEGA + alpha * result["time"]
     step = 2e-3  # five-point differences in phi: truncation (step z)^4 ~1e-11, round-off 1e-16 z / step^2
     travel = [exact_pose(result["phi_in"] + k * step, beta, R, L).plunger_positions for k in (-2, -1, 0, 1, 2)]
     dz = (travel[0] - 8 * travel[1] + 8 * travel[3] - travel[4]) / (12 * step)
     d2z = (-travel[0] + 16 * travel[1] - 30 * travel[2] + 16 * travel[3] - travel[4]) / (12 * step**2)
-    zdot, zddot = dz * OMEGA, d2z * OMEGA**2 + dz * alpha
-    energy_rate = M * (3 * R**2 * OMEGA * alpha + np.sum(zdot * zddot, axis=1))
-    residual = result["T_in"] * OMEGA - T_load * result["omega_spin"] - energy_rate
+    zdot, zddot = dz * omega[:, None], d2z * omega[:, None] ** 2 + dz * alpha
+    energy_rate = M * (3 * R**2 * omega * alpha + np.sum(zdot * zddot, axis=1))
+    residual = result["T_in"] * omega - T_load * result["omega_spin"] - energy_rate
     assert np.abs(residual).max() < 1e-9 * (T_load * OMEGA + M * R**2 * OMEGA**3)  # measured 1e-6 W
     # the geometric phase of a cone traced three times per turn: 3 omega_in (1 - cos theta), to 2 %
-    phase = 3 * OMEGA * (1 - np.cos(result["theta"]))
+    phase = 3 * omega * (1 - np.cos(result["theta"]))
     np.testing.assert_allclose(result["omega_out"] - result["omega_spin"], phase, rtol=0.03)
 
 
@@ -206,7 +224,6 @@ def test_bad_input_is_refused_with_a_reason_and_the_run_can_go_on(tripod_fmu, va
         assert refused.value.status == "Discard"
         assert any(name in message for message in refused.value.messages)
         assert fmu.get(["phi_in", "phi_out"]) == before  # the refused step left no trace
-        fmu.time -= 1e-3  # the host retries the same step with a good input
         fmu.set({"beta": 0.3, "omega_in": OMEGA, "T_load": 100.0, "alpha_in": 0.0})
         fmu.step(1e-3)
         assert fmu.get(["phi_in"])[0] == pytest.approx(2 * OMEGA * 1e-3, rel=1e-12)

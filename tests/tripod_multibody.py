@@ -10,7 +10,12 @@ negligible rotational inertia). Joints, all generic joints of Exudyn:
 * plunger j: prismatic along its groove (rotations locked to the input shaft);
 * ball j: the plunger's centre stays on tripod arm j (both normal offsets locked, sliding
   along the arm and all rotations free: sliding ball and spherical joint in one);
-* tripod: spherical support at S = l e_out, load torque -T_load about its own axis.
+* tripod: spherical support at S = l e_out(beta), load torque -T_load about its own axis.
+
+A case may ramp the bend angle or the speed after the run-up: the output bearing's support then
+moves along S(t) = l e_out(beta(t)) (a prescribed offset of the spherical joint), with beta(t)
+rising as ``beta + delta (s - sin(2 pi s) / (2 pi))`` over the ramp (rate ``2 delta / T sin^2(pi s)``,
+zero rate and acceleration at both ends), or the speed rises linearly.
 
 Only the initial pose at phi_in = 0 comes from this project (the Newton closure of
 ``driveline.tripod.exact``); Exudyn integrates the motion from rest and returns the joint
@@ -43,15 +48,31 @@ class Case:
     r: float = 0.026
     l: float = 0.700
     m: float = 0.2
+    beta_end: float | None = None  # rad: the bend ramps from beta to beta_end over ramp_time ...
+    omega_end: float | None = None  # rad/s: ... or the speed from omega to omega_end, linearly
+    ramp_time: float = 0.0  # s, starting once the run-up is over
+
+    def bend(self, t: float, start: float) -> tuple[float, float, float]:
+        """Bend angle, its rate and acceleration at time t for a ramp starting at ``start``."""
+        if self.beta_end is None or not start < t:
+            return self.beta, 0.0, 0.0
+        delta, T = self.beta_end - self.beta, self.ramp_time
+        if t >= start + T:
+            return self.beta_end, 0.0, 0.0
+        s = (t - start) / T
+        return (self.beta + delta * (s - math.sin(2 * math.pi * s) / (2 * math.pi)),
+                2 * delta / T * math.sin(math.pi * s) ** 2, 2 * math.pi * delta / T**2 * math.sin(2 * math.pi * s))
 
 
 @dataclass(frozen=True)
 class Result:
-    """Reactions over a third of a turn at constant speed, sampled every step (FMU names)."""
+    """Reactions over a third of a turn at constant speed (or over a ramp's window), sampled
+    every step (FMU names), from ``time[0]`` on."""
 
     phi_in: np.ndarray
     step: float
     values: dict[str, np.ndarray]
+    time: np.ndarray | None = None
 
 
 def _rotation_z(angle: float) -> np.ndarray:
@@ -67,29 +88,38 @@ def _tripod_start(case: Case) -> tuple[np.ndarray, np.ndarray]:
     return pose.tripod_centre[0], columns.T
 
 
-def _run_up(turn_time: float, omega: float) -> tuple:
+def _run_up(turn_time: float, case: Case) -> tuple:
     """Input angle and speed: a run-up from rest during ``turn_time`` whose speed follows
-    ``6 s^5 - 15 s^4 + 10 s^3`` (acceleration and jerk zero at both ends), then ``omega``."""
+    ``6 s^5 - 15 s^4 + 10 s^3`` (acceleration and jerk zero at both ends), then ``case.omega``,
+    rising linearly to ``case.omega_end`` over ``case.ramp_time`` if given."""
+    omega = case.omega
+    rate = 0.0 if case.omega_end is None else (case.omega_end - omega) / case.ramp_time
 
     def angle(t: float) -> float:
         s = min(t / turn_time, 1.0)
         ramp = turn_time * (s**6 - 3 * s**5 + 2.5 * s**4)
-        return omega * (ramp + max(t - turn_time, 0.0))
+        after = max(t - turn_time, 0.0)
+        rising = min(after, case.ramp_time) if rate else 0.0
+        return omega * (ramp + after) + rate * (0.5 * rising**2 + rising * (after - rising))
 
     def speed(t: float) -> float:
         s = min(t / turn_time, 1.0)
-        return omega * (6 * s**5 - 15 * s**4 + 10 * s**3)
+        rising = min(max(t - turn_time, 0.0), case.ramp_time) if rate else 0.0
+        return omega * (6 * s**5 - 15 * s**4 + 10 * s**3) + rate * rising
 
     return angle, speed
 
 
-def simulate(case: Case, steps_per_turn: int = 1500) -> Result:
+def simulate(case: Case, steps_per_turn: int = 1500, window: float | None = None) -> Result:
     """Run the model up to speed over a third of a turn's time, then record a third of a turn:
     the bearing reactions repeat every third of a turn, and the three arms' forces together
-    cover each arm's whole turn."""
+    cover each arm's whole turn. A ramp is recorded from its start over ``window`` (default:
+    the whole ramp)."""
     period = 2 * math.pi / case.omega / 3
     step = 3 * period / steps_per_turn
-    angle, speed = _run_up(period, case.omega)
+    record = period if case.ramp_time == 0.0 else (case.ramp_time if window is None else window)
+    steps = round((period + record) / step)
+    angle, speed = _run_up(period, case)
     system = exu.SystemContainer()
     mbs = system.AddSystem()
     ground = mbs.CreateGround(referencePosition=[0.0, 0.0, 0.0])
@@ -117,7 +147,18 @@ def simulate(case: Case, steps_per_turn: int = 1500) -> Result:
                                  referencePosition=list(centre), referenceRotationMatrix=rotation)
     tripod_marker = marker(tripod, (0, 0, 0))
     S = case.l * np.array([-math.sin(case.beta), 0.0, math.cos(case.beta)])
-    sphere_out = joint(marker(ground, S), marker(tripod, (0, 0, case.l)), [1, 1, 1, 0, 0, 0])
+
+    def bearing_offset(t: float) -> list[float]:
+        beta = case.bend(t, period)[0]
+        return [-case.l * math.sin(beta) - S[0], 0.0, case.l * math.cos(beta) - S[2], 0.0, 0.0, 0.0]
+
+    def bearing_velocity(t: float) -> list[float]:
+        beta, rate, _ = case.bend(t, period)
+        return [-case.l * math.cos(beta) * rate, 0.0, -case.l * math.sin(beta) * rate, 0.0, 0.0, 0.0]
+
+    sphere_out = joint(marker(ground, S), marker(tripod, (0, 0, case.l)), [1, 1, 1, 0, 0, 0],
+                       offsetUserFunction=lambda mbs, t, item, p: bearing_offset(t),
+                       offsetUserFunction_t=lambda mbs, t, item, p: bearing_velocity(t))
     mbs.AddLoad(items.LoadTorqueVector(markerNumber=tripod_marker, loadVector=[0, 0, -case.T_load], bodyFixed=True))
 
     arm_joints = []
@@ -148,8 +189,8 @@ def simulate(case: Case, steps_per_turn: int = 1500) -> Result:
     }
     mbs.Assemble()
     settings = exu.SimulationSettings()
-    settings.timeIntegration.endTime = 2 * period
-    settings.timeIntegration.numberOfSteps = 2 * steps_per_turn // 3
+    settings.timeIntegration.endTime = steps * step
+    settings.timeIntegration.numberOfSteps = steps
     settings.timeIntegration.verboseMode = 0
     settings.timeIntegration.newton.relativeTolerance = 1e-12
     settings.timeIntegration.newton.absoluteTolerance = 1e-12
@@ -159,23 +200,29 @@ def simulate(case: Case, steps_per_turn: int = 1500) -> Result:
     mbs.SolveDynamic(settings)
     data = {name: mbs.GetSensorStoredData(index) for name, index in sensors.items()}
     time = data["drive"][:, 0]
-    turn = (time > period + 0.5 * step) & (time < 2 * period + 0.5 * step)
+    if case.ramp_time == 0.0:
+        turn = (time > period + 0.5 * step) & (time < 2 * period + 0.5 * step)
+    else:
+        turn = (time > period - 0.5 * step) & (time < period + record + 0.5 * step)
     raw = {name: values[turn, 1:] for name, values in data.items()}
     phi_in = np.array([angle(t) for t in time[turn]])
-    return Result(phi_in, step, reactions(case, raw))
+    beta = np.array([case.bend(t, period)[0] for t in time[turn]])
+    return Result(phi_in, step, reactions(case, raw, beta), time[turn])
 
 
-def reactions(case: Case, raw: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def reactions(case: Case, raw: dict[str, np.ndarray], beta: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """The FMU's reaction outputs from Exudyn's joint forces (the force on marker 0's body, in
-    marker 0's joint frame; the drive's torque as it acts on the shaft)."""
+    marker 0's joint frame; the drive's torque as it acts on the shaft) at the bend ``beta`` of
+    each sample (default: the case's)."""
     sphere_in, radial_in = raw["sphere_in"], raw["radial_in"]
     # the shaft is marker 1 of both supports
     bearing_in = -(sphere_in + radial_in)
     moment_in = np.cross(np.array([0.0, 0.0, -SUPPORT_SPACING]), -radial_in)
     rotation = raw["tripod_rotation"].reshape(-1, 3, 3)
     U = rotation[:, :, 2]
-    e_out = np.array([-math.sin(case.beta), 0.0, math.cos(case.beta)])
-    E1, E2 = _twist_free_frame(e_out, U, case.beta)
+    beta = np.full(len(U), case.beta) if beta is None else beta
+    e_out = np.stack([-np.sin(beta), np.zeros_like(beta), np.cos(beta)], axis=1)
+    E1, E2 = _twist_free_frame(e_out, U, beta)
     bearing_out = -raw["sphere_out"]
     values = {
         "Rx_in": bearing_in[:, 0], "Ry_in": bearing_in[:, 1], "Mx_in": moment_in[:, 0], "My_in": moment_in[:, 1],
@@ -191,16 +238,17 @@ def reactions(case: Case, raw: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return values
 
 
-def _twist_free_frame(e_out: np.ndarray, U: np.ndarray, beta: float) -> tuple[np.ndarray, np.ndarray]:
+def _twist_free_frame(e_out: np.ndarray, U: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Images of the nominal output frame's x and y axes under the smallest rotation taking
-    e_out onto U (Rodrigues), one row per sample."""
-    nominal = (np.array([math.cos(beta), 0.0, math.sin(beta)]), np.array([0.0, 1.0, 0.0]))
+    e_out onto U (Rodrigues), one row per sample (nominal axis and bend per sample)."""
+    zero, one = np.zeros_like(beta), np.ones_like(beta)
+    nominal = (np.stack([np.cos(beta), zero, np.sin(beta)], axis=1), np.stack([zero, one, zero], axis=1))
     axis = np.cross(e_out, U)
     sin_angle = np.linalg.norm(axis, axis=1, keepdims=True)
-    cos_angle = U @ e_out
+    cos_angle = np.sum(U * e_out, axis=1)
     unit = axis / np.where(sin_angle > 0, sin_angle, 1.0)
     images = []
     for v in nominal:
         images.append(v * cos_angle[:, None] + np.cross(unit, v) * sin_angle
-                      + unit * (unit @ v)[:, None] * (1 - cos_angle[:, None]))
+                      + unit * np.sum(unit * v, axis=1)[:, None] * (1 - cos_angle[:, None]))
     return images[0], images[1]

@@ -185,6 +185,12 @@ class Driveline:
         """Phase constant: the bare shaft has a mode every pi of ``kappa * sqrt(w)``."""
         return float(sum(s.length * (s.mass_per_length / s.bending_stiffness) ** 0.25 for s in self.segments))
 
+    @property
+    def freedoms(self) -> int:
+        """Degrees of freedom the point elements add at their nodes, each of which can add a root
+        anywhere in a search range (the search grids are that much finer)."""
+        return sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
+
     # -- determinant -----------------------------------------------------------
     def determinant(self, w: ArrayLike, spin: ArrayLike = 0.0) -> FloatArray:
         """Scaled frequency determinant ``f(w, spin)`` (seed Eq. 31), vectorised.
@@ -209,8 +215,7 @@ class Driveline:
         bare-shaft root only), plus a logarithmic lead-in for heavy masses on soft
         bearings near zero.
         """
-        extra = sum(len(frozenset().union(*(el.freedoms for el in node))) for node in self._chain.points)
-        extra = 0 if coarse else extra
+        extra = 0 if coarse else self.freedoms
         per_pi = POINTS_PER_ROOT * (1 + extra) * (1 if self.is_isotropic else 2)
         kappa = self._kappa * math.sqrt(abs(ratio))
         theta_max = kappa * math.sqrt(x_max)

@@ -26,6 +26,7 @@ from .campbell import WhirlTable, whirl_branches
 from .driveline import SEARCH_LIMIT, Driveline, OrderResonance
 from .elements import Bearing, Unbalance
 from .loader import example_path, load_driveline, one_piece_shaft
+from .mechanism import MECHANISM_HINGE, MECHANISM_RIGID, mechanism_error
 from .spec import SPEC
 from .unbalance_outputs import UnbalanceOutputs
 
@@ -124,11 +125,30 @@ def implausibility(natural: np.ndarray, whirl: WhirlTable) -> str | None:
     return None
 
 
-def build_driveline(layout: str, shaft: dict[str, float]) -> Driveline:
-    """The one-piece tube of ``shaft``, or the described layout (file or shipped name)."""
-    if not layout:
-        return one_piece_shaft(**shaft)
+SHEAR_CONFLICT = ("shear = False conflicts with the layout, whose segments keep shear deformation: a layout's "
+                  "segments decide it themselves (shear = false in each [[segments]] table), the parameter "
+                  "shear applies to the one-piece tube")
+
+
+def load_layout(layout: str) -> Driveline:
+    """The described layout: a file (a path ending in '.toml', any case) or a shipped name."""
     return load_driveline(Path(layout) if layout.lower().endswith(".toml") else example_path(layout))
+
+
+def build_driveline(layout: str, shaft: dict[str, float]) -> Driveline:
+    """The one-piece tube of ``shaft``, or the described layout (file or shipped name). Refused
+    (ValueError) when the supports leave it a mechanism (:mod:`.mechanism`) or when ``shaft``'s
+    ``shear`` is false while a layout segment keeps shear deformation."""
+    if not layout:
+        driveline = one_piece_shaft(**shaft)
+    else:
+        driveline = load_layout(layout)
+        if not shaft.get("shear", True) and any(segment.shear for segment in driveline.segments):
+            raise ValueError(SHEAR_CONFLICT)
+    reason = mechanism_error(driveline)
+    if reason is not None:
+        raise ValueError(reason)
+    return driveline
 
 
 def analyse_structure(driveline: Driveline) -> Structure:
@@ -176,6 +196,8 @@ class CriticalSpeedsModel(SteppedModel):
     derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts", "_unbalance")
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
+    native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d"),
+                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT}
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None

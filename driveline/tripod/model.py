@@ -5,19 +5,43 @@ from __future__ import annotations
 from ..model import DrivenShaftModel
 from .outputs import coupling_outputs
 from .plane_solver import Solution
-from .spec import CLOSED_FORM, EXACT, SPEC
+from .spec import CLOSED_FORM, EXACT, RATES_FROM_SAMPLES, SPEC
+
+BETA_LEAVES_RANGE = "beta extrapolated to the end of the step, beta + beta_dot h + beta_ddot h^2/2, leaves [0, beta_max]"
+
+
+def sampled_rates(samples: tuple[tuple[float, float], ...]) -> tuple[float, float]:
+    """Rate and acceleration at the newest of up to three ``(time, beta)`` samples (newest first):
+    the derivatives of the polynomial through them (Newton's divided differences); one sample
+    gives zero rates, two a constant rate. Equal steps h: errors h^2 beta'''/3 and h beta'''."""
+    if len(samples) < 2:
+        return 0.0, 0.0
+    (t0, b0), (t1, b1) = samples[0], samples[1]
+    slope = (b0 - b1) / (t0 - t1)
+    if len(samples) < 3:
+        return slope, 0.0
+    t2, b2 = samples[2]
+    curvature = (slope - (b1 - b2) / (t1 - t2)) / (t0 - t2)
+    return slope + curvature * (t0 - t1), 2.0 * curvature
 
 
 class TripodCouplingModel(DrivenShaftModel):
-    """The ``TripodCoupling`` co-simulation model (inputs held constant over a step)."""
+    """The ``TripodCoupling`` co-simulation model: inputs set at a communication point, speed and
+    bend following their rates over the step, outputs at the step's end."""
 
     spec = SPEC
 
     def reset_internal_state(self) -> None:
         self._solution: Solution | None = None  # warm start of the exact solver
+        self._beta_samples: tuple[tuple[float, float], ...] = ()  # (time, beta), newest first, at most 2
 
     def internal_from_saved(self, state: dict) -> dict:
-        """The warm start of a saved state: five floats, or none."""
+        """The warm start (five floats, or none) and the bend samples (up to two pairs of floats)."""
+        samples = state["_beta_samples"]
+        if not (isinstance(samples, tuple) and len(samples) <= 2
+                and all(isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(v, float) for v in pair)
+                        for pair in samples)):
+            raise ValueError("the saved bend samples are not up to two (time, beta) pairs of floats")
         saved = state["_solution"]
         if saved is None:
             return {}
@@ -25,6 +49,8 @@ class TripodCouplingModel(DrivenShaftModel):
                 and all(isinstance(value, float) for value in saved)):
             raise ValueError(f"the saved warm start of the solver is not {len(Solution._fields)} floats")
         return {"_solution": Solution(*saved)}
+
+    native_constants = {"RATES_FROM_SAMPLES": RATES_FROM_SAMPLES, "BETA_LEAVES_RANGE": f"ValueError: {BETA_LEAVES_RANGE}"}
 
     extra_parameter_probes = {"friction_needs_exact": {"mu": 0.05, "kinematics": CLOSED_FORM}}
 
@@ -35,13 +61,32 @@ class TripodCouplingModel(DrivenShaftModel):
 
     def start(self, start_time: float) -> None:
         self._solution = None
+        self._beta_samples = ()
         super().start(start_time)
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        """phi_in advances by ``omega_in h + alpha_in h^2 / 2`` (exact on a linear speed ramp)."""
+        self.phi_in = self.phi_in + (self.omega_in + 0.5 * self.alpha_in * step_size) * step_size
+        self._evaluate(current_time, step_size)
 
     def evaluate(self, input_time: float) -> None:
         """Outputs at the current phi_in and inputs."""
+        self._evaluate(input_time, 0.0)
+
+    def _evaluate(self, input_time: float, elapsed: float) -> None:
+        """Outputs ``elapsed`` after ``input_time``, with speed and bend moved on by their rates."""
+        if self.beta_rate == RATES_FROM_SAMPLES:
+            samples = ((input_time, self.beta),) + tuple(s for s in self._beta_samples if s[0] < input_time)
+            self._beta_samples = samples[:2]
+            beta_dot, beta_ddot = sampled_rates(samples[:3])
+        else:
+            beta_dot, beta_ddot = self.beta_dot, self.beta_ddot
+        beta = self.beta + (beta_dot + 0.5 * beta_ddot * elapsed) * elapsed
+        if not 0.0 <= beta <= self.beta_max:
+            raise ValueError(BETA_LEAVES_RANGE)
         values, self._solution = coupling_outputs(
-            self.phi_in, self.beta, self.omega_in, self.T_load,
+            self.phi_in, beta, self.omega_in + self.alpha_in * elapsed, self.T_load,
             self.r, self.l, self.m_plunger, self.kinematics, self._solution, self.alpha_in, self.seed_reactions,
-            self.mu, self.v_slip,
+            self.mu, self.v_slip, beta_dot + beta_ddot * elapsed, beta_ddot,
         )
         self.__dict__.update(values)

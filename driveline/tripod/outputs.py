@@ -19,17 +19,30 @@ ARMS = ("1", "2", "3")
 
 
 def efficiency(output_power: Real, loss: Real) -> Real:
-    """``P_out / (P_out + P_friction)`` with ``P_out = T_load omega_spin``; 1 where no power flows."""
-    total = output_power + loss
-    if type(total) is float:
-        return output_power / total if total else 1.0
-    return np.divide(output_power, total, out=np.ones_like(total), where=total != 0)
+    """Delivered over supplied power, whichever side drives. ``output_power = T_load omega_spin``
+    is the power the load takes and ``output_power + loss`` the power the input shaft gives:
+
+    * drive (``output_power >= 0``): ``output_power / (output_power + loss)``; 1 where no power flows;
+    * coast (the load drives, ``output_power + loss <= 0``): ``(output_power + loss) / output_power``;
+    * in between (both shafts supply power, friction takes it all): 0.
+
+    Continuous through the change of direction: 0 from ``output_power = 0`` to ``-loss``."""
+    supplied = output_power + loss
+    if type(supplied) is float:
+        if output_power >= 0.0:
+            return output_power / supplied if supplied else 1.0
+        coast = supplied / output_power
+        return coast if coast > 0.0 else 0.0
+    drive = np.divide(output_power, supplied, out=np.ones_like(supplied), where=supplied != 0)
+    coast = np.divide(supplied, output_power, out=np.zeros_like(supplied), where=output_power < 0)
+    return np.where(output_power >= 0.0, drive, np.where(coast > 0.0, coast, 0.0))
 
 
 def coupling_outputs(
     phi_in: Real, beta: Real, omega_in: Real, T_load: Real, r: float, l: float, m: float,
     kinematics: int, solution: plane_solver.Solution | None = None,
     alpha_in: Real = 0.0, seed_reactions: int = 0, mu: float = 0.0, v_slip: float = 1e-3,
+    beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
 ) -> tuple[dict[str, Real], plane_solver.Solution | None]:
     """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's solution.
 
@@ -38,19 +51,22 @@ def coupling_outputs(
     (:mod:`.reactions_closed_form`); ``seed_reactions = 1`` replaces ``a_plunger_sum``,
     ``Rz_out``, ``Rx_in`` and ``Ry_in`` by the seed's eqs 20, 30, 33 and 34 as printed.
     ``mu`` > 0 (exact mode only) adds Coulomb friction regularised over ``v_slip`` [m/s].
+    ``beta_dot``, ``beta_ddot``: rates of the bend angle (the output bearing moves with beta).
     """
     rho = orbit_radius(beta, r)
     pin = dynamics.pin_force(T_load, rho, r)
     if kinematics == EXACT:
         phi_out, ratio, solution = plane_solver.solve(phi_in, beta, r, l, solution)
         theta = solution.cone_angle
-        forces = exact_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, mu, v_slip)
+        forces = exact_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, mu, v_slip,
+                                 beta_dot, beta_ddot)
         omega_spin, axial_in, loss = forces.omega_spin, forces.Rz_in, forces.P_friction
     else:
         deviation, ratio = closed_form.kinematics(phi_in, beta, r, l)
         phi_out = phi_in + deviation
         theta = arcsin(rho / l)
-        forces = leading_order_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, ratio, pin)
+        forces = leading_order_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, ratio, pin,
+                                         beta_dot, beta_ddot)
         omega_spin, axial_in, loss = omega_in * ratio, 0.0 * ratio, 0.0 * ratio
     output_power = T_load * omega_spin
     values = {

@@ -31,8 +31,11 @@ Both 3x3 solves use Cramer's rule with the same three cross products of the rows
 With Coulomb friction (``friction`` > 0) step 4 adds a force along each arm and one along each
 groove whose sizes follow the normal forces; :func:`_frictional_balance` repeats step 4 with
 them until the forces settle, and step 5 then includes the grooves' axial friction.
-Input speed and its rate are those at the evaluated instant; beta is constant (its rate is
-not an input).
+Input speed and its rate are those at the evaluated instant. A changing bend angle moves the
+output bearing along ``S = l e_out(beta)``: ``Sdot = l betadot de_out/dbeta`` joins the tripod's
+velocities in step 2 (``Sdot + Omega x d_j - omega e_z x g_j = zdot_j e_z - sigma_j e_j``) and
+``Sddot = l (betaddot de_out/dbeta - betadot^2 e_out)`` its accelerations in step 3; the force
+balance keeps its form (massless tripod, bearing force through S).
 """
 
 from __future__ import annotations
@@ -71,6 +74,7 @@ class ExactReactions(NamedTuple):
 def exact_reactions(
     phi_in: Real, beta: Real, omega: Real, omega_dot: Real, T_load: Real,
     r: float, l: float, m: float, x: Real, y: Real, friction: float = 0.0, slip_speed: float = 1e-3,
+    beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
 ) -> ExactReactions:
     """Reactions at input angle ``phi_in``, bend ``beta``, input speed ``omega`` and its rate
     ``omega_dot``, for the output-shaft axis ``(x, y, sqrt(1 - x^2 - y^2))`` in the nominal
@@ -78,7 +82,8 @@ def exact_reactions(
     floats or arrays, written out per component (the module's steps 1-5; with ``n_j``
     horizontal, ``k_j = (d_z e_x, d_z e_y, -(d_x e_x + d_y e_y))`` and
     ``e_j x n_j = (e_z e_x, e_z e_y, -(e_x^2 + e_y^2))``). ``friction`` > 0 adds Coulomb
-    friction in both sliding pairs (:func:`_frictional_balance`); 0 is the frictionless balance."""
+    friction in both sliding pairs (:func:`_frictional_balance`); 0 is the frictionless balance.
+    ``beta_dot``, ``beta_ddot``: the bend angle's rates, which move the output bearing S."""
     xp = lib(phi_in, beta, x, y)
     cb, sb = xp.cos(beta), xp.sin(beta)
     zn = xp.sqrt(1.0 - x * x - y * y)
@@ -90,6 +95,9 @@ def exact_reactions(
     E2x, E2y, E2z = cb * e2x + sb * y, e2y, sb * e2x - cb * y
     Ux, Uy, Uz = cb * x - sb * zn, y, sb * x + cb * zn
     Sx, Sz = -l * sb, l * cb
+    # the moving bearing: Sdot = l betadot (-cos, 0, -sin), Sddot = l betaddot (-cos, 0, -sin) - l betadot^2 e_out
+    Svx, Svz = -l * cb * beta_dot, -l * sb * beta_dot
+    Sax, Saz = l * (sb * beta_dot * beta_dot - cb * beta_ddot), -l * (cb * beta_dot * beta_dot + sb * beta_ddot)
     Px, Py, Pz = Sx - l * Ux, -l * Uy, Sz - l * Uz
     p_dot_u = Px * Ux + Py * Uy + Pz * Uz
     omega2 = omega * omega
@@ -114,8 +122,8 @@ def exact_reactions(
     )
     inv_det = 1.0 / (k0x * adj[0][0] + k0y * adj[0][1] + k0z * adj[0][2])
 
-    # 2. angular velocity of the output shaft: (e_z x g_j) . n_j = -(g_x e_x + g_y e_y)
-    rhs = [-omega * (a[0] * a[3] + a[1] * a[4]) * inv_det for a in arms]
+    # 2. angular velocity of the output shaft: (e_z x g_j) . n_j = -(g_x e_x + g_y e_y), Sdot . n_j = Sdot_x e_y
+    rhs = [(-omega * (a[0] * a[3] + a[1] * a[4]) - Svx * a[4]) * inv_det for a in arms]
     Wx = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
     Wy = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]
     Wz = rhs[0] * adj[0][2] + rhs[1] * adj[1][2] + rhs[2] * adj[2][2]
@@ -125,18 +133,18 @@ def exact_reactions(
     known, slides = [], []
     for gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_ in arms:
         # sliding rate along the arm (sigma e_j = sdot a_j) from the velocity closure
-        vx = Wy * dz - Wz * dy + omega * gy
+        vx = Wy * dz - Wz * dy + omega * gy + Svx
         vy = Wz * dx - Wx * dz - omega * gx
         sigma = -(vx * ex + vy * ey) / exy2
         wd = Wx * dx + Wy * dy + Wz * dz  # Omega x (Omega x d) = Omega (Omega . d) - d |Omega|^2
-        # whirl + 2 sigma Omega x e
-        hx = Wx * wd - dx * W2 + 2.0 * sigma * (Wy * ez - Wz * ey)
+        # whirl + 2 sigma Omega x e + the bearing's acceleration
+        hx = Wx * wd - dx * W2 + 2.0 * sigma * (Wy * ez - Wz * ey) + Sax
         hy = Wy * wd - dy * W2 + 2.0 * sigma * (Wz * ex - Wx * ez)
-        hz = Wz * wd - dz * W2 + 2.0 * sigma * (Wx * ey - Wy * ex)
+        hz = Wz * wd - dz * W2 + 2.0 * sigma * (Wx * ey - Wy * ex) + Saz
         ax = -omega_dot * gy - omega2 * gx  # groove point's acceleration, radial and tangential
         ay = omega_dot * gx - omega2 * gy
         known.append((ax, ay, hx, hy, hz))
-        slides.append((Wx * dy - Wy * dx + sigma * ez, sigma))  # (zdot_j, sdot_j / |e_j|)
+        slides.append((Wx * dy - Wy * dx + sigma * ez + Svz, sigma))  # (zdot_j, sdot_j / |e_j|)
     rhs = [((kn[0] - kn[2]) * a[4] - (kn[1] - kn[3]) * a[3]) * inv_det for kn, a in zip(known, arms)]
     Ax = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
     Ay = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]

@@ -3,7 +3,9 @@
 Same bodies, loads and sign conventions as :mod:`.reactions`. At leading order the output
 shaft lies on its nominal axis, the tripod plane passes through O and each plunger travels
 ``z_j = r tan(beta) cos phi_j`` (``phi_j = phi_in + 2 pi j / 3``), so its axial force is
-``m zddot_j = -m r tan(beta) (omega^2 cos phi_j + omegadot sin phi_j)``. The plungers'
+``m zddot_j = -m r tan(beta) (omega^2 cos phi_j + omegadot sin phi_j)``; a changing bend adds
+``m r sec^2(beta) (cos phi_j (betaddot + 2 tan(beta) betadot^2) - 2 omega betadot sin phi_j)``
+(the second derivative of ``r tan(beta) cos phi_j``), the only rate term of this mode. The plungers'
 radial and tangential inertia forces at these heights and the axial ones give, with
 ``A = 3/2 m r^2 tan(beta) / cos^2(beta)`` and ``t = tan(beta / 2)``:
 
@@ -46,9 +48,10 @@ class LeadingOrderReactions(NamedTuple):
 def leading_order_reactions(
     phi_in: Real, beta: Real, omega: Real, omega_dot: Real, T_load: Real,
     r: float, l: float, m: float, speed_ratio: Real, pin_force: Real,
+    beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
 ) -> LeadingOrderReactions:
     """The closed forms above; ``speed_ratio`` d(phi_out)/d(phi_in) and ``pin_force`` from
-    the closed-form kinematics and eq 24."""
+    the closed-form kinematics and eq 24; ``beta_dot``, ``beta_ddot`` the bend angle's rates."""
     xp = lib(phi_in, beta)
     cb = xp.cos(beta)
     tb = xp.sin(beta) / cb
@@ -56,10 +59,13 @@ def leading_order_reactions(
     A = 1.5 * m * r * r * tb / (cb * cb)
     omega2 = omega * omega
     ry_in = -(T_load * half + A * omega_dot * cb) / l
+    bend = m * r / (cb * cb)
+    bend_rates = beta_ddot + 2.0 * tb * beta_dot * beta_dot
     forces = []
     for j in range(3):
         angle = phi_in + THIRD_TURN * j
-        forces.append(-m * r * tb * (omega2 * xp.cos(angle) + omega_dot * xp.sin(angle)))
+        c, s = xp.cos(angle), xp.sin(angle)
+        forces.append(-m * r * tb * (omega2 * c + omega_dot * s) + bend * (c * bend_rates - 2.0 * omega * beta_dot * s))
     return LeadingOrderReactions(
         Rx_in=-A * omega2 / (l * cb),
         Ry_in=ry_in,

@@ -7,6 +7,7 @@ import math
 from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 CLOSED_FORM, EXACT = 0, 1
+RATES_FROM_INPUTS, RATES_FROM_SAMPLES = 0, 1
 ARM_OUTPUTS = tuple(
     Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N")
     for name, text in (
@@ -46,13 +47,15 @@ SPEC = ModelSpec(
                  "Slip speed of the friction's regularised sign u/sqrt(1 + u^2), u = sliding speed / v_slip",
                  "m/s", min=0.0, min_exclusive=True),
         Variable("phi_in_start", "parameter", 0.0, "Input shaft angle phi_in at the start time", "rad", "deg"),
-        Variable("omega_in", "input", 2000.0 * math.pi / 30.0, "Input shaft speed omega_1 (held over a step)",
+        Variable("omega_in", "input", 2000.0 * math.pi / 30.0,
+                 "Input shaft speed omega_1 at the step's start (rising at alpha_in over the step)",
                  "rad/s", "rpm"),
         Variable("beta", "input", math.radians(30.0), "Bend angle beta between input and output axes",
                  "rad", "deg", min=0.0, max=math.radians(60.0)),
         Variable("alpha_in", "input", 0.0,
-                 "Input shaft angular acceleration d(omega_in)/dt: enters the plunger inertia "
-                 "(phi_in advances with the held omega_in)", "rad/s2"),
+                 "Input shaft angular acceleration d(omega_in)/dt over the step: phi_in advances by "
+                 "omega_in h + alpha_in h^2/2 and the outputs at the step's end use omega_in + alpha_in h",
+                 "rad/s2", derivative="omega_in"),
         Variable("T_load", "input", 100.0,
                  "Load torque T0 on the output shaft, about its own axis, resisting its rotation (eq 22)", "N.m"),
         Variable("phi_in", "output", 0.0, "Input shaft angle phi_1, integrated from omega_in", "rad", "deg"),
@@ -91,6 +94,18 @@ SPEC = ModelSpec(
                  "Instantaneous efficiency T_load omega_spin / (T_load omega_spin + P_friction); 1 without power flow",
                  "1"),
         *ARM_OUTPUTS,
+        # appended after every other variable: value references are positions, so those of
+        # the variables above stay what hosts, SSP files and reference results know
+        Variable("beta_dot", "input", 0.0,
+                 "Bend angle rate d(beta)/dt over the step (beta_rate = 0): the moving output bearing's "
+                 "terms in the force balance; beta at the step's end is beta + beta_dot h + beta_ddot h^2/2",
+                 "rad/s", derivative="beta"),
+        Variable("beta_ddot", "input", 0.0, "Bend angle acceleration d(beta_dot)/dt over the step (beta_rate = 0)",
+                 "rad/s2", derivative="beta_dot"),
+        Variable("beta_rate", "parameter", RATES_FROM_INPUTS,
+                 "Source of the bend angle's rates: 0 = the inputs beta_dot and beta_ddot, 1 = estimated "
+                 "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored)",
+                 type="Integer", min=RATES_FROM_INPUTS, max=RATES_FROM_SAMPLES),
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
     relations=(

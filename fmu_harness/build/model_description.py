@@ -56,10 +56,14 @@ def _complete(
         unit_definitions.extend(_unit_element("Unit", unit) for unit in spec.units)
         root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions)
     outputs = []
+    references = {element.get("name"): element.get("valueReference") for element, _ in variables}
+    fmi3 = root.get("fmiVersion", "").startswith("3")
     for index, (element, typed) in enumerate(variables, start=1):
         variable = spec[element.get("name")]
         element.set("description", variable.description)
         typed.attrib.update(_type_attributes(variable))
+        if fmi3 and variable.derivative is not None:  # FMI 3.0: an input's derivative is an input too
+            element.set("derivative", references[variable.derivative])
         if variable.causality == "output":
             outputs.append((index, element))
     model_structure = root.find("ModelStructure")

@@ -25,10 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-import os
 import re
-import shutil
-import subprocess
 import tempfile
 import uuid
 import xml.etree.ElementTree as ET
@@ -41,17 +38,19 @@ import fmpy
 import fmu_src
 from driveline import __version__
 from driveline.catalog import MODELS
-from driveline.model import SteppedModel
+from driveline.model import TIME_TOLERANCE, SteppedModel
 from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
+from . import toolchain
 from .model_description import complete_fmi2, complete_fmi3
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
+DOCS = NATIVE_SRC.parent / "docs"  # the repository's docs/ (a link, so that the wheel carries them)
+LICENSE = NATIVE_SRC.parent / "LICENSE"
 MODEL_SOURCES = NATIVE_SRC
 SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c", "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
-CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-fPIC", "-O2", "-fvisibility=hidden")
 TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
 
@@ -96,6 +95,19 @@ def native_models() -> list[str]:
 def fmu_path(dest: Path, name: str, fmi: str = "2") -> Path:
     """Where :func:`build` puts the native FMU of ``name`` for FMI version ``fmi``."""
     return dest / SUBDIR[fmi] / f"{name}.fmu"
+
+
+def library_path(unzipdir: Path, name: str, fmi: str, platform: toolchain.Platform) -> Path:
+    """Where an extracted FMU holds its binary for ``platform``."""
+    return unzipdir / "binaries" / platform.folder(fmi) / f"{name}{platform.suffix}"
+
+
+def host_library(unzipdir: Path, name: str, fmi: str) -> Path:
+    """The binary of an extracted FMU for this machine."""
+    host = toolchain.host_platform()
+    if host is None:
+        raise RuntimeError("this machine is none of the native FMUs' platforms")
+    return library_path(unzipdir, name, fmi, host)
 
 
 def fmi_headers() -> Path:
@@ -255,6 +267,9 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
     spec = model.spec
     probes = model.extra_parameter_probes
     names = "\n".join(f"    V_{v.name} = {index}," for index, v in enumerate(spec.variables))
+    derivatives = input_derivatives(spec)
+    constants = "".join(f"#define {name} {_c_string(value) if isinstance(value, str) else value}\n"
+                        for name, value in model.native_constants.items())
     extra_enum = "" if not probes else "\n/* messages of the model's own checks */\nenum {\n" + "".join(
         f"    MESSAGE_{name} = {index},\n" for index, name in enumerate(probes)) + "};\n"
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
@@ -262,11 +277,17 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_VARIABLES_H
 
 #define MODEL_NAME {_c_string(spec.name)}
-#define MODEL_TOKEN {_c_string(token)}
+#define MODEL_TOKEN model_token
 #define MODEL_VARIABLE_COUNT {len(spec.variables)}
 #define MODEL_STRING_COUNT {sum(v.type == "String" for v in spec.variables)}
 #define MODEL_RELATION_COUNT {len(spec.relations)}
 #define MODEL_EXTRA_MESSAGE_COUNT {len(probes)}
+/* driveline.model.TIME_TOLERANCE: how far, relative to the time reached, a step may start before it */
+#define MODEL_TIME_TOLERANCE {_c_double(TIME_TOLERANCE)}
+#define MODEL_INPUT_DERIVATIVE_COUNT {len(derivatives)}
+{constants}
+/* the FMU's token (FMI 2.0 GUID, FMI 3.0 instantiation token): the FMI version's, in model_variables.c */
+extern const char model_token[];
 
 /* value references */
 enum {{
@@ -282,6 +303,8 @@ enum {{
 #include <math.h>
 
 #include "fmu_instance.h"
+
+const char model_token[] = {_c_string(token)};
 
 const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 {entries}
@@ -300,7 +323,26 @@ const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT] = {{
 {extra}
 }};
 """
+    if derivatives:
+        table = "\n".join(f"    {{V_{of}, {order}, V_{target}}}," for of, order, target in derivatives)
+        source += f"""
+const InputDerivative model_input_derivatives[MODEL_INPUT_DERIVATIVE_COUNT] = {{
+{table}
+}};
+"""
     return {"model_variables.h": header, "model_variables.c": source}
+
+
+def input_derivatives(spec: ModelSpec) -> list[tuple[str, int, str]]:
+    """``(input, order, variable)``: the inputs that hold an input's time derivatives, by order."""
+    found = []
+    for variable in spec.of("input"):
+        base, order = variable.name, 0
+        while spec[base].derivative is not None:
+            base, order = spec[base].derivative, order + 1
+        if order:
+            found.append((base, order, variable.name))
+    return found
 
 
 # -- model description ----------------------------------------------------------------------------
@@ -330,7 +372,8 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
         "modelIdentifier": spec.name, "needsExecutionTool": "false", "canHandleVariableCommunicationStepSize": "true",
         "canBeInstantiatedOnlyOncePerProcess": "false", f"canGetAndSetFMU{state}": "true",
         f"canSerializeFMU{state}": "true",
-        **({} if fmi3 else {"canInterpolateInputs": "false", "canNotUseMemoryManagementFunctions": "true"}),
+        **({} if fmi3 else {"canInterpolateInputs": "true" if input_derivatives(spec) else "false",
+                             "canNotUseMemoryManagementFunctions": "true"}),
     })
     if not fmi3:
         files = ET.SubElement(cosimulation, "SourceFiles")
@@ -370,24 +413,25 @@ def model_description(spec: ModelSpec, fmi: str, token: str, sources: list[str])
     return (complete_fmi3 if fmi == "3" else complete_fmi2)(skeleton, spec)
 
 
+MATH_LIBRARY = ("the C math library: link it where it is a library of its own (Linux: -lm; with fmpy's "
+                "build_platform_binary, cmake_options=REBUILD_CMAKE_OPTIONS)")
+#: What fmpy's ``build_platform_binary`` needs to link libm into a rebuilt binary on Linux: its CMake
+#: project links no library, and FMI 2.0 has no place to name one (FMI 3.0: ``<Library name="m"/>``).
+REBUILD_CMAKE_OPTIONS = {"CMAKE_C_STANDARD_LIBRARIES:STRING": "-lm"}
+
+
 def build_description(name: str, sources: list[str]) -> bytes:
     """FMI 3.0 ``sources/buildDescription.xml``: the C sources and their language."""
     root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
     configuration = ET.SubElement(root, "BuildConfiguration", modelIdentifier=name)
     files = ET.SubElement(configuration, "SourceFileSet", language="C99")
     files.extend(ET.Element("SourceFile", name=source) for source in sources)
+    ET.SubElement(configuration, "Library", name="m", description=MATH_LIBRARY)
     ET.indent(root)
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
 # -- build ------------------------------------------------------------------------------------------
-
-
-def compiler() -> str:
-    found = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if not found:
-        raise RuntimeError("the native FMUs need a C compiler (cc or gcc; Debian: apt-get install gcc)")
-    return found
 
 
 def _library_sources(name: str) -> dict[str, bytes]:
@@ -418,44 +462,84 @@ def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
     return files
 
 
-def build(name: str, dest: Path, fmi: str = "2", model_file: Path | None = None) -> Path:
-    """Build the native FMU of catalog model ``name`` for FMI ``fmi`` under ``dest``.
+VERSIONED = ("model_variables.c", *LAYER.values())  # compiled per FMI version; the rest once per platform
+SHARED_OBJECTS = ("python_numbers.c",)  # compiled once per platform for every model
 
-    ``model_file`` replaces the model's C port (the benchmarks' no-physics twin)."""
-    spec = MODELS[name].spec
-    files = _sources(name, fmi, model_file or model_source(name))
-    token = files.pop("token").decode()
-    compiled = sorted(source for source in files if source.endswith(".c"))
-    platform = fmpy.platform_tuple if fmi == "3" else fmpy.platform
-    target = fmu_path(dest, name, fmi)
+
+def _write(folder: Path, files: dict[str, bytes]) -> None:
+    for source, data in files.items():
+        (folder / source).parent.mkdir(parents=True, exist_ok=True)
+        (folder / source).write_bytes(data)
+
+
+def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain.Platform, Path], target: Path) -> None:
+    """Zip the FMU: model description, one binary per platform, sources, resources, the model's
+    doc page and the licence (``documentation/licenses/``)."""
+    token = files["token"].decode()
+    sources = {source: data for source, data in files.items() if source != "token"}
+    compiled = sorted(source for source in sources if source.endswith(".c"))
+    members = {
+        "modelDescription.xml": model_description(MODELS[name].spec, fmi, token, compiled),
+        **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": library.read_bytes() for p, library in binaries.items()},
+        **{f"sources/{source}": data for source, data in sources.items()},
+        **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
+        f"documentation/{snake_case(name)}.md": (DOCS / f"{snake_case(name)}.md").read_bytes(),
+        "documentation/licenses/LICENSE.txt": LICENSE.read_bytes(),
+    }
+    if fmi == "3":
+        members["sources/buildDescription.xml"] = build_description(name, compiled)
     target.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory() as work:
-        sources = Path(work) / "sources"
-        sources.mkdir()
-        for source, data in files.items():
-            (sources / source).parent.mkdir(parents=True, exist_ok=True)
-            (sources / source).write_bytes(data)
-        library = Path(work) / f"{name}.so"
-        command = [compiler(), *CFLAGS, "-shared", "-I", str(sources), "-I", str(fmi_headers()),
-                   *[str(sources / source) for source in compiled], "-o", str(library), "-lm"]
-        done = subprocess.run(command, capture_output=True, text=True)
-        if done.returncode:
-            raise RuntimeError(f"compiling the native {name} FMU failed:\n{done.stderr}")
-        members = {
-            "modelDescription.xml": model_description(spec, fmi, token, compiled),
-            f"binaries/{platform}/{name}.so": library.read_bytes(),
-            **{f"sources/{source}": data for source, data in files.items()},
-            **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
-        }
-        if fmi == "3":
-            members["sources/buildDescription.xml"] = build_description(name, compiled)
-        with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
-            for member, data in members.items():
-                archive.writestr(member, data)
-    return target
+    with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
+        for member, data in members.items():
+            archive.writestr(member, data)
 
 
-def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] = ("2", "3")) -> list[Path]:
-    """The native FMUs of ``names`` (default: every model with a C port) that have one."""
+def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] = ("2", "3"),
+              release: bool | None = None, model_file: Path | None = None) -> list[Path]:
+    """The native FMUs of ``names`` (default: every model with a C port) that have one, for each
+    FMI version in ``fmi``, with binaries for every platform (``release``; the default when ziglang
+    is installed, :func:`toolchain.chosen_platforms`) or for this machine's alone.
+
+    Each source is compiled once per platform (the FMI layer and the generated table once per FMI
+    version), all in parallel, then linked once per FMU and platform. ``model_file`` replaces the
+    models' C port (the benchmarks' no-physics twin)."""
     chosen = [name for name in (names or native_models()) if has_c_port(name)]
-    return [build(name, dest, version) for version in fmi for name in chosen]
+    platforms = toolchain.chosen_platforms(release)
+    host_only = len(platforms) == 1 and not (release or (release is None and toolchain.release_available()))
+    files = {(name, v): _sources(name, v, model_file or model_source(name)) for name in chosen for v in fmi}
+    with tempfile.TemporaryDirectory() as work:
+        root = Path(work)
+        for (name, v), sources in files.items():  # the FMI version's own files apart, the rest shared
+            _write(root / "sources" / name / f"fmi{v}", {s: d for s, d in sources.items() if s in VERSIONED})
+            _write(root / "sources" / name / "common",
+                   {s: d for s, d in sources.items() if s not in VERSIONED and s != "token"})
+        compiles, links, libraries = [], [], {}
+        for target in platforms:
+            objects = root / "objects" / target.tuple
+            shared = {source: objects / f"{source}.o" for source in SHARED_OBJECTS}
+            for name in chosen:
+                source_dir = root / "sources" / name
+                include = (source_dir / "common", fmi_headers())
+                common = sorted(s for s in files[name, fmi[0]] if s.endswith(".c") and s not in VERSIONED)
+                model_objects = [shared.get(s, objects / name / f"{s}.o") for s in common]
+                compiles += [toolchain.compile_step(target, source_dir / "common" / s, obj, *include, host_only)
+                             for s, obj in zip(common, model_objects) if s not in shared or name == chosen[0]]
+                for v in fmi:
+                    own = [s for s in files[name, v] if s in VERSIONED]
+                    own_objects = [objects / name / f"fmi{v}" / f"{s}.o" for s in own]
+                    compiles += [toolchain.compile_step(target, source_dir / f"fmi{v}" / s, obj, *include, host_only)
+                                 for s, obj in zip(own, own_objects)]
+                    library = root / "binaries" / target.tuple / f"fmi{v}" / f"{name}{target.suffix}"
+                    links.append(toolchain.link_step(target, [*model_objects, *own_objects], library, host_only))
+                    libraries.setdefault((name, v), {})[target] = library
+        toolchain.run(compiles)
+        toolchain.run(links)
+        for (name, v), binaries in libraries.items():
+            _pack(name, v, files[name, v], binaries, fmu_path(dest, name, v))
+    return [fmu_path(dest, name, v) for v in fmi for name in chosen]
+
+
+def build(name: str, dest: Path, fmi: str = "2", model_file: Path | None = None, release: bool | None = None) -> Path:
+    """Build the native FMU of catalog model ``name`` for FMI ``fmi`` under ``dest`` (see
+    :func:`build_all`)."""
+    return build_all(dest, [name], (fmi,), release, model_file)[0]

@@ -8,7 +8,6 @@
 
 #include "fmu_instance.h"
 
-#define VALUE(name) (data->real_value[V_##name])
 #define OMEGA_SAMPLE (data->internal[0]) /* omega_in of the last evaluation [rad/s] */
 #define SAMPLE_TIME (data->internal[1])  /* time of that evaluation [s] */
 #define HAS_SAMPLE (data->internal[2])   /* 1 once there was an evaluation */
@@ -48,4 +47,4 @@ static const char *evaluate(ModelData *data, double input_time)
 
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {reset_internal, NULL, start, advance, NULL, NULL, NULL};
+const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance};

@@ -17,7 +17,6 @@
 #include "critical_speeds/rotor.h"
 #include "fmu_instance.h"
 
-#define VALUE(name) (data->real_value[V_##name])
 
 /* driveline/rotor/model.py */
 #define MAX_ORDERS 16
@@ -343,14 +342,45 @@ static void orders_tuple(const int *orders, int count, char *out, size_t size)
 
 /* ---- the analysis ------------------------------------------------------------------------------ */
 
-/* build_driveline: the one-piece tube of the parameters, or the layout (a file or a shipped name). */
+static int build_one_piece(const ModelData *data, Driveline *out, char *error);
+
+/* build_driveline: the one-piece tube of the parameters, or the layout (a file or a shipped name);
+ * refused when shear = false meets a layout segment with shear, or when the supports leave the
+ * shaft a mechanism (mechanism.py). */
 static int build_driveline(const ModelData *data, Driveline *out, char *error)
 {
-    OnePieceShaft shaft;
     const char *layout = data->string_value[V_layout];
+    int failed, hinge = 0, node = 0, i;
     if (layout[0] != '\0') {
-        return driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
+        failed = driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
+        for (i = 0; !failed && !data->int_value[V_shear] && i < out->n_segments; i++) {
+            if (out->segments[i].shear) {
+                snprintf(error, ERROR_SIZE, "%s", SHEAR_CONFLICT);
+                failed = -1;
+            }
+        }
+    } else {
+        failed = build_one_piece(data, out, error);
     }
+    switch (failed ? MECHANISM_NONE : driveline_mechanism(out, &hinge, &node)) {
+    case MECHANISM_NONE:
+        return failed;
+    case MECHANISM_HINGE_FOLDS:
+        snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node);
+        return -1;
+    case MECHANISM_RIGID_BODY:
+        snprintf(error, ERROR_SIZE, "%s", MECHANISM_RIGID);
+        return -1;
+    default:
+        snprintf(error, ERROR_SIZE, "out of memory");
+        return -1;
+    }
+}
+
+/* loader.one_piece_shaft of the parameters. */
+static int build_one_piece(const ModelData *data, Driveline *out, char *error)
+{
+    OnePieceShaft shaft;
     shaft.L_shaft = VALUE(L_shaft);
     shaft.D_outer = VALUE(D_outer);
     shaft.D_inner = VALUE(D_inner);
@@ -683,4 +713,5 @@ static const char *advance(ModelData *data, double current_time UNUSED, double s
     return evaluate(data);
 }
 
-const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, NULL, free_analysis};
+const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors,
+                                .free_derived = free_analysis};

@@ -3,7 +3,8 @@
  * Calls out of sequence, unknown value references, wrong types and bad FMU states return
  * fmi2Error with a logged reason (the instance then accepts only get, reset, free and set FMU
  * state, as the standard says); a refused step returns fmi2Discard with the model unchanged and
- * the host may correct its inputs and step again (fmi2Terminated stays false). Messages reach
+ * fmi2Terminated true: the same step would be refused again, so a master that retries a discarded
+ * step (fmusim, fmpy) stops; one that corrects its inputs may step again. Messages reach
  * the logger as data: its format argument is always "%s".
  */
 #include <stdlib.h>
@@ -11,6 +12,15 @@
 
 #include "fmi2Functions.h"
 #include "fmu_instance.h"
+
+/* FMI2_FUNCTION_PREFIX prefixes the entry points (several FMUs linked into one program), as the
+ * standard's fmi2Functions.h does; some copies of that header (fmpy's) leave it out. */
+#ifdef FMI2_FUNCTION_PREFIX
+#undef fmi2FullName
+#define fmi2PrefixPaste(a, b) a##b
+#define fmi2PrefixName(a, b) fmi2PrefixPaste(a, b)
+#define fmi2FullName(name) fmi2PrefixName(FMI2_FUNCTION_PREFIX, name)
+#endif
 
 static void emit(const Instance *instance, Status status, const char *category, const char *message)
 {
@@ -122,9 +132,9 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         const fmi2Real dvKnown[] UNUSED, fmi2Real dvUnknown[] UNUSED)
 ON_INSTANCE(fmi2, instance_unsupported(instance, "GetDirectionalDerivative"))
 
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
-                                       const fmi2Integer order[] UNUSED, const fmi2Real value[] UNUSED)
-ON_INSTANCE(fmi2, instance_unsupported(instance, "SetRealInputDerivatives"))
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[])
+ON_INSTANCE(fmi2, instance_set_input_derivatives(instance, "SetRealInputDerivatives", vr, nvr, order, value))
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[] UNUSED, size_t nvr UNUSED,
                                         const fmi2Integer order[] UNUSED, fmi2Real value[] UNUSED)
@@ -144,7 +154,7 @@ fmi2Status fmi2CancelStep(fmi2Component c)
 ON_INSTANCE(fmi2, instance_unsupported(instance, "CancelStep"))
 
 /* Only what the standard defines for a finished step is available: the last successful time and
- * fmi2Terminated (always false: a refused step is retryable); any other query gets fmi2Discard. */
+ * fmi2Terminated (true after a refused step, until a step is taken); any other query gets fmi2Discard. */
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s UNUSED, fmi2Status *value UNUSED)
 ON_INSTANCE(fmi2, fmi2Discard)
 
@@ -167,7 +177,7 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
     if (s != fmi2Terminated || value == NULL) {
         return fmi2Discard;
     }
-    *value = fmi2False;
+    *value = instance->terminated ? fmi2True : fmi2False;
     return fmi2OK;
 }
 

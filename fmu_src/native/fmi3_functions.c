@@ -3,7 +3,8 @@
  * The model is initialised at the startTime given to fmi3EnterInitializationMode. Misuse returns
  * fmi3Error with a logged reason (the instance then accepts only get, reset, free and set FMU
  * state); a refused step returns fmi3Discard with the model unchanged, lastSuccessfulTime =
- * currentCommunicationPoint and terminateSimulation false. The independent variable ``time``
+ * currentCommunicationPoint and terminateSimulation true (the same step would be refused again, so
+ * the importer stops; one that corrects its inputs may step again). The independent variable ``time``
  * has the value reference after the spec's variables. Functions of the model exchange and
  * scheduled execution interfaces, clocks, event mode and derivatives are exported, as the
  * standard requires, and return fmi3Error (instantiation: NULL).
@@ -213,7 +214,7 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
     }
     status = instance_do_step(instance, currentCommunicationPoint, communicationStepSize);
     *eventHandlingNeeded = fmi3False;
-    *terminateSimulation = fmi3False;
+    *terminateSimulation = status == STATUS_DISCARD ? fmi3True : fmi3False; /* retrying gets the same refusal */
     *earlyReturn = fmi3False;
     *lastSuccessfulTime = status == STATUS_OK ? instance->data.time : currentCommunicationPoint;
     return (fmi3Status)status;

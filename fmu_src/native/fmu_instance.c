@@ -333,7 +333,10 @@ Status instance_fail(Instance *instance, const char *first, ...)
     va_start(pieces, first);
     append_pieces(message, sizeof message, first, pieces);
     va_end(pieces);
-    instance->emit(instance, STATUS_ERROR, "logStatusError", message);
+    if (instance->mode != MODE_ERROR || strcmp(message, instance->refusal) != 0) { /* repeated: logged once */
+        instance->emit(instance, STATUS_ERROR, "logStatusError", message);
+        strcpy(instance->refusal, message);
+    }
     instance->mode = MODE_ERROR;
     return STATUS_ERROR;
 }
@@ -427,6 +430,8 @@ Status instance_reset(Instance *instance)
         model_hooks.reset_internal(&instance->data);
     }
     instance->start_time = 0.0;
+    instance->terminated = 0;
+    instance->refusal[0] = '\0';
     instance->mode = MODE_INSTANTIATED;
     return STATUS_OK;
 }
@@ -450,8 +455,14 @@ Status instance_exit_initialization(Instance *instance)
         return STATUS_ERROR;
     }
     instance->messages.count = 0;
+    parameter_errors(&instance->data, &instance->messages);
+    if (instance->messages.count) { /* parameters that no input can make valid: Error */
+        instance_log_messages(instance, STATUS_ERROR);
+        instance->mode = MODE_ERROR;
+        return STATUS_ERROR;
+    }
     initialize(instance, instance->start_time);
-    instance_log_messages(instance, STATUS_ERROR); /* as the Python FMUs: logged, and OK */
+    instance_log_messages(instance, STATUS_ERROR); /* inputs the host may still correct: logged, and OK */
     instance->mode = MODE_STEP;
     return STATUS_OK;
 }
@@ -473,12 +484,24 @@ Status instance_do_step(Instance *instance, double current_time, double step_siz
         return instance_fail(instance, instance->fmi_prefix, "DoStep: currentCommunicationPoint = ", shown,
                              " is not finite", (const char *)NULL);
     }
+    if (current_time < instance->data.time - MODEL_TIME_TOLERANCE * fmax(1.0, fabs(instance->data.time))) {
+        char reached[40];
+        python_float_repr(current_time, shown, sizeof shown);
+        python_float_repr(instance->data.time, reached, sizeof reached);
+        return instance_fail(instance, instance->fmi_prefix, "DoStep: currentCommunicationPoint = ", shown,
+                             " is before the time the FMU reached, ", reached, (const char *)NULL);
+    }
     instance->messages.count = 0;
     step(instance, current_time, step_size);
-    if (instance->messages.count) {
-        instance_log_messages(instance, STATUS_ERROR);
+    instance->terminated = instance->messages.count > 0;
+    if (instance->terminated) { /* the same call would be refused again: its reasons are logged once */
+        if (strcmp(instance->refusal, instance->messages.text[0]) != 0) {
+            instance_log_messages(instance, STATUS_ERROR);
+            strcpy(instance->refusal, instance->messages.text[0]);
+        }
         return STATUS_DISCARD;
     }
+    instance->refusal[0] = '\0';
     return STATUS_OK;
 }
 
@@ -559,6 +582,44 @@ Status instance_set_real(Instance *instance, const char *function, const uint32_
         instance->data.real_value[vr[i]] = value[i];
     }
     return STATUS_OK;
+}
+
+Status instance_set_input_derivatives(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                                      const int32_t order[], const double value[])
+{
+#if MODEL_INPUT_DERIVATIVE_COUNT > 0
+    uint32_t target[MODEL_INPUT_DERIVATIVE_COUNT];
+    size_t i;
+    int k;
+    if (n > 0 && (vr == NULL || order == NULL || value == NULL)) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": a NULL array", (const char *)NULL);
+    }
+    if (n > MODEL_INPUT_DERIVATIVE_COUNT) {
+        return instance_fail(instance, instance->fmi_prefix, function, ": more derivatives than the model's inputs hold",
+                             (const char *)NULL);
+    }
+    for (i = 0; i < n; i++) {
+        for (k = 0; k < MODEL_INPUT_DERIVATIVE_COUNT; k++) {
+            const InputDerivative *d = &model_input_derivatives[k];
+            if ((uint32_t)d->input == vr[i] && d->order == order[i]) {
+                target[i] = (uint32_t)d->target;
+                break;
+            }
+        }
+        if (k == MODEL_INPUT_DERIVATIVE_COUNT) {
+            return instance_fail(instance, instance->fmi_prefix, function,
+                                 ": no input holds that derivative (input and order: see the model's inputs "
+                                 "with a derivative)", (const char *)NULL);
+        }
+    }
+    return instance_set_real(instance, function, target, n, value);
+#else
+    (void)vr;
+    (void)n;
+    (void)order;
+    (void)value;
+    return instance_unsupported(instance, function);
+#endif
 }
 
 Status instance_set_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n,
@@ -761,7 +822,7 @@ Status instance_unsupported(Instance *instance, const char *function)
 /* ---- FMU state ---------------------------------------------------------------------------- */
 
 #define STATE_TAG 0x4452564C53544154ull /* marks a live StoredState */
-#define STATE_FORMAT 3u /* 3: String values (2: six internal slots; 1 had four) */
+#define STATE_FORMAT 4u /* 4: eleven internal slots (3: String values; 2: six internal slots; 1 had four) */
 static const char STATE_MAGIC[8] = {'D', 'R', 'V', 'L', 'S', 'T', 'A', 'T'};
 
 /* A stored state owns the copies of its strings; its ``data.cache`` is NULL. */
@@ -856,6 +917,8 @@ Status state_set(Instance *instance, const char *function, const void *state)
         instance->data.string_value[i] = strings[i];
     }
     instance->data.cache = &instance->cache;
+    instance->terminated = 0;
+    instance->refusal[0] = '\0';
     return STATUS_OK;
 }
 

@@ -22,12 +22,11 @@
 #define UNUSED
 #endif
 
-#define FMU_PI 3.14159265358979323846
 #define FMU_MESSAGE_SIZE 1024 /* a message names a layout file by its absolute path: room for a long one */
 #define FMU_MAX_MESSAGES 48
 /* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
  * five-number warm start); a new count needs a new STATE_FORMAT (fmu_instance.c). */
-#define FMU_INTERNAL_SLOTS 6
+#define FMU_INTERNAL_SLOTS 11
 /* Longest String value accepted, in characters (code points; model_adapter.MAX_STRING), and so
  * in bytes of UTF-8 at most four times that. */
 #define FMU_MAX_STRING 4096
@@ -83,7 +82,15 @@ typedef struct {
     MessageTemplate message;
 } ExtraMessage;
 
+/* An input that holds the ``order``-th time derivative of input ``input`` (Variable.derivative). */
+typedef struct {
+    int input, order, target;
+} InputDerivative;
+
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
+#if MODEL_INPUT_DERIVATIVE_COUNT > 0
+extern const InputDerivative model_input_derivatives[MODEL_INPUT_DERIVATIVE_COUNT];
+#endif
 #if MODEL_RELATION_COUNT > 0
 extern const RelationInfo model_relations[MODEL_RELATION_COUNT];
 #endif
@@ -137,10 +144,12 @@ struct Instance {
     const char *fmi_prefix;   /* "fmi2" or "fmi3", for misuse messages */
     Mode mode;
     double start_time;
+    int terminated; /* the last step was refused: the same call is refused again (fmi2Terminated) */
     ModelData data;
     Messages messages;
     ModelCache cache;
     char *resources; /* owned; cache.resources points at it */
+    char refusal[FMU_MESSAGE_SIZE]; /* the first reason of the last refusal or misuse: a repeat is not logged */
 };
 
 /* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
@@ -162,6 +171,9 @@ typedef struct {
 } ModelHooks;
 
 extern const ModelHooks model_hooks;
+
+/* A Real variable of the model by its name, in a hook whose ModelData is ``data`` */
+#define VALUE(name) (data->real_value[V_##name])
 
 /* ``start`` and ``advance`` of a model driven by an input shaft (DrivenShaftModel in
  * driveline/model.py): phi_in starts at phi_in_start and integrates the held omega_in exactly;
@@ -201,6 +213,10 @@ Status instance_set_real(Instance *instance, const char *function, const uint32_
                          const double value[]);
 Status instance_set_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                             const int32_t value[]);
+/* Sets the inputs that hold the ``order[i]``-th derivatives of inputs ``vr[i]`` (FMI 2.0's
+ * SetRealInputDerivatives); Error, setting none, if one has no such input. */
+Status instance_set_input_derivatives(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                                      const int32_t order[], const double value[]);
 Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[]);
 Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[]);
 /* Booleans as the FMI version's type of ``size`` bytes (fmi2Boolean: int, fmi3Boolean: bool):

@@ -5,6 +5,8 @@
 
 #include <stddef.h>
 
+#define FMU_PI 3.14159265358979323846 /* math.pi */
+
 /* Python's math.fsum of ``count`` values into ``*sum``: NULL, or the text of the exception Python
  * raises ("intermediate overflow in fsum", "-inf + inf in fsum"). */
 const char *python_fsum(const double values[], int count, double *sum);

@@ -3,7 +3,6 @@
 
 #include "fmu_instance.h"
 
-#define VALUE(name) (data->real_value[V_##name])
 
 /* omega(t) = omega_start + ramp_rate t + a sin(w t), alpha = d(omega)/dt, phi its exact integral. */
 static const char *evaluate(ModelData *data, double t)
@@ -19,4 +18,4 @@ static const char *evaluate(ModelData *data, double t)
     return NULL;
 }
 
-const ModelHooks model_hooks = {NULL, evaluate, NULL, NULL, NULL, NULL, NULL};
+const ModelHooks model_hooks = {.at_time = evaluate};

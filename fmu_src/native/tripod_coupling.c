@@ -13,11 +13,14 @@
 
 #include "fmu_instance.h"
 
-#define VALUE(name) (data->real_value[V_##name])
 #define INTEGER(name) (data->int_value[V_##name])
 /* the exact solver's warm start (plane_solver.Solution): a flag, then phi_in, x, y, dx/dphi, dy/dphi */
 #define HAS_SOLUTION (data->internal[0])
 #define SOLUTION (data->internal + 1)
+/* the bend samples of the last two communication points (beta_rate = RATES_FROM_SAMPLES), newest
+ * first: their count, then time and beta of each (TripodCouplingModel._beta_samples) */
+#define SAMPLE_COUNT (data->internal[6])
+#define SAMPLES (data->internal + 7)
 
 #define EXACT 1
 #define THIRD_TURN (2.0 * FMU_PI / 3.0)
@@ -175,6 +178,7 @@ typedef struct {
 
 typedef struct {
     double phi_in, cb, sb, omega, omega_dot, T_load, r, l, m, friction, slip_speed; /* cb, sb: cos, sin of beta */
+    double beta_dot, beta_ddot;
 } Load;
 
 /* One arm of the exact balance: groove point g, ball height bz, arm vector e = b - P,
@@ -264,6 +268,9 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     double E2x = cb * e2x + sb * y, E2y = e2y, E2z = sb * e2x - cb * y;
     double Ux = cb * x - sb * zn, Uy = y, Uz = sb * x + cb * zn;
     double Sx = -l * sb, Sz = l * cb, Px = Sx - l * Ux, Py = -l * Uy, Pz = Sz - l * Uz;
+    /* the moving bearing: Sdot = l betadot (-cos, 0, -sin), Sddot = l betaddot (-cos, 0, -sin) - l betadot^2 e_out */
+    double bd = load->beta_dot, bdd = load->beta_ddot;
+    double Svx = -l * cb * bd, Svz = -l * sb * bd, Sax = l * (sb * bd * bd - cb * bdd), Saz = -l * (cb * bd * bd + sb * bdd);
     double p_dot_u = Px * Ux + Py * Uy + Pz * Uz, omega2 = omega * omega;
     double c[3], s[3], adj[3][3], inv_det, rhs[3], Wx, Wy, Wz, W2, Ax, Ay, Az, Mx, My, Mz;
     double lams[3], mus[3], slips[3] = {0.0, 0.0, 0.0}, grooves[3] = {0.0, 0.0, 0.0}, moment[3];
@@ -302,9 +309,9 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
         adj[j][2] = p[0] * q[1] - p[1] * q[0];
     }
     inv_det = divide(guard, 1.0, arm[0].k[0] * adj[0][0] + arm[0].k[1] * adj[0][1] + arm[0].k[2] * adj[0][2]);
-    /* 2. angular velocity of the output shaft: (e_z x g_j) . n_j = -(g_x e_x + g_y e_y) */
+    /* 2. angular velocity of the output shaft: (e_z x g_j) . n_j = -(g_x e_x + g_y e_y), Sdot . n_j = Sdot_x e_y */
     for (j = 0; j < 3; j++) {
-        rhs[j] = -omega * (arm[j].gx * arm[j].ex + arm[j].gy * arm[j].ey) * inv_det;
+        rhs[j] = (-omega * (arm[j].gx * arm[j].ex + arm[j].gy * arm[j].ey) - Svx * arm[j].ey) * inv_det;
     }
     Wx = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0];
     Wy = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1];
@@ -313,15 +320,15 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     /* 3. accelerations: known terms per arm, then K Omegadot = (known . n_j) */
     for (j = 0; j < 3; j++) {
         Arm *a = &arm[j];
-        double vx = Wy * a->dz - Wz * a->dy + omega * a->gy, vy = Wz * a->dx - Wx * a->dz - omega * a->gx;
+        double vx = Wy * a->dz - Wz * a->dy + omega * a->gy + Svx, vy = Wz * a->dx - Wx * a->dz - omega * a->gx;
         double wd = Wx * a->dx + Wy * a->dy + Wz * a->dz; /* Omega x (Omega x d) = Omega (Omega . d) - d |Omega|^2 */
         a->sigma = divide(guard, -(vx * a->ex + vy * a->ey), a->exy2);
-        a->hx = Wx * wd - a->dx * W2 + 2.0 * a->sigma * (Wy * a->ez - Wz * a->ey);
+        a->hx = Wx * wd - a->dx * W2 + 2.0 * a->sigma * (Wy * a->ez - Wz * a->ey) + Sax;
         a->hy = Wy * wd - a->dy * W2 + 2.0 * a->sigma * (Wz * a->ex - Wx * a->ez);
-        a->hz = Wz * wd - a->dz * W2 + 2.0 * a->sigma * (Wx * a->ey - Wy * a->ex);
+        a->hz = Wz * wd - a->dz * W2 + 2.0 * a->sigma * (Wx * a->ey - Wy * a->ex) + Saz;
         a->ax = -omega_dot * a->gy - omega2 * a->gx; /* groove point's acceleration */
         a->ay = omega_dot * a->gx - omega2 * a->gy;
-        a->zdot = Wx * a->dy - Wy * a->dx + a->sigma * a->ez;
+        a->zdot = Wx * a->dy - Wy * a->dx + a->sigma * a->ez + Svz;
     }
     for (j = 0; j < 3; j++) {
         rhs[j] = ((arm[j].ax - arm[j].hx) * arm[j].ey - (arm[j].ay - arm[j].hy) * arm[j].ex) * inv_det;
@@ -397,10 +404,12 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
     double cb = load->cb, tb = divide(guard, load->sb, cb), half = divide(guard, load->sb, 1.0 + cb);
     double A = divide(guard, 1.5 * m * r * r * tb, cb * cb), omega2 = load->omega * load->omega;
     double ry_in = divide(guard, -(T * half + A * omega_dot * cb), l);
+    double bend = divide(guard, m * r, cb * cb), bend_rates = load->beta_ddot + 2.0 * tb * load->beta_dot * load->beta_dot;
     int j;
     for (j = 0; j < 3; j++) {
-        double angle = load->phi_in + THIRD_TURN * j;
-        out->F_plunger[j] = -m * r * tb * (omega2 * cosine(guard, angle) + omega_dot * sine(guard, angle));
+        double angle = load->phi_in + THIRD_TURN * j, c = cosine(guard, angle), s = sine(guard, angle);
+        out->F_plunger[j] = -m * r * tb * (omega2 * c + omega_dot * s) +
+                            bend * (c * bend_rates - 2.0 * load->omega * load->beta_dot * s);
         out->F_arm[j] = pin;
     }
     out->Rx_in = divide(guard, -A * omega2, l * cb);
@@ -416,18 +425,68 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
 
 /* ---- outputs (outputs.coupling_outputs) ------------------------------------------------------ */
 
-static const char *evaluate(ModelData *data, double input_time UNUSED)
+/* Rate and acceleration of beta at the newest of ``count`` (time, beta) samples, newest first
+ * (tripod.model.sampled_rates: the derivatives of the polynomial through them). */
+static void sampled_rates(const double *samples, int count, double *rate, double *acceleration)
+{
+    double slope, curvature;
+    *rate = 0.0;
+    *acceleration = 0.0;
+    if (count < 2) {
+        return;
+    }
+    slope = (samples[1] - samples[3]) / (samples[0] - samples[2]);
+    if (count < 3) {
+        *rate = slope;
+        return;
+    }
+    curvature = (slope - (samples[3] - samples[5]) / (samples[2] - samples[4])) / (samples[0] - samples[4]);
+    *rate = slope + curvature * (samples[0] - samples[2]);
+    *acceleration = 2.0 * curvature;
+}
+
+/* Outputs ``elapsed`` after ``input_time`` (TripodCouplingModel._evaluate), with the speed and the
+ * bend moved on by their rates. */
+static const char *evaluate(ModelData *data, double input_time, double elapsed)
 {
     Guard guard = {NULL};
     Load load;
     Reactions forces;
-    double phi_in = VALUE(phi_in), beta = VALUE(beta), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
-    double cos_beta = cos(beta), sin_beta = sin(beta), rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin;
+    double beta_dot = VALUE(beta_dot), beta_ddot = VALUE(beta_ddot), beta, omega;
+    double phi_in = VALUE(phi_in), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
+    double cos_beta, sin_beta, rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin;
     double output_power, total;
+    if (INTEGER(beta_rate) == RATES_FROM_SAMPLES) {
+        double samples[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        int count = 1, k;
+        samples[0] = input_time;
+        samples[1] = VALUE(beta);
+        for (k = 0; k < (int)SAMPLE_COUNT; k++) {
+            if (SAMPLES[2 * k] < input_time) {
+                samples[2 * count] = SAMPLES[2 * k];
+                samples[2 * count + 1] = SAMPLES[2 * k + 1];
+                count++;
+            }
+        }
+        sampled_rates(samples, count, &beta_dot, &beta_ddot);
+        SAMPLE_COUNT = count < 2 ? count : 2;
+        for (k = 0; k < 4; k++) {
+            SAMPLES[k] = samples[k];
+        }
+    }
+    beta = VALUE(beta) + (beta_dot + 0.5 * beta_ddot * elapsed) * elapsed;
+    if (!(0.0 <= beta && beta <= VALUE(beta_max))) {
+        return BETA_LEAVES_RANGE;
+    }
+    omega = VALUE(omega_in) + VALUE(alpha_in) * elapsed;
+    cos_beta = cos(beta);
+    sin_beta = sin(beta);
     load.phi_in = phi_in;
     load.cb = cos_beta;
     load.sb = sin_beta;
-    load.omega = VALUE(omega_in);
+    load.beta_dot = beta_dot + beta_ddot * elapsed;
+    load.beta_ddot = beta_ddot;
+    load.omega = omega;
     load.omega_dot = VALUE(alpha_in);
     load.T_load = T_load;
     load.r = r;
@@ -455,7 +514,7 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
         phi_out = phi_in + deviation;
         theta = arcsine(&guard, divide(&guard, rho, l));
         leading_order_reactions(&guard, &load, ratio, pin, &forces);
-        omega_spin = VALUE(omega_in) * ratio;
+        omega_spin = omega * ratio;
         forces.Rz_in = 0.0 * ratio;
         forces.P_friction = 0.0 * ratio;
     }
@@ -463,7 +522,7 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
     total = output_power + forces.P_friction;
     VALUE(phi_out) = phi_out;
     VALUE(delta_phi) = phi_out - phi_in;
-    VALUE(omega_out) = VALUE(omega_in) * ratio;
+    VALUE(omega_out) = omega * ratio;
     VALUE(omega_spin) = omega_spin;
     VALUE(T_in) = forces.T_in;
     VALUE(F_pin) = pin;
@@ -479,7 +538,13 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
     VALUE(My_in) = forces.My_in;
     VALUE(Rz_in) = forces.Rz_in;
     VALUE(P_friction) = forces.P_friction;
-    VALUE(efficiency) = total != 0.0 ? output_power / total : 1.0;
+    /* delivered over supplied power (outputs.efficiency): drive, coast, 0 in between */
+    if (output_power >= 0.0) {
+        VALUE(efficiency) = total != 0.0 ? output_power / total : 1.0;
+    } else {
+        double coast = total / output_power;
+        VALUE(efficiency) = coast > 0.0 ? coast : 0.0;
+    }
     VALUE(F_arm1) = forces.F_arm[0];
     VALUE(F_arm2) = forces.F_arm[1];
     VALUE(F_arm3) = forces.F_arm[2];
@@ -488,7 +553,7 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
     VALUE(F_plunger3) = forces.F_plunger[2];
     if (INTEGER(seed_reactions)) {
         /* eqs 20, 30, 33, 34 as printed, with the seed's phi */
-        double omega_squared = VALUE(omega_in) * VALUE(omega_in), tan_beta = tan(beta);
+        double omega_squared = omega * omega, tan_beta = tan(beta);
         double phi = phi_in + PAPER_PHASE, cos_3phi = cosine(&guard, 3.0 * phi);
         double a_sum = -6.0 * omega_squared * rho * sin_beta * cos_3phi, m = VALUE(m_plunger);
         VALUE(a_plunger_sum) = a_sum;                                                        /* eq 20 */
@@ -500,9 +565,22 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
     return guard.failure;
 }
 
-/* The warm start is empty at the start, as TripodCouplingModel.start leaves it: reset clears it
- * and a refused start is undone. */
-DRIVEN_SHAFT_HOOKS(evaluate)
+/* The warm start and the bend samples are empty at the start, as TripodCouplingModel.start leaves
+ * them: reset clears them and a refused start is undone. */
+static const char *start(ModelData *data, double start_time)
+{
+    HAS_SOLUTION = 0.0;
+    SAMPLE_COUNT = 0.0;
+    VALUE(phi_in) = VALUE(phi_in_start);
+    return evaluate(data, start_time, 0.0);
+}
+
+/* phi_in advances by omega_in h + alpha_in h^2 / 2 (TripodCouplingModel.advance). */
+static const char *advance(ModelData *data, double current_time, double step_size)
+{
+    VALUE(phi_in) = VALUE(phi_in) + (VALUE(omega_in) + 0.5 * VALUE(alpha_in) * step_size) * step_size;
+    return evaluate(data, current_time, step_size);
+}
 
 /* TripodCouplingModel.extra_parameter_errors: friction needs the exact kinematics. */
 static void extra_parameter_errors(const ModelData *data, Messages *out)
@@ -512,4 +590,4 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     }
 }
 
-const ModelHooks model_hooks = {NULL, NULL, start, advance, extra_parameter_errors, NULL, NULL};
+const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors};

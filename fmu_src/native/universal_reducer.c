@@ -6,7 +6,6 @@
 
 #include "fmu_instance.h"
 
-#define VALUE(name) (data->real_value[V_##name])
 #define INTEGER(name) (data->int_value[V_##name])
 
 typedef struct {
@@ -63,4 +62,4 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
 
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {NULL, NULL, start, advance, NULL, NULL, NULL};
+const ModelHooks model_hooks = {.start = start, .advance = advance};

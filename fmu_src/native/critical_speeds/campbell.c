@@ -18,7 +18,6 @@
 #define REFINEMENTS 4
 #define MAX_KNOTS 400
 #define NOISE 10.0
-#define PI 3.14159265358979323846
 
 struct WhirlTable {
     CubicSpline spline; /* forward columns first, then backward */
@@ -561,7 +560,7 @@ done:
 static int isotropic_branches(const Chain *chain, const double *spins, int points, int n_modes, Found *found,
                               Branches branches[2], char *error, size_t size)
 {
-    double reach = (n_modes + 2) * PI / chain_kappa(chain);
+    double reach = (n_modes + 2) * FMU_PI / chain_kappa(chain);
     double x_hi = fmin(reach * reach, ROTOR_SEARCH_LIMIT);
     for (;;) {
         int final = 0;

@@ -1,17 +1,16 @@
 /* Damped finite-element model of a driveline (damped.DampedRotor) and what the FMU reports of it
  * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver up to DENSE_SIZE
  * first-order unknowns and by shift-invert Arnoldi on a banded factorisation above, the synchronous
- * unbalance response from a banded complex LU solve. */
+ * unbalance response from a banded complex LU solve (the linear algebra in linalg.c). */
 #include "rotor.h"
 
-#include <complex.h>
+#include "linalg.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef double complex cplx;
 
 #define OUT_OF_MEMORY "out of memory"
 /* damped.py */
@@ -29,432 +28,6 @@ static void set_error(char *error, size_t size, const char *message)
     if (error && size) {
         snprintf(error, size, "%s", message);
     }
-}
-
-/* re + i im (C99 has no CMPLX; a complex is laid out as two doubles) */
-static cplx make_complex(double re, double im)
-{
-    double parts[2] = {re, im};
-    cplx z;
-    memcpy(&z, parts, sizeof z);
-    return z;
-}
-
-/* a b and conj(a) b written out, without the recovery of infinities (C99 Annex G) that the operator
- * adds to every product of the inner loops; finite values give the same result */
-static cplx mul(cplx a, cplx b)
-{
-    return make_complex(creal(a) * creal(b) - cimag(a) * cimag(b), creal(a) * cimag(b) + cimag(a) * creal(b));
-}
-
-static cplx mul_conj(cplx a, cplx b)
-{
-    return make_complex(creal(a) * creal(b) + cimag(a) * cimag(b), creal(a) * cimag(b) - cimag(a) * creal(b));
-}
-
-/* 1 / d without overflow or a library call (Smith's division; LAPACK's gbtf2 scales a column by the
- * pivot's reciprocal too) */
-static cplx reciprocal(cplx d)
-{
-    double re = creal(d), im = cimag(d);
-    if (fabs(re) >= fabs(im)) {
-        double ratio = im / re, denominator = re + im * ratio;
-        return make_complex(1.0 / denominator, -ratio / denominator);
-    }
-    double ratio = re / im, denominator = re * ratio + im;
-    return make_complex(ratio / denominator, -1.0 / denominator);
-}
-
-static double cabs1(cplx z)
-{
-    return fabs(creal(z)) + fabs(cimag(z));
-}
-
-/* ---- the dense complex eigenproblem (numpy.linalg.eig) ------------------------------------- */
-/* Balancing by powers of two: a[i][j] -> a[i][j] d[j] / d[i] with row and column norms brought
- * together, as LAPACK's gebal does before the QR iteration. */
-static void balance(cplx *a, int n, double *d)
-{
-    for (int i = 0; i < n; i++) {
-        d[i] = 1.0;
-    }
-    for (int sweep = 0, changed = 1; changed && sweep < 100; sweep++) {
-        changed = 0;
-        for (int i = 0; i < n; i++) {
-            double c = 0.0, r = 0.0;
-            for (int j = 0; j < n; j++) {
-                if (j != i) {
-                    cplx column = a[(size_t)j * (size_t)n + (size_t)i], row = a[(size_t)i * (size_t)n + (size_t)j];
-                    c += creal(column) * creal(column) + cimag(column) * cimag(column);
-                    r += creal(row) * creal(row) + cimag(row) * cimag(row);
-                }
-            }
-            c = sqrt(c);
-            r = sqrt(r);
-            if (c == 0.0 || r == 0.0 || !isfinite(c) || !isfinite(r)) {
-                continue;
-            }
-            /* f = 2^k nearest sqrt(r / c): the column times f, the row over f */
-            int exponent;
-            frexp(sqrt(r / c), &exponent);
-            double f = ldexp(1.0, exponent - 1);
-            if (sqrt(r / c) / f > 1.4142135623730951) {
-                f *= 2.0;
-            }
-            if (f == 1.0 || c * f + r / f >= 0.95 * (c + r)) {
-                continue;
-            }
-            changed = 1;
-            d[i] *= f;
-            for (int j = 0; j < n; j++) {
-                a[(size_t)j * (size_t)n + (size_t)i] *= f;
-                a[(size_t)i * (size_t)n + (size_t)j] /= f;
-            }
-        }
-    }
-}
-
-/* Householder reduction to upper Hessenberg form, A = Q H Q^*; the reflector of column k is
- * I - tau_k v v^* with v = (1, a[k+2..][k]) over rows k+1.. (kept for the eigenvectors); v and w
- * are n long. */
-static void hessenberg(cplx *a, int n, cplx *v, cplx *w, double *tau)
-{
-    for (int k = 0; k + 2 < n; k++) {
-        int m = n - k - 1;
-        double norm2 = 0.0;
-        for (int i = 0; i < m; i++) {
-            cplx x = a[(size_t)(k + 1 + i) * (size_t)n + (size_t)k];
-            v[i] = x;
-            norm2 += creal(x) * creal(x) + cimag(x) * cimag(x);
-        }
-        double below = norm2 - (creal(v[0]) * creal(v[0]) + cimag(v[0]) * cimag(v[0]));
-        if (below == 0.0) {
-            tau[k] = 0.0;
-            continue;
-        }
-        double norm = sqrt(norm2), first = cabs(v[0]);
-        cplx phase = first == 0.0 ? 1.0 : v[0] / first;
-        cplx alpha = -phase * norm;
-        v[0] -= alpha;
-        double vv = 0.0;
-        for (int i = 0; i < m; i++) {
-            vv += creal(v[i]) * creal(v[i]) + cimag(v[i]) * cimag(v[i]);
-        }
-        double t = 2.0 / vv;
-        /* left: rows k+1.., columns k.., through w = t v^* A row by row */
-        for (int j = k; j < n; j++) {
-            w[j] = 0.0;
-        }
-        for (int i = 0; i < m; i++) {
-            const cplx *row = a + (size_t)(k + 1 + i) * (size_t)n;
-            for (int j = k; j < n; j++) {
-                w[j] += mul_conj(v[i], row[j]);
-            }
-        }
-        for (int j = k; j < n; j++) {
-            w[j] *= t;
-        }
-        for (int i = 0; i < m; i++) {
-            cplx *row = a + (size_t)(k + 1 + i) * (size_t)n;
-            for (int j = k; j < n; j++) {
-                row[j] -= mul(v[i], w[j]);
-            }
-        }
-        /* right: all rows, columns k+1.. */
-        for (int i = 0; i < n; i++) {
-            cplx *row = a + (size_t)i * (size_t)n + (size_t)(k + 1);
-            cplx sum = 0.0;
-            for (int j = 0; j < m; j++) {
-                sum += mul(row[j], v[j]);
-            }
-            sum *= t;
-            for (int j = 0; j < m; j++) {
-                row[j] -= mul_conj(v[j], sum);
-            }
-        }
-        /* the column below the subdiagonal is zero now: keep v there, scaled to v[0] = 1 (see
-         * hessenberg_part) */
-        a[(size_t)(k + 1) * (size_t)n + (size_t)k] = alpha;
-        for (int i = 1; i < m; i++) {
-            a[(size_t)(k + 1 + i) * (size_t)n + (size_t)k] = v[i] / v[0];
-        }
-        tau[k] = t * (creal(v[0]) * creal(v[0]) + cimag(v[0]) * cimag(v[0]));
-    }
-}
-
-/* The eigenvalues of the upper Hessenberg ``h`` (destroyed): implicitly single-shifted complex QR
- * with Wilkinson shifts, exceptional shifts after 10 and 20 steps on one eigenvalue, deflation of
- * negligible subdiagonal entries; -1 after 30 max(10, n) steps in all. */
-static int hessenberg_eigenvalues(cplx *h, int n, cplx *lambda)
-{
-#define H(i, j) h[(size_t)(i) * (size_t)n + (size_t)(j)]
-    int hi = n - 1, steps = 0, cap = 30 * (n > 10 ? n : 10), its = 0;
-    while (hi >= 0) {
-        int lo = hi;
-        while (lo > 0) {
-            if (H(lo, lo - 1) == 0.0) {
-                break;
-            }
-            /* negligible against its diagonal neighbours, and (Ahues and Tisseur) the deflation
-             * perturbs the eigenvalues of the 2 x 2 around it no more than rounding does */
-            double near = cabs1(H(lo - 1, lo - 1)) + cabs1(H(lo, lo)), sub = cabs1(H(lo, lo - 1));
-            if (sub <= DBL_EPSILON * near) {
-                double super = cabs1(H(lo - 1, lo)), ab = fmax(sub, super), ba = fmin(sub, super);
-                double d1 = cabs1(H(lo, lo)), d2 = cabs1(H(lo - 1, lo - 1) - H(lo, lo));
-                double aa = fmax(d1, d2), bb = fmin(d1, d2), s = aa + ab;
-                if (ba * (ab / s) <= fmax(DBL_MIN, DBL_EPSILON * (bb * (aa / s)))) {
-                    H(lo, lo - 1) = 0.0;
-                    break;
-                }
-            }
-            lo--;
-        }
-        if (lo == hi) {
-            lambda[hi] = H(hi, hi);
-            hi--;
-            its = 0;
-            continue;
-        }
-        if (++steps > cap) {
-            return -1;
-        }
-        its++;
-        cplx mu;
-        if (its == 10 || its == 20) {
-            mu = H(hi, hi) + 0.75 * cabs1(H(hi, hi - 1));
-        } else { /* the eigenvalue of the trailing 2 x 2 nearer its last diagonal entry */
-            cplx a = H(hi - 1, hi - 1), b = H(hi - 1, hi), c = H(hi, hi - 1), d = H(hi, hi);
-            cplx p = 0.5 * (a - d), bc = b * c, root = csqrt(p * p + bc);
-            cplx plus = p + root, minus = p - root, den = cabs(plus) >= cabs(minus) ? plus : minus;
-            mu = den == 0.0 ? d : d - bc / den;
-        }
-        cplx x = H(lo, lo) - mu, y = H(lo + 1, lo);
-        for (int k = lo; k < hi; k++) {
-            if (k > lo) {
-                x = H(k, k - 1);
-                y = H(k + 1, k - 1);
-            }
-            double ax = cabs(x), norm = hypot(ax, cabs(y));
-            if (norm == 0.0) {
-                continue;
-            }
-            double c = ax / norm;
-            cplx s = (ax == 0.0 ? 1.0 : x / ax) * conj(y) / norm;
-            if (ax == 0.0) {
-                s = conj(y) / norm;
-            }
-            int first = k > lo ? k - 1 : lo;
-            for (int j = first; j <= hi; j++) {
-                cplx top = H(k, j), bottom = H(k + 1, j);
-                H(k, j) = c * top + mul(s, bottom);
-                H(k + 1, j) = c * bottom - mul_conj(s, top);
-            }
-            if (k > lo) {
-                H(k + 1, k - 1) = 0.0;
-            }
-            int last = k + 2 < hi ? k + 2 : hi;
-            for (int i = lo; i <= last; i++) {
-                cplx left = H(i, k), right = H(i, k + 1);
-                H(i, k) = left * c + mul_conj(s, right);
-                H(i, k + 1) = right * c - mul(left, s);
-            }
-        }
-    }
-    return 0;
-#undef H
-}
-
-/* An eigenvector of the Hessenberg ``h`` for ``lambda`` by inverse iteration, into ``x`` (n):
- * the LU of h - lambda I with row interchanges between neighbours (``lu`` n x n, ``multiplier`` and
- * ``swapped`` n), a first solve U x = ones (any right-hand side will do) and a second full solve. */
-static void inverse_iteration(const cplx *h, int n, cplx lambda, cplx *lu, cplx *multiplier, unsigned char *swapped,
-                              cplx *x)
-{
-    double norm = 0.0;
-    for (size_t i = 0; i < (size_t)n * (size_t)n; i++) {
-        norm = fmax(norm, cabs1(h[i]));
-    }
-    double tiny = DBL_EPSILON * (norm > 0.0 ? norm : 1.0);
-    memcpy(lu, h, (size_t)n * (size_t)n * sizeof *lu);
-    for (int i = 0; i < n; i++) {
-        lu[(size_t)i * (size_t)n + (size_t)i] -= lambda;
-    }
-    for (int k = 0; k + 1 < n; k++) {
-        cplx *row = lu + (size_t)k * (size_t)n, *next = row + n;
-        swapped[k] = cabs1(next[k]) > cabs1(row[k]);
-        if (swapped[k]) {
-            for (int j = k; j < n; j++) {
-                cplx t = row[j];
-                row[j] = next[j];
-                next[j] = t;
-            }
-        }
-        if (row[k] == 0.0) { /* exactly singular: perturb the pivot by the rounding level */
-            row[k] = tiny;
-        }
-        multiplier[k] = next[k] / row[k];
-        for (int j = k + 1; j < n; j++) {
-            next[j] -= mul(multiplier[k], row[j]);
-        }
-        next[k] = 0.0;
-    }
-    if (lu[(size_t)n * (size_t)n - 1] == 0.0) {
-        lu[(size_t)n * (size_t)n - 1] = tiny;
-    }
-    for (int i = 0; i < n; i++) {
-        x[i] = 1.0;
-    }
-    for (int pass = 0; pass < 2; pass++) {
-        if (pass) { /* L^-1 P */
-            for (int k = 0; k + 1 < n; k++) {
-                if (swapped[k]) {
-                    cplx t = x[k];
-                    x[k] = x[k + 1];
-                    x[k + 1] = t;
-                }
-                x[k + 1] -= mul(multiplier[k], x[k]);
-            }
-        }
-        for (int i = n - 1; i >= 0; i--) {
-            const cplx *row = lu + (size_t)i * (size_t)n;
-            cplx sum = x[i];
-            for (int j = i + 1; j < n; j++) {
-                sum -= mul(row[j], x[j]);
-            }
-            x[i] = sum / row[i];
-        }
-        double largest = 0.0;
-        for (int i = 0; i < n; i++) {
-            largest = fmax(largest, cabs1(x[i]));
-        }
-        for (int i = 0; i < n && largest > 0.0 && isfinite(largest); i++) {
-            x[i] /= largest;
-        }
-    }
-}
-
-/* The Hessenberg matrix of hessenberg()'s ``a`` without the reflectors below its subdiagonal */
-static void hessenberg_part(const cplx *a, int n, cplx *h)
-{
-    for (int i = 0; i < n; i++) {
-        for (int j = 0; j < n; j++) {
-            h[(size_t)i * (size_t)n + (size_t)j] = j + 1 >= i ? a[(size_t)i * (size_t)n + (size_t)j] : 0.0;
-        }
-    }
-}
-
-/* x <- D Q x: an eigenvector of the Hessenberg matrix back to the balanced, then the original one */
-static void back_transform(const cplx *a, int n, const double *tau, const double *d, cplx *x)
-{
-    for (int k = n - 3; k >= 0; k--) {
-        if (tau[k] == 0.0) {
-            continue;
-        }
-        cplx sum = x[k + 1];
-        for (int i = k + 2; i < n; i++) {
-            sum += mul_conj(a[(size_t)i * (size_t)n + (size_t)k], x[i]);
-        }
-        sum *= tau[k];
-        x[k + 1] -= sum;
-        for (int i = k + 2; i < n; i++) {
-            x[i] -= mul(a[(size_t)i * (size_t)n + (size_t)k], sum);
-        }
-    }
-    for (int i = 0; i < n; i++) {
-        x[i] *= d[i];
-    }
-}
-
-/* ---- the banded complex LU solve (LAPACK gbsv's storage: (i, j) at ab[j][kl + ku + i - j]) ---- */
-typedef struct {
-    int n, kl, ku, rows; /* rows = 2 kl + ku + 1 per column */
-} Band;
-
-#define AB(band, ab, i, j) (ab)[(size_t)(j) * (size_t)(band).rows + (size_t)((band).kl + (band).ku + (i) - (j))]
-
-/* LU factors of ab in place with partial pivoting (``pivots`` n, the row swapped with each row as
- * it is eliminated); -1 on an exactly zero pivot (singular) */
-static int band_factor(Band band, cplx *ab, int *pivots)
-{
-    int n = band.n, kl = band.kl, ju = 0; /* ju: the last column U reaches so far (LAPACK's gbtf2) */
-    for (int j = 0; j < n; j++) {
-        int last = j + kl < n ? j + kl : n - 1, pivot = j;
-        double best = cabs1(AB(band, ab, j, j));
-        for (int i = j + 1; i <= last; i++) {
-            double size = cabs1(AB(band, ab, i, j));
-            if (size > best) {
-                best = size;
-                pivot = i;
-            }
-        }
-        pivots[j] = pivot;
-        if (AB(band, ab, pivot, j) == 0.0) {
-            return -1;
-        }
-        int reach = pivot + band.ku < n ? pivot + band.ku : n - 1, end;
-        ju = reach > ju ? reach : ju;
-        end = ju;
-        if (pivot != j) {
-            for (int c = j; c <= end; c++) {
-                cplx t = AB(band, ab, j, c);
-                AB(band, ab, j, c) = AB(band, ab, pivot, c);
-                AB(band, ab, pivot, c) = t;
-            }
-        }
-        cplx inverse = reciprocal(AB(band, ab, j, j));
-        for (int i = j + 1; i <= last; i++) {
-            cplx factor = mul(AB(band, ab, i, j), inverse);
-            AB(band, ab, i, j) = factor;
-            if (factor == 0.0) {
-                continue;
-            }
-            for (int c = j + 1; c <= end; c++) {
-                AB(band, ab, i, c) -= mul(factor, AB(band, ab, j, c));
-            }
-        }
-    }
-    return 0;
-}
-
-/* b <- ab^-1 b in place, ab factorised by band_factor */
-static void band_substitute(Band band, const cplx *ab, const int *pivots, cplx *b)
-{
-    int n = band.n, kl = band.kl, width = kl + band.ku;
-    for (int j = 0; j < n; j++) {
-        int last = j + kl < n ? j + kl : n - 1;
-        if (pivots[j] != j) {
-            cplx t = b[j];
-            b[j] = b[pivots[j]];
-            b[pivots[j]] = t;
-        }
-        for (int i = j + 1; i <= last; i++) {
-            cplx factor = AB(band, ab, i, j);
-            if (factor != 0.0) {
-                b[i] -= mul(factor, b[j]);
-            }
-        }
-    }
-    for (int i = n - 1; i >= 0; i--) {
-        int end = i + width < n ? i + width : n - 1;
-        cplx sum = b[i];
-        for (int c = i + 1; c <= end; c++) {
-            cplx u = AB(band, ab, i, c);
-            if (u != 0.0) { /* beyond the columns pivoting reached, U is zero */
-                sum -= mul(u, b[c]);
-            }
-        }
-        b[i] = mul(sum, reciprocal(AB(band, ab, i, i)));
-    }
-}
-
-/* Solves ab x = b in place (ab factorised, ``pivots`` n); -1 on an exactly zero pivot (singular) */
-static int band_solve(Band band, cplx *ab, int *pivots, cplx *b)
-{
-    if (band_factor(band, ab, pivots)) {
-        return -1;
-    }
-    band_substitute(band, ab, pivots, b);
-    return 0;
 }
 
 /* ---- damped.DampedRotor ---------------------------------------------------------------------- */
@@ -491,8 +64,8 @@ static void rotor_free(Rotor *rotor)
 /* elements._components: the coefficients of u and conj(u) of [[xx, xy], [yx, yy]] */
 static void components(double xx, double yy, double xy, double yx, cplx *a, cplx *b)
 {
-    *a = make_complex(0.5 * (xx + yy), 0.5 * (yx - xy));
-    *b = make_complex(0.5 * (xx - yy), 0.5 * (yx + xy));
+    *a = cplx_make(0.5 * (xx + yy), 0.5 * (yx - xy));
+    *b = cplx_make(0.5 * (xx - yy), 0.5 * (yx + xy));
 }
 
 /* DampedRotor.__init__ (with fem.assemble_damped) */
@@ -514,7 +87,7 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
         goto out_of_memory;
     }
     for (size_t i = 0; i < cells; i++) {
-        Ka[i] = fe->K[i];
+        Ka[i] = cplx_real(fe->K[i]);
     }
     int doubled = 0;
     rotor->n_bearings = nb;
@@ -529,10 +102,10 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
             continue;
         }
         size_t at = (size_t)row * (size_t)n + (size_t)row;
-        Ka[at] += c[0];
-        Kb[at] += c[1];
-        Ca[at] += c[2];
-        Cb[at] += c[3];
+        Ka[at] = cplx_add(Ka[at], c[0]);
+        Kb[at] = cplx_add(Kb[at], c[1]);
+        Ca[at] = cplx_add(Ca[at], c[2]);
+        Cb[at] = cplx_add(Cb[at], c[3]);
     }
     int damped = 0, symmetric = 1;
     for (int i = 0; i < nb; i++) {
@@ -540,8 +113,8 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
         symmetric &= d->bearings[i].kxy == d->bearings[i].kyx;
         if (row >= 0) {
             size_t at = (size_t)row * (size_t)n + (size_t)row;
-            doubled |= Kb[at] != 0.0 || Cb[at] != 0.0;
-            damped |= Ca[at] != 0.0 || Cb[at] != 0.0;
+            doubled |= !cplx_is_zero(Kb[at]) || !cplx_is_zero(Cb[at]);
+            damped |= !cplx_is_zero(Ca[at]) || !cplx_is_zero(Cb[at]);
         }
     }
     rotor->conservative = !damped && symmetric;
@@ -573,16 +146,16 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
             size_t at = (size_t)i * (size_t)n + (size_t)j, top = (size_t)i * (size_t)m + (size_t)j;
             rotor->K[top] = Ka[at];
             rotor->C[top] = Ca[at];
-            rotor->G[top] = make_complex(0.0, -fe->G[at]);
+            rotor->G[top] = cplx_make(0.0, -fe->G[at]);
             if (doubled) {
                 size_t right = top + (size_t)n, below = top + (size_t)n * (size_t)m, across = below + (size_t)n;
                 rotor->K[right] = Kb[at];
                 rotor->C[right] = Cb[at];
-                rotor->K[below] = conj(Kb[at]);
-                rotor->C[below] = conj(Cb[at]);
-                rotor->K[across] = conj(Ka[at]);
-                rotor->C[across] = conj(Ca[at]);
-                rotor->G[across] = make_complex(0.0, fe->G[at]);
+                rotor->K[below] = cplx_conj(Kb[at]);
+                rotor->C[below] = cplx_conj(Cb[at]);
+                rotor->K[across] = cplx_conj(Ka[at]);
+                rotor->C[across] = cplx_conj(Ca[at]);
+                rotor->G[across] = cplx_make(0.0, fe->G[at]);
             }
         }
     }
@@ -601,7 +174,7 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
             size_t at = (size_t)rotor->order[i] * (size_t)m + (size_t)rotor->order[j];
             int mass = rotor->order[i] / n == rotor->order[j] / n &&
                        fe->M[(size_t)(rotor->order[i] % n) * (size_t)n + (size_t)(rotor->order[j] % n)] != 0.0;
-            if (rotor->K[at] != 0.0 || rotor->C[at] != 0.0 || rotor->G[at] != 0.0 || mass) {
+            if (!cplx_is_zero(rotor->K[at]) || !cplx_is_zero(rotor->C[at]) || !cplx_is_zero(rotor->G[at]) || mass) {
                 kl = i - j > kl ? i - j : kl;
                 ku = j - i > ku ? j - i : ku;
             }
@@ -624,13 +197,13 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
             AB(band, rotor->banded[1], i, j) = rotor->C[at];
             AB(band, rotor->banded[2], i, j) = rotor->G[at];
             AB(band, rotor->banded[3], i, j) =
-                r / n == c / n ? fe->M[(size_t)(r % n) * (size_t)n + (size_t)(c % n)] : 0.0;
+                cplx_real(r / n == c / n ? fe->M[(size_t)(r % n) * (size_t)n + (size_t)(c % n)] : 0.0);
         }
     }
     /* DampedRotor._scale = sqrt(max |diag K2| / max diag M2) */
     double k_max = 0.0, m_max = -INFINITY;
     for (int i = 0; i < m; i++) {
-        double k = cabs(rotor->K[(size_t)i * (size_t)m + (size_t)i]);
+        double k = cplx_abs(rotor->K[(size_t)i * (size_t)m + (size_t)i]);
         k_max = k > k_max || isnan(k) ? k : k_max;
         m_max = fmax(m_max, fe->M[(size_t)(i % n) * (size_t)n + (size_t)(i % n)]);
     }
@@ -657,7 +230,7 @@ typedef struct {
 static int by_frequency(const void *a, const void *b)
 {
     const Mode *x = a, *y = b;
-    double u = cimag(x->eigenvalue), v = cimag(y->eigenvalue);
+    double u = x->eigenvalue.im, v = y->eigenvalue.im;
     if (u != v) {
         return (u > v) - (u < v);
     }
@@ -738,79 +311,18 @@ static void krylov_apply(const Rotor *rotor, const Krylov *krylov, const cplx *v
     const cplx *v1 = v, *v2 = v + m, *mass = rotor->banded[3];
     cplx *y1 = y, *y2 = y + m;
     for (int i = 0; i < m; i++) {
-        y1[i] = 0.0;
+        y1[i] = cplx_real(0.0);
     }
     for (int j = 0; j < m; j++) { /* -s M2 v2 - (C2 + spin Gv + SHIFT M2) v1, column by column */
         int first = j - band.ku > 0 ? j - band.ku : 0, last = j + band.kl < m ? j + band.kl : m - 1;
-        cplx a = -s * v2[j], b = v1[j];
+        cplx a = cplx_scale(-s, v2[j]), b = v1[j];
         for (int i = first; i <= last; i++) {
-            y1[i] += mul(AB(band, mass, i, j), a) - mul(AB(band, krylov->coupling, i, j), b);
+            y1[i] = cplx_add(y1[i], cplx_sub(cplx_mul(AB(band, mass, i, j), a), cplx_mul(AB(band, krylov->coupling, i, j), b)));
         }
     }
     band_substitute(band, krylov->q, krylov->pivots, y1);
     for (int i = 0; i < m; i++) {
-        y2[i] = (v1[i] + SHIFT * y1[i]) / s;
-    }
-}
-
-static double vector_norm(const cplx *x, int n)
-{
-    double scale = 0.0;
-    for (int i = 0; i < n; i++) {
-        scale = fmax(scale, cabs1(x[i]));
-    }
-    if (!(scale > 0.0) || !isfinite(scale)) {
-        return scale;
-    }
-    double sum = 0.0;
-    for (int i = 0; i < n; i++) {
-        double re = creal(x[i]) / scale, im = cimag(x[i]) / scale;
-        sum += re * re + im * im;
-    }
-    return scale * sqrt(sum);
-}
-
-/* w minus its projection on the first ``count`` basis vectors, twice (classical Gram-Schmidt with one
- * reorthogonalisation); the coefficients added to ``column`` (stride ``stride``) unless it is NULL */
-static void orthogonalize(const cplx *basis, int count, int order, cplx *w, cplx *column, int stride)
-{
-    for (int pass = 0; pass < 2; pass++) {
-        for (int j = 0; j < count; j++) {
-            const cplx *v = basis + (size_t)j * (size_t)order;
-            cplx c = 0.0;
-            for (int i = 0; i < order; i++) {
-                c += mul_conj(v[i], w[i]);
-            }
-            for (int i = 0; i < order; i++) {
-                w[i] -= mul(c, v[i]);
-            }
-            if (column) {
-                column[(size_t)j * (size_t)stride] += c;
-            }
-        }
-    }
-}
-
-/* A unit start vector, orthogonal to the first ``count`` basis vectors, from a fixed pseudo-random sequence */
-static void start_vector(const cplx *basis, int count, int order, unsigned long *seed, cplx *w)
-{
-    for (int attempt = 0; attempt < 3; attempt++) {
-        for (int i = 0; i < order; i++) {
-            double part[2];
-            for (int k = 0; k < 2; k++) { /* a 32-bit linear congruential sequence */
-                *seed = (*seed * 1664525UL + 1013904223UL) & 0xffffffffUL;
-                part[k] = (double)*seed / 4294967296.0 - 0.5;
-            }
-            w[i] = make_complex(part[0], part[1]);
-        }
-        orthogonalize(basis, count, order, w, NULL, 0);
-        double norm = vector_norm(w, order);
-        if (norm > 0.0) {
-            for (int i = 0; i < order; i++) {
-                w[i] /= norm;
-            }
-            return;
-        }
+        y2[i] = cplx_div_real(cplx_add(v1[i], cplx_scale(SHIFT, y1[i])), s);
     }
 }
 
@@ -835,7 +347,7 @@ static int krylov_converged(Krylov *krylov, int steps, int order, int wanted)
     for (int k = 0; k < wanted; k++) { /* partial selection by descending |nu| */
         int best = k;
         for (int i = k + 1; i < steps; i++) {
-            if (cabs(krylov->ritz[rank[i]]) > cabs(krylov->ritz[rank[best]])) {
+            if (cplx_abs(krylov->ritz[rank[i]]) > cplx_abs(krylov->ritz[rank[best]])) {
                 best = i;
             }
         }
@@ -846,13 +358,13 @@ static int krylov_converged(Krylov *krylov, int steps, int order, int wanted)
     if (steps == order) { /* the whole space: the Ritz values are the eigenvalues */
         return 1;
     }
-    double beta = cabs(krylov->hess[(size_t)steps * (size_t)cap + (size_t)(steps - 1)]);
-    double bound = RITZ_TOLERANCE * cabs(krylov->ritz[rank[0]]);
+    double beta = cplx_abs(krylov->hess[(size_t)steps * (size_t)cap + (size_t)(steps - 1)]);
+    double bound = RITZ_TOLERANCE * cplx_abs(krylov->ritz[rank[0]]);
     for (int k = 0; k < wanted; k++) { /* |h_{m+1,m} e_m^T z| with z a unit eigenvector of H */
         inverse_iteration(krylov->small, steps, krylov->ritz[rank[k]], krylov->lu, krylov->multiplier,
                           krylov->swapped, krylov->z);
         double norm = vector_norm(krylov->z, steps);
-        if (!(beta * cabs(krylov->z[steps - 1]) <= bound * norm)) {
+        if (!(beta * cplx_abs(krylov->z[steps - 1]) <= bound * norm)) {
             return 0;
         }
     }
@@ -871,8 +383,9 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
     }
     size_t cells = (size_t)rotor->band.rows * (size_t)m;
     for (size_t i = 0; i < cells; i++) {
-        krylov->coupling[i] = rotor->banded[1][i] + spin * rotor->banded[2][i] + SHIFT * rotor->banded[3][i];
-        krylov->q[i] = rotor->banded[0][i] + SHIFT * krylov->coupling[i];
+        krylov->coupling[i] = cplx_add(cplx_add(rotor->banded[1][i], cplx_scale(spin, rotor->banded[2][i])),
+                                       cplx_scale(SHIFT, rotor->banded[3][i]));
+        krylov->q[i] = cplx_add(rotor->banded[0][i], cplx_scale(SHIFT, krylov->coupling[i]));
     }
     if (band_factor(rotor->band, krylov->q, krylov->pivots)) {
         set_error(error, size, "the damped model is singular at the Arnoldi shift");
@@ -894,9 +407,9 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
         double beta = vector_norm(w, order);
         steps++;
         if (beta > 1e-12 * before) {
-            krylov->hess[(size_t)steps * (size_t)cap + (size_t)(steps - 1)] = beta;
+            krylov->hess[(size_t)steps * (size_t)cap + (size_t)(steps - 1)] = cplx_real(beta);
             for (int i = 0; i < order; i++) {
-                w[i] /= beta;
+                w[i] = cplx_div_real(w[i], beta);
             }
         } else if (steps < order) { /* an invariant subspace: go on with a new direction */
             start_vector(krylov->basis, steps, order, &seed, w);
@@ -918,7 +431,8 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
     }
     krylov->steps = steps;
     for (int k = 0; k < wanted; k++) {
-        lambda[k] = SHIFT + 1.0 / krylov->ritz[krylov->rank[k]];
+        cplx inverse = cplx_div(cplx_real(1.0), krylov->ritz[krylov->rank[k]]);
+        lambda[k] = cplx_make(SHIFT + inverse.re, inverse.im);
     }
     return 0;
 }
@@ -933,11 +447,11 @@ static void krylov_shares(const Rotor *rotor, Krylov *krylov, int k, double *for
     for (int t = 0; t < rotor->n_translations; t++) { /* x = y1 = V z at the rows of p_U and q_U */
         int rows[2] = {krylov->place[rotor->translations[t]], krylov->place[rotor->n + rotor->translations[t]]};
         for (int half = 0; half < 2; half++) {
-            cplx x = 0.0;
+            cplx x = cplx_real(0.0);
             for (int j = 0; j < steps; j++) {
-                x += mul(krylov->basis[(size_t)j * (size_t)order + (size_t)rows[half]], krylov->z[j]);
+                x = cplx_add(x, cplx_mul(krylov->basis[(size_t)j * (size_t)order + (size_t)rows[half]], krylov->z[j]));
             }
-            *(half ? backward : forward) += creal(x) * creal(x) + cimag(x) * cimag(x);
+            *(half ? backward : forward) += x.re * x.re + x.im * x.im;
         }
     }
 }
@@ -965,73 +479,6 @@ static void dense_free(Dense *dense)
     }
     krylov_free(&dense->krylov);
     memset(dense, 0, sizeof *dense);
-}
-
-/* LU factors with partial pivoting of the real ``m`` (numpy.linalg.solve); -1 if it is singular */
-static int lu_factor(double *m, int n, int *pivots)
-{
-    for (int j = 0; j < n; j++) {
-        int pivot = j;
-        for (int i = j + 1; i < n; i++) {
-            if (fabs(m[(size_t)i * (size_t)n + (size_t)j]) > fabs(m[(size_t)pivot * (size_t)n + (size_t)j])) {
-                pivot = i;
-            }
-        }
-        pivots[j] = pivot;
-        if (m[(size_t)pivot * (size_t)n + (size_t)j] == 0.0) {
-            return -1;
-        }
-        if (pivot != j) {
-            for (int c = 0; c < n; c++) {
-                double t = m[(size_t)j * (size_t)n + (size_t)c];
-                m[(size_t)j * (size_t)n + (size_t)c] = m[(size_t)pivot * (size_t)n + (size_t)c];
-                m[(size_t)pivot * (size_t)n + (size_t)c] = t;
-            }
-        }
-        const double *row_j = m + (size_t)j * (size_t)n;
-        for (int i = j + 1; i < n; i++) {
-            double *row_i = m + (size_t)i * (size_t)n;
-            double factor = row_i[j] / row_j[j];
-            row_i[j] = factor;
-            if (factor != 0.0) {
-                for (int c = j + 1; c < n; c++) {
-                    row_i[c] -= factor * row_j[c];
-                }
-            }
-        }
-    }
-    return 0;
-}
-
-/* x <- -M^-1 x for the n rows of x (``columns`` wide, ``stride`` apart), M by its LU factors */
-static void mass_solve(const double *lu, const int *pivots, int n, cplx *x, int columns, int stride)
-{
-    for (int c = 0; c < columns; c++) {
-        for (int i = 0; i < n; i++) {
-            if (pivots[i] != i) {
-                cplx t = x[(size_t)i * (size_t)stride + (size_t)c];
-                x[(size_t)i * (size_t)stride + (size_t)c] = x[(size_t)pivots[i] * (size_t)stride + (size_t)c];
-                x[(size_t)pivots[i] * (size_t)stride + (size_t)c] = t;
-            }
-        }
-        for (int i = 0; i < n; i++) {
-            cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
-            for (int k = 0; k < i; k++) {
-                sum -= lu[(size_t)i * (size_t)n + (size_t)k] * x[(size_t)k * (size_t)stride + (size_t)c];
-            }
-            x[(size_t)i * (size_t)stride + (size_t)c] = sum;
-        }
-        for (int i = n - 1; i >= 0; i--) {
-            cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
-            for (int k = i + 1; k < n; k++) {
-                sum -= lu[(size_t)i * (size_t)n + (size_t)k] * x[(size_t)k * (size_t)stride + (size_t)c];
-            }
-            x[(size_t)i * (size_t)stride + (size_t)c] = sum / lu[(size_t)i * (size_t)n + (size_t)i];
-        }
-        for (int i = 0; i < n; i++) {
-            x[(size_t)i * (size_t)stride + (size_t)c] = -x[(size_t)i * (size_t)stride + (size_t)c];
-        }
-    }
 }
 
 /* DampedRotor._dense_blocks and the eigen solver's arrays */
@@ -1089,7 +536,7 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
         return -1;
     }
     for (size_t i = 0; i < block; i++) {
-        dense->stiffness[i] = rotor->K[i] / rotor->scale;
+        dense->stiffness[i] = cplx_div_real(rotor->K[i], rotor->scale);
         dense->damping[i] = rotor->C[i];
         dense->gyro[i] = rotor->G[i];
     }
@@ -1114,15 +561,15 @@ static int dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char
         for (int j = 0; j < order; j++) {
             size_t at = (size_t)i * (size_t)order + (size_t)j;
             if (i < m) {
-                a[at] = j == m + i ? rotor->scale : 0.0;
+                a[at] = cplx_real(j == m + i ? rotor->scale : 0.0);
             } else {
                 size_t b = (size_t)(i - m) * (size_t)m + (size_t)(j < m ? j : j - m);
-                a[at] = j < m ? dense->stiffness[b] : dense->damping[b] + spin * dense->gyro[b];
+                a[at] = j < m ? dense->stiffness[b] : cplx_add(dense->damping[b], cplx_scale(spin, dense->gyro[b]));
             }
         }
     }
     for (size_t i = 0; i < (size_t)order * (size_t)order; i++) {
-        if (!isfinite(creal(a[i])) || !isfinite(cimag(a[i]))) { /* numpy.linalg's check */
+        if (!isfinite(a[i].re) || !isfinite(a[i].im)) { /* numpy.linalg's check */
             set_error(error, size, "Array must not contain infs or NaNs");
             return -1;
         }
@@ -1163,28 +610,28 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
     }
     if (rotor->conservative) { /* the eigensolver's real parts are round-off (DampedRotor.modes) */
         for (int k = 0; k < count; k++) {
-            dense->lambda[index[k]] = make_complex(0.0, cimag(dense->lambda[index[k]]));
+            dense->lambda[index[k]] = cplx_make(0.0, (dense->lambda[index[k]]).im);
         }
     }
     double largest = 0.0;
     for (int k = 0; k < count; k++) {
-        double size_k = cabs(dense->lambda[index[k]]);
+        double size_k = cplx_abs(dense->lambda[index[k]]);
         largest = size_k > largest || isnan(size_k) ? size_k : largest;
     }
     /* whirling: not overdamped or static */
     int kept = 0;
     for (int k = 0; k < count; k++) {
         cplx value = dense->lambda[index[k]];
-        if (!isfinite(creal(value)) || !isfinite(cimag(value)) || !(fabs(cimag(value)) > 1e-9 * largest)) {
+        if (!isfinite(value.re) || !isfinite(value.im) || !(fabs(value.im) > 1e-9 * largest)) {
             continue;
         }
         Mode *mode = &dense->modes[kept];
         mode->place = k;
         if (!rotor->doubled) { /* u = p exp(lam t): Im lam < 0 whirls backward */
-            mode->eigenvalue = make_complex(creal(value), fabs(cimag(value)));
-            mode->forward_share = cimag(value) > 0.0 ? 1.0 : 0.0;
+            mode->eigenvalue = cplx_make(value.re, fabs(value.im));
+            mode->forward_share = value.im > 0.0 ? 1.0 : 0.0;
             kept++;
-        } else if (cimag(value) > 0.0) { /* each mode also appears conjugated, at -w_d */
+        } else if (value.im > 0.0) { /* each mode also appears conjugated, at -w_d */
             mode->eigenvalue = value;
             mode->forward_share = 0.0; /* from its eigenvector below */
             kept++;
@@ -1204,8 +651,8 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
                 back_transform(dense->a, order, dense->tau, dense->d, dense->x);
                 for (int t = 0; t < rotor->n_translations; t++) {
                     cplx p = dense->x[rotor->translations[t]], q = dense->x[rotor->n + rotor->translations[t]];
-                    forward += creal(p) * creal(p) + cimag(p) * cimag(p);
-                    backward += creal(q) * creal(q) + cimag(q) * cimag(q);
+                    forward += p.re * p.re + p.im * p.im;
+                    backward += q.re * q.re + q.im * q.im;
                 }
             }
             out[k].forward_share = forward / (forward + backward);
@@ -1248,12 +695,12 @@ static int shape_row(const Rotor *rotor, double z, double length, cplx *row, cha
     double x2 = xi * xi, x3 = pow(xi, 3.0);
     double shape[4] = {1 - 3 * x2 + 2 * x3, h * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, h * (x3 - x2)};
     for (int i = 0; i < rotor->n; i++) {
-        row[i] = 0.0;
+        row[i] = cplx_real(0.0);
     }
     for (int k = 0; k < 4; k++) {
         int target = fe->index[fe->elements[4 * e + k]];
         if (target >= 0) {
-            row[target] += shape[k];
+            row[target].re += shape[k];
         }
     }
     return 0;
@@ -1296,8 +743,8 @@ static int mode_table(const Driveline *d, const int *counts, const double *spins
         for (int k = 0; k < found && excited < DAMPED_MODES && !status; k++) {
             if (modes[k].forward_share >= ROTOR_EXCITED_SHARE) {
                 cplx value = modes[k].eigenvalue;
-                out[excited] = cimag(value);
-                out[DAMPED_MODES + excited] = -creal(value) / cabs(value);
+                out[excited] = value.im;
+                out[DAMPED_MODES + excited] = -value.re / cplx_abs(value);
                 excited++;
             }
         }
@@ -1368,9 +815,9 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
             unbalance_outputs_free(outputs);
             return NULL;
         }
-        cplx phasor = unbalances[u].amount * cexp(make_complex(0.0, unbalances[u].phase));
+        cplx phasor = cplx_scale(unbalances[u].amount, cplx_expi(unbalances[u].phase));
         for (int i = 0; i < rotor->n; i++) {
-            outputs->load[i] += phasor * rows[i];
+            outputs->load[i] = cplx_add(outputs->load[i], cplx_mul(phasor, rows[i]));
         }
     }
     free(rows);
@@ -1426,44 +873,47 @@ void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, d
     Band band = rotor->band;
     int m = rotor->size, n = rotor->n;
     /* K2 + i Omega (C2 + Omega Gv) - Omega^2 M2 */
-    cplx spin_c = make_complex(0.0, speed), spin_g = make_complex(0.0, speed * speed);
+    cplx spin_c = cplx_make(0.0, speed), spin_g = cplx_make(0.0, speed * speed);
     double squared = speed * speed;
     size_t cells = (size_t)band.rows * (size_t)m;
     for (size_t i = 0; i < cells; i++) {
-        outputs->ab[i] = rotor->banded[0][i] + mul(spin_c, rotor->banded[1][i]) + mul(spin_g, rotor->banded[2][i]) -
-                         squared * rotor->banded[3][i];
+        outputs->ab[i] = cplx_sub(cplx_add(cplx_add(rotor->banded[0][i], cplx_mul(spin_c, rotor->banded[1][i])),
+                                            cplx_mul(spin_g, rotor->banded[2][i])),
+                                   cplx_scale(squared, rotor->banded[3][i]));
     }
     for (int i = 0; i < m; i++) {
-        outputs->x[i] = squared * outputs->load[rotor->order[i]];
+        outputs->x[i] = cplx_scale(squared, outputs->load[rotor->order[i]]);
     }
     if (band_solve(band, outputs->ab, outputs->pivots, outputs->x)) { /* an undamped resonance hit exactly */
         out[0] = out[1] = INFINITY;
         return;
     }
     /* the solution back in the order [p, q]: x[i] is unknown order[i] */
-    cplx forward = 0.0, backward = 0.0;
+    cplx forward = cplx_real(0.0), backward = cplx_real(0.0);
     const cplx *x = outputs->x;
     int *place = outputs->pivots; /* free again after the solve */
     for (int i = 0; i < m; i++) {
         place[rotor->order[i]] = i;
     }
     for (int j = 0; j < n; j++) {
-        forward += x[place[j]] * outputs->row[j];
+        forward = cplx_add(forward, cplx_mul(x[place[j]], outputs->row[j]));
         if (rotor->doubled) {
-            backward += x[place[n + j]] * outputs->row[j];
+            backward = cplx_add(backward, cplx_mul(x[place[n + j]], outputs->row[j]));
         }
     }
-    out[0] = cabs(forward) + cabs(conj(backward));
+    out[0] = cplx_abs(forward) + cplx_abs(cplx_conj(backward));
     double largest = 0.0; /* np.max(forces, initial=0.0), nan propagated */
     for (int b = 0; b < rotor->n_bearings; b++) {
         int row = rotor->bearing_rows[b];
         double force = 0.0;
         if (row >= 0) {
             const cplx *c = rotor->coefficients + 4 * b;
-            cplx a = x[place[row]], q = rotor->doubled ? x[place[n + row]] : 0.0;
-            cplx fa = (c[0] + spin_c * c[2]) * a + (c[1] + spin_c * c[3]) * q;
-            cplx fq = (conj(c[1]) + spin_c * conj(c[3])) * a + (conj(c[0]) + spin_c * conj(c[2])) * q;
-            force = cabs(fa) + cabs(fq);
+            cplx a = x[place[row]], q = rotor->doubled ? x[place[n + row]] : cplx_real(0.0);
+            cplx fa = cplx_add(cplx_mul(cplx_add(c[0], cplx_mul(spin_c, c[2])), a),
+                               cplx_mul(cplx_add(c[1], cplx_mul(spin_c, c[3])), q));
+            cplx fq = cplx_add(cplx_mul(cplx_add(cplx_conj(c[1]), cplx_mul(spin_c, cplx_conj(c[3]))), a),
+                               cplx_mul(cplx_add(cplx_conj(c[0]), cplx_mul(spin_c, cplx_conj(c[2]))), q));
+            force = cplx_abs(fa) + cplx_abs(fq);
         }
         if (isnan(force) || force > largest) {
             largest = isnan(largest) ? largest : force;

@@ -2,13 +2,14 @@
  * frequencies of its plausibility check (model.natural_frequencies). */
 #include "rotor.h"
 
+#include "elements.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define PI 3.14159265358979323846
 #define OUT_OF_MEMORY "out of memory"
 
 static void set_error(char *error, size_t size, const char *message)
@@ -26,77 +27,6 @@ void fe_elements_by_length(const Driveline *driveline, int most, int *counts)
         double share = ceil(most * driveline->segments[k].length / half - 1e-9);
         int count = share >= most ? most : (int)share;
         counts[k] = count < 1 ? 1 : count;
-    }
-}
-
-/* ---- elements.ShaftSegment ------------------------------------------------------------------ */
-static double segment_area(const RotorSegment *s)
-{
-    return PI / 4.0 * (pow(s->outer_diameter, 2.0) - pow(s->inner_diameter, 2.0));
-}
-
-static double segment_second_moment(const RotorSegment *s)
-{
-    return PI / 64.0 * (pow(s->outer_diameter, 4.0) - pow(s->inner_diameter, 4.0));
-}
-
-/* ShaftSegment.shear_stiffness (Cowper's coefficient of a hollow circle) */
-static double segment_shear_stiffness(const RotorSegment *s)
-{
-    double nu = s->poisson_ratio;
-    double m2 = pow(s->inner_diameter / s->outer_diameter, 2.0);
-    double r12 = pow(1.0 + m2, 2.0);
-    double kappa = 6.0 * (1.0 + nu) * r12 / ((7.0 + 6.0 * nu) * r12 + (20.0 + 12.0 * nu) * m2);
-    return kappa * s->youngs_modulus / (2.0 * (1.0 + nu)) * segment_area(s);
-}
-
-/* elements._symmetric_element times ``scale`` */
-static void symmetric_element(double scale, double d11, double d12, double d13, double d14, double d22, double d23,
-                              double d24, double out[16])
-{
-    const double entries[16] = {d11, d12, d13, d14, d12, d22, d23, d24, d13, d23, d11, -d12, d14, d24, -d12, d22};
-    for (int i = 0; i < 16; i++) {
-        out[i] = scale * entries[i];
-    }
-}
-
-/* ShaftSegment.fe_matrices: one element's k, m, g (Hermite, or Timoshenko with shear) */
-static void segment_element(const RotorSegment *s, double h, double k[16], double m[16], double g[16])
-{
-    double I = segment_second_moment(s);
-    double EI = s->youngs_modulus * I;
-    double rhoA = s->density * segment_area(s);
-    double rhoI = s->density * I;
-    double phi = s->shear ? 12.0 * EI / (segment_shear_stiffness(s) * h * h) : 0.0;
-    double mt[16], mr[16];
-    if (phi == 0.0) {
-        double kh = EI / pow(h, 3.0), mh = rhoA * h / 420, rh = rhoI / (30 * h);
-        const double ke[16] = {12, 6 * h, -12, 6 * h, 6 * h, 4 * h * h, -6 * h, 2 * h * h,
-                               -12, -6 * h, 12, -6 * h, 6 * h, 2 * h * h, -6 * h, 4 * h * h};
-        const double me[16] = {156, 22 * h, 54, -13 * h, 22 * h, 4 * h * h, 13 * h, -3 * h * h,
-                               54, 13 * h, 156, -22 * h, -13 * h, -3 * h * h, -22 * h, 4 * h * h};
-        const double re[16] = {36, 3 * h, -36, 3 * h, 3 * h, 4 * h * h, -3 * h, -h * h,
-                               -36, -3 * h, 36, -3 * h, 3 * h, -h * h, -3 * h, 4 * h * h};
-        for (int i = 0; i < 16; i++) {
-            k[i] = kh * ke[i];
-            mt[i] = mh * me[i];
-            mr[i] = rh * re[i];
-        }
-    } else { /* elements._shear_element */
-        double p2 = phi * phi;
-        symmetric_element(EI / ((1 + phi) * pow(h, 3.0)), 12, 6 * h, -12, 6 * h, (4 + phi) * h * h, -6 * h,
-                          (2 - phi) * h * h, k);
-        symmetric_element(rhoA * h / pow(1 + phi, 2.0), 13.0 / 35 + 7 * phi / 10 + p2 / 3,
-                          (11.0 / 210 + 11 * phi / 120 + p2 / 24) * h, 9.0 / 70 + 3 * phi / 10 + p2 / 6,
-                          -(13.0 / 420 + 3 * phi / 40 + p2 / 24) * h, (1.0 / 105 + phi / 60 + p2 / 120) * h * h,
-                          (13.0 / 420 + 3 * phi / 40 + p2 / 24) * h, -(1.0 / 140 + phi / 60 + p2 / 120) * h * h, mt);
-        symmetric_element(rhoI / (pow(1 + phi, 2.0) * h), 6.0 / 5, (1.0 / 10 - phi / 2) * h, -6.0 / 5,
-                          (1.0 / 10 - phi / 2) * h, (2.0 / 15 + phi / 6 + p2 / 3) * h * h, -(1.0 / 10 - phi / 2) * h,
-                          (-1.0 / 30 - phi / 6 + p2 / 6) * h * h, mr);
-    }
-    for (int i = 0; i < 16; i++) {
-        m[i] = s->rotary_inertia ? mt[i] + mr[i] : mt[i];
-        g[i] = s->gyroscopic ? 2.0 * mr[i] : 0.0;
     }
 }
 
@@ -227,7 +157,7 @@ static int walk_mesh(const Driveline *d, const int *counts, int with_bearings, F
             double *K = segment, *M = segment + (size_t)n * (size_t)n, *G = M + (size_t)n * (size_t)n;
             double k[16], m[16], g[16];
             memset(segment, 0, 3 * (size_t)n * (size_t)n * sizeof *segment);
-            segment_element(s, h, k, m, g);
+            segment_fe_element(s, h, k, m, g);
             for (int e = 0; e < count; e++) {
                 for (int i = 0; i < 4; i++) {
                     for (int j = 0; j < 4; j++) {

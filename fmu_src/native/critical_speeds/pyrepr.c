@@ -116,16 +116,16 @@ void python_str_repr_n(const char *text, size_t length, size_t max_chars, char *
         } else if (code == '\t' || code == '\n' || code == '\r') {
             snprintf(piece, sizeof piece, "\\%c", code == '\t' ? 't' : code == '\n' ? 'n' : 'r');
         } else if (code < 0x20 || code == 0x7F) {
-            snprintf(piece, sizeof piece, "\\x%02lx", code);
+            snprintf(piece, sizeof piece, "\\x%02x", (unsigned int)code);
         } else if (code < 0x80 || printable(code)) {
             memcpy(piece, text + at, width);
             piece[width] = '\0';
         } else if (code < 0x100) {
-            snprintf(piece, sizeof piece, "\\x%02lx", code);
+            snprintf(piece, sizeof piece, "\\x%02x", (unsigned int)code);
         } else if (code < 0x10000) {
-            snprintf(piece, sizeof piece, "\\u%04lx", code);
+            snprintf(piece, sizeof piece, "\\u%04x", (unsigned int)code);
         } else {
-            snprintf(piece, sizeof piece, "\\U%08lx", (unsigned long)code & 0x1FFFFFUL);
+            snprintf(piece, sizeof piece, "\\U%08x", (unsigned int)(code & 0x1FFFFFL));
         }
         text_append(out, size, &used, piece, strlen(piece));
     }

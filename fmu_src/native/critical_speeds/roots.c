@@ -14,9 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
 
 #define SUBGRID 24          /* roots.SUBGRID */
 #define MAX_DEPTH 16        /* roots.MAX_DEPTH */
@@ -223,7 +220,7 @@ static double *grid_new(const Chain *chain, double x_max, double ratio, int coar
     double kappa = chain_kappa(chain) * sqrt(fabs(ratio)), theta_max, steps, step, log_start, log_stop, *x;
     per_pi = POINTS_PER_ROOT * (1 + extra) * (chain_isotropic(chain) ? 1 : 2);
     theta_max = kappa * sqrt(x_max);
-    steps = ceil(theta_max / M_PI * per_pi);
+    steps = ceil(theta_max / FMU_PI * per_pi);
     if (!(steps < (double)(INT_MAX / 2))) {
         set_error(error, size, "out of memory");
         return NULL;
@@ -325,7 +322,7 @@ static int line_roots(const Chain *chain, const RotorLine *lines, int m, int n, 
         return speed_error("limit", limit, error, size);
     }
     for (j = 0; j < m; j++) {
-        double ratio = fabs(lines[j].w), x_hi = (n + 2) * M_PI / (chain_kappa(chain) * sqrt(ratio));
+        double ratio = fabs(lines[j].w), x_hi = (n + 2) * FMU_PI / (chain_kappa(chain) * sqrt(ratio));
         x_hi = x_hi * x_hi;
         x_hi = x_hi < limit ? x_hi : limit;
         for (;;) { /* a line short of n roots is searched again over a 4x wider range, until limit */

@@ -2,9 +2,11 @@
  * stays the readable reference; every function names the Python function it ports).
  *
  * One header for the library's modules, one module per concern:
- *   layout.c     the driveline (segments, point elements, unbalances), the one-piece tube and the
- *                TOML-subset layout reader with the Python loader's messages and work limits
+ *   layout.c     the driveline (segments, point elements, unbalances) of a layout read by the
+ *                TOML-subset reader (toml.h), checked with the Python loader's messages and work
+ *                limits; the one-piece tube
  *   pyrepr.c     Python's repr() of the values the messages show
+ *   mechanism.c  whether the supports hold the shaft still (no zero-frequency mechanism mode)
  *   transfer.c   element transfer matrices and the scaled frequency determinant (seed Eqs. 16-31)
  *   roots.c      the batched bracketing root search and the searches along lines (w, spin)
  *   spline.c     not-a-knot cubic splines (scipy's CubicSpline default)
@@ -73,6 +75,12 @@ typedef struct {
     RotorUnbalance *unbalances;
     EndCondition left, right;
 } Driveline;
+
+/* mechanism.mechanism_error: MECHANISM_NONE when the supports hold the driveline still,
+ * MECHANISM_HINGE_FOLDS with the index (in ``hinges``) and node of the hinge that folds, or
+ * MECHANISM_RIGID_BODY when the whole shaft moves rigidly; -1: out of memory. */
+enum { MECHANISM_NONE = 0, MECHANISM_HINGE_FOLDS = 1, MECHANISM_RIGID_BODY = 2 };
+int driveline_mechanism(const Driveline *driveline, int *hinge_index, int *hinge_node);
 
 /* The parameters of loader.one_piece_shaft (the FMU's one-piece tube). */
 typedef struct {

@@ -9,15 +9,13 @@
  * triangular factors is summed, so that nothing overflows. */
 #include "rotor.h"
 
+#include "elements.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
 #define MAX_PIECE_PHASE 2.0 /* transfer.MAX_PIECE_PHASE */
-#define SERIES_LIMIT 0.1    /* elements._SERIES_LIMIT */
 #define LOG_SCALE_CLIP 700.0
 #define MODE_MIN_PIECES 4 /* mode_shape(..., points_per_segment=4) */
 #define JACOBI_SWEEPS 60
@@ -69,85 +67,6 @@ static void set_error(char *error, size_t size, const char *text)
     }
 }
 
-/* ---- elements.py: Krylov functions ------------------------------------------------------------ */
-
-/* elements._sinh_minus_x_over_x3 */
-static double sinh_minus_x_over_x3(double x)
-{
-    double x2;
-    if (x >= SERIES_LIMIT) {
-        return (sinh(x) - x) / pow(x, 3.0);
-    }
-    x2 = x * x;
-    return 1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (1.0 / 5040.0 + x2 / 362880.0));
-}
-
-/* elements._x_minus_sin_over_x3 */
-static double x_minus_sin_over_x3(double y)
-{
-    double y2;
-    if (y >= SERIES_LIMIT) {
-        return (y - sin(y)) / pow(y, 3.0);
-    }
-    y2 = y * y;
-    return 1.0 / 6.0 - y2 * (1.0 / 120.0 - y2 * (1.0 / 5040.0 - y2 / 362880.0));
-}
-
-/* elements._cosh_minus_1_over_x2 */
-static double cosh_minus_1_over_x2(double x)
-{
-    double h = 0.5 * x;
-    double r = h == 0.0 ? 1.0 : sinh(h) / h;
-    return 0.5 * r * r;
-}
-
-/* elements._1_minus_cos_over_y2 (numpy.sinc of y / (2 pi)) */
-static double one_minus_cos_over_y2(double y)
-{
-    double t = y / (2.0 * M_PI);
-    double u = M_PI * (t == 0.0 ? 1.0e-20 : t);
-    double r = sin(u) / u;
-    return 0.5 * r * r;
-}
-
-/* elements._betas: beta1^2, beta2^2 of U'''' + a U'' - b U = 0 (seed Eqs. 22-23) */
-static void betas(double a, double b, double *b1sq, double *b2sq)
-{
-    double r = sqrt(0.25 * a * a + b);
-    double big2 = a >= 0.0 ? r + 0.5 * a : r - 0.5 * a;
-    double small2 = big2 > 0.0 ? b / big2 : 0.0;
-    *b1sq = a >= 0.0 ? small2 : big2;
-    *b2sq = a >= 0.0 ? big2 : small2;
-}
-
-/* elements._krylov: C0..C3 of y'''' + a y'' - b y = 0 at z */
-static void krylov(double a, double b, double z, double C[4])
-{
-    double b1sq, b2sq, x, y, s, w1, w2, b_over_s, g1, g2, h1, h2, z2, z3;
-    betas(a, b, &b1sq, &b2sq);
-    x = sqrt(fabs(b1sq)) * z;
-    y = sqrt(b2sq) * z;
-    s = b1sq + b2sq;
-    w1 = s > 0.0 ? b1sq / s : 0.5;
-    w2 = s > 0.0 ? b2sq / s : 0.5;
-    b_over_s = s > 0.0 ? b / s : 0.0;
-    if (b1sq < 0.0) { /* a shear beam above its cut-off: trigonometric in |beta1| */
-        g1 = x_minus_sin_over_x3(x);
-        h1 = one_minus_cos_over_y2(x);
-    } else {
-        g1 = sinh_minus_x_over_x3(x);
-        h1 = cosh_minus_1_over_x2(x);
-    }
-    g2 = x_minus_sin_over_x3(y);
-    h2 = one_minus_cos_over_y2(y);
-    z2 = z * z;
-    z3 = pow(z, 3.0);
-    C[0] = 1.0 + b_over_s * z2 * (h1 - h2);
-    C[1] = z + b_over_s * z3 * (g1 - g2);
-    C[2] = z2 * (w1 * h1 + w2 * h2);
-    C[3] = z3 * (w1 * g1 + w2 * g2);
-}
-
 /* ---- elements.ShaftSegment ------------------------------------------------------------------- */
 
 /* ShaftSegment._couple: c = rho I w^2 - rho Ip Omega w, Ip = 2 I */
@@ -181,35 +100,8 @@ static double beta1(const ChainSegment *seg, double w, double spin)
 {
     double a, b, b1sq, b2sq;
     wave_coefficients(seg, couple(seg, w, spin), w, &a, &b);
-    betas(a, b, &b1sq, &b2sq);
+    element_betas(a, b, &b1sq, &b2sq);
     return sqrt(b1sq > 0.0 ? b1sq : 0.0);
-}
-
-/* elements.beam_field_matrix (seed Eqs. 16-20, corrected) */
-static void beam_field_matrix(double z, double EI, double c, double a, double b, double H[4][4])
-{
-    double C[4], C1a, C0a, phi[4][4];
-    int i, j;
-    krylov(a, b, z, C);
-    C1a = C[1] - a * C[3];
-    C0a = C[0] - a * C[2];
-    for (j = 0; j < 4; j++) {
-        phi[0][j] = C[j];
-    }
-    phi[1][0] = b * C[3]; phi[1][1] = C[0]; phi[1][2] = C1a; phi[1][3] = C[2];
-    phi[2][0] = b * C[2]; phi[2][1] = b * C[3]; phi[2][2] = C0a; phi[2][3] = C1a;
-    phi[3][0] = b * C1a; phi[3][1] = b * C[2]; phi[3][2] = b * C[3] - a * C1a; phi[3][3] = C0a;
-    for (j = 0; j < 4; j++) { /* s = S d */
-        H[0][j] = phi[0][j];
-        H[1][j] = phi[1][j];
-        H[2][j] = EI * phi[2][j];
-        H[3][j] = EI * phi[3][j] + c * phi[1][j];
-    }
-    for (i = 0; i < 4; i++) { /* ... times S^-1 */
-        H[i][1] -= c / EI * H[i][3];
-        H[i][2] /= EI;
-        H[i][3] /= EI;
-    }
 }
 
 /* elements.shear_beam_field_matrix: expm(A l) = C0 + C1 A + C2 A^2 + C3 A^3 */
@@ -218,7 +110,7 @@ static void shear_beam_field_matrix(const ChainSegment *seg, double z, double c,
 {
     double C[4], A[4][4] = {{0.0}}, power[4][4], next[4][4];
     int i, j, k, p;
-    krylov(a, b, z, C);
+    element_krylov(a, b, z, C);
     A[0][1] = 1.0;
     A[0][3] = -1.0 / seg->shear_stiffness;
     A[1][2] = 1.0 / seg->EI;
@@ -846,20 +738,15 @@ static int check_node(const char *kind, int i, int node, int n_nodes, int inner,
     return 0;
 }
 
-/* ShaftSegment's derived constants (area, second_moment, bending_stiffness, mass_per_length,
- * shear_coefficient (Cowper), shear_stiffness) */
+/* ShaftSegment's derived constants the transfer matrices use */
 static void segment_constants(const RotorSegment *s, ChainSegment *out)
 {
-    double D = s->outer_diameter, d = s->inner_diameter, nu = s->poisson_ratio;
-    double area = M_PI / 4.0 * (pow(D, 2.0) - pow(d, 2.0));
-    double second_moment = M_PI / 64.0 * (pow(D, 4.0) - pow(d, 4.0));
-    double m2 = pow(d / D, 2.0), r12 = pow(1.0 + m2, 2.0);
-    double kappa = 6.0 * (1.0 + nu) * r12 / ((7.0 + 6.0 * nu) * r12 + (20.0 + 12.0 * nu) * m2);
+    double area = segment_area(s), second_moment = segment_second_moment(s);
     out->length = s->length;
     out->EI = s->youngs_modulus * second_moment;
     out->mass_per_length = s->density * area;
     out->rho_I = s->density * second_moment;
-    out->shear_stiffness = kappa * s->youngs_modulus / (2.0 * (1.0 + nu)) * area;
+    out->shear_stiffness = segment_shear_stiffness(s);
     out->rotary_inertia = s->rotary_inertia;
     out->gyroscopic = s->gyroscopic;
     out->shear = s->shear;

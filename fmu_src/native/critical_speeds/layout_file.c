@@ -1,0 +1,281 @@
+/* A layout by file or shipped name (loader.load_driveline, loader.example_path): the path made
+ * absolute as pathlib does, the file read with stdio, at most MAX_FILE_BYTES, only a regular file. */
+#include "toml.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#ifdef _WIN32
+#include <direct.h> /* _getcwd */
+#else
+#include <unistd.h> /* getcwd */
+#endif
+
+/* ---- what ISO C cannot ask the operating system ------------------------------------------ */
+/* Standard C has neither the working directory nor a file's type, and opening a FIFO with fopen
+ * blocks until a writer comes: these two calls, with the C library each platform has, are all the
+ * loader asks of the system beyond stdio. */
+
+/* The working directory into ``out`` (``room`` bytes); NULL with errno (ERANGE: too small). */
+static char *working_directory(char *out, size_t room)
+{
+#ifdef _WIN32
+    return _getcwd(out, room > INT_MAX ? INT_MAX : (int)room);
+#else
+    return getcwd(out, room);
+#endif
+}
+
+/* 1 when ``path`` names a regular file, 0 when it names something else (a directory, a FIFO, a
+ * device), -1 with errno when it names nothing that can be looked at. */
+static int regular_file(const char *path)
+{
+#ifdef _WIN32
+    struct _stat64 info;
+    if (_stat64(path, &info) != 0) {
+        return -1;
+    }
+    return (info.st_mode & _S_IFMT) == _S_IFREG;
+#else
+    struct stat info;
+    if (stat(path, &info) != 0) {
+        return -1;
+    }
+    return S_ISREG(info.st_mode) != 0;
+#endif
+}
+
+/* os.strerror */
+static void error_text(int err, char *out, size_t size)
+{
+    const char *text = strerror(err);
+    if (text != NULL) {
+        snprintf(out, size, "%s", text);
+    } else {
+        snprintf(out, size, "error %d", err);
+    }
+}
+
+#ifdef _WIN32
+#define SEPARATOR "\\"
+#define IS_ABSOLUTE(path) ((path)[0] == '/' || (path)[0] == '\\' || ((path)[0] != '\0' && (path)[1] == ':'))
+#else
+#define SEPARATOR "/"
+#define IS_ABSOLUTE(path) ((path)[0] == '/')
+#endif
+
+/* pathlib's Path(path).absolute(): the working directory before a relative path, "//" and "."
+ * parts dropped (a leading "//" kept), ".." kept (on Windows only the working directory put
+ * before a relative path). Owned (free()); NULL with errno. */
+static char *absolute_path(const char *path)
+{
+    char *joined, *out, *cwd = NULL;
+    size_t n, used = 0, at, root;
+    if (!IS_ABSOLUTE(path)) {
+        size_t room = 256;
+        for (;;) {
+            char *grown = realloc(cwd, room);
+            if (grown == NULL) {
+                free(cwd);
+                errno = ENOMEM;
+                return NULL;
+            }
+            cwd = grown;
+            if (working_directory(cwd, room) != NULL) {
+                break;
+            }
+            if (errno != ERANGE) {
+                free(cwd);
+                return NULL;
+            }
+            room *= 2;
+        }
+    }
+    n = (cwd != NULL ? strlen(cwd) + 1 : 0) + strlen(path) + 1;
+    joined = malloc(n);
+    out = malloc(n + 1);
+    if (joined == NULL || out == NULL) {
+        free(cwd);
+        free(joined);
+        free(out);
+        errno = ENOMEM;
+        return NULL;
+    }
+    snprintf(joined, n, "%s%s%s", cwd != NULL ? cwd : "", cwd != NULL ? SEPARATOR : "", path);
+    free(cwd);
+#ifdef _WIN32
+    free(out);
+    return joined;
+#endif
+    out[used++] = '/';
+    if (joined[0] == '/' && joined[1] == '/' && joined[2] != '/') {
+        out[used++] = '/';
+    }
+    root = used;
+    for (at = 0; joined[at] != '\0';) {
+        size_t start, part;
+        while (joined[at] == '/') {
+            at++;
+        }
+        start = at;
+        while (joined[at] != '\0' && joined[at] != '/') {
+            at++;
+        }
+        part = at - start;
+        if (part == 0 || (part == 1 && joined[start] == '.')) {
+            continue;
+        }
+        if (used > root) {
+            out[used++] = '/';
+        }
+        memcpy(out + used, joined + start, part);
+        used += part;
+    }
+    out[used] = '\0';
+    free(joined);
+    return out;
+}
+
+/* loader._read_regular_file: refuse what is not a regular file before opening it (a FIFO would block
+ * fopen), read at most MAX_FILE_BYTES + 1 bytes. ``*data`` owned (free()). */
+static int read_regular_file(const char *path, char **data, size_t *length, char *error, size_t size)
+{
+    char reason[128];
+    size_t used = 0;
+    int err = 0, regular;
+    FILE *file = NULL;
+    *data = NULL;
+    errno = 0;
+    regular = regular_file(path);
+    if (regular == 0) {
+        return layout_error(error, size, "driveline file %r is not a regular file", path);
+    }
+    if (regular < 0 || (file = fopen(path, "rb")) == NULL) {
+        err = errno != 0 ? errno : EINVAL;
+    } else if ((*data = malloc(LAYOUT_MAX_FILE_BYTES + 1)) == NULL) {
+        fclose(file);
+        return layout_error(error, size, "out of memory");
+    } else {
+        while (used <= LAYOUT_MAX_FILE_BYTES) {
+            size_t got = fread(*data + used, 1, LAYOUT_MAX_FILE_BYTES + 1 - used, file);
+            if (got == 0) {
+                break;
+            }
+            used += got;
+        }
+        if (ferror(file)) {
+            err = errno != 0 ? errno : EIO;
+        }
+        fclose(file);
+    }
+    if (err != 0) {
+        free(*data);
+        *data = NULL;
+        error_text(err, reason, sizeof reason);
+        return layout_error(error, size, "cannot read driveline file %r: %s", path, reason);
+    }
+    if (used > LAYOUT_MAX_FILE_BYTES) {
+        free(*data);
+        *data = NULL;
+        return layout_error(error, size, "driveline file %r is larger than %d bytes", path, LAYOUT_MAX_FILE_BYTES);
+    }
+    *length = used;
+    return 0;
+}
+
+/* loader.load_driveline */
+static int load_driveline(const char *path, Driveline *out, char *error, size_t size)
+{
+    char *p = absolute_path(path), *data, *message;
+    size_t length = 0, p_length;
+    const char *reason;
+    long bad;
+    int status;
+    memset(out, 0, sizeof *out);
+    if (p == NULL && errno == ENOMEM) {
+        return layout_error(error, size, "out of memory");
+    }
+    if (p == NULL) { /* the working directory is gone (os.getcwd's OSError) */
+        char reason_text[128];
+        error_text(errno, reason_text, sizeof reason_text);
+        return layout_error(error, size, "cannot read driveline file %r: %s", path, reason_text);
+    }
+    if (read_regular_file(p, &data, &length, error, size) != 0) {
+        free(p);
+        return -1;
+    }
+    bad = toml_utf8_error((const unsigned char *)data, length, &reason);
+    if (bad >= 0) {
+        char at[32];
+        snprintf(at, sizeof at, "%ld", bad);
+        layout_error(error, size, "driveline file %r is not UTF-8 text (%s at byte %s)", p, reason, at);
+        free(data);
+        free(p);
+        return -1;
+    }
+    status = driveline_from_text(data, length, p, out, error, size);
+    free(data);
+    p_length = strlen(p);
+    if (status != 0 && size > 0 && strncmp(error, p, p_length) != 0) {
+        message = malloc(size);
+        if (message == NULL) {
+            layout_error(error, size, "out of memory");
+        } else {
+            memcpy(message, error, size);
+            message[size - 1] = '\0';
+            layout_error(error, size, "%s: %s", p, message);
+            free(message);
+        }
+    }
+    free(p);
+    return status;
+}
+
+/* model.build_driveline for a layout: a ".toml" file or a shipped name (loader.example_path). */
+int driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size)
+{
+    size_t n = strlen(layout), i;
+    char *path;
+    int status;
+    memset(out, 0, sizeof *out);
+    if (size > 0) {
+        error[0] = '\0';
+    }
+    if (n >= 5 && layout[n - 5] == '.' && (layout[n - 4] | 0x20) == 't' && (layout[n - 3] | 0x20) == 'o' &&
+        (layout[n - 2] | 0x20) == 'm' && (layout[n - 1] | 0x20) == 'l') {
+        return load_driveline(layout, out, error, size);
+    }
+    for (i = 0; i < n; i++) {
+        if (!(toml_bare_key_char((unsigned char)layout[i]) && layout[i] != '-')) {
+            break;
+        }
+    }
+    if (n == 0 || n > 64 || i < n) {
+        Text text = {error, size, 0};
+        text_put(&text, "no shipped example named ");
+        if (text.used + 1 < size) {
+            python_str_repr_n(layout, n, 80, error + text.used, size - text.used);
+            text.used += strlen(error + text.used);
+        }
+        text_put(&text, " (names are letters, digits and '_')");
+        return -1;
+    }
+    if (resources == NULL) {
+        return layout_error(error, size, "no shipped example named %r", layout);
+    }
+    path = malloc(strlen(resources) + n + 8);
+    if (path == NULL) {
+        return layout_error(error, size, "out of memory");
+    }
+    sprintf(path, "%s/%s.toml", resources, layout);
+    if (regular_file(path) != 1) {
+        free(path);
+        return layout_error(error, size, "no shipped example named %r", layout);
+    }
+    status = load_driveline(path, out, error, size);
+    free(path);
+    return status;
+}
