@@ -10,9 +10,10 @@ uses, so that test files carry none:
 * ``core``: neither, the FMI-free core and tools;
 * ``slow``: measured at :data:`SLOW_SECONDS` of CPU time or more in ``tests/durations.json``
   (:func:`pytest_runtest_call`: the test's call and fixtures, with the subprocesses they waited
-  for; not the session's FMU builds), and the FMU tests run for
+  for; not the FMU builds every FMU test shares), and the FMU tests run for
   every model when the model is ``CriticalSpeeds`` (its analysis costs about a second per
-  instance). ``python -m pytest -p no:randomly --update-durations [TESTS]`` measures the tests it
+  instance), and the tests of the five-platform build (``release_dir``: what it costs depends on
+  ziglang's cache). ``python -m pytest -p no:randomly --update-durations [TESTS]`` measures the tests it
   runs and writes their times into the file (the others' stay); without ``-n`` and without
   ``TESTS`` (``--collect-only`` will do) it also drops the tests no longer collected.
 
@@ -28,6 +29,7 @@ import json
 import resource
 import sys
 import time
+import warnings
 from collections.abc import Callable
 from datetime import datetime, timezone
 from pathlib import Path
@@ -47,7 +49,10 @@ IMPORTER_MODULES = ("fmu_harness.importers", "fmu_harness.interop")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
 DURATIONS = Path(__file__).with_name("durations.json")
-SLOW_SECONDS = 2.0  # CPU seconds of a test at which it is slow
+SLOW_SECONDS = 0.5  # CPU seconds of a test at which it is slow
+RELEASE_FIXTURE = "release_dir"  # the five-platform build: its cost depends on ziglang's cache
+#: The session's FMU builds, which every FMU test shares: charged to no test when measuring.
+SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "fmu_unzipdir", "open_fmu", "tripod_fmu", "native_dir"}
 
 
 QUICK_VERSIONS = ["2"]
@@ -178,7 +183,7 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
 @pytest.hookimpl(tryfirst=True)  # before ``-m`` selects by these markers
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark every test (see the module docstring); with ``--fmi``, deselect the other versions'
-    variants of tests parametrized by ``fmi`` or ``version``; a whole-suite collection refuses
+    variants of tests parametrized by ``fmi`` or ``version``; a whole-suite collection warns of
     a durations file that names tests no longer collected."""
     durations = measured()
     if config.args_source == pytest.Config.ArgsSource.TESTPATHS and not config.getoption("quick"):
@@ -186,8 +191,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if stale and config.getoption("update_durations") and not hasattr(config, "workerinput"):
             _write_durations({n: s for n, s in durations.items() if n not in stale})
         elif stale:
-            raise pytest.UsageError(f"tests/{DURATIONS.name} names tests no longer collected, e.g. {stale[:3]}: "
-                                    "refresh it with python -m pytest -p no:randomly --update-durations")
+            warnings.warn(pytest.PytestWarning(
+                f"tests/{DURATIONS.name} names {len(stale)} tests no longer collected, e.g. {stale[0]}: drop them "
+                "with python -m pytest -q --collect-only --update-durations"))
     versions = selected_versions(config)
     kept, dropped = [], []
     for item in items:
@@ -204,7 +210,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.fmu)
         elif not item.get_closest_marker("importers"):
             item.add_marker(pytest.mark.core)
-        if durations.get(item.nodeid, 0.0) >= SLOW_SECONDS or (
+        if durations.get(item.nodeid, 0.0) >= SLOW_SECONDS or RELEASE_FIXTURE in item.fixturenames or (
                 item.get_closest_marker("fmu") and SLOW_MODEL in params.values()):
             item.add_marker(pytest.mark.slow)
     if config.getoption("quick"):
@@ -229,7 +235,7 @@ _NESTED: list[float] = []  # CPU seconds of the fixtures set up within each fixt
 @pytest.hookimpl(hookwrapper=True)
 def pytest_fixture_setup(fixturedef: pytest.FixtureDef, request: pytest.FixtureRequest):
     """With ``--update-durations``, the CPU time of each fixture's own setup (without the fixtures
-    it asks for); a session fixture's (the FMU builds) is charged to no test."""
+    it asks for); the :data:`SHARED_BUILDS` are charged to no test."""
     if not request.config.getoption("update_durations"):
         yield
         return
@@ -240,7 +246,7 @@ def pytest_fixture_setup(fixturedef: pytest.FixtureDef, request: pytest.FixtureR
     own = total - _NESTED.pop()
     if _NESTED:
         _NESTED[-1] += total
-    if fixturedef.scope != "session":
+    if fixturedef.argname not in SHARED_BUILDS:
         key = (request.node.nodeid, fixturedef.argname)
         _FIXTURE_COSTS[key] = _FIXTURE_COSTS.get(key, 0.0) + own
 
@@ -248,15 +254,15 @@ def pytest_fixture_setup(fixturedef: pytest.FixtureDef, request: pytest.FixtureR
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_call(item: pytest.Item):
     """With ``--update-durations``, a test's cost: its call's CPU time (this process and the
-    subprocesses it waited for) and the setup of every fixture it uses but the session's, a
-    module's fixture counted for each of its tests (each needs it when run alone). It travels
-    with the report, also from pytest-xdist workers."""
+    subprocesses it waited for) and the setup of every fixture it uses but the shared FMU builds,
+    a module's or the session's fixture counted for each of its tests (each needs it when run
+    alone). It travels with the report, also from pytest-xdist workers."""
     start = _cpu_seconds()
     yield
     if item.config.getoption("update_durations"):
         fixtures = sum(cost for (node, name), cost in _FIXTURE_COSTS.items()
-                       if name in item.fixturenames and (node == item.nodeid or item.nodeid.startswith(f"{node}::")
-                                                         or item.nodeid.startswith(f"{node}/")))
+                       if name in item.fixturenames and (not node or node == item.nodeid
+                                                         or item.nodeid.startswith((f"{node}::", f"{node}/"))))
         item.user_properties.append(("cpu_seconds", _cpu_seconds() - start + fixtures))
         for key in [key for key in _FIXTURE_COSTS if key[0] == item.nodeid]:
             del _FIXTURE_COSTS[key]
