@@ -117,6 +117,11 @@ class SteppedModel(ABC):
     #: string as a C string), generated into its variable header so they are written once.
     native_constants: ClassVar[dict[str, str | int | float]] = {}
 
+    #: The parts of the model's derived data and the parameters each is built for: a changed
+    #: parameter redoes the parts that list it and keeps the others. The native build writes the
+    #: table into the model's variable header (``PART_<NAME>``, ``model_part_values``).
+    derived_parts: ClassVar[dict[str, tuple[str, ...]]] = {}
+
     #: Files a native FMU of the model ships in its ``resources/`` folder, by their path here (the
     #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.
     resource_files: ClassVar[tuple[Path, ...]] = ()
@@ -158,9 +163,11 @@ class SteppedModel(ABC):
             return [f"{what} could not be checked ({type(error).__name__}: {error})"]
 
     def output_errors(self) -> list[str]:
+        """Outputs that are not finite, then outputs beyond their declared bounds (a physical bound
+        the model's equations no longer describe): the step is not taken."""
         values = [getattr(self, name) for name in self._real_outputs]
         if math.isfinite(math.fsum(values)):
-            return []
+            return [e for v in self.spec.of("output") if (e := self._range_error(v))]
         return [
             f"output {name} is not finite ({value!r}); the step was not taken"
             for name, value in zip(self._real_outputs, values)

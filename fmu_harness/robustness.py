@@ -181,6 +181,7 @@ LAYOUTS = (
     ("segments.toml", "many segments", "[[segments]] tables are more than the 100 accepted"),
     ("nested.toml", "deep nesting", "brackets nest deeper than 16 levels"),
     ("large.toml", "large file", "is larger than 65536 bytes"),
+    ("stations.toml", "many stations", "the analysis would"),  # with the default omega_max: 875 shaft modes
     ("missing.toml", "", "No such file or directory"),
     ("../../../etc/passwd", "", "no shipped example named"),
     ("x" * 300 + ".toml", "", "File name too long"),
@@ -223,6 +224,14 @@ PERSISTENT = (
     ("UniversalReducer", "alpha", 4.0, "alpha"),
     ("CriticalSpeeds", "layout", "nosuch", "no shipped example named 'nosuch'"),
 )
+
+
+def _output_bounds(fmu_path: FmuPath, fmi: str) -> list[Case]:
+    """The reducer at alpha = alpha_max = pi - 1e-12: eq 21 once gave stresses of 3.2e19 Pa with OK."""
+    alpha = math.pi - 1e-12
+    return [Case("outputs beyond a physical bound", "UniversalReducer at alpha = pi - 1e-12", "bounded_output",
+                 (str(fmu_path("UniversalReducer", fmi)), {"alpha_max": alpha, "alpha": alpha},
+                  "is above its maximum 10000000000.0 Pa"), fmi)]
 
 
 def _persistent(fmu_path: FmuPath, fmi: str) -> list[Case]:
@@ -282,6 +291,7 @@ def cases(fmu_path: FmuPath, slow: bool = False, versions: Iterable[str] = ("2",
                   + _step_sizes(fmu_path, fmi, slow) + _misuse(fmu_path, fmi) + _states(fmu_path, fmi)
                   + _instances(fmu_path, fmi, slow)
                   + _layouts(fmu_path, fmi) + _limits(fmu_path, fmi) + _persistent(fmu_path, fmi)
+                  + _output_bounds(fmu_path, fmi)
                   + _start_time(fmu_path, fmi)
                   + (_model_failures(fmu_path, fmi) if family == "python" else []))
         if slow:

@@ -393,6 +393,10 @@ def hostile_file(target: Path, kind: str) -> None:
         target.symlink_to("/dev/zero")
     elif kind == "directory":
         target.mkdir()
+    elif kind == "many stations":  # inside every loader limit; its analysis once took 566 s (native)
+        from .analysis_work import layout_text
+
+        target.write_text(layout_text(100, 1.4, 202, 202, 200))
     elif kind == "deep nesting":
         target.write_text("x = " + "[" * 1000 + "]" * 1000)
     else:
@@ -413,6 +417,18 @@ def parameter_limit(path: str, name: str, value: Any, fragment: str) -> None:
     """A parameter beyond what the analysis can do in bounded time or resolve is refused quickly,
     at initialisation."""
     _refused_parameters(Probe(path), {name: value}, fragment)
+
+
+def bounded_output(path: str, values: dict[str, Any], fragment: str) -> None:
+    """Inputs whose outputs lie beyond a declared physical bound: logged at initialisation (OK, the
+    host may still correct them), every step refused with the bound named and the master asked to stop."""
+    probe = Probe(path)
+    expect(probe.initialize(values), "OK", what="exitInitializationMode")
+    status, stop = probe.step_stopping(1e-3)
+    expect(status, "Discard", what=f"doStep with {values}")
+    if not stop or not any(fragment in text for text in probe.errors_logged()):
+        raise Wrong("status", f"stop {stop}, no message with {fragment!r}: {[t[:120] for t in probe.errors_logged()]}")
+    probe.close()
 
 
 def long_string(path: str, name: str, length: int) -> None:

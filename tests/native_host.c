@@ -181,6 +181,9 @@ static void *instantiate2(const char *name, const char *token)
 {
     char uri[4096 + 16] = "file://";
     size_t at = strlen(uri), i;
+    if (resources != NULL && resources[0] != '/') { /* a Windows path, C:/...: file:///C:/... */
+        uri[at++] = '/';
+    }
     for (i = 0; resources != NULL && resources[i] != '\0' && at + 4 < sizeof uri; i++) {
         if (resources[i] == '%' || resources[i] == ' ') { /* the characters a URI must escape here */
             at += (size_t)sprintf(uri + at, "%%%02X", (unsigned)(unsigned char)resources[i]);

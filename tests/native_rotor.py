@@ -20,6 +20,8 @@ from driveline.rotor import Driveline
 from driveline.rotor.elements import Hinge
 
 from fmu_harness.build import native, toolchain
+from fmu_harness.build.native_constants import HEADER as CONSTANTS_HEADER
+from fmu_harness.build.native_constants import constants_header
 
 ROTOR_SOURCES = native.NATIVE_SRC / "critical_speeds"
 TEST_FLAGS = (*(flag for flag in toolchain.CFLAGS if not flag.startswith("-fvisibility")), "-fPIC")
@@ -39,8 +41,9 @@ def compile_rotor(folder: Path, modules: list[str], shims: list[Path] = ()) -> c
     they need (:data:`NEEDS`) and ``shims``, built in ``folder``."""
     needed = list(dict.fromkeys(part for module in modules for part in (module, *NEEDS.get(module, ()))))
     sources = [str(ROTOR_SOURCES / f"{module}.c") for module in needed] + [str(shim) for shim in shims]
+    (folder / CONSTANTS_HEADER).write_text(constants_header())  # the native build's generated header
     library = folder / f"rotor_{'_'.join(modules)}.so"
-    command = [*toolchain.host_compiler(), *TEST_FLAGS, "-shared", "-I", str(ROTOR_SOURCES), *sources,
+    command = [*toolchain.host_compiler(), *TEST_FLAGS, "-shared", "-I", str(ROTOR_SOURCES), "-I", str(folder), *sources,
                str(native.NATIVE_SRC / "python_numbers.c"), "-o", str(library), "-lm"]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode:

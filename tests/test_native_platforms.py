@@ -13,13 +13,14 @@ import subprocess
 import zipfile
 from pathlib import Path
 
-import lief
 import pytest
+from fmpy.validation import validate_fmu
 from test_native_host import HOST_SOURCE, RUNS, TOLERANCES, _host_command
 
 from fmu_harness.build import native, toolchain
 
-VERSIONS = ("2", "3")
+lief = pytest.importorskip("lief", reason="the binaries' structural checks need lief (pip install lief)")
+
 EMULATED = {"x86_64-windows": "wine (Debian: apt-get install wine wine64)",
             "aarch64-linux": "qemu-aarch64 (Debian: apt-get install qemu-user) and the aarch64 C library "
                              "(Debian: apt-get install libc6-arm64-cross)"}
@@ -46,6 +47,7 @@ def _binary(release_dir: Path, name: str, fmi: str, platform: toolchain.Platform
 def test_every_native_fmu_carries_the_five_platforms(release_dir, name, fmi):
     expected = {f"binaries/{p.folder(fmi)}/{name}{p.suffix}" for p in toolchain.PLATFORMS}
     assert set(_members(release_dir, name, fmi)) == expected
+    assert validate_fmu(str(native.fmu_path(release_dir, name, fmi))) == []
 
 
 def _glibc_versions(binary: lief.ELF.Binary) -> set[tuple[int, ...]]:
@@ -76,18 +78,28 @@ MACHO_LINKER_SYMBOLS = {"__mh_dylib_header", "___dso_handle"}
 @pytest.mark.parametrize("name", native.native_models())
 @pytest.mark.parametrize("platform", [p for p in toolchain.PLATFORMS if p.system == "darwin"], ids=lambda p: p.tuple)
 def test_macos_binaries_are_dylibs_of_the_right_architecture(release_dir, name, fmi, platform):
-    """macOS binaries cannot run here: a Mach-O dylib of the platform's CPU, for macOS 11 or newer,
-    exporting the FMI functions only, linked against libSystem alone; the arm64 one code-signed
-    (ad hoc), as Apple silicon requires of any code it loads."""
-    binary = lief.MachO.parse(list(_binary(release_dir, name, fmi, platform))).at(0)
-    assert binary.header.file_type == lief.MachO.Header.FILE_TYPE.DYLIB
-    assert binary.header.cpu_type.name == {"x86_64": "X86_64", "aarch64": "ARM64"}[platform.tuple.split("-")[0]]
-    loaded = [c.name for c in binary.commands if c.command == lief.MachO.LoadCommand.TYPE.LOAD_DYLIB]
-    assert loaded == ["/usr/lib/libSystem.B.dylib"]
-    exported = {s.name for s in binary.exported_symbols} - MACHO_LINKER_SYMBOLS
-    assert exported and all(symbol.startswith(f"_fmi{fmi}") for symbol in exported)
-    assert tuple(binary.build_version.minos) <= (11, 0, 0)
-    assert binary.has_code_signature or platform.tuple == "x86_64-darwin"
+    """macOS binaries cannot run here: Mach-O dylibs of the platform's CPU, for macOS 11 or newer,
+    exporting the FMI functions only, linked against libSystem alone; the arm64 ones code-signed
+    (ad hoc), as Apple silicon requires of any code it loads. FMI 2.0's ``darwin64`` is universal
+    (x86_64 and arm64: importers on Apple silicon look there), its arm64 slice the
+    ``aarch64-darwin`` binary."""
+    fat = lief.MachO.parse(list(_binary(release_dir, name, fmi, platform)))
+    slices = [fat.at(index) for index in range(fat.size)]
+    architectures = {"x86_64": ["X86_64"], "aarch64": ["ARM64"]}[platform.tuple.split("-")[0]]
+    if platform.folder(fmi) == "darwin64":
+        architectures = ["X86_64", "ARM64"]
+        arm = _binary(release_dir, name, fmi, toolchain.BY_TUPLE["aarch64-darwin"])
+        offset = fat.at(1).fat_offset
+        assert _binary(release_dir, name, fmi, platform)[offset:offset + len(arm)] == arm
+    assert [binary.header.cpu_type.name for binary in slices] == architectures
+    for binary in slices:
+        assert binary.header.file_type == lief.MachO.Header.FILE_TYPE.DYLIB
+        loaded = [c.name for c in binary.commands if c.command == lief.MachO.LoadCommand.TYPE.LOAD_DYLIB]
+        assert loaded == ["/usr/lib/libSystem.B.dylib"]
+        exported = {s.name for s in binary.exported_symbols} - MACHO_LINKER_SYMBOLS
+        assert exported and all(symbol.startswith(f"_fmi{fmi}") for symbol in exported)
+        assert tuple(binary.build_version.minos) <= (11, 0, 0)
+        assert binary.has_code_signature or binary.header.cpu_type.name == "X86_64"
 
 
 @pytest.mark.parametrize("name", native.native_models())
@@ -191,7 +203,10 @@ def test_emulated_binary_reproduces_the_x86_64_binary(hosts, release_dir, fmu_pa
     tolerance = PLATFORM_TOLERANCES.get((platform, name), TOLERANCES.get(name, 1e-12))
     scenario = _with_expected(Path(arguments[3]), reference, tolerance, work / f"{platform}.scenario")
     outputs = work / f"{platform}.txt"
-    done = subprocess.run([*_runner(platform, hosts[platform]), str(library), fmi, arguments[2], str(scenario), arguments[4],
+    # on Windows the resources folder as a Windows path (wine's drive Z: is /): FMI 2.0 hands it
+    # over as file:///Z:/..., FMI 3.0 as Z:/...
+    resources = f"Z:{arguments[4]}" if platform == "x86_64-windows" else arguments[4]
+    done = subprocess.run([*_runner(platform, hosts[platform]), str(library), fmi, arguments[2], str(scenario), resources,
                            str(outputs)], capture_output=True, text=True, timeout=600,
                           env={**os.environ, "WINEDEBUG": "-all"})
     assert done.returncode == 0, done.stdout + done.stderr[-3000:]

@@ -18,8 +18,8 @@ from fmu_harness.failing_model import FailingModel
 
 CLASSES = {"non-finite values", "out-of-range values", "step sizes", "call sequence misuse",
            "state round trips and corrupt state", "instances and threads", "hostile layout values",
-           "work, memory and resolution limits", "outputs at a start time other than 0",
-           "model failures outside its checks"}
+           "work, memory and resolution limits", "refusals that end a run", "outputs beyond a physical bound",
+           "outputs at a start time other than 0", "model failures outside its checks"}
 #: Classes of the Python failing model, and of CriticalSpeeds alone while its C port is incomplete.
 NOT_NATIVE = {"model failures outside its checks"} | (
     set() if "CriticalSpeeds" in native.native_models() else {"hostile layout values", "work, memory and resolution limits"})

@@ -7,6 +7,10 @@ import math
 from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 SINGULAR = "eq 21 is singular at 0 and 180 deg"
+#: Largest stress [Pa] of the connecting shaft an output may report: ten times the tensile strength of
+#: the strongest shaft steels (about 1 GPa). Beyond it no shaft carries the load and the rigid-body
+#: statics of eqs 18-21 describe nothing; near alpha = 180 deg eq 21 gave 3.2e19 Pa with status OK.
+MAX_STRESS = 1e10
 
 SPEC = ModelSpec(
     name="UniversalReducer",
@@ -60,11 +64,13 @@ SPEC = ModelSpec(
         Variable("M_C1", "output", 0.0, "Torque M_C1 = F_t r2 on the connecting shaft at C (eq 20)", "N.m"),
         Variable("M_B", "output", 0.0, "Moment M_B at B from the balance eq 21", "N.m"),
         Variable("M_C", "output", 0.0, "Bending moment M_C at C from the balance eq 21", "N.m"),
-        Variable("sigma_bend", "output", 0.0, "Bending stress of the connecting shaft at C, M_C / W", "Pa", "MPa"),
+        Variable("sigma_bend", "output", 0.0, "Bending stress of the connecting shaft at C, M_C / W", "Pa", "MPa",
+                 min=-MAX_STRESS, max=MAX_STRESS),
         Variable("tau_torsion", "output", 0.0, "Torsional stress of the connecting shaft at C, M_C1 / W_t",
-                 "Pa", "MPa"),
+                 "Pa", "MPa", min=-MAX_STRESS, max=MAX_STRESS),
         Variable("sigma_eq", "output", 0.0,
-                 "Equivalent stress at C, third strength theory sqrt(sigma^2 + 4 tau^2)", "Pa", "MPa"),
+                 "Equivalent stress at C, third strength theory sqrt(sigma^2 + 4 tau^2)", "Pa", "MPa",
+                 max=MAX_STRESS),
         Variable("utilisation", "output", 0.0, "sigma_eq / sigma_allow (at most 1 to pass the seed's check)", "1"),
         Variable("T_in_allow", "output", 0.0,
                  "Input torque at which sigma_eq reaches sigma_allow at the current alpha", "N.m"),

@@ -26,6 +26,12 @@ Whirl = Literal["forward", "backward"]
 POINTS_PER_ROOT = 16
 #: Default upper limit of any search [rad/s] (about 955 000 rpm).
 SEARCH_LIMIT = 1.0e5
+#: Grid offset of the scan, an irrational fraction of a step: pinned-beam roots sit at theta = k pi.
+GRID_OFFSET = 0.6180339887498949
+#: Points of the logarithmic lead-in below the scan's first point (the last of them is that point).
+LEAD_POINTS = 9
+#: Points per segment of the mode shape whose forward fraction tells a whirl's direction.
+DIRECTION_POINTS = 4
 
 
 @dataclass(frozen=True)
@@ -220,11 +226,10 @@ class Driveline:
         kappa = self._kappa * math.sqrt(abs(ratio))
         theta_max = kappa * math.sqrt(x_max)
         n = max(math.ceil(theta_max / math.pi * per_pi), 8)
-        # offset by an irrational fraction of a step: pinned-beam roots sit at theta = k pi
-        theta = (np.arange(n) + 0.6180339887498949) * (theta_max / n)
+        theta = (np.arange(n) + GRID_OFFSET) * (theta_max / n)
         theta = np.append(theta, theta_max)  # the scan must reach x_max itself
         x = (theta / kappa) ** 2
-        lead = np.geomspace(x[0] * 1e-4, x[0], 9)[:-1]
+        lead = np.geomspace(x[0] * 1e-4, x[0], LEAD_POINTS)[:-1]
         return np.concatenate([lead, x])
 
     def _line_roots(
@@ -305,7 +310,7 @@ class Driveline:
                 out.append({wh: self._take(found[c, 1.0 if wh == "forward" else -1.0], n) for wh in whirls})
             else:
                 roots = found[c, 1.0]
-                kinds = np.array(["forward" if self.mode_shape(r * x, s * x + o, 4).forward_fraction >= 0.5
+                kinds = np.array(["forward" if self.mode_shape(r * x, s * x + o, DIRECTION_POINTS).forward_fraction >= 0.5
                                   else "backward" for x in roots], dtype=object)
                 out.append({wh: self._take(roots[kinds == wh], n) for wh in whirls})
         return out
@@ -405,7 +410,7 @@ class Driveline:
         if self.is_isotropic:
             return [CriticalSpeed(r.spin, 1.0) for r in self.order_resonances((1,), ("forward",), n, spin_max, limit)]
         found = self.order_resonances((1,), ("forward", "backward"), None if n is None else n + 1, spin_max, limit)
-        shares = [(r.spin, self.mode_shape(r.spin, r.spin, 4).forward_fraction) for r in found]
+        shares = [(r.spin, self.mode_shape(r.spin, r.spin, DIRECTION_POINTS).forward_fraction) for r in found]
         excited = [CriticalSpeed(spin, share) for spin, share in sorted(shares) if share >= EXCITED_SHARE]
         return excited if n is None else excited[:n]
 

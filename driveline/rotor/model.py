@@ -29,6 +29,7 @@ from .loader import example_path, load_driveline, one_piece_shaft
 from .mechanism import MECHANISM_HINGE, MECHANISM_RIGID, mechanism_error
 from .spec import SPEC
 from .unbalance_outputs import UnbalanceOutputs
+from .work import NATIVE_CONSTANTS, estimate
 
 #: Orders watched at most, and the highest order (joints excite low orders: 1, 2, 3, 6).
 MAX_ORDERS = 16
@@ -46,6 +47,15 @@ SHAFT_PARAMETERS = ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", 
 #: Parameters of the damped model only (the critical speeds and whirl frequencies are the undamped ones).
 DAMPING_PARAMETERS = ("c_bearing",)
 UNBALANCE_PARAMETERS = ("unbalance", "unbalance_position", "response_position")
+#: The parts of the analysis and the parameters each is built for besides ``layout`` (the resonances
+#: also for ``orders``): a changed parameter redoes the parts that list it, and no other.
+ANALYSIS_PARTS = {
+    "driveline": SHAFT_PARAMETERS + DAMPING_PARAMETERS,
+    "structure": SHAFT_PARAMETERS,
+    "whirl": SHAFT_PARAMETERS + ("omega_max",),
+    "resonances": SHAFT_PARAMETERS + ("omega_max",),
+    "unbalance": SHAFT_PARAMETERS + DAMPING_PARAMETERS + UNBALANCE_PARAMETERS + ("omega_max",),
+}
 
 
 @dataclass(frozen=True)
@@ -196,8 +206,9 @@ class CriticalSpeedsModel(SteppedModel):
     derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts", "_unbalance")
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
+    derived_parts = ANALYSIS_PARTS
     native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d"),
-                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT}
+                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT, **NATIVE_CONSTANTS}
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None
@@ -205,11 +216,9 @@ class CriticalSpeedsModel(SteppedModel):
         self._parts: dict[str, tuple[tuple, object]] = {}
         self._unbalance: UnbalanceOutputs | None = None
 
-    def _structure(self) -> tuple:
-        return (self.layout, *self._values(SHAFT_PARAMETERS))
-
-    def _values(self, names: tuple[str, ...]) -> tuple:
-        return tuple(getattr(self, n) for n in names)
+    def _key(self, part: str, *more: object) -> tuple:
+        """What the analysis part ``part`` is built for (:data:`ANALYSIS_PARTS`), and ``more``."""
+        return (self.layout, *(getattr(self, n) for n in ANALYSIS_PARTS[part]), *more)
 
     def _part(self, name: str, key: tuple, compute: Callable[[], Any]) -> Any:
         """The part ``name`` of the analysis for ``key``: kept from the last analysis if its key is unchanged."""
@@ -223,29 +232,29 @@ class CriticalSpeedsModel(SteppedModel):
         check) only when a structural parameter changed, the Campbell table when it or ``omega_max``
         did, the order resonances when either or ``orders`` did, the unbalance outputs when the
         structure, the damping, the unbalance parameters or ``omega_max`` did. Its errors are the checks."""
-        shape = self._structure()
-        damped = (shape, self._values(DAMPING_PARAMETERS))
-        forced = (damped, self._values(UNBALANCE_PARAMETERS))
-        key = (forced, self.orders, self.omega_max)
+        key = self._key("unbalance", self.orders)  # every parameter of the analysis
         if key == self._analysed_for:
             return []
         try:
             orders = parse_orders(self.orders)
-            driveline = self._part("driveline", damped, lambda: build_driveline(
+            driveline = self._part("driveline", self._key("driveline"), lambda: build_driveline(
                 self.layout, {n: getattr(self, n) for n in SHAFT_PARAMETERS + DAMPING_PARAMETERS}))
             work = searched_modes(driveline, orders, self.omega_max)
             if not work <= MAX_SEARCHED_MODES:
                 raise ValueError(f"the analysis would scan {work:.3g} shaft modes, more than the "
                                  f"{MAX_SEARCHED_MODES:.0f} accepted (shorter or stiffer shaft, fewer or "
                                  "lower orders, or a smaller omega_max)")
-            structure = self._part("structure", shape, lambda: analyse_structure(driveline))
-            whirl = self._part("whirl", (shape, self.omega_max), lambda: whirl_table(structure, self.omega_max))
-            found = self._part("resonances", (shape, orders, self.omega_max),
+            refusal = estimate(driveline, orders, self.omega_max, CAMPBELL_POINTS, FE_ELEMENTS).refusal()
+            if refusal is not None:
+                raise ValueError(refusal)
+            structure = self._part("structure", self._key("structure"), lambda: analyse_structure(driveline))
+            whirl = self._part("whirl", self._key("whirl"), lambda: whirl_table(structure, self.omega_max))
+            found = self._part("resonances", self._key("resonances", orders),
                                lambda: resonances(driveline, orders, self.omega_max))
             analysis = Analysis(structure.critical_speeds, structure.critical_speed_count, whirl, found)
             unbalances = driveline.unbalances if self.layout else (
                 Unbalance(self.unbalance_position * driveline.length, self.unbalance),)
-            self._unbalance = self._part("unbalance", (forced, self.omega_max), lambda: UnbalanceOutputs.build(
+            self._unbalance = self._part("unbalance", self._key("unbalance"), lambda: UnbalanceOutputs.build(
                 driveline, unbalances, self.response_position, self.omega_max))
             self._analysis = analysis
             self._resonance_speeds = analysis.resonance_speeds

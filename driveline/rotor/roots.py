@@ -39,6 +39,9 @@ MAX_DEPTH = 16
 DIP_RATIO = 0.9
 #: Iteration cap of the bracket refinement (it halves a bracket at least every third step).
 MAX_ITERATIONS = 200
+#: Default absolute and relative tolerance of a root.
+XTOL = 1e-12
+RTOL = 4.0 * float(np.finfo(float).eps)
 
 
 @dataclass(frozen=True)
@@ -53,7 +56,7 @@ class BatchReport:
 
 
 def find_roots_batch(
-    f: BatchFunc, grids: Sequence[FloatArray], xtol: float = 1e-12, rtol: float = 4.0 * np.finfo(float).eps
+    f: BatchFunc, grids: Sequence[FloatArray], xtol: float = XTOL, rtol: float = RTOL
 ) -> BatchReport:
     """Roots of the functions ``f(., k)`` inside ``[grids[k][0], grids[k][-1]]``, all searched together.
 

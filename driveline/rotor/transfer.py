@@ -38,6 +38,8 @@ FloatArray = NDArray[np.float64]
 
 #: Largest ``beta1 * piece_length`` per propagation step (growth ``e**2`` per step).
 MAX_PIECE_PHASE = 2.0
+#: Bound of the accumulated log scale put back into the determinant (exp stays finite).
+LOG_SCALE_CLIP = 700.0
 
 
 @dataclass(frozen=True)
@@ -249,7 +251,7 @@ def _determinant(chain: Chain, w: FloatArray, spin: FloatArray) -> FloatArray:
     else:
         f = np.linalg.det(sub)
     # keep the factor finite; sign and zeros are unaffected
-    return sign * f * np.exp(np.clip(log_scale, -700.0, 700.0))
+    return sign * f * np.exp(np.clip(log_scale, -LOG_SCALE_CLIP, LOG_SCALE_CLIP))
 
 
 @dataclass(frozen=True)

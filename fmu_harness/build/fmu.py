@@ -22,6 +22,7 @@ from driveline.catalog import MODELS
 from driveline.model import SteppedModel
 from driveline.variables import ModelSpec
 
+from . import documentation
 from .model_description import complete_fmi2, complete_fmi3
 from .shipped_files import shipped_files
 
@@ -124,6 +125,7 @@ def build(name: str, dest: Path, fmi: str = "2", model: type[SteppedModel] | Non
         {
             "modelDescription.xml": version.complete(xml, model.spec),
             "resources/requirements.txt": REQUIREMENTS.encode(),
+            **documentation.members(name),
         },
     )
     return fmu

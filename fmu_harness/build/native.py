@@ -13,10 +13,10 @@ version this module
   (:mod:`model_description`: units, display units, min/max, descriptions, model structure), so a
   host can swap one FMU for the other, plus the sources the FMU carries (FMI 2.0 ``SourceFiles``,
   FMI 3.0 ``sources/buildDescription.xml``);
-* compiles the shared library with the machine's C compiler (``cc``, or ``$CC``) and the FMI
-  headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its sources
-  (the library folder's as ``<folder>/<file>``) and the resource files its model class declares
-  (``SteppedModel.resource_files``, into ``resources/``).
+* compiles the shared library for each platform (:mod:`.toolchain`: zig, five platforms) with
+  the FMI headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its
+  sources (the library folder's as ``<folder>/<file>``), the resource files its model class
+  declares (``SteppedModel.resource_files``, into ``resources/``), its doc page and the licence.
 
 FMI 2.0 FMUs land in ``<dest>/native/``, FMI 3.0 ones in ``<dest>/native/fmi3/``.
 """
@@ -41,23 +41,19 @@ from driveline.catalog import MODELS
 from driveline.model import TIME_TOLERANCE, SteppedModel
 from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
-from . import toolchain
+from . import documentation, toolchain
+from .documentation import snake_case
 from .model_description import complete_fmi2, complete_fmi3
+from .native_constants import HEADER as CONSTANTS_HEADER
+from .native_constants import constants_header
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
-DOCS = NATIVE_SRC.parent / "docs"  # the repository's docs/ (a link, so that the wheel carries them)
-LICENSE = NATIVE_SRC.parent / "LICENSE"
 MODEL_SOURCES = NATIVE_SRC
 SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c", "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
-
-
-def snake_case(name: str) -> str:
-    """``CardanJoint`` -> ``cardan_joint``: the model file's name."""
-    return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
 
 
 def model_source(name: str) -> Path:
@@ -270,7 +266,13 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
     derivatives = input_derivatives(spec)
     constants = "".join(f"#define {name} {_c_string(value) if isinstance(value, str) else value}\n"
                         for name, value in model.native_constants.items())
-    extra_enum = "" if not probes else "\n/* messages of the model's own checks */\nenum {\n" + "".join(
+    parts = model.derived_parts
+    most = max((len(names) for names in parts.values()), default=0)
+    part_enum = "" if not parts else (
+        "\n/* the parts of the derived data (derived_parts): model_part_values lists the parameters each is\n"
+        " * built for, -1 ending a list */\nenum {\n" + "".join(f"    PART_{name.upper()},\n" for name in parts)
+        + f"    PARTS\n}};\n#define PART_MOST_VALUES {most}\nextern const int model_part_values[PARTS][PART_MOST_VALUES + 1];\n")
+    extra_enum = part_enum + "" if not probes else part_enum + "\n/* messages of the model's own checks */\nenum {\n" + "".join(
         f"    MESSAGE_{name} = {index},\n" for index, name in enumerate(probes)) + "};\n"
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
 #ifndef MODEL_VARIABLES_H
@@ -321,6 +323,13 @@ const RelationInfo model_relations[MODEL_RELATION_COUNT] = {{
         source += f"""
 const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT] = {{
 {extra}
+}};
+"""
+    if parts:
+        lists = "\n".join("    {" + ", ".join([*(f"V_{name}" for name in names), "-1"]) + "}," for names in parts.values())
+        source += f"""
+const int model_part_values[PARTS][PART_MOST_VALUES + 1] = {{
+{lists}
 }};
 """
     if derivatives:
@@ -451,6 +460,7 @@ def resource_files(name: str) -> dict[str, bytes]:
 def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
     """Every source file the FMU carries, by name, with the token computed from all of them."""
     files = {source: (NATIVE_SRC / source).read_bytes() for source in (*SHARED_SOURCES, LAYER[fmi])}
+    files[CONSTANTS_HEADER] = constants_header().encode()
     files[model_file.name] = model_file.read_bytes()
     files.update(_library_sources(name))
     untokened = variable_table(MODELS[name], "")
@@ -478,13 +488,17 @@ def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain
     token = files["token"].decode()
     sources = {source: data for source, data in files.items() if source != "token"}
     compiled = sorted(source for source in sources if source.endswith(".c"))
+    libraries = {p: library.read_bytes() for p, library in binaries.items()}
+    intel, arm = toolchain.BY_TUPLE["x86_64-darwin"], toolchain.BY_TUPLE["aarch64-darwin"]
+    if fmi == "2" and intel in libraries and arm in libraries:
+        # FMI 2.0's darwin64 universal: importers on Apple silicon (fmpy among them) look there
+        libraries[intel] = toolchain.universal([libraries[intel], libraries[arm]])
     members = {
         "modelDescription.xml": model_description(MODELS[name].spec, fmi, token, compiled),
-        **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": library.read_bytes() for p, library in binaries.items()},
+        **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": data for p, data in libraries.items()},
         **{f"sources/{source}": data for source, data in sources.items()},
         **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
-        f"documentation/{snake_case(name)}.md": (DOCS / f"{snake_case(name)}.md").read_bytes(),
-        "documentation/licenses/LICENSE.txt": LICENSE.read_bytes(),
+        **documentation.members(name),
     }
     if fmi == "3":
         members["sources/buildDescription.xml"] = build_description(name, compiled)

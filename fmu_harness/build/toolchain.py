@@ -14,6 +14,7 @@ import os
 import platform as _platform
 import shlex
 import shutil
+import struct
 import subprocess
 import sys
 from collections.abc import Iterable, Sequence
@@ -83,12 +84,17 @@ def host_compiler() -> list[str]:
     ``zig cc``, else ``cc``/``gcc``."""
     if os.environ.get("CC"):
         return shlex.split(os.environ["CC"])
-    if (found := zig()) is not None:
-        return [str(found), "cc"]
-    system = shutil.which("cc") or shutil.which("gcc")
+    if (found := zig()) is not None:  # the baseline CPU, not this one's (valgrind knows every instruction)
+        return [str(found), "cc", "-mcpu=baseline"]
+    system = system_compiler()
     if system is None:
         raise NoCompiler(NO_COMPILER)
     return [system]
+
+
+def system_compiler() -> str | None:
+    """The machine's own C compiler on the PATH, if any."""
+    return shutil.which("cc") or shutil.which("gcc")
 
 
 def release_available() -> bool:
@@ -138,6 +144,23 @@ def link_flags(target: Platform, library: Path) -> list[str]:
     elif target.system == "darwin":
         flags.append(f"-Wl,-install_name,@rpath/{library.name}")
     return flags
+
+
+def universal(slices: Sequence[bytes]) -> bytes:
+    """A universal (fat) Mach-O file of thin ones: the big-endian fat header, one entry per slice
+    (its CPU type and subtype, read from the slice's own header), each slice aligned to 2^14."""
+    align = 14
+    header = struct.pack(">II", 0xCAFEBABE, len(slices))
+    offset = -(-(len(header) + 20 * len(slices)) // (1 << align)) * (1 << align)
+    entries, body = b"", b""
+    for thin in slices:
+        cpu_type, cpu_subtype = struct.unpack_from("<ii", thin, 4)
+        entries += struct.pack(">iiIII", cpu_type, cpu_subtype, offset, len(thin), align)
+        padded = -(-len(thin) // (1 << align)) * (1 << align)
+        body += thin + bytes(padded - len(thin))
+        offset += padded
+    start = header + entries
+    return start + bytes(-(-len(start) // (1 << align)) * (1 << align) - len(start)) + body
 
 
 @dataclass(frozen=True)

@@ -17,40 +17,21 @@
 #include "critical_speeds/rotor.h"
 #include "fmu_instance.h"
 
-
-/* driveline/rotor/model.py */
-#define MAX_ORDERS 16
-#define MAX_ORDER 100
-#define MAX_SEARCHED_MODES 250.0
-#define FE_ELEMENTS 4
-#define PLAUSIBLE_DEVIATION 0.02
-#define CAMPBELL_POINTS 41
-#define WHIRL_MODES 2
 #define ERROR_SIZE FMU_MESSAGE_SIZE
 
 /* ---- the parts of the analysis and their keys ------------------------------------------------ */
 
-typedef enum { PART_DRIVELINE, PART_STRUCTURE, PART_WHIRL, PART_RESONANCES, PART_UNBALANCE, PARTS } Part;
-
-/* The parameters each part depends on besides ``layout`` (and ``orders`` for the resonances):
- * shape = SHAFT_PARAMETERS, damped = shape + DAMPING_PARAMETERS, forced = damped +
- * UNBALANCE_PARAMETERS; -1 ends a list. */
-#define SHAPE V_L_shaft, V_D_outer, V_D_inner, V_E, V_density, V_m_joint, V_Jp_joint, V_Jd_joint, V_k_bearing, V_shear
-#define KEY_VALUES 16
-static const int PART_VALUES[PARTS][KEY_VALUES] = {
-    {SHAPE, V_c_bearing, -1},
-    {SHAPE, -1},
-    {SHAPE, V_omega_max, -1},
-    {SHAPE, V_omega_max, -1},
-    {SHAPE, V_c_bearing, V_unbalance, V_unbalance_position, V_response_position, V_omega_max, -1},
-};
+/* A part of the analysis (PART_<NAME>) and the parameters each is built for besides ``layout`` (and
+ * ``orders`` for the resonances): model_part_values, generated from the Python model's
+ * ANALYSIS_PARTS (driveline/rotor/model.py). */
+typedef int Part;
 
 /* The parameters a part was built for (compared by value, as Python compares the key tuples). */
 typedef struct {
     int held;
     char *layout; /* owned */
-    double values[KEY_VALUES];
-    int orders[MAX_ORDERS], n_orders;
+    double values[PART_MOST_VALUES];
+    int orders[ROTOR_MODEL_MAX_ORDERS], n_orders;
 } Key;
 
 typedef struct {
@@ -79,8 +60,8 @@ static int key_matches(const Key *key, const ModelData *data, Part part, const i
     if (!key->held || strcmp(key->layout, data->string_value[V_layout]) != 0) {
         return 0;
     }
-    for (i = 0; PART_VALUES[part][i] >= 0; i++) {
-        if (!(key->values[i] == parameter(data, PART_VALUES[part][i]))) {
+    for (i = 0; model_part_values[part][i] >= 0; i++) {
+        if (!(key->values[i] == parameter(data, model_part_values[part][i]))) {
             return 0;
         }
     }
@@ -110,8 +91,8 @@ static int key_store(Key *key, const ModelData *data, Part part, const int *orde
         return 0;
     }
     memcpy(key->layout, data->string_value[V_layout], length + 1);
-    for (i = 0; PART_VALUES[part][i] >= 0; i++) {
-        key->values[i] = parameter(data, PART_VALUES[part][i]);
+    for (i = 0; model_part_values[part][i] >= 0; i++) {
+        key->values[i] = parameter(data, model_part_values[part][i]);
     }
     key->n_orders = part == PART_RESONANCES ? n_orders : 0;
     for (i = 0; i < key->n_orders; i++) {
@@ -284,8 +265,8 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
     for (at = 0; at < length; at++) {
         commas += text[at] == ',';
     }
-    if (commas >= MAX_ORDERS) { /* text.split(",", MAX_ORDERS) gives more than MAX_ORDERS entries */
-        snprintf(error, ERROR_SIZE, "parameter orders lists more than %d orders", MAX_ORDERS);
+    if (commas >= ROTOR_MODEL_MAX_ORDERS) { /* text.split(",", ROTOR_MODEL_MAX_ORDERS) gives more than ROTOR_MODEL_MAX_ORDERS entries */
+        snprintf(error, ERROR_SIZE, "parameter orders lists more than %d orders", ROTOR_MODEL_MAX_ORDERS);
         return -1;
     }
     *count = 0;
@@ -309,7 +290,7 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
             ascii_digits = ascii_digits && text[at] >= '0' && text[at] <= '9';
             value = ascii_digits && at - first < 3 ? 10 * value + (text[at] - '0') : value;
         }
-        if (!(ascii_digits && end > first && end - first <= 3 && value >= 1 && value <= MAX_ORDER)) {
+        if (!(ascii_digits && end > first && end - first <= 3 && value >= 1 && value <= ROTOR_MODEL_MAX_ORDER)) {
             for (cut = first; cut < end && points < 20; points++) { /* digits[:20] */
                 code_point(bytes, cut, end, &size);
                 cut += size;
@@ -317,7 +298,7 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
             memcpy(prefix, text + first, cut - first);
             prefix[cut - first] = '\0';
             python_str_repr(prefix, 20, shown, sizeof shown);
-            snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown, MAX_ORDER);
+            snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown, ROTOR_MODEL_MAX_ORDER);
             return -1;
         }
         orders[(*count)++] = value;
@@ -401,8 +382,8 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
                           char *error)
 {
     double *terms, kappa, scanned, squared_outer, squared_inner, fourth_outer, fourth_inner, ratio, root;
-    int seen[MAX_ORDER + 1] = {0}, i, n = 0, failed = 0;
-    terms = malloc(((size_t)driveline->n_segments + MAX_ORDERS + 1) * sizeof *terms);
+    int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, i, n = 0, failed = 0;
+    terms = malloc(((size_t)driveline->n_segments + ROTOR_MODEL_MAX_ORDERS + 1) * sizeof *terms);
     if (terms == NULL) {
         snprintf(error, ERROR_SIZE, "out of memory");
         return -1;
@@ -450,6 +431,95 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
     return 0;
 }
 
+/* ---- work.py: the estimate of every stage, before any stage starts ------------------------------ */
+
+/* work._grid: points of one search line up to the bare-shaft phase ``phase``. */
+static double work_grid(double per_pi, double phase)
+{
+    return per_pi * phase / FMU_PI + 8.0;
+}
+
+/* work.estimate, then Work.refusal: 0, or -1 with the refusal (or a failure) in ``error``. */
+static int work_refusal(const Driveline *driveline, const int *orders, int n_orders, double omega_max, char *error)
+{
+    static const char *const names[WORK_STAGE_COUNT] = {WORK_STAGE_0, WORK_STAGE_1, WORK_STAGE_2,
+                                                   WORK_STAGE_3, WORK_STAGE_4, WORK_STAGE_5};
+    double seconds[WORK_STAGE_COUNT], terms[ROTOR_MODEL_MAX_ORDERS + 1], per_pi, kappa, to_limit, resonances, check, total, search;
+    int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, *counts, i, n = 0, stations, planes = 1, isotropic, freedoms, table = 0,
+        response = 0;
+    char shown[40], stage[80];
+    size_t used;
+    Chain *chain = chain_new(driveline, error, ERROR_SIZE);
+    counts = malloc(((size_t)driveline->n_segments + 1) * sizeof *counts);
+    if (chain == NULL || counts == NULL) {
+        chain_free(chain);
+        free(counts);
+        if (chain != NULL) {
+            snprintf(error, ERROR_SIZE, "out of memory");
+        }
+        return -1;
+    }
+    isotropic = chain_isotropic(chain);
+    freedoms = chain_freedoms(chain);
+    kappa = chain_kappa(chain);
+    chain_free(chain);
+    stations = driveline->n_segments + 1 + driveline->n_masses + driveline->n_bearings + driveline->n_hinges;
+    per_pi = (double)(ROTOR_DRIVELINE_POINTS_PER_ROOT * (1 + freedoms) * (isotropic ? 1 : 2));
+    to_limit = work_grid(per_pi, kappa * sqrt(ROTOR_DRIVELINE_SEARCH_LIMIT));
+    seen[1] = 1; /* {1, *orders} */
+    terms[n++] = 2.0 * work_grid(per_pi, kappa * sqrt(2.0 * 1 * omega_max)) +
+                 2.0 * work_grid(per_pi, kappa * sqrt(1 * ROTOR_DRIVELINE_SEARCH_LIMIT));
+    for (i = 0; i < n_orders; i++) {
+        if (!seen[orders[i]]) {
+            seen[orders[i]] = 1;
+            terms[n++] = 2.0 * work_grid(per_pi, kappa * sqrt(2.0 * orders[i] * omega_max)) +
+                         2.0 * work_grid(per_pi, kappa * sqrt(orders[i] * ROTOR_DRIVELINE_SEARCH_LIMIT));
+        }
+    }
+    for (i = 0; i < driveline->n_bearings; i++) {
+        planes = driveline->bearings[i].kxx == driveline->bearings[i].kyy ? planes : 2;
+    }
+    fe_elements_by_length(driveline, ROTOR_UNBALANCE_OUTPUTS_TABLE_ELEMENTS, counts);
+    for (i = 0; i < driveline->n_segments; i++) {
+        table += counts[i];
+    }
+    fe_elements_by_length(driveline, ROTOR_UNBALANCE_OUTPUTS_FE_ELEMENTS, counts);
+    for (i = 0; i < driveline->n_segments; i++) {
+        response += counts[i];
+    }
+    free(counts);
+    if (fsum(terms, n, &resonances, error)) {
+        return -1;
+    }
+    check = planes * pow(2.0 * (ROTOR_MODEL_FE_ELEMENTS * driveline->n_segments + 1 + driveline->n_hinges), 3.0);
+    search = ROTOR_WORK_RATE_SEARCH * stations;
+    seconds[0] = search * (2.0 * to_limit);
+    seconds[1] = search * resonances;
+    seconds[2] = search * (2.0 * 2.0 * (ROTOR_MODEL_CAMPBELL_POINTS + ROTOR_CAMPBELL_MAX_KNOTS) * to_limit);
+    seconds[3] = ROTOR_WORK_RATE_DENSE * check;
+    seconds[4] = ROTOR_WORK_RATE_BANDED * (ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 4.0 * (table + 1));
+    seconds[5] = ROTOR_WORK_RATE_BANDED * (4.0 * (response + 1));
+    if (fsum(seconds, WORK_STAGE_COUNT, &total, error)) {
+        return -1;
+    }
+    if (total <= ROTOR_WORK_MAX_ANALYSIS_SECONDS) {
+        return 0;
+    }
+    python_g(total, 3, shown, sizeof shown);
+    snprintf(error, ERROR_SIZE, "the analysis would take about %s s (", shown);
+    used = strlen(error);
+    for (i = 0; i < WORK_STAGE_COUNT; i++) {
+        python_g(seconds[i], 3, shown, sizeof shown);
+        snprintf(stage, sizeof stage, "%s%s %s s", i ? ", " : "", names[i], shown);
+        text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
+    }
+    python_g(ROTOR_WORK_MAX_ANALYSIS_SECONDS, 6, shown, sizeof shown);
+    snprintf(stage, sizeof stage, "), more than the %s s accepted ", shown);
+    text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
+    text_append(error, ERROR_SIZE, &used, WORK_ADVICE, strlen(WORK_ADVICE));
+    return -1;
+}
+
 /* analyse_structure: the chain, the critical speeds (missing ones read as the search limit) and the
  * finite-element check's natural frequencies. */
 static int analyse_structure(Analysis *analysis, char *error)
@@ -464,24 +534,24 @@ static int analyse_structure(Analysis *analysis, char *error)
         return -1;
     }
     for (i = 0; i < 3; i++) {
-        analysis->critical[i] = i < count ? spins[i] : ROTOR_SEARCH_LIMIT;
+        analysis->critical[i] = i < count ? spins[i] : ROTOR_DRIVELINE_SEARCH_LIMIT;
     }
     analysis->critical_count = count;
-    return fe_natural_frequencies(&analysis->driveline, FE_ELEMENTS, &analysis->natural, &analysis->natural_count,
+    return fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural, &analysis->natural_count,
                                   error, ERROR_SIZE);
 }
 
 /* implausibility: the first two whirl frequencies at standstill must each match a natural
- * frequency of the finite-element check within PLAUSIBLE_DEVIATION. */
+ * frequency of the finite-element check within ROTOR_MODEL_PLAUSIBLE_DEVIATION. */
 static int implausibility(const Analysis *analysis, char *error)
 {
-    double at_rest[2 * WHIRL_MODES], nearest, deviation, best = 0.0;
+    double at_rest[2 * ROTOR_MODEL_WHIRL_MODES], nearest, deviation, best = 0.0;
     char frequency_shown[40], nearest_shown[40];
     int i, j, found;
     whirl_table_evaluate(analysis->whirl, 0.0, at_rest);
-    for (i = 0; i < WHIRL_MODES; i++) {
+    for (i = 0; i < ROTOR_MODEL_WHIRL_MODES; i++) {
         double frequency = at_rest[i];
-        if (frequency >= ROTOR_SEARCH_LIMIT) {
+        if (frequency >= ROTOR_DRIVELINE_SEARCH_LIMIT) {
             continue;
         }
         if (analysis->natural_count == 0) {
@@ -501,7 +571,7 @@ static int implausibility(const Analysis *analysis, char *error)
             }
         }
         nearest = analysis->natural[found];
-        if (!(fabs(nearest - frequency) <= PLAUSIBLE_DEVIATION * frequency)) {
+        if (!(fabs(nearest - frequency) <= ROTOR_MODEL_PLAUSIBLE_DEVIATION * frequency)) {
             python_g(frequency, 6, frequency_shown, sizeof frequency_shown);
             python_g(nearest, 6, nearest_shown, sizeof nearest_shown);
             snprintf(error, ERROR_SIZE,
@@ -518,16 +588,16 @@ static int implausibility(const Analysis *analysis, char *error)
  * forward one of each order when none lies there. */
 static int resonances(Analysis *analysis, const int *orders, int n_orders, double omega_max, char *error)
 {
-    char tuple[4 * MAX_ORDERS + 8];
+    char tuple[4 * ROTOR_MODEL_MAX_ORDERS + 8];
     if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD | WHIRL_BACKWARD, 0, 2.0 * omega_max,
-                               ROTOR_SEARCH_LIMIT, &analysis->resonances, &analysis->resonance_count, error,
+                               ROTOR_DRIVELINE_SEARCH_LIMIT, &analysis->resonances, &analysis->resonance_count, error,
                                ERROR_SIZE)) {
         return -1;
     }
     if (analysis->resonance_count == 0) {
         free(analysis->resonances);
         analysis->resonances = NULL;
-        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0, ROTOR_SEARCH_LIMIT,
+        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT,
                                    &analysis->resonances, &analysis->resonance_count, error, ERROR_SIZE)) {
             return -1;
         }
@@ -580,7 +650,7 @@ static int part(Analysis *analysis, const ModelData *data, Part which, const int
         failed = analyse_structure(analysis, error);
         break;
     case PART_WHIRL:
-        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), CAMPBELL_POINTS, WHIRL_MODES, error,
+        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS, ROTOR_MODEL_WHIRL_MODES, error,
                                           ERROR_SIZE);
         failed = analysis->whirl == NULL || implausibility(analysis, error);
         break;
@@ -620,7 +690,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
     ModelCache *cache = data->cache;
     Analysis *analysis = cache->derived;
-    int orders[MAX_ORDERS], n_orders = 0, failed;
+    int orders[ROTOR_MODEL_MAX_ORDERS], n_orders = 0, failed;
     double work = 0.0;
     char error[ERROR_SIZE] = "", shown[40];
     if (analysis == NULL) {
@@ -637,14 +707,15 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     }
     failed = failed || part(analysis, data, PART_DRIVELINE, orders, n_orders, error) ||
              searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
-    if (!failed && !(work <= MAX_SEARCHED_MODES)) {
+    if (!failed && !(work <= ROTOR_MODEL_MAX_SEARCHED_MODES)) {
         python_g(work, 3, shown, sizeof shown);
         snprintf(error, sizeof error,
                  "the analysis would scan %s shaft modes, more than the %.0f accepted (shorter or stiffer shaft, "
-                 "fewer or lower orders, or a smaller omega_max)", shown, MAX_SEARCHED_MODES);
+                 "fewer or lower orders, or a smaller omega_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);
         failed = 1;
     }
-    failed = failed || part(analysis, data, PART_STRUCTURE, orders, n_orders, error) ||
+    failed = failed || work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), error) ||
+             part(analysis, data, PART_STRUCTURE, orders, n_orders, error) ||
              part(analysis, data, PART_WHIRL, orders, n_orders, error) ||
              part(analysis, data, PART_RESONANCES, orders, n_orders, error) ||
              part(analysis, data, PART_UNBALANCE, orders, n_orders, error);
@@ -661,7 +732,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
 static const char *evaluate(ModelData *data)
 {
     const Analysis *analysis = data->cache->derived;
-    double speed = fabs(VALUE(omega)), whirl[2 * WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
+    double speed = fabs(VALUE(omega)), whirl[2 * ROTOR_MODEL_WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
     int closest = 0, count = 0, i;
     if (analysis == NULL || analysis->whirl == NULL || analysis->resonance_count == 0 ||
         analysis->unbalance == NULL) { /* the parameter check builds it before every step */

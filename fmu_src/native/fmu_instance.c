@@ -199,7 +199,8 @@ static SumOutcome fsum_outcome(const double values[], int count)
     return isfinite(sum) ? SUM_FINITE : SUM_NOT_FINITE;
 }
 
-/* SteppedModel.output_errors; an arithmetic failure of the sum itself becomes ``failure``. */
+/* SteppedModel.output_errors (not finite, then beyond the declared bounds); an arithmetic failure
+ * of the sum itself becomes ``failure``. */
 static void output_errors(const ModelData *data, Messages *out, const char **failure)
 {
     double values[MODEL_VARIABLE_COUNT];
@@ -217,6 +218,8 @@ static void output_errors(const ModelData *data, Messages *out, const char **fai
         *failure = "OverflowError: intermediate overflow in fsum";
     } else if (outcome == SUM_OPPOSITE_INFINITIES) {
         *failure = "ValueError: -inf + inf in fsum";
+    } else if (outcome == SUM_FINITE) {
+        range_errors(data, CAUSALITY_OUTPUT, out);
     } else if (outcome == SUM_NOT_FINITE) {
         for (i = 0; i < count; i++) {
             if (!isfinite(values[i])) {

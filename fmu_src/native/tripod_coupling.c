@@ -11,6 +11,7 @@
  */
 #include <math.h>
 
+#include "driveline_constants.h"
 #include "fmu_instance.h"
 
 #define INTEGER(name) (data->int_value[V_##name])
@@ -21,15 +22,6 @@
  * first: their count, then time and beta of each (TripodCouplingModel._beta_samples) */
 #define SAMPLE_COUNT (data->internal[6])
 #define SAMPLES (data->internal + 7)
-
-#define EXACT 1
-#define THIRD_TURN (2.0 * FMU_PI / 3.0)
-#define PAPER_PHASE (0.5 * FMU_PI) /* the seed's phi is phi_in + PAPER_PHASE (closed_form.py) */
-#define FD_STEP 1e-7
-#define LAST_UPDATE 1e-9
-#define MAX_ITERATIONS 20
-#define FRICTION_TOLERANCE 1e-13
-#define MAX_FRICTION_ITERATIONS 200
 
 static const char MATH_DOMAIN[] = "ValueError: math domain error";
 static const char ZERO_DIVISION[] = "ZeroDivisionError: float division by zero";
@@ -130,32 +122,32 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
     }
     turn3[0] = cosine(guard, 3.0 * phi_in);
     turn3[1] = sine(guard, 3.0 * phi_in);
-    for (i = 0; i < MAX_ITERATIONS && guard->failure == NULL; i++) {
+    for (i = 0; i < TRIPOD_PLANE_SOLVER_MAX_ITERATIONS && guard->failure == NULL; i++) {
         f = star_centre(guard, x, y, turn3, cb, sb, r, l);
-        fx = star_centre(guard, x + FD_STEP, y, turn3, cb, sb, r, l);
-        fy = star_centre(guard, x, y + FD_STEP, turn3, cb, sb, r, l);
-        jxx = (fx.fx - f.fx) / FD_STEP;
-        jyx = (fx.fy - f.fy) / FD_STEP;
-        jxy = (fy.fx - f.fx) / FD_STEP;
-        jyy = (fy.fy - f.fy) / FD_STEP;
+        fx = star_centre(guard, x + TRIPOD_PLANE_SOLVER_FD_STEP, y, turn3, cb, sb, r, l);
+        fy = star_centre(guard, x, y + TRIPOD_PLANE_SOLVER_FD_STEP, turn3, cb, sb, r, l);
+        jxx = (fx.fx - f.fx) / TRIPOD_PLANE_SOLVER_FD_STEP;
+        jyx = (fx.fy - f.fy) / TRIPOD_PLANE_SOLVER_FD_STEP;
+        jxy = (fy.fx - f.fx) / TRIPOD_PLANE_SOLVER_FD_STEP;
+        jyy = (fy.fy - f.fy) / TRIPOD_PLANE_SOLVER_FD_STEP;
         det = jxx * jyy - jxy * jyx;
         dx = divide(guard, jyy * f.fx - jxy * f.fy, det);
         dy = divide(guard, jxx * f.fy - jyx * f.fx, det);
         x = x - dx;
         y = y - dy;
-        if (fabs(dx) + fabs(dy) <= LAST_UPDATE) {
+        if (fabs(dx) + fabs(dy) <= TRIPOD_PLANE_SOLVER_LAST_UPDATE) {
             break;
         }
     }
-    if (i == MAX_ITERATIONS) {
+    if (i == TRIPOD_PLANE_SOLVER_MAX_ITERATIONS) {
         refuse(guard, "ArithmeticError: tripod closure: plane iteration did not converge");
     }
     if (guard->failure != NULL) {
         return;
     }
     /* the last update moved (x, y) by (-dx, -dy): carry arg(alpha) along to first order */
-    gradient_x = (fx.twist - f.twist) / FD_STEP;
-    gradient_y = (fy.twist - f.twist) / FD_STEP;
+    gradient_x = (fx.twist - f.twist) / TRIPOD_PLANE_SOLVER_FD_STEP;
+    gradient_y = (fy.twist - f.twist) / TRIPOD_PLANE_SOLVER_FD_STEP;
     twist = f.twist - (gradient_x * dx + gradient_y * dy);
     /* d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit */
     dx_dphi = -(jyy * (3.0 * f.orbit_i) - jxy * (-3.0 * f.orbit_r)) / det;
@@ -210,7 +202,7 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
         signs[j][0] = slip_sign(guard, a->zdot, load->slip_speed);
         signs[j][1] = slip_sign(guard, a->sigma * root(guard, a->exy2 + a->ez * a->ez), load->slip_speed);
     }
-    for (iteration = 0; iteration < MAX_FRICTION_ITERATIONS && guard->failure == NULL; iteration++) {
+    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure == NULL; iteration++) {
         double Mx = load_moment[0], My = load_moment[1], Mz = load_moment[2], change = 0.0, scale = 0.0;
         for (j = 0; j < 3; j++) {
             const Arm *a = &arm[j];
@@ -241,11 +233,11 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
             lams[j] = new_lams[j];
             mus[j] = new_mus[j];
         }
-        if (change <= FRICTION_TOLERANCE * scale) {
+        if (change <= TRIPOD_REACTIONS_FRICTION_TOLERANCE * scale) {
             break;
         }
     }
-    if (iteration == MAX_FRICTION_ITERATIONS) {
+    if (iteration == TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS) {
         refuse(guard, "ArithmeticError: tripod friction balance did not converge (friction coefficient too large?)");
     }
     *power = 0.0;
@@ -407,7 +399,7 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
     double bend = divide(guard, m * r, cb * cb), bend_rates = load->beta_ddot + 2.0 * tb * load->beta_dot * load->beta_dot;
     int j;
     for (j = 0; j < 3; j++) {
-        double angle = load->phi_in + THIRD_TURN * j, c = cosine(guard, angle), s = sine(guard, angle);
+        double angle = load->phi_in + TRIPOD_GEOMETRY_THIRD_TURN * j, c = cosine(guard, angle), s = sine(guard, angle);
         out->F_plunger[j] = -m * r * tb * (omega2 * c + omega_dot * s) +
                             bend * (c * bend_rates - 2.0 * load->omega * load->beta_dot * s);
         out->F_arm[j] = pin;
@@ -496,7 +488,7 @@ static const char *evaluate(ModelData *data, double input_time, double elapsed)
     load.slip_speed = VALUE(v_slip);
     rho = divide(&guard, r * (1.0 - cos_beta), 2.0 * cos_beta); /* orbit radius of the tripod centre */
     pin = divide(&guard, T_load, 3.0 * (r + rho));              /* eq 24 with the corrected eq 21 */
-    if (INTEGER(kinematics) == EXACT) {
+    if (INTEGER(kinematics) == TRIPOD_SPEC_EXACT) {
         plane_solve(&guard, phi_in, cos_beta, sin_beta, r, l, HAS_SOLUTION != 0.0, SOLUTION, &phi_out, &ratio);
         if (guard.failure != NULL) {
             return guard.failure;
@@ -508,7 +500,7 @@ static const char *evaluate(ModelData *data, double input_time, double elapsed)
     } else {
         /* eq 18 with the seed's phi, A cos 3 phi = A sin 3 phi_in, and its derivative (not eq 19) */
         double amplitude = divide(&guard, r * (1.0 - cos_beta), 2.0 * l * (1.0 + cos_beta)) * tan(beta);
-        double phase = 3.0 * (phi_in + PAPER_PHASE);
+        double phase = 3.0 * (phi_in + TRIPOD_CLOSED_FORM_PAPER_PHASE);
         double deviation = amplitude * cosine(&guard, phase);
         ratio = 1.0 - 3.0 * amplitude * sine(&guard, phase);
         phi_out = phi_in + deviation;
@@ -554,7 +546,7 @@ static const char *evaluate(ModelData *data, double input_time, double elapsed)
     if (INTEGER(seed_reactions)) {
         /* eqs 20, 30, 33, 34 as printed, with the seed's phi */
         double omega_squared = omega * omega, tan_beta = tan(beta);
-        double phi = phi_in + PAPER_PHASE, cos_3phi = cosine(&guard, 3.0 * phi);
+        double phi = phi_in + TRIPOD_CLOSED_FORM_PAPER_PHASE, cos_3phi = cosine(&guard, 3.0 * phi);
         double a_sum = -6.0 * omega_squared * rho * sin_beta * cos_3phi, m = VALUE(m_plunger);
         VALUE(a_plunger_sum) = a_sum;                                                        /* eq 20 */
         VALUE(Rz_out) = -6.0 * m * rho * omega_squared * tan_beta * cos_3phi;               /* eq 30 */
@@ -585,7 +577,7 @@ static const char *advance(ModelData *data, double current_time, double step_siz
 /* TripodCouplingModel.extra_parameter_errors: friction needs the exact kinematics. */
 static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
-    if (VALUE(mu) > 0.0 && INTEGER(kinematics) != EXACT) {
+    if (VALUE(mu) > 0.0 && INTEGER(kinematics) != TRIPOD_SPEC_EXACT) {
         messages_add_extra(out, data, MESSAGE_friction_needs_exact);
     }
 }

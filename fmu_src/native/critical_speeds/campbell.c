@@ -12,13 +12,6 @@
 
 #include "rotor.h"
 
-/* campbell.py's constants */
-#define SLOPE_STEP 1e-6
-#define SPLINE_RTOL 1e-12
-#define REFINEMENTS 4
-#define MAX_KNOTS 400
-#define NOISE 10.0
-
 struct WhirlTable {
     CubicSpline spline; /* forward columns first, then backward */
     int forward, n_modes;
@@ -104,7 +97,7 @@ static int roots_over_speeds(const Chain *chain, const double *spin, int count, 
         lines[i].o = spin[speed];
         coarse[i] = (unsigned char)(i < lines_n);
     }
-    if (rotor_line_roots(chain, lines, total, 0, x_hi, ROTOR_SEARCH_LIMIT, coarse, roots, error, size)) {
+    if (rotor_line_roots(chain, lines, total, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, coarse, roots, error, size)) {
         goto done;
     }
     for (int i = 0; i < count && !failed; ++i) {
@@ -123,7 +116,7 @@ static int roots_over_speeds(const Chain *chain, const double *spin, int count, 
     if (failed) {
         rotor_roots_free(roots, total);
         memset(roots, 0, (size_t)total * sizeof *roots);
-        if (rotor_line_roots(chain, lines, lines_n, 0, x_hi, ROTOR_SEARCH_LIMIT, NULL, roots, error, size)) {
+        if (rotor_line_roots(chain, lines, lines_n, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, NULL, roots, error, size)) {
             goto done;
         }
         total = lines_n;
@@ -178,7 +171,7 @@ static int slopes_of(const Chain *chain, const Found *found, double *slopes[2], 
         for (int i = 0; i < found->count; ++i) {
             const RotorRoots *r = &found->roots[s][i];
             for (int j = 0; j < r->count; ++j, ++k) {
-                double x = r->x[j], h = SLOPE_STEP * x, o = found->spin[i];
+                double x = r->x[j], h = ROTOR_CAMPBELL_SLOPE_STEP * x, o = found->spin[i];
                 w[4 * k] = sign * (x + h);
                 spin[4 * k] = o;
                 w[4 * k + 1] = sign * (x - h);
@@ -341,7 +334,7 @@ static double *side_by_side(const Branches branches[2], int speeds, int pad, dou
 }
 
 /* campbell._spline_error: the relative error of the branches' splines at the middle of every knot
- * interval (largest of all branches) by one Newton step on the determinant there, zero within NOISE
+ * interval (largest of all branches) by one Newton step on the determinant there, zero within ROTOR_CAMPBELL_NOISE
  * times the same step at the interval's ends; ``error_of`` has count - 1 entries. A branch missing at
  * some speed (NaN) has no spline and contributes no error. */
 static int spline_error(const Chain *chain, const Found *found, const Branches branches[2], double *error_of,
@@ -403,7 +396,7 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
             double *row = w + (size_t)p * m;
             cubic_spline_evaluate(&spline, at, row);
             for (int c = 0; c < m; ++c, ++n) {
-                double sign = c < forward ? 1.0 : -1.0, h = SLOPE_STEP * row[c];
+                double sign = c < forward ? 1.0 : -1.0, h = ROTOR_CAMPBELL_SLOPE_STEP * row[c];
                 at_w[3 * n] = sign * row[c];
                 at_w[3 * n + 1] = sign * (row[c] + h);
                 at_w[3 * n + 2] = sign * (row[c] - h);
@@ -412,14 +405,14 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
         }
         chain_determinant(chain, 3 * cells, at_w, at_spin, f);
         for (n = 0; n < cells; ++n) {
-            double x = w[n], h = SLOPE_STEP * x;
+            double x = w[n], h = ROTOR_CAMPBELL_SLOPE_STEP * x;
             double estimate = fabs(f[3 * n] * 2.0 * h / (f[3 * n + 1] - f[3 * n + 2])) / x;
             step[n] = isfinite(estimate) ? estimate : 0.0;
         }
         for (int i = 0; i + 1 < knots; ++i) {
             const double *middle = step + (size_t)i * m, *lo = step + (size_t)(knots - 1 + i) * m, *hi = lo + m;
             for (int c = 0; c < m; ++c) {
-                double noise = NOISE * (lo[c] > hi[c] ? lo[c] : hi[c]);
+                double noise = ROTOR_CAMPBELL_NOISE * (lo[c] > hi[c] ? lo[c] : hi[c]);
                 double e = middle[c] > noise ? middle[c] : 0.0;
                 error_of[i] = e > error_of[i] ? e : error_of[i];
             }
@@ -528,7 +521,7 @@ static int refine(const Chain *chain, Found *found, const Branches branches[2], 
         goto done;
     }
     for (int i = 0; i + 1 < knots; ++i) {
-        if (error_of[i] > SPLINE_RTOL) {
+        if (error_of[i] > ROTOR_CAMPBELL_SPLINE_RTOL) {
             rough[n_rough] = i;
             middles[n_rough] = 0.5 * (found->spin[i] + found->spin[i + 1]);
             for (int side = 0; side < 2; ++side) {
@@ -561,13 +554,13 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
                               Branches branches[2], char *error, size_t size)
 {
     double reach = (n_modes + 2) * FMU_PI / chain_kappa(chain);
-    double x_hi = fmin(reach * reach, ROTOR_SEARCH_LIMIT);
+    double x_hi = fmin(reach * reach, ROTOR_DRIVELINE_SEARCH_LIMIT);
     for (;;) {
         int final = 0;
         if (roots_over_speeds(chain, spins, points, x_hi, NULL, found, error, size)) {
             return -1;
         }
-        for (int round = 0; round <= REFINEMENTS; ++round) {
+        for (int round = 0; round <= ROTOR_CAMPBELL_REFINEMENTS; ++round) {
             int refined;
             if (follow_both(chain, found, n_modes, branches, error, size)) {
                 found_free(found);
@@ -579,8 +572,8 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
                     enough = enough && found->roots[s][i].count >= n_modes;
                 }
             }
-            final = x_hi >= ROTOR_SEARCH_LIMIT || (enough && branches_complete(branches, found->count));
-            if (round == REFINEMENTS || found->count > MAX_KNOTS || !final) {
+            final = x_hi >= ROTOR_DRIVELINE_SEARCH_LIMIT || (enough && branches_complete(branches, found->count));
+            if (round == ROTOR_CAMPBELL_REFINEMENTS || found->count > ROTOR_CAMPBELL_MAX_KNOTS || !final) {
                 break; /* a round to be widened restarts from ``spins``: refining it is wasted */
             }
             if (refine(chain, found, branches, x_hi, &refined, error, size)) {
@@ -598,7 +591,7 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
         }
         branches_free(branches);
         found_free(found);
-        x_hi = fmin(4.0 * x_hi, ROTOR_SEARCH_LIMIT);
+        x_hi = fmin(4.0 * x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT);
     }
 }
 
@@ -625,7 +618,7 @@ static int sorted_table(const Chain *chain, const double *spins, int points, int
         cases[i].s = 0.0;
         cases[i].o = spins[i];
     }
-    if (rotor_roots_by_whirl(chain, cases, points, n_modes, 0.0, ROTOR_SEARCH_LIMIT, roots[0], roots[1], error,
+    if (rotor_roots_by_whirl(chain, cases, points, n_modes, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT, roots[0], roots[1], error,
                              size)) {
         goto done;
     }
@@ -696,7 +689,7 @@ WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, in
     }
     if (!status) { /* WhirlTable.__init__ */
         int m;
-        double *values = side_by_side(branches, count, n_modes, ROTOR_SEARCH_LIMIT, &m, &table->forward);
+        double *values = side_by_side(branches, count, n_modes, ROTOR_DRIVELINE_SEARCH_LIMIT, &m, &table->forward);
         status = values ? cubic_spline_build(&table->spline, count, knots, m, values) : -1;
         if (status) {
             out_of_memory(error, size);

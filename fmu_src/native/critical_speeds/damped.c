@@ -1,5 +1,5 @@
 /* Damped finite-element model of a driveline (damped.DampedRotor) and what the FMU reports of it
- * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver up to DENSE_SIZE
+ * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver up to ROTOR_DAMPED_DENSE_SIZE
  * first-order unknowns and by shift-invert Arnoldi on a banded factorisation above, the synchronous
  * unbalance response from a banded complex LU solve (the linear algebra in linalg.c). */
 #include "rotor.h"
@@ -13,15 +13,6 @@
 #include <string.h>
 
 #define OUT_OF_MEMORY "out of memory"
-/* damped.py */
-#define EXTRA_EIGENVALUES 6
-#define DENSE_SIZE 160
-#define SHIFT (-1.0)
-/* unbalance_outputs.py */
-#define FE_ELEMENTS 16
-#define TABLE_ELEMENTS 8
-#define DAMPING_POINTS 11
-#define DAMPED_MODES 4
 
 static void set_error(char *error, size_t size, const char *message)
 {
@@ -237,12 +228,12 @@ static int by_frequency(const void *a, const void *b)
     return (x->place > y->place) - (x->place < y->place);
 }
 
-/* ---- shift-invert Arnoldi (DampedRotor.modes above DENSE_SIZE) ------------------------------
- * The eigenvalues nu of (A - SHIFT B)^-1 B are 1 / (lam - SHIFT): the largest |nu| are the lam nearest
- * SHIFT. With y = [y1, y2] and v = [v1, v2] (x and x'/s blocks, each in the interleaved order),
- * (A - SHIFT B) y = B v reads -SHIFT y1 + s y2 = v1 and -K2 y1 / s - (C2 + spin Gv + SHIFT M2) y2 = M2 v2,
- * so that Q(SHIFT) y1 = -s M2 v2 - (C2 + spin Gv + SHIFT M2) v1 with the banded
- * Q(SHIFT) = K2 + SHIFT (C2 + spin Gv) + SHIFT^2 M2, and y2 = (v1 + SHIFT y1) / s. */
+/* ---- shift-invert Arnoldi (DampedRotor.modes above ROTOR_DAMPED_DENSE_SIZE) ------------------------------
+ * The eigenvalues nu of (A - ROTOR_DAMPED_SHIFT B)^-1 B are 1 / (lam - ROTOR_DAMPED_SHIFT): the largest |nu| are the lam nearest
+ * ROTOR_DAMPED_SHIFT. With y = [y1, y2] and v = [v1, v2] (x and x'/s blocks, each in the interleaved order),
+ * (A - ROTOR_DAMPED_SHIFT B) y = B v reads -ROTOR_DAMPED_SHIFT y1 + s y2 = v1 and -K2 y1 / s - (C2 + spin Gv + ROTOR_DAMPED_SHIFT M2) y2 = M2 v2,
+ * so that Q(ROTOR_DAMPED_SHIFT) y1 = -s M2 v2 - (C2 + spin Gv + ROTOR_DAMPED_SHIFT M2) v1 with the banded
+ * Q(ROTOR_DAMPED_SHIFT) = K2 + ROTOR_DAMPED_SHIFT (C2 + spin Gv) + ROTOR_DAMPED_SHIFT^2 M2, and y2 = (v1 + ROTOR_DAMPED_SHIFT y1) / s. */
 /* most Krylov vectors: memory 2 size (KRYLOV_CAP + 1) complex numbers */
 #define KRYLOV_CAP 400
 /* a Ritz value has converged when its residual estimate is below this times the largest |nu| */
@@ -250,7 +241,7 @@ static int by_frequency(const void *a, const void *b)
 
 typedef struct {
     int cap, steps;        /* most Krylov vectors (0: the dense path); vectors of the last run */
-    cplx *q, *coupling;    /* Q(SHIFT) factorised and C2 + spin Gv + SHIFT M2, band storage */
+    cplx *q, *coupling;    /* Q(ROTOR_DAMPED_SHIFT) factorised and C2 + spin Gv + ROTOR_DAMPED_SHIFT M2, band storage */
     int *pivots, *place;   /* Q's row swaps; place[order[i]] = i */
     cplx *basis;           /* cap + 1 orthonormal vectors of 2 size */
     cplx *hess;            /* (cap + 1) x cap Hessenberg matrix of the Arnoldi relation, by rows */
@@ -302,7 +293,7 @@ static int krylov_init(Krylov *krylov, const Rotor *rotor)
     return 0;
 }
 
-/* y = (A - SHIFT B)^-1 B v (2 size each, blocks in the interleaved order) */
+/* y = (A - ROTOR_DAMPED_SHIFT B)^-1 B v (2 size each, blocks in the interleaved order) */
 static void krylov_apply(const Rotor *rotor, const Krylov *krylov, const cplx *v, cplx *y)
 {
     Band band = rotor->band;
@@ -313,7 +304,7 @@ static void krylov_apply(const Rotor *rotor, const Krylov *krylov, const cplx *v
     for (int i = 0; i < m; i++) {
         y1[i] = cplx_real(0.0);
     }
-    for (int j = 0; j < m; j++) { /* -s M2 v2 - (C2 + spin Gv + SHIFT M2) v1, column by column */
+    for (int j = 0; j < m; j++) { /* -s M2 v2 - (C2 + spin Gv + ROTOR_DAMPED_SHIFT M2) v1, column by column */
         int first = j - band.ku > 0 ? j - band.ku : 0, last = j + band.kl < m ? j + band.kl : m - 1;
         cplx a = cplx_scale(-s, v2[j]), b = v1[j];
         for (int i = first; i <= last; i++) {
@@ -322,7 +313,7 @@ static void krylov_apply(const Rotor *rotor, const Krylov *krylov, const cplx *v
     }
     band_substitute(band, krylov->q, krylov->pivots, y1);
     for (int i = 0; i < m; i++) {
-        y2[i] = cplx_div_real(cplx_add(v1[i], cplx_scale(SHIFT, y1[i])), s);
+        y2[i] = cplx_div_real(cplx_add(v1[i], cplx_scale(ROTOR_DAMPED_SHIFT, y1[i])), s);
     }
 }
 
@@ -371,7 +362,7 @@ static int krylov_converged(Krylov *krylov, int steps, int order, int wanted)
     return 1;
 }
 
-/* The ``wanted`` eigenvalues lam nearest SHIFT at ``spin`` into ``lambda`` (ranked by descending
+/* The ``wanted`` eigenvalues lam nearest ROTOR_DAMPED_SHIFT at ``spin`` into ``lambda`` (ranked by descending
  * |nu|); afterwards ritz[rank[k]] is the Ritz value of lambda[k] and small the Hessenberg matrix */
 static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wanted, cplx *lambda, char *error,
                         size_t size)
@@ -384,8 +375,8 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
     size_t cells = (size_t)rotor->band.rows * (size_t)m;
     for (size_t i = 0; i < cells; i++) {
         krylov->coupling[i] = cplx_add(cplx_add(rotor->banded[1][i], cplx_scale(spin, rotor->banded[2][i])),
-                                       cplx_scale(SHIFT, rotor->banded[3][i]));
-        krylov->q[i] = cplx_add(rotor->banded[0][i], cplx_scale(SHIFT, krylov->coupling[i]));
+                                       cplx_scale(ROTOR_DAMPED_SHIFT, rotor->banded[3][i]));
+        krylov->q[i] = cplx_add(rotor->banded[0][i], cplx_scale(ROTOR_DAMPED_SHIFT, krylov->coupling[i]));
     }
     if (band_factor(rotor->band, krylov->q, krylov->pivots)) {
         set_error(error, size, "the damped model is singular at the Arnoldi shift");
@@ -432,7 +423,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
     krylov->steps = steps;
     for (int k = 0; k < wanted; k++) {
         cplx inverse = cplx_div(cplx_real(1.0), krylov->ritz[krylov->rank[k]]);
-        lambda[k] = cplx_make(SHIFT + inverse.re, inverse.im);
+        lambda[k] = cplx_make(ROTOR_DAMPED_SHIFT + inverse.re, inverse.im);
     }
     return 0;
 }
@@ -466,7 +457,7 @@ typedef struct {
     unsigned char *swapped;
     Mode *modes;
     int *index;
-    Krylov krylov;                     /* above DENSE_SIZE (krylov.cap > 0): none of the dense arrays */
+    Krylov krylov;                     /* above ROTOR_DAMPED_DENSE_SIZE (krylov.cap > 0): none of the dense arrays */
 } Dense;
 
 static void dense_free(Dense *dense)
@@ -489,7 +480,7 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
     size_t block = (size_t)m * (size_t)m, full = (size_t)order * (size_t)order;
     dense->size = m;
     dense->order = order;
-    if (order > DENSE_SIZE) { /* shift-invert Arnoldi: the banded matrices and O(order KRYLOV_CAP) work */
+    if (order > ROTOR_DAMPED_DENSE_SIZE) { /* shift-invert Arnoldi: the banded matrices and O(order KRYLOV_CAP) work */
         int cap = order < KRYLOV_CAP ? order : KRYLOV_CAP;
         dense->lambda = malloc((size_t)cap * sizeof(cplx));
         dense->modes = malloc((size_t)cap * sizeof(Mode));
@@ -592,8 +583,8 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
                        size_t size)
 {
     int order = dense->order, count, *index = dense->index;
-    if (dense->krylov.cap) { /* above DENSE_SIZE: the 2 n + EXTRA_EIGENVALUES nearest SHIFT by Arnoldi */
-        count = 2 * n + EXTRA_EIGENVALUES < dense->krylov.cap ? 2 * n + EXTRA_EIGENVALUES : dense->krylov.cap;
+    if (dense->krylov.cap) { /* above ROTOR_DAMPED_DENSE_SIZE: the 2 n + ROTOR_DAMPED_EXTRA_EIGENVALUES nearest ROTOR_DAMPED_SHIFT by Arnoldi */
+        count = 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES < dense->krylov.cap ? 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES : dense->krylov.cap;
         if (krylov_modes(rotor, &dense->krylov, spin, count, dense->lambda, error, size)) {
             return -1;
         }
@@ -664,10 +655,10 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
 
 /* ---- unbalance_outputs.UnbalanceOutputs ------------------------------------------------------ */
 struct UnbalanceOutputs {
-    Rotor rotor;        /* the response model (FE_ELEMENTS), its band matrices only */
+    Rotor rotor;        /* the response model (ROTOR_UNBALANCE_OUTPUTS_FE_ELEMENTS), its band matrices only */
     cplx *load;         /* DampedRotor.load per unit Omega^2, rotor.size */
     cplx *row;          /* DampedRotor.shape_rows at the response position, rotor.n */
-    CubicSpline modes;  /* DAMPED_MODES damped frequencies, then their damping ratios */
+    CubicSpline modes;  /* ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES damped frequencies, then their damping ratios */
     cplx *ab, *x;       /* evaluate's work: one object is evaluated by one caller at a time */
     int *pivots;
 };
@@ -721,7 +712,7 @@ void unbalance_outputs_free(UnbalanceOutputs *outputs)
     free(outputs);
 }
 
-/* The mode table of UnbalanceOutputs.build: DAMPING_POINTS rows of 2 DAMPED_MODES */
+/* The mode table of UnbalanceOutputs.build: ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS rows of 2 ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES */
 static int mode_table(const Driveline *d, const int *counts, const double *spins, double *table, char *error,
                       size_t size)
 {
@@ -735,22 +726,22 @@ static int mode_table(const Driveline *d, const int *counts, const double *spins
         return -1;
     }
     int status = 0;
-    Mode modes[4 * DAMPED_MODES];
-    for (int i = 0; i < DAMPING_POINTS && !status; i++) {
+    Mode modes[4 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
+    for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS && !status; i++) {
         int found = 0, excited = 0;
-        status = rotor_modes(&coarse, &dense, spins[i], 4 * DAMPED_MODES, modes, &found, error, size);
-        double *out = table + (size_t)i * 2 * DAMPED_MODES;
-        for (int k = 0; k < found && excited < DAMPED_MODES && !status; k++) {
-            if (modes[k].forward_share >= ROTOR_EXCITED_SHARE) {
+        status = rotor_modes(&coarse, &dense, spins[i], 4 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, modes, &found, error, size);
+        double *out = table + (size_t)i * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES;
+        for (int k = 0; k < found && excited < ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES && !status; k++) {
+            if (modes[k].forward_share >= ROTOR_DRIVELINE_EXCITED_SHARE) {
                 cplx value = modes[k].eigenvalue;
                 out[excited] = value.im;
-                out[DAMPED_MODES + excited] = -value.re / cplx_abs(value);
+                out[ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES + excited] = -value.re / cplx_abs(value);
                 excited++;
             }
         }
-        for (; excited < DAMPED_MODES; excited++) { /* a short model: beyond the search limit, undamped */
-            out[excited] = ROTOR_SEARCH_LIMIT;
-            out[DAMPED_MODES + excited] = 0.0;
+        for (; excited < ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES; excited++) { /* a short model: beyond the search limit, undamped */
+            out[excited] = ROTOR_DRIVELINE_SEARCH_LIMIT;
+            out[ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES + excited] = 0.0;
         }
     }
     dense_free(&dense);
@@ -770,19 +761,19 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         set_error(error, size, OUT_OF_MEMORY);
         return NULL;
     }
-    double spins[DAMPING_POINTS], table[DAMPING_POINTS * 2 * DAMPED_MODES];
-    double step = omega_max / (DAMPING_POINTS - 1); /* numpy.linspace */
-    for (int i = 0; i < DAMPING_POINTS; i++) {
+    double spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS], table[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
+    double step = omega_max / (ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS - 1); /* numpy.linspace */
+    for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS; i++) {
         spins[i] = i * step + 0.0;
     }
-    spins[DAMPING_POINTS - 1] = omega_max;
-    fe_elements_by_length(d, TABLE_ELEMENTS, counts);
+    spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS - 1] = omega_max;
+    fe_elements_by_length(d, ROTOR_UNBALANCE_OUTPUTS_TABLE_ELEMENTS, counts);
     if (mode_table(d, counts, spins, table, error, size)) {
         free(counts);
         free(outputs);
         return NULL;
     }
-    fe_elements_by_length(d, FE_ELEMENTS, counts);
+    fe_elements_by_length(d, ROTOR_UNBALANCE_OUTPUTS_FE_ELEMENTS, counts);
     Rotor *rotor = &outputs->rotor;
     if (rotor_init(rotor, d, counts, error, size)) {
         free(counts);
@@ -827,14 +818,14 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
     }
     /* CubicSpline(spins, table) and its checks */
     const char *refused = NULL;
-    for (int i = 0; i < DAMPING_POINTS * 2 * DAMPED_MODES; i++) {
+    for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES; i++) {
         refused = isfinite(table[i]) ? refused : "`y` must contain only finite values.";
     }
-    for (int i = 0; i < DAMPING_POINTS; i++) {
+    for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS; i++) {
         refused = i > 0 && !(spins[i] > spins[i - 1]) && !refused ? "`x` must be strictly increasing sequence." : refused;
     }
     refused = isfinite(omega_max) ? refused : "`x` must contain only finite values.";
-    if (refused || cubic_spline_build(&outputs->modes, DAMPING_POINTS, spins, 2 * DAMPED_MODES, table)) {
+    if (refused || cubic_spline_build(&outputs->modes, ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS, spins, 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, table)) {
         memset(&outputs->modes, 0, sizeof outputs->modes);
         unbalance_outputs_free(outputs);
         set_error(error, size, refused ? refused : OUT_OF_MEMORY);
@@ -843,7 +834,7 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
     return outputs;
 }
 
-void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed, double out[2 * DAMPED_MODES])
+void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed, double out[2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES])
 {
     cubic_spline_evaluate(&outputs->modes, speed, out);
 }
@@ -851,10 +842,10 @@ void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed, doub
 /* UnbalanceOutputs.evaluate (DampedRotor.solve, components and bearing_forces at one speed) */
 void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3])
 {
-    double table[2 * DAMPED_MODES];
+    double table[2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
     cubic_spline_evaluate(&outputs->modes, speed, table);
     int nearest = 0; /* numpy.argmin: the first of equal ones, the first nan */
-    for (int k = 0; k < DAMPED_MODES; k++) {
+    for (int k = 0; k < ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES; k++) {
         double distance = fabs(table[k] - speed);
         if (isnan(distance)) {
             nearest = k;
@@ -864,7 +855,7 @@ void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, d
             nearest = k;
         }
     }
-    out[2] = table[DAMPED_MODES + nearest];
+    out[2] = table[ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES + nearest];
     if (speed == 0.0) {
         out[0] = out[1] = 0.0;
         return;

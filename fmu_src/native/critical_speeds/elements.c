@@ -5,7 +5,6 @@
 
 #include <math.h>
 
-#define SERIES_LIMIT 0.1 /* elements._SERIES_LIMIT */
 
 double segment_area(const RotorSegment *s)
 {
@@ -85,7 +84,7 @@ void segment_fe_element(const RotorSegment *s, double h, double k[16], double m[
 static double sinh_minus_x_over_x3(double x)
 {
     double x2;
-    if (x >= SERIES_LIMIT) {
+    if (x >= ROTOR_ELEMENTS_SERIES_LIMIT) {
         return (sinh(x) - x) / pow(x, 3.0);
     }
     x2 = x * x;
@@ -96,7 +95,7 @@ static double sinh_minus_x_over_x3(double x)
 static double x_minus_sin_over_x3(double y)
 {
     double y2;
-    if (y >= SERIES_LIMIT) {
+    if (y >= ROTOR_ELEMENTS_SERIES_LIMIT) {
         return (y - sin(y)) / pow(y, 3.0);
     }
     y2 = y * y;

@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NODE_SNAP 1e-9 /* loader.NODE_SNAP */
 
 /* ---- the loader (loader.py) --------------------------------------------------------------- */
 
@@ -540,7 +539,7 @@ static int unbalance(const Loader *loader, int i, const Value *t, const double *
         return -1;
     }
     position = at.is_node ? ends[at.node] : at.value;
-    if (position > right + NODE_SNAP) {
+    if (position > right + ROTOR_LOADER_NODE_SNAP) {
         return layout_error(loader->error, loader->size, "%s.position = %g m lies beyond the right end (%g m)", where,
                     at.value, right);
     }
@@ -589,14 +588,14 @@ static int cut(const Loader *loader, const RotorSegment *old, int n_old, Station
             if (stations[kind][i].is_node) {
                 continue;
             }
-            if (value > ends[n_old] + NODE_SNAP) {
+            if (value > ends[n_old] + ROTOR_LOADER_NODE_SNAP) {
                 return layout_error(loader->error, loader->size, "%s[%d].position = %g m lies beyond the right end (%g m)",
                             kinds[kind], i, value, ends[n_old]);
             }
             for (k = 0; k < n_old && !(ends[k] <= value && value <= ends[k + 1]); k++) {
             }
             k = k == n_old ? 0 : k;
-            if ((value - ends[k] < ends[k + 1] - value ? value - ends[k] : ends[k + 1] - value) > NODE_SNAP) {
+            if ((value - ends[k] < ends[k + 1] - value ? value - ends[k] : ends[k + 1] - value) > ROTOR_LOADER_NODE_SNAP) {
                 segment_of[n_cuts] = k;
                 cuts[n_cuts++] = value;
             }
@@ -777,7 +776,7 @@ static int end_condition(const Loader *loader, const Value *data, const char *ke
 static int load(const Loader *loader, const Value *data, Driveline *d)
 {
     static const char *const kinds[] = {"masses", "bearings", "hinges"};
-    static const int limits[] = {LAYOUT_MAX_POINT_ELEMENTS, LAYOUT_MAX_POINT_ELEMENTS, LAYOUT_MAX_POINT_ELEMENTS};
+    static const int limits[] = {ROTOR_LOADER_MAX_POINT_ELEMENTS, ROTOR_LOADER_MAX_POINT_ELEMENTS, ROTOR_LOADER_MAX_POINT_ELEMENTS};
     const Value *name = get(data, "name"), *segs, *unbs, *tables[3];
     const Item *item;
     Material *mats;
@@ -793,7 +792,7 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
     }
     if (end_condition(loader, data, "left_end", &d->left) != 0 ||
         end_condition(loader, data, "right_end", &d->right) != 0 || materials(loader, data, &mats, &n_mats) != 0 ||
-        counted(loader, data, "segments", LAYOUT_MAX_SEGMENTS, &segs) != 0) {
+        counted(loader, data, "segments", ROTOR_LOADER_MAX_SEGMENTS, &segs) != 0) {
         return -1;
     }
     n_old = list_count(segs);
@@ -812,7 +811,7 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
         }
         ends[i + 1] = ends[i] + old[i].length;
     }
-    if (counted(loader, data, "unbalances", LAYOUT_MAX_POINT_ELEMENTS, &unbs) != 0) {
+    if (counted(loader, data, "unbalances", ROTOR_LOADER_MAX_POINT_ELEMENTS, &unbs) != 0) {
         return -1;
     }
     n_unb = list_count(unbs);
@@ -872,8 +871,8 @@ static int nesting_errors(const char *text, size_t length, const char *source, c
     int depth = 0;
     for (i = 0; i < length; i++) {
         if (text[i] == '[' || text[i] == '{') {
-            if (++depth > LAYOUT_MAX_NESTING) {
-                return layout_error(error, size, "%s: brackets nest deeper than %d levels", source, LAYOUT_MAX_NESTING);
+            if (++depth > ROTOR_LOADER_MAX_NESTING) {
+                return layout_error(error, size, "%s: brackets nest deeper than %d levels", source, ROTOR_LOADER_MAX_NESTING);
             }
         } else if ((text[i] == ']' || text[i] == '}') && depth > 0) {
             depth--;

@@ -155,12 +155,12 @@ static int read_regular_file(const char *path, char **data, size_t *length, char
     }
     if (regular < 0 || (file = fopen(path, "rb")) == NULL) {
         err = errno != 0 ? errno : EINVAL;
-    } else if ((*data = malloc(LAYOUT_MAX_FILE_BYTES + 1)) == NULL) {
+    } else if ((*data = malloc(ROTOR_LOADER_MAX_FILE_BYTES + 1)) == NULL) {
         fclose(file);
         return layout_error(error, size, "out of memory");
     } else {
-        while (used <= LAYOUT_MAX_FILE_BYTES) {
-            size_t got = fread(*data + used, 1, LAYOUT_MAX_FILE_BYTES + 1 - used, file);
+        while (used <= ROTOR_LOADER_MAX_FILE_BYTES) {
+            size_t got = fread(*data + used, 1, ROTOR_LOADER_MAX_FILE_BYTES + 1 - used, file);
             if (got == 0) {
                 break;
             }
@@ -177,10 +177,10 @@ static int read_regular_file(const char *path, char **data, size_t *length, char
         error_text(err, reason, sizeof reason);
         return layout_error(error, size, "cannot read driveline file %r: %s", path, reason);
     }
-    if (used > LAYOUT_MAX_FILE_BYTES) {
+    if (used > ROTOR_LOADER_MAX_FILE_BYTES) {
         free(*data);
         *data = NULL;
-        return layout_error(error, size, "driveline file %r is larger than %d bytes", path, LAYOUT_MAX_FILE_BYTES);
+        return layout_error(error, size, "driveline file %r is larger than %d bytes", path, ROTOR_LOADER_MAX_FILE_BYTES);
     }
     *length = used;
     return 0;

@@ -14,16 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
-#define SUBGRID 24          /* roots.SUBGRID */
-#define MAX_DEPTH 16        /* roots.MAX_DEPTH */
-#define DIP_RATIO 0.9       /* roots.DIP_RATIO */
-#define MAX_ITERATIONS 200  /* roots.MAX_ITERATIONS */
-#define XTOL 1e-12          /* find_roots_batch's xtol */
-#define RTOL (4.0 * DBL_EPSILON)
-#define POINTS_PER_ROOT 16  /* driveline.POINTS_PER_ROOT */
-#define GRID_OFFSET 0.6180339887498949
-#define LEAD_POINTS 9
 #define N_NONE INT_MIN      /* n = None */
 
 /* One search: the determinant along the line (w, spin) = (w x, s x + o) and the roots found so far. */
@@ -96,7 +86,7 @@ static int refine(Search *st, double a, double b, double fa, double fb)
     double f_ends = fabs(fa) > fabs(fb) ? fabs(fa) : fabs(fb);
     double c, fc, t = 0.5;
     int iteration;
-    for (iteration = 0; iteration < MAX_ITERATIONS; iteration++) {
+    for (iteration = 0; iteration < ROTOR_ROOTS_MAX_ITERATIONS; iteration++) {
         double xt = a + t * (b - a), ft = line_f(st, xt), xm, fm, tlim, xi, phi;
         if (sign_of(ft) == sign_of(fa)) { /* the new point replaces a; else b becomes a */
             c = a;
@@ -116,7 +106,7 @@ static int refine(Search *st, double a, double b, double fa, double fb)
             xm = b;
             fm = fb;
         }
-        tlim = (XTOL + RTOL * fabs(xm)) / fabs(b - a);
+        tlim = (ROTOR_ROOTS_XTOL + ROTOR_ROOTS_RTOL * fabs(xm)) / fabs(b - a);
         if (fm == 0.0 || tlim > 0.5) {
             if (fabs(fm) > f_ends) { /* |f| grew towards the 'root': a pole */
                 return 0;
@@ -140,7 +130,7 @@ static int refine(Search *st, double a, double b, double fa, double fb)
 }
 
 /* roots._scan for one sampled sequence: its zeros and sign changes, then its dips re-scanned on
- * sub-grids of SUBGRID steps (a dip that persists down to the root tolerance is a double root). */
+ * sub-grids of ROTOR_ROOTS_SUBGRID steps (a dip that persists down to the root tolerance is a double root). */
 static int scan(Search *st, const double *x, const double *fx, int n, int depth)
 {
     int i, j;
@@ -157,14 +147,14 @@ static int scan(Search *st, const double *x, const double *fx, int n, int depth)
     for (i = 1; i + 1 < n; i++) {
         double s = sign_of(fx[i]), lo = x[i - 1], hi = x[i + 1], mid = x[i];
         double a0 = fabs(fx[i - 1]), a1 = fabs(fx[i]), a2 = fabs(fx[i + 1]);
-        double sx[SUBGRID + 1], sf[SUBGRID + 1];
+        double sx[ROTOR_ROOTS_SUBGRID + 1], sf[ROTOR_ROOTS_SUBGRID + 1];
         if (!(sign_of(fx[i - 1]) == s && s == sign_of(fx[i + 1]) && s != 0.0)) {
             continue;
         }
-        if (!(a1 < a0 && a1 <= a2 && a1 <= DIP_RATIO * (a0 > a2 ? a0 : a2))) {
+        if (!(a1 < a0 && a1 <= a2 && a1 <= ROTOR_ROOTS_DIP_RATIO * (a0 > a2 ? a0 : a2))) {
             continue;
         }
-        if (hi - lo <= 2.0 * (XTOL + RTOL * fabs(mid)) || depth >= MAX_DEPTH) {
+        if (hi - lo <= 2.0 * (ROTOR_ROOTS_XTOL + ROTOR_ROOTS_RTOL * fabs(mid)) || depth >= ROTOR_ROOTS_MAX_DEPTH) {
             if (found(st, mid) || found(st, mid)) {
                 return -1;
             }
@@ -172,13 +162,13 @@ static int scan(Search *st, const double *x, const double *fx, int n, int depth)
         }
         sx[0] = lo;
         sf[0] = fx[i - 1];
-        for (j = 1; j < SUBGRID; j++) {
-            sx[j] = lo + (hi - lo) * (j * (1.0 / SUBGRID)); /* numpy.linspace(0, 1, SUBGRID + 1) */
+        for (j = 1; j < ROTOR_ROOTS_SUBGRID; j++) {
+            sx[j] = lo + (hi - lo) * (j * (1.0 / ROTOR_ROOTS_SUBGRID)); /* numpy.linspace(0, 1, ROTOR_ROOTS_SUBGRID + 1) */
             sf[j] = line_f(st, sx[j]);
         }
-        sx[SUBGRID] = hi;
-        sf[SUBGRID] = fx[i + 1];
-        if (scan(st, sx, sf, SUBGRID + 1, depth + 1)) {
+        sx[ROTOR_ROOTS_SUBGRID] = hi;
+        sf[ROTOR_ROOTS_SUBGRID] = fx[i + 1];
+        if (scan(st, sx, sf, ROTOR_ROOTS_SUBGRID + 1, depth + 1)) {
             return -1;
         }
     }
@@ -211,14 +201,14 @@ static int find_roots(Search *st, const double *grid, int n)
     return status;
 }
 
-/* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with POINTS_PER_ROOT points per
+/* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with ROTOR_DRIVELINE_POINTS_PER_ROOT points per
  * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] 1e-4, x[0], 9)[:-1]). */
 static double *grid_new(const Chain *chain, double x_max, double ratio, int coarse, int *count, char *error,
                         size_t size)
 {
     int extra = coarse ? 0 : chain_freedoms(chain), per_pi, n, i;
     double kappa = chain_kappa(chain) * sqrt(fabs(ratio)), theta_max, steps, step, log_start, log_stop, *x;
-    per_pi = POINTS_PER_ROOT * (1 + extra) * (chain_isotropic(chain) ? 1 : 2);
+    per_pi = ROTOR_DRIVELINE_POINTS_PER_ROOT * (1 + extra) * (chain_isotropic(chain) ? 1 : 2);
     theta_max = kappa * sqrt(x_max);
     steps = ceil(theta_max / FMU_PI * per_pi);
     if (!(steps < (double)(INT_MAX / 2))) {
@@ -226,24 +216,24 @@ static double *grid_new(const Chain *chain, double x_max, double ratio, int coar
         return NULL;
     }
     n = steps > 8.0 ? (int)steps : 8;
-    x = malloc((size_t)(LEAD_POINTS - 1 + n + 1) * sizeof *x);
+    x = malloc((size_t)(ROTOR_DRIVELINE_LEAD_POINTS - 1 + n + 1) * sizeof *x);
     if (x == NULL) {
         set_error(error, size, "out of memory");
         return NULL;
     }
     step = theta_max / n;
     for (i = 0; i < n; i++) { /* offset by an irrational fraction of a step */
-        double t = (i + GRID_OFFSET) * step / kappa;
-        x[LEAD_POINTS - 1 + i] = t * t;
+        double t = (i + ROTOR_DRIVELINE_GRID_OFFSET) * step / kappa;
+        x[ROTOR_DRIVELINE_LEAD_POINTS - 1 + i] = t * t;
     }
-    x[LEAD_POINTS - 1 + n] = (theta_max / kappa) * (theta_max / kappa);
-    x[0] = x[LEAD_POINTS - 1] * 1e-4;
+    x[ROTOR_DRIVELINE_LEAD_POINTS - 1 + n] = (theta_max / kappa) * (theta_max / kappa);
+    x[0] = x[ROTOR_DRIVELINE_LEAD_POINTS - 1] * 1e-4;
     log_start = log10(x[0]);
-    log_stop = log10(x[LEAD_POINTS - 1]);
-    for (i = 1; i < LEAD_POINTS - 1; i++) {
-        x[i] = pow(10.0, i * ((log_stop - log_start) / (LEAD_POINTS - 1)) + log_start);
+    log_stop = log10(x[ROTOR_DRIVELINE_LEAD_POINTS - 1]);
+    for (i = 1; i < ROTOR_DRIVELINE_LEAD_POINTS - 1; i++) {
+        x[i] = pow(10.0, i * ((log_stop - log_start) / (ROTOR_DRIVELINE_LEAD_POINTS - 1)) + log_start);
     }
-    *count = LEAD_POINTS + n;
+    *count = ROTOR_DRIVELINE_LEAD_POINTS + n;
     return x;
 }
 
@@ -574,7 +564,7 @@ int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, 
     int found_count = 0, i;
     *count = 0;
     if (chain_isotropic(chain)) {
-        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD, n, 0.0, ROTOR_SEARCH_LIMIT, &found_list,
+        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD, n, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT, &found_list,
                              &found_count, error, size)) {
             return -1;
         }
@@ -583,7 +573,7 @@ int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, 
         }
     } else {
         Share *shares;
-        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD | WHIRL_BACKWARD, n + 1, 0.0, ROTOR_SEARCH_LIMIT,
+        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD | WHIRL_BACKWARD, n + 1, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT,
                              &found_list, &found_count, error, size)) {
             return -1;
         }
@@ -599,7 +589,7 @@ int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, 
         }
         qsort(shares, (size_t)found_count, sizeof *shares, compare_shares);
         for (i = 0; i < found_count && *count < n; i++) {
-            if (shares[i].share >= ROTOR_EXCITED_SHARE) {
+            if (shares[i].share >= ROTOR_DRIVELINE_EXCITED_SHARE) {
                 spins[(*count)++] = shares[i].spin;
             }
         }

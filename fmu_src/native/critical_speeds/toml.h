@@ -13,7 +13,7 @@
 
 /* Tables and arrays nested below the document at the most (deeper is refused as malformed TOML:
  * a bound on a key's parts and on the stack of text_put_repr). */
-#define TREE_DEPTH (4 * LAYOUT_MAX_NESTING)
+#define TREE_DEPTH (4 * ROTOR_LOADER_MAX_NESTING)
 
 /* ---- messages (messages.c) ----------------------------------------------------------------- */
 

@@ -15,9 +15,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#define MAX_PIECE_PHASE 2.0 /* transfer.MAX_PIECE_PHASE */
-#define LOG_SCALE_CLIP 700.0
-#define MODE_MIN_PIECES 4 /* mode_shape(..., points_per_segment=4) */
 #define JACOBI_SWEEPS 60
 
 enum { POINT_MASS, POINT_BEARING, POINT_HINGE };
@@ -564,7 +561,7 @@ static void propagate(const Chain *chain, double w, double spin, int min_pieces,
             *log_scale -= backward * seg->length;
             growth = growth > backward ? growth : backward;
         }
-        phase = ceil(growth * seg->length / MAX_PIECE_PHASE);
+        phase = ceil(growth * seg->length / ROTOR_TRANSFER_MAX_PIECE_PHASE);
         piece_count = phase > 1.0 ? (int)phase : 1;
         if (piece_count < min_pieces) {
             piece_count = min_pieces;
@@ -610,10 +607,10 @@ void chain_determinant(const Chain *chain, size_t n, const double *w, const doub
         propagate(chain, w[i], spin[i], 1, &Y, &log_scale, &sign, NULL);
         final_rows(chain, &Y, S);
         d = chain->isotropic ? S[0][0] * S[1][1] - S[0][1] * S[1][0] : lu_det(4, S);
-        if (log_scale > LOG_SCALE_CLIP) { /* keep the factor finite; sign and zeros are unaffected */
-            log_scale = LOG_SCALE_CLIP;
-        } else if (log_scale < -LOG_SCALE_CLIP) {
-            log_scale = -LOG_SCALE_CLIP;
+        if (log_scale > ROTOR_TRANSFER_LOG_SCALE_CLIP) { /* keep the factor finite; sign and zeros are unaffected */
+            log_scale = ROTOR_TRANSFER_LOG_SCALE_CLIP;
+        } else if (log_scale < -ROTOR_TRANSFER_LOG_SCALE_CLIP) {
+            log_scale = -ROTOR_TRANSFER_LOG_SCALE_CLIP;
         }
         f[i] = sign * d * exp(log_scale);
     }
@@ -695,7 +692,7 @@ double chain_forward_fraction(const Chain *chain, double w, double spin)
     Basis Y;
     Gram g = {0, {{0.0}}, {{0.0}}};
     double log_scale, sign, S[4][4], q[4], ef, eb;
-    propagate(chain, w, spin, MODE_MIN_PIECES, &Y, &log_scale, &sign, &g);
+    propagate(chain, w, spin, ROTOR_DRIVELINE_DIRECTION_POINTS, &Y, &log_scale, &sign, &g);
     final_rows(chain, &Y, S);
     null_vector(Y.cols, S, q);
     ef = quadratic_form(Y.cols, g.forward, q);

@@ -1,0 +1,51 @@
+"""The bound on one CriticalSpeeds analysis: every stage on the worst inputs the limits allow.
+
+``python -m benchmarks.analysis_work [NATIVE_FMU]`` (default ``models/native/CriticalSpeeds.fmu``, built by
+``python build_fmu.py``): the cases of :mod:`fmu_harness.analysis_work`, each in a process of its own
+under a limit of CPU time and address space, the Python analysis stage by stage and the native FMU's
+whole analysis; prints the table and exits 1 if an accepted case exceeds its budget (Python 30 s and
+2 GB, native 5 s and 500 MB) or the issue's layout is accepted.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+from benchmarks.timing import machine
+from fmu_harness.analysis_work import NATIVE_BUDGET, PYTHON_BUDGET, measure, table
+
+
+def over_budget(results: dict[str, dict]) -> list[str]:
+    """What exceeds its budget, or is accepted though it should be refused."""
+    found = []
+    for name, result in results.items():
+        python, native = result["python"], result.get("native")
+        if "failed" in python or (native is not None and "failed" in native):
+            found.append(f"{name}: {python.get('failed') or native.get('failed')}")
+            continue
+        if name.startswith("issue") != (python["refusal"] is not None):
+            found.append(f"{name}: refused {python['refusal'] is not None}")
+        for stage, (seconds, peak) in python["stages"].items():
+            if seconds > PYTHON_BUDGET[0] or peak > PYTHON_BUDGET[1]:
+                found.append(f"{name}, {stage}: Python {seconds:.3g} s, {peak / 2**20:.0f} MB")
+        if native is not None and (native["seconds"] > NATIVE_BUDGET[0] or native["peak"] > NATIVE_BUDGET[1]):
+            found.append(f"{name}: native {native['seconds']:.3g} s, {native['peak'] / 2**20:.0f} MB")
+    return found
+
+
+def main() -> None:
+    fmu = Path(sys.argv[1] if len(sys.argv) > 1 else "models/native/CriticalSpeeds.fmu")
+    with tempfile.TemporaryDirectory() as folder:
+        results = measure(Path(folder), fmu if fmu.exists() else None)
+    print(table(results))
+    print(f"\n{machine()}; CPU seconds of each process")
+    over = over_budget(results)
+    for line in over:
+        print(f"over budget: {line}")
+    sys.exit(1 if over else 0)
+
+
+if __name__ == "__main__":
+    main()

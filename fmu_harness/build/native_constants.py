@@ -1,0 +1,76 @@
+"""The constants the Python core and its C port share, declared once: the names below are the Python
+modules' own constants, and the native build writes their values into the generated header
+``driveline_constants.h`` that every native FMU carries (next to ``model_variables.h``), as
+``<PACKAGE>_<MODULE>_<NAME>`` (``driveline.rotor.roots.SUBGRID`` is ``ROTOR_ROOTS_SUBGRID``).
+
+A C file defines none of these numbers itself (tests/test_native_constants.py checks every
+``#define`` and ``static const`` of ``fmu_src/native``). Numbers only the C port has (the Arnoldi
+iteration's cap and tolerance, which scipy's ARPACK holds for Python; buffer sizes) stay in C.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+
+#: Python module -> the names of its constants that the C port uses.
+SHARED = {
+    "driveline.rotor.driveline": ("SEARCH_LIMIT", "EXCITED_SHARE", "POINTS_PER_ROOT", "GRID_OFFSET", "LEAD_POINTS",
+                                  "DIRECTION_POINTS"),
+    "driveline.rotor.loader": ("MAX_FILE_BYTES", "MAX_NESTING", "MAX_SEGMENTS", "MAX_POINT_ELEMENTS", "NODE_SNAP"),
+    "driveline.rotor.elements": ("_SERIES_LIMIT",),
+    "driveline.rotor.transfer": ("MAX_PIECE_PHASE", "LOG_SCALE_CLIP"),
+    "driveline.rotor.roots": ("SUBGRID", "MAX_DEPTH", "DIP_RATIO", "MAX_ITERATIONS", "XTOL", "RTOL"),
+    "driveline.rotor.campbell": ("SLOPE_STEP", "SPLINE_RTOL", "REFINEMENTS", "MAX_KNOTS", "NOISE"),
+    "driveline.rotor.damped": ("EXTRA_EIGENVALUES", "DENSE_SIZE", "SHIFT"),
+    "driveline.rotor.unbalance_outputs": ("FE_ELEMENTS", "TABLE_ELEMENTS", "DAMPING_POINTS", "DAMPED_MODES"),
+    "driveline.rotor.work": ("MAX_ANALYSIS_SECONDS", "RATE_SEARCH", "RATE_DENSE", "RATE_BANDED"),
+    "driveline.rotor.model": ("MAX_ORDERS", "MAX_ORDER", "MAX_SEARCHED_MODES", "FE_ELEMENTS", "PLAUSIBLE_DEVIATION",
+                              "CAMPBELL_POINTS", "WHIRL_MODES"),
+    "driveline.tripod.spec": ("EXACT",),
+    "driveline.tripod.geometry": ("THIRD_TURN",),
+    "driveline.tripod.closed_form": ("PAPER_PHASE",),
+    "driveline.tripod.plane_solver": ("FD_STEP", "LAST_UPDATE", "MAX_ITERATIONS"),
+    "driveline.tripod.reactions": ("FRICTION_TOLERANCE", "MAX_FRICTION_ITERATIONS"),
+}
+
+HEADER = "driveline_constants.h"
+
+
+def c_name(module: str, name: str) -> str:
+    """``driveline.rotor.roots``, ``SUBGRID`` -> ``ROTOR_ROOTS_SUBGRID``."""
+    package, leaf = module.split(".")[-2:]
+    return f"{package}_{leaf}_{name.lstrip('_')}".upper()
+
+
+def shared_constants() -> dict[str, tuple[str, int | float]]:
+    """Every shared constant: C name -> (its Python name, its value)."""
+    found = {}
+    for module, names in SHARED.items():
+        loaded = importlib.import_module(module)
+        for name in names:
+            value = getattr(loaded, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise TypeError(f"{module}.{name} = {value!r}: a shared constant is a finite int or float")
+            found[c_name(module, name)] = (f"{module}.{name}", value)
+    return found
+
+
+def _literal(value: int | float) -> str:
+    text = str(value) if isinstance(value, int) else repr(float(value))  # repr: the same double in C
+    return f"({text})" if value < 0 else text
+
+
+def constants_header() -> str:
+    """The text of ``driveline_constants.h``."""
+    lines = [f"#define {name} {_literal(value)} /* {python} */" for name, (python, value) in shared_constants().items()]
+    body = "\n".join(lines)
+    return f"""/* The constants the Python core and its C port share, generated from the Python modules by the
+ * native build (fmu_harness/build/native_constants.py): do not edit. */
+#ifndef DRIVELINE_CONSTANTS_H
+#define DRIVELINE_CONSTANTS_H
+
+{body}
+
+#endif
+"""

@@ -1,0 +1,56 @@
+"""The work model of the CriticalSpeeds analysis (driveline/rotor/work.py): every stage estimated before
+any starts, the worst inputs the limits allow analysed within the budgets, the rest refused at
+initialisation with the estimate, in both cores alike."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from benchmarks.analysis_work import over_budget
+from driveline.rotor.loader import example_path, load_driveline, loads_driveline
+from driveline.rotor.model import CAMPBELL_POINTS, FE_ELEMENTS, CriticalSpeedsModel
+from driveline.rotor.work import MAX_ANALYSIS_SECONDS, estimate
+from fmu_harness.analysis_work import layout_text, measure, worst_cases
+from fmu_harness.build import native
+from fmu_harness.runner import FmuInstance, StepRefused
+
+ISSUE_LAYOUT = layout_text(100, 1.4, 202, 202, 200)  # every loader limit kept; once 566 s native, 16 GB Python
+
+
+def test_the_propshaft_engineers_shaft_stays_well_inside():
+    """A 20-segment two-piece shaft with 10 masses and 6 bearings, and the shipped examples, are
+    estimated at most half the limit (measured: a tenth of the budgets, docs/robustness.md)."""
+    for driveline in (loads_driveline(layout_text(20, 1.6, 10, 6, 4)), load_driveline(example_path("two_piece_propshaft")),
+                      load_driveline(example_path("two_piece_propshaft_hinged"))):
+        assert estimate(driveline, (1, 2, 3), 1500.0, CAMPBELL_POINTS, FE_ELEMENTS).total < MAX_ANALYSIS_SECONDS / 2
+
+
+def test_the_issues_layout_is_refused_at_initialisation_by_both_cores_alike(native_dir, tmp_path, fmi):
+    """The layout whose native analysis took 566 s is refused within a second, before any stage, with
+    the estimate of every stage in the message, word for word the Python core's."""
+    layout = tmp_path / "stations.toml"
+    layout.write_text(ISSUE_LAYOUT)
+    values = {"layout": str(layout), "omega_max": 1e-3, "orders": "1", "omega": 0.0}
+    core = CriticalSpeedsModel()
+    for name, value in values.items():
+        setattr(core, name, value)
+    errors = core.parameter_errors()
+    assert len(errors) == 1 and "the analysis would take about" in errors[0] and "Campbell table" in errors[0]
+    with FmuInstance(native.fmu_path(native_dir, "CriticalSpeeds", fmi)) as fmu:
+        started = time.perf_counter()
+        with pytest.raises(StepRefused) as refused:
+            fmu.initialize(values)
+        assert time.perf_counter() - started < 1.0
+    assert (refused.value.status, refused.value.messages) == ("Error", errors)
+
+
+def test_the_worst_inputs_the_limits_allow_stay_within_the_budgets(native_dir, tmp_path):
+    """Every worst case of fmu_harness.analysis_work (most stations of every kind, most segments,
+    shortest segments, stations between nodes, most and highest orders, smallest and largest
+    omega_max): each Python stage within 30 s and 2 GB, the native analysis within 5 s and 500 MB,
+    each in a process under a limit of time and address space; the issue's layout refused."""
+    assert set(worst_cases()) >= {"most stations", "most orders", "smallest omega_max", "largest omega_max"}
+    results = measure(tmp_path, native.fmu_path(native_dir, "CriticalSpeeds", "2"))
+    assert over_budget(results) == []

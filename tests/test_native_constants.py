@@ -1,0 +1,96 @@
+"""The constants both cores use exist once, in the Python modules: the native build writes them into
+``driveline_constants.h`` (fmu_harness/build/native_constants.py), and no C file of
+``fmu_src/native`` defines one of them itself, by its name or by its value."""
+
+from __future__ import annotations
+
+import ast
+import math
+import re
+import sys
+
+from fmu_harness.build import native
+from fmu_harness.build.native_constants import SHARED, constants_header, shared_constants
+
+DEFINE = re.compile(r"^[ \t]*#[ \t]*define[ \t]+(\w+)[ \t]+(.+?)[ \t]*(?:/\*.*)?$", re.MULTILINE)
+STATIC_CONST = re.compile(r"\bstatic\s+const\s+(?:unsigned\s+|signed\s+)?(?:double|float|int|long|size_t)\s+(\w+)\s*=\s*([^;{]+);")
+#: What a C number may be written with besides digits and operators.
+C_NAMES = {"FMU_PI": math.pi, "DBL_EPSILON": sys.float_info.epsilon, "DBL_MIN": sys.float_info.min,
+           "DBL_MAX": sys.float_info.max}
+
+
+def _value(expression: str) -> float | None:
+    """The number a C constant expression stands for (literals, the names above, + - * /), else None."""
+    text = re.sub(r"(?<=\d)[uUlLfF]+\b", "", expression.strip())
+    for name, value in C_NAMES.items():
+        text = re.sub(rf"\b{name}\b", repr(value), text)
+    try:
+        tree = ast.parse(text, mode="eval")
+    except SyntaxError:
+        return None
+    allowed = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Constant, ast.Add, ast.Sub, ast.Mult, ast.Div, ast.USub,
+               ast.UAdd)
+    if not all(isinstance(node, allowed) for node in ast.walk(tree)) or not any(
+            isinstance(node, ast.Constant) for node in ast.walk(tree)):
+        return None
+    value = eval(compile(tree, "<c>", "eval"))  # numbers and arithmetic only (checked above)
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+
+
+def _c_numbers() -> list[tuple[str, str, float]]:
+    """(file, name, value) of every number a C source of fmu_src/native defines."""
+    found = []
+    for path in sorted(native.NATIVE_SRC.rglob("*.[ch]")):
+        text = path.read_text()
+        for name, expression in DEFINE.findall(text) + STATIC_CONST.findall(text):
+            value = _value(expression)
+            if value is not None:
+                found.append((path.relative_to(native.NATIVE_SRC).as_posix(), name, value))
+    return found
+
+
+def test_the_header_holds_every_declared_constant_with_its_python_value():
+    header = dict(DEFINE.findall(constants_header()))
+    constants = shared_constants()
+    assert len(constants) == sum(len(names) for names in SHARED.values())
+    assert set(header) == set(constants)
+    for name, (python, value) in constants.items():
+        written = _value(header[name])
+        assert written == value and type(written) is type(value), (name, python)
+
+
+def test_no_c_file_defines_a_number_the_python_modules_hold():
+    constants = shared_constants()
+    names = {python.rsplit(".", 1)[1].lstrip("_") for python, _ in constants.values()}
+    fractions = {value for _, value in constants.values() if isinstance(value, float) and not value.is_integer()}
+    copies = [(path, name, value) for path, name, value in _c_numbers()
+              if name in names or any(name.endswith("_" + known) for known in names)
+              or (isinstance(value, float) and value in fractions)]
+    assert copies == []
+
+
+def test_the_check_finds_a_copy():
+    """The scanner sees the numbers as they were written before the header (a define of a declared
+    name, a value written as an expression)."""
+    assert _value("(2.0 * FMU_PI / 3.0)") == 2.0 * math.pi / 3.0
+    assert _value("(4.0 * DBL_EPSILON)") == 4.0 * sys.float_info.epsilon
+    assert _value("16u") == 16 and _value("(-1.0)") == -1.0 and _value("FMU_MESSAGE_SIZE") is None
+    assert DEFINE.findall("#define SUBGRID 24          /* roots.SUBGRID */") == [("SUBGRID", "24")]
+    assert STATIC_CONST.findall("static const double NOISE = 10.0;") == [("NOISE", "10.0")]
+
+
+def test_the_rule_of_which_parameter_redoes_which_analysis_part_is_generated_from_python():
+    """The C model keeps each part of the CriticalSpeeds analysis for the parameters the Python model
+    keys it by (ANALYSIS_PARTS): the table is generated, the C file lists none of its own."""
+    from driveline.catalog import MODELS
+    from driveline.rotor.model import ANALYSIS_PARTS
+
+    model = MODELS["CriticalSpeeds"]
+    assert model.derived_parts is ANALYSIS_PARTS
+    generated = native.variable_table(model, "")
+    rows = re.findall(r"^    \{((?:V_\w+, )*)-1\},$", generated["model_variables.c"], re.MULTILINE)
+    assert [tuple(re.findall(r"V_(\w+)", row)) for row in rows] == list(ANALYSIS_PARTS.values())
+    assert [f"PART_{name.upper()}" for name in ANALYSIS_PARTS] == re.findall(
+        r"^    (PART_\w+),$", generated["model_variables.h"], re.MULTILINE)
+    c_model = (native.NATIVE_SRC / "critical_speeds.c").read_text()
+    assert "model_part_values" in c_model and not re.search(r"\bPART_\w+\s*[,=]", c_model.split("typedef int Part;")[0])
