@@ -49,7 +49,8 @@ from .native_constants import constants_header
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
 MODEL_SOURCES = NATIVE_SRC
-SHARED_SOURCES = ("fmu_instance.h", "fmu_instance.c", "python_numbers.h", "python_numbers.c")
+SHARED_SOURCES = ("fmu_instance.h", "fmu_layer.h", "fmu_instance.c", "fmu_checks.c", "fmu_values.c", "fmu_state.c",
+                  "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
