@@ -9,7 +9,6 @@
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .result_table import write_csv  # noqa: E402
 from .runner import FmuInstance, simulate  # noqa: E402
 
 SPEED = 1500.0 * math.pi / 30.0  # rad/s
@@ -80,11 +80,8 @@ def write(models: Path, out: Path, betas_deg: list[float] | None = None) -> list
     betas_deg = betas_deg or [5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0]
     rows = speed_fluctuation_table(models, betas_deg)
     out.mkdir(parents=True, exist_ok=True)
-    table = out / "coupling_comparison.csv"
-    with table.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
+    table = write_csv(out / "coupling_comparison.csv", ("beta [deg]", "coupling", "fluctuation [1]", "order [1]"),
+                      ((r["beta_deg"], r["coupling"], r["fluctuation"], r["order"] or "") for r in rows))
     markdown = out / "coupling_comparison.md"
     lines = ["| beta [deg] | " + " | ".join(c.name for c in COUPLINGS) + " |", "|---" * (len(COUPLINGS) + 1) + "|"]
     for beta_deg in betas_deg:

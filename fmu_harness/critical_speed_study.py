@@ -1,8 +1,13 @@
-"""Main-job study of the CriticalSpeeds FMU: a speed ramp, the Campbell diagram, a table of critical speeds."""
+"""Main-job study of the CriticalSpeeds FMU: a speed ramp past its third critical speed, a table of
+the critical speeds, and the Campbell diagram with the order lines and every crossing marked.
+
+The FMU outputs the first two forward and backward whirl frequencies; the diagram adds the third
+mode's from the rotor core (``driveline.rotor``, the FMU's reference), so that every critical speed
+it names lies on a drawn branch.
+"""
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
@@ -12,58 +17,129 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .runner import simulate  # noqa: E402
+from driveline.rotor.campbell import whirl_branches  # noqa: E402
+from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline  # noqa: E402
+from driveline.rotor.spec import SPEC  # noqa: E402
+
+from .result_table import column, write_csv  # noqa: E402
+from .runner import FmuInstance  # noqa: E402
 
 RPM = 30.0 / math.pi
-ORDERS = (2, 3)  # Cardan joints; the tripod coupling excites the 3rd (docs/tripod_coupling.md)
-WHIRL = ("whirl_forward_1", "whirl_forward_2", "whirl_backward_1", "whirl_backward_2")
+ORDERS = (1, 2, 3)  # unbalance; Cardan joints; the tripod coupling (docs/tripod_coupling.md)
+CRITICALS = ("omega_crit_1", "omega_crit_2", "omega_crit_3")
+MODES = 2  # whirl pairs the FMU outputs
+BEYOND = 1.1  # the ramp ends this far beyond the highest critical speed
+STEPS = 300
+SENSES = {"forward": ("tab:blue", "-", "o"), "backward": ("tab:orange", "--", "s")}  # colour, line, marker
+MARKER_SIZE = {"forward": 8, "backward": 5}  # where they meet, the forward ring holds the backward square
 
 
-def ramp(fmu: Path, omega_max: float = 1500.0, seconds: float = 1.0, steps: int = 300) -> np.ndarray:
-    """The FMU on a speed ramp from 0 to ``omega_max``."""
-    return simulate(fmu, seconds, seconds / steps, inputs={"omega": lambda t: omega_max * t / seconds},
-                    start_values={"omega_max": omega_max})
+def critical_speeds(fmu: Path) -> tuple[float, ...]:
+    """The FMU's critical speeds [rad/s] at its start values."""
+    with FmuInstance(fmu) as instance:
+        instance.initialize()
+        return tuple(instance.get(CRITICALS))
+
+
+def ramp(fmu: Path, omega_max: float, steps: int = STEPS, seconds: float = 1.0) -> np.ndarray:
+    """The FMU on a speed ramp from 0 to ``omega_max`` over ``seconds``: each step's input is the
+    ramp's value at the step's end, so each row's outputs belong to its own time and speed."""
+    names = [v.name for v in SPEC.of("output")]
+    dt = seconds / steps
+    with FmuInstance(fmu) as instance:
+        instance.initialize({"omega_max": omega_max, "omega": 0.0})
+        read, write = instance.reader(names), instance.writer(["omega"])
+        rows = [(0.0, 0.0, *read())]
+        for k in range(1, steps + 1):
+            speed = omega_max * k / steps
+            write([speed])
+            instance.step(dt)
+            rows.append((k * dt, speed, *read()))
+    return np.array(rows, dtype=[(n, float) for n in ("time", "omega", *names)])
+
+
+def crossings(spins: np.ndarray, whirl: np.ndarray, order: int) -> list[float]:
+    """Speeds [rad/s] where ``order * spin`` meets the branch ``whirl(spins)`` (linear between samples)."""
+    gap = order * spins - whirl
+    found = []
+    for i in np.flatnonzero(np.sign(gap[:-1]) * np.sign(gap[1:]) < 0):
+        fraction = gap[i] / (gap[i] - gap[i + 1])
+        found.append(float(spins[i] + fraction * (spins[i + 1] - spins[i])))
+    return found
+
+
+def branches(result: np.ndarray) -> dict[tuple[str, int], np.ndarray]:
+    """Whirl branches [rad/s] over the ramp's speeds by (sense, mode): modes 1-2 from the FMU,
+    mode 3 from the rotor core at the FMU's start values."""
+    found = {(sense, mode): result[f"whirl_{sense}_{mode}"] for sense in SENSES for mode in range(1, MODES + 1)}
+    shaft = {name: SPEC[name].start for name in SHAFT_PARAMETERS}
+    core = whirl_branches(build_driveline("", shaft), result["omega"], MODES + 1)
+    found["forward", MODES + 1] = core.forward[:, MODES]
+    found["backward", MODES + 1] = core.backward[:, MODES]
+    return found
 
 
 def write(fmu: Path, out: Path) -> list[Path]:
+    """Run the study, write the two CSV files and the figure into ``out``; return the files written."""
     out.mkdir(parents=True, exist_ok=True)
-    result = ramp(fmu)
-    speed = result["time"][1:] * 1500.0 - 1500.0 / 300  # input held over each step
-    speed = np.concatenate([[0.0], speed])
-    criticals = [result[f"omega_crit_{k}"][-1] for k in (1, 2, 3)]
-    table = out / "critical_speeds.csv"
-    with table.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(("mode", "critical speed [rad/s]", "critical speed [rpm]"))
-        writer.writerows((k, f"{w:.6g}", f"{w * RPM:.6g}") for k, w in enumerate(criticals, start=1))
-    ramp_csv = out / "critical_speeds_ramp.csv"
-    with ramp_csv.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(("omega",) + result.dtype.names[1:])
-        writer.writerows(zip(speed, *(result[name] for name in result.dtype.names[1:])))
+    criticals = critical_speeds(fmu)
+    omega_max = math.ceil(BEYOND * max(criticals) / 100.0) * 100.0
+    result = ramp(fmu, omega_max)
+    table = write_csv(out / "critical_speeds.csv",
+                      ("mode [1]", "critical speed [rad/s]", "critical speed [rpm]"),
+                      ((k, f"{w:.6g}", f"{w * RPM:.6g}") for k, w in enumerate(criticals, start=1)))
+    names = result.dtype.names
+    ramp_csv = write_csv(out / "critical_speeds_ramp.csv", ("time [s]", *(column(SPEC, n) for n in names[1:])),
+                         result.tolist())
+    figure = campbell_figure(result, branches(result), criticals, out / "campbell_diagram.png")
+    return [table, ramp_csv, figure]
 
-    fig, ax = plt.subplots(figsize=(7, 5))
-    styles = {"whirl_forward": ("tab:blue", "forward whirl"), "whirl_backward": ("tab:orange", "backward whirl")}
-    for name in WHIRL:
-        color, label = styles[name.rsplit("_", 1)[0]]
-        ax.plot(speed * RPM, result[name] * RPM, color=color, label=label if name.endswith("_1") else None)
-    top = max(result[name].max() for name in WHIRL) * RPM * 1.05
-    for order in (1, *ORDERS):
-        ax.plot([0, top / order], [0, top], "k-" if order == 1 else "k:", lw=0.8)
-        ax.annotate(f"{order}x", (min(top / order, speed[-1] * RPM), min(top, order * speed[-1] * RPM)), fontsize=8)
-    for k, w in enumerate(criticals, start=1):
-        if w <= speed[-1]:
-            ax.plot(w * RPM, w * RPM, "rv", label="critical speed" if k == 1 else None)
-    ax.set_xlim(0, speed[-1] * RPM)
-    ax.set_ylim(0, top)
+
+def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray], criticals: tuple[float, ...],
+                    path: Path) -> Path:
+    """Whirl branches against shaft speed, the order lines labelled inside the axes, every crossing
+    marked with its speed; the 1x forward crossings (the critical speeds) in red."""
+    spins = result["omega"]
+    x_top = spins[-1] * RPM
+    y_top = 1.08 * max(np.nanmax(values) for values in whirl.values()) * RPM
+    fig, ax = plt.subplots(figsize=(9, 7))
+    for (sense, mode), values in whirl.items():
+        color, style, _ = SENSES[sense]
+        from_fmu = mode <= MODES
+        label = {1: f"{sense} whirl, modes 1-{MODES} (FMU)", MODES + 1: f"{sense} whirl, mode {mode} (rotor core)"}
+        ax.plot(spins * RPM, values * RPM, style, color=color, lw=1.6 if from_fmu else 1.1,
+                alpha=1.0 if from_fmu else 0.75, label=label.get(mode))
+    for (sense, mode), values in whirl.items():
+        color, _, marker = SENSES[sense]
+        for order in ORDERS:
+            for speed in crossings(spins, values, order):
+                critical = order == 1 and sense == "forward"
+                ax.plot(speed * RPM, order * speed * RPM, marker, ms=MARKER_SIZE[sense],
+                        mfc="red" if critical else "none", mec="red" if critical else color, mew=1.4,
+                        zorder=5 if critical else 7 if sense == "forward" else 6)
+                ax.annotate(f"{speed * RPM:.0f}", (speed * RPM, order * speed * RPM),
+                            xytext=(5, -11) if sense == "forward" else (-5, 4), textcoords="offset points",
+                            ha="left" if sense == "forward" else "right", fontsize=7.5,
+                            color="red" if critical else color, fontweight="bold" if critical else "normal")
+    ax.plot([], [], "o", mfc="red", mec="red", label="critical speed (1x, forward) [rpm]")
+    ax.plot([], [], "o", ms=8, mfc="none", mec="tab:blue", label="order resonance, forward [rpm]")
+    ax.plot([], [], "s", ms=5, mfc="none", mec="tab:orange", label="order resonance, backward [rpm]")
+    ax.set_xlim(0, x_top)
+    ax.set_ylim(0, y_top)
     ax.set_xlabel("shaft speed [rpm]")
     ax.set_ylabel("whirl frequency [rpm]")
     ax.set_title("Campbell diagram, one-piece propshaft (CriticalSpeeds FMU)\n"
                  "critical speeds " + ", ".join(f"{w * RPM:.0f}" for w in criticals) + " rpm")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper left", fontsize=8)
+    ax.legend(loc="lower right", fontsize=8, framealpha=0.95)
     fig.tight_layout()
-    figure = out / "campbell_diagram.png"
-    fig.savefig(figure, dpi=120)
+    for order in ORDERS:  # after the layout: the labels' angles follow the lines on the page
+        end = min(x_top, y_top / order)
+        ax.plot([0.0, end], [0.0, order * end], color="0.35", lw=0.9, ls="-" if order == 1 else (0, (1, 1.5)))
+        at = np.array([0.55 * y_top / order, 0.55 * y_top])  # between the first two modes' branches
+        angle = ax.transData.transform_angles(np.array([math.degrees(math.atan(order))]), at[None, :])[0]
+        ax.annotate(f"{order}x", at, xytext=(-4, 4), textcoords="offset points", fontsize=10, color="0.2",
+                    ha="right", va="bottom", rotation=angle, rotation_mode="anchor")
+    fig.savefig(path, dpi=120)
     plt.close(fig)
-    return [table, ramp_csv, figure]
+    return path

@@ -1,7 +1,8 @@
 """Reference results in the FMI Cross-Check layout, next to every built FMU.
 
 Usage: ``python -m fmu_harness.crosscheck [--models models]`` (``python build_fmu.py`` runs it).
-For each ``<Model>.fmu`` (FMI 2.0 in ``models/``, FMI 3.0 in ``models/fmi3/``) it writes
+For each ``<Model>.fmu`` (Python FMUs: FMI 2.0 in ``models/``, FMI 3.0 in ``models/fmi3/``; native
+ones in ``models/native/`` and ``models/native/fmi3/``) it writes
 
 * ``<Model>_ref.csv``: time and at most ten outputs of the model's standard run
   (:mod:`fmu_harness.scenario`), header names quoted as in the model description;
@@ -81,9 +82,10 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     args = parser.parse_args(argv)
-    for fmu in sorted(args.models.glob("*.fmu")) + sorted(args.models.glob("fmi3/*.fmu")):
-        for path in write(fmu):
-            print(path)
+    for pattern in ("*.fmu", "fmi3/*.fmu", "native/*.fmu", "native/fmi3/*.fmu"):
+        for fmu in sorted(args.models.glob(pattern)):
+            for path in write(fmu):
+                print(path)
 
 
 if __name__ == "__main__":

@@ -4,7 +4,6 @@ for several bend angles and two loads, and their mean and 3rd-order parts agains
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
@@ -16,7 +15,9 @@ import numpy as np  # noqa: E402
 
 from driveline.tripod import closed_form  # noqa: E402
 from driveline.tripod.exact import exact_pose  # noqa: E402
+from driveline.tripod.spec import SPEC  # noqa: E402
 
+from . import result_table  # noqa: E402
 from .runner import simulate  # noqa: E402
 
 SPEED = 2000.0 * math.pi / 30.0  # rad/s, the seed's 2000 rpm
@@ -60,16 +61,11 @@ def write(fmu: Path, out: Path) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     runs = {(beta, load): run_turns(fmu, beta, 1, load) for beta in BETAS_DEG for load in LOADS}
     seed = {beta: run_turns(fmu, beta, 1, seed_reactions=1) for beta in BETAS_DEG}
-    csv_path = out / "tripod_coupling.csv"
-    with csv_path.open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(("beta_deg", "T_load", "reactions") + COLUMNS)
-        for (beta, load), result in runs.items():
-            writer.writerows((beta, load, "force balance", *row) for row in result.tolist())
-        for beta, result in seed.items():
-            writer.writerows((beta, 500.0, "seed", *row) for row in result.tolist())
-
-    files = [csv_path]
+    rows = [(beta, load, "force balance", *row) for (beta, load), result in runs.items() for row in result.tolist()]
+    rows += [(beta, LOADS[-1], "seed", *row) for beta, result in seed.items() for row in result.tolist()]
+    header = ("beta [deg]", result_table.column(SPEC, "T_load"), "reactions", "time [s]",
+              *(result_table.column(SPEC, n) for n in COLUMNS[1:]))
+    files = [result_table.write_csv(out / "tripod_coupling.csv", header, rows)]
     loaded = {beta: runs[beta, LOADS[-1]] for beta in BETAS_DEG}
     fig, ax = plt.subplots(figsize=(7, 4.6))
     for beta, result in loaded.items():

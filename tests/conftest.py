@@ -8,9 +8,14 @@ uses, so that test files carry none:
 * ``importers``: its module drives the external importers (imports ``fmu_harness.importers``
   or ``fmu_harness.interop``: libcosim, Ecos, fmutool);
 * ``core``: neither, the FMI-free core and tools;
-* ``slow``: listed in :data:`SLOW` (over about 5 s each on two busy cores), and the FMU tests
-  run for every model when the model is ``CriticalSpeeds`` (its analysis costs about a second
-  per instance).
+* ``slow``: measured at :data:`SLOW_SECONDS` of CPU time or more in ``tests/durations.json``
+  (:func:`pytest_runtest_call`: the test's call and fixtures, with the subprocesses they waited
+  for; not the FMU builds every FMU test shares), and the FMU tests run for
+  every model when the model is ``CriticalSpeeds`` (its analysis costs about a second per
+  instance), and the tests of the five-platform build (``release_dir``: what it costs depends on
+  ziglang's cache). ``python -m pytest -p no:randomly --update-durations [TESTS]`` measures the tests it
+  runs and writes their times into the file (the others' stay); without ``-n`` and without
+  ``TESTS`` (``--collect-only`` will do) it also drops the tests no longer collected.
 
 ``--fmi 2`` (or ``3``) builds and tests one FMI version only. ``--quick`` is the core and the
 FMI 2.0 FMUs without the slow and importer tests (``-m "not slow and not importers" --fmi 2``),
@@ -20,8 +25,13 @@ and does not even import the modules that hold slow tests only (ROSS takes secon
 
 from __future__ import annotations
 
+import json
+import resource
 import sys
+import time
+import warnings
 from collections.abc import Callable
+from datetime import datetime, timezone
 from pathlib import Path
 
 import pytest
@@ -38,33 +48,11 @@ FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir"}
 IMPORTER_MODULES = ("fmu_harness.importers", "fmu_harness.interop")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
-SLOW = (
-    "tests/test_tripod_moving_bearing.py",
-    "tests/test_analysis_work.py::test_the_worst_inputs_the_limits_allow_stay_within_the_budgets",
-    "tests/test_coupling_comparison.py::test_two_cardan_joints_cancel_when_phased_and_double_when_not",
-    "tests/test_critical_speeds_model.py::test_a_layout_brings_its_own_unbalance_and_damping",
-    "tests/test_critical_speeds_model.py::test_analysis_runs_only_when_the_structure_changes",
-    "tests/test_critical_speeds_model.py::test_fmu_follows_a_speed_ramp_and_refuses_overspeed",
-    "tests/test_critical_speeds_model.py::test_shear_parameter_selects_the_beam_theory",
-    "tests/test_critical_speeds_model.py::test_shipped_layout_by_name",
-    "tests/test_host_environment.py",
-    "tests/test_install.py::test_installed_wheel_builds_every_fmu_and_both_systems",
-    "tests/test_install.py::test_wheel_carries_what_the_native_build_needs",
-    "tests/test_interop.py",
-    "tests/test_packaging.py::test_different_fmus_alive_at_once_in_one_host",
-    "tests/test_packaging.py::test_markers_follow_what_the_tests_use",
-    "tests/test_native_platforms.py",
-    "tests/test_native_static_link.py",
-    "tests/test_robustness.py",
-    "tests/test_rotor_hinge.py::test_fmu_analyses_a_hinged_layout",
-    "tests/test_rotor_hinge.py::test_hinged_two_piece_matches_finite_elements",
-    "tests/test_rotor_hinge.py::test_spring_hinge_matches_finite_elements",
-    "tests/test_rotor_roots.py::test_random_drivelines_match_finite_elements",
-    "tests/test_rotor_roots.py::test_root_count_matches_finite_elements",
-    "tests/test_rotor_ross.py",
-    "tests/test_rotor_shear.py::test_shear_tube_matches_finite_elements",
-    "tests/test_sweep.py",
-)
+DURATIONS = Path(__file__).with_name("durations.json")
+SLOW_SECONDS = 0.5  # CPU seconds of a test at which it is slow
+RELEASE_FIXTURE = "release_dir"  # the five-platform build: its cost depends on ziglang's cache
+#: The session's FMU builds, which every FMU test shares: charged to no test when measuring.
+SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "fmu_unzipdir", "open_fmu", "tripod_fmu", "native_dir"}
 
 
 QUICK_VERSIONS = ["2"]
@@ -75,6 +63,21 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      help="FMI version to build and test (repeat for several; default: all)")
     parser.addoption("--quick", action="store_true",
                      help='the quick run: -m "not slow and not importers" --fmi 2, slow-only modules not imported')
+    parser.addoption("--update-durations", action="store_true",
+                     help=f"measure the tests run and write their CPU times into {DURATIONS.name}")
+
+
+def measured() -> dict[str, float]:
+    """CPU seconds of each test's call, by node id, as last measured (``--update-durations``)."""
+    return json.loads(DURATIONS.read_text())["cpu_seconds"] if DURATIONS.exists() else {}
+
+
+def slow_modules(durations: dict[str, float]) -> set[str]:
+    """Test files all of whose measured tests are slow."""
+    by_file: dict[str, list[float]] = {}
+    for nodeid, seconds in durations.items():
+        by_file.setdefault(nodeid.split("::")[0], []).append(seconds)
+    return {path for path, times in by_file.items() if min(times) >= SLOW_SECONDS}
 
 
 def selected_versions(config: pytest.Config) -> list[str]:
@@ -83,7 +86,7 @@ def selected_versions(config: pytest.Config) -> list[str]:
 
 def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
     """With ``--quick``, a module whose tests are all slow is not imported."""
-    if config.getoption("quick") and f"tests/{collection_path.name}" in SLOW:
+    if config.getoption("quick") and f"tests/{collection_path.name}" in slow_modules(measured()):
         return True
     return None
 
@@ -180,12 +183,17 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
 @pytest.hookimpl(tryfirst=True)  # before ``-m`` selects by these markers
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark every test (see the module docstring); with ``--fmi``, deselect the other versions'
-    variants of tests parametrized by ``fmi`` or ``version``; a whole-suite collection refuses
-    :data:`SLOW` entries that name no test any more."""
+    variants of tests parametrized by ``fmi`` or ``version``; a whole-suite collection warns of
+    a durations file that names tests no longer collected."""
+    durations = measured()
     if config.args_source == pytest.Config.ArgsSource.TESTPATHS and not config.getoption("quick"):
-        stale = [entry for entry in SLOW if not any(item.nodeid.startswith(entry) for item in items)]
-        if stale:
-            raise pytest.UsageError(f"tests/conftest.py SLOW names no collected test: {stale}")
+        stale = sorted(set(durations) - {item.nodeid for item in items})
+        if stale and config.getoption("update_durations") and not hasattr(config, "workerinput"):
+            _write_durations({n: s for n, s in durations.items() if n not in stale})
+        elif stale:
+            warnings.warn(pytest.PytestWarning(
+                f"tests/{DURATIONS.name} names {len(stale)} tests no longer collected, e.g. {stale[0]}: drop them "
+                "with python -m pytest -q --collect-only --update-durations"))
     versions = selected_versions(config)
     kept, dropped = [], []
     for item in items:
@@ -202,7 +210,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.fmu)
         elif not item.get_closest_marker("importers"):
             item.add_marker(pytest.mark.core)
-        if item.nodeid.startswith(SLOW) or (item.get_closest_marker("fmu") and SLOW_MODEL in params.values()):
+        if durations.get(item.nodeid, 0.0) >= SLOW_SECONDS or RELEASE_FIXTURE in item.fixturenames or (
+                item.get_closest_marker("fmu") and SLOW_MODEL in params.values()):
             item.add_marker(pytest.mark.slow)
     if config.getoption("quick"):
         left_out = {item for item in kept if item.get_closest_marker("slow") or item.get_closest_marker("importers")}
@@ -211,3 +220,69 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if dropped:
         config.hook.pytest_deselected(items=dropped)
         items[:] = kept
+
+
+def _cpu_seconds() -> float:
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
+_MEASURED: dict[str, float] = {}
+_FIXTURE_COSTS: dict[tuple[str, str], float] = {}  # (node id of the fixture's scope, name) -> CPU seconds
+_NESTED: list[float] = []  # CPU seconds of the fixtures set up within each fixture being set up
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_fixture_setup(fixturedef: pytest.FixtureDef, request: pytest.FixtureRequest):
+    """With ``--update-durations``, the CPU time of each fixture's own setup (without the fixtures
+    it asks for); the :data:`SHARED_BUILDS` are charged to no test."""
+    if not request.config.getoption("update_durations"):
+        yield
+        return
+    start = _cpu_seconds()
+    _NESTED.append(0.0)
+    yield
+    total = _cpu_seconds() - start
+    own = total - _NESTED.pop()
+    if _NESTED:
+        _NESTED[-1] += total
+    if fixturedef.argname not in SHARED_BUILDS:
+        key = (request.node.nodeid, fixturedef.argname)
+        _FIXTURE_COSTS[key] = _FIXTURE_COSTS.get(key, 0.0) + own
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_call(item: pytest.Item):
+    """With ``--update-durations``, a test's cost: its call's CPU time (this process and the
+    subprocesses it waited for) and the setup of every fixture it uses but the shared FMU builds,
+    a module's or the session's fixture counted for each of its tests (each needs it when run
+    alone). It travels with the report, also from pytest-xdist workers."""
+    start = _cpu_seconds()
+    yield
+    if item.config.getoption("update_durations"):
+        fixtures = sum(cost for (node, name), cost in _FIXTURE_COSTS.items()
+                       if name in item.fixturenames and (not node or node == item.nodeid
+                                                         or item.nodeid.startswith((f"{node}::", f"{node}/"))))
+        item.user_properties.append(("cpu_seconds", _cpu_seconds() - start + fixtures))
+        for key in [key for key in _FIXTURE_COSTS if key[0] == item.nodeid]:
+            del _FIXTURE_COSTS[key]
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    if report.when == "call":
+        _MEASURED.update((report.nodeid, value) for name, value in report.user_properties if name == "cpu_seconds")
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """With ``--update-durations``, merge this session's measurements into the durations file
+    (once, in the controlling process)."""
+    if session.config.getoption("update_durations") and not hasattr(session.config, "workerinput") and _MEASURED:
+        _write_durations({**measured(), **{nodeid: round(seconds, 3) for nodeid, seconds in _MEASURED.items()}})
+
+
+def _write_durations(durations: dict[str, float]) -> None:
+    DURATIONS.write_text(json.dumps({
+        "updated": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "what": "CPU seconds of each test: its call and its fixtures but the session's, with the subprocesses waited for",
+        "cpu_seconds": dict(sorted(durations.items())),
+    }, indent=1) + "\n")

@@ -1,5 +1,5 @@
-"""The FMI Cross-Check reference files: every FMU re-run from its _in.csv and _ref.opt alone
-(fmpy's simulate_fmu) reproduces its _ref.csv."""
+"""The FMI Cross-Check reference files: every FMU, Python and native, re-run from its _in.csv and
+_ref.opt alone (fmpy's simulate_fmu) reproduces its _ref.csv."""
 
 from __future__ import annotations
 
@@ -7,11 +7,20 @@ import numpy as np
 from fmpy import read_model_description
 
 from fmu_harness import crosscheck
+from fmu_harness.build import native
 
 
 def test_rerun_from_the_reference_files_matches(model_name, fmi, fmu_path, tmp_path):
-    fmu = tmp_path / fmu_path(model_name, fmi).name
-    fmu.write_bytes(fmu_path(model_name, fmi).read_bytes())
+    rerun_matches(fmu_path(model_name, fmi), model_name, tmp_path)
+
+
+def test_native_rerun_from_the_reference_files_matches(model_name, fmi, native_dir, tmp_path):
+    rerun_matches(native.fmu_path(native_dir, model_name, fmi), model_name, tmp_path)
+
+
+def rerun_matches(built, model_name, tmp_path):
+    fmu = tmp_path / built.name
+    fmu.write_bytes(built.read_bytes())
     written = {path.name for path in crosscheck.write(fmu)}
     has_inputs = any(v.causality == "input" for v in read_model_description(str(fmu)).modelVariables)
     assert written == {f"{model_name}_ref.csv", f"{model_name}_ref.opt"} | ({f"{model_name}_in.csv"} if has_inputs else set())

@@ -14,6 +14,8 @@ import pytest
 from fmu_harness import cli
 from fmu_harness.build import FMI_VERSIONS, fmu_path, native
 
+from conftest import SLOW_SECONDS, measured
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -126,13 +128,16 @@ def collected(*options: str) -> set[str]:
 
 
 def test_markers_follow_what_the_tests_use():
-    """Assigned in conftest.py: a built FMU makes an ``fmu`` test, none a ``core`` one; ``--fmi 2``
-    drops the FMI 3.0 variants."""
+    """Assigned in conftest.py: a built FMU makes an ``fmu`` test, none a ``core`` one, a measured
+    cost of SLOW_SECONDS or more a ``slow`` one; ``--fmi 2`` drops the FMI 3.0 variants."""
     fmu, core = collected("-m", "fmu"), collected("-m", "core")
     assert {"test_each_fmu_ships_the_modules_its_model_imports", "test_build_command_builds_one_model"} <= fmu
     assert {"test_every_command_has_help", "test_a_declared_rule_refuses_with_its_message"} <= core
     assert not fmu & core and "test_markers_follow_what_the_tests_use" in core
-    assert "test_different_fmus_alive_at_once_in_one_host" in collected("-m", "slow")
+    measured_slow = {nodeid.split("::")[1].split("[")[0] for nodeid, seconds in measured().items()
+                     if nodeid.startswith(("tests/test_packaging.py", "tests/test_validity.py"))
+                     and seconds >= SLOW_SECONDS}
+    assert measured_slow and measured_slow <= collected("-m", "slow")
     run = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "--fmi", "2",
                           "tests/test_packaging.py"], capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert "[2]" in run.stdout and "[3]" not in run.stdout

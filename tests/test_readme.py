@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from driveline.catalog import MODELS
+from fmu_harness import system
 from fmu_harness.doc_sections import model_page, replace_section, section
 from fmu_harness.variable_table import markdown
 
@@ -38,6 +39,16 @@ def test_a_stale_table_is_found_and_regenerated(tmp_path):
 
 def test_readme_holds_the_ci_test_command():
     assert 'python -m pip install -e ".[test,interop]" && python -m pytest -q' in README.read_text()
+
+
+def test_readme_connects_the_models_as_the_ssp_system_does():
+    driveline = system.driveline()
+    model = {component.name: component.model for component in driveline.components}
+    text = README.read_text()
+    for connection in driveline.connections:
+        (start, output), (end, input_) = connection.start, connection.end
+        assert f"| `{model[start]}.{output}` | `{model[end]}.{input_}`" in text
+    assert "`models/Driveline.ssp`" in text and "`models/native/Driveline.ssp`" in text
 
 
 def test_readme_stays_short():

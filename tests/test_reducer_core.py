@@ -201,6 +201,14 @@ def test_steps_keep_the_ratio_exact_while_alpha_varies() -> None:
         assert model.s_b == float(mechanics.cylinder_slide(model.phi_in, model.alpha, E))
 
 
+def test_start_values_pass_the_strength_check() -> None:
+    """The start values are the hand-checked prototype above: M_in = 10 N.m at 160 deg."""
+    model = started()
+    assert model.T_in == pytest.approx(10.0, rel=1e-15)
+    assert model.utilisation == pytest.approx(50.06191 / 60.0, rel=1e-6)
+    assert model.utilisation <= 1.0
+
+
 def test_strength_outputs_scale_with_the_torque() -> None:
     model = started(T_load=68.0, alpha=math.radians(160.0))  # M_in = 10 N.m, as by hand above
     assert model.sigma_eq == pytest.approx(50.06191e6, rel=1e-6)

@@ -1,14 +1,16 @@
-"""Build every FMU of the project, FMI 2.0 into ``models/`` and FMI 3.0 into ``models/fmi3/``.
+"""Build every FMU of the project: the Python FMUs, FMI 2.0 into ``models/`` and FMI 3.0 into
+``models/fmi3/``, and the native (C) FMUs into ``models/native/`` and ``models/native/fmi3/``.
 
 Usage: ``driveline-fmus build [--dest models] [--fmi 2 3] [--no-references] [--host-only] [--native]
-[NAME ...]`` (or ``python build_fmu.py ...``). Every model of ``driveline.catalog.MODELS`` becomes one FMU per
-FMI version (:mod:`.fmu`). Then the FMI Cross-Check reference results are written next to
-each FMU (:mod:`fmu_harness.crosscheck`) and, once its FMI 2.0 FMUs are there, the driveline
-system's SSP packages, with the Python FMUs and with the native ones where they exist
-(:mod:`fmu_harness.system`). The native (C) FMUs of the models with a C port
-go to ``native/`` and ``native/fmi3/`` below ``--dest`` (:mod:`.native`), with binaries for the five
+[NAME ...]`` (or ``python build_fmu.py ...``). Every model of ``driveline.catalog.MODELS`` becomes one
+Python FMU per FMI version (:mod:`.fmu`). The native (C) FMUs of the models with a C port go to
+``native/`` and ``native/fmi3/`` below ``--dest`` (:mod:`.native`), with binaries for the five
 platforms when ziglang is installed (``--host-only``: this machine's alone). Without a C compiler
 the build says what to install in one line and builds the rest; it fails only with ``--native``.
+Then the FMI Cross-Check reference results are written next to each FMU, Python and native
+(:mod:`fmu_harness.crosscheck`), and, once its FMI 2.0 FMUs are there, the driveline system's SSP
+packages, ``Driveline.ssp`` with the Python FMUs and ``native/Driveline.ssp`` with the native ones
+(:mod:`fmu_harness.system`).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from .fmu import FMI_VERSIONS, build_all
 
 
 def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Path("models")) -> None:
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0].replace("``", ""))
     parser.add_argument("names", nargs="*", help=f"models to build (default: all of {', '.join(MODELS)})")
     parser.add_argument("--dest", type=Path, default=dest, help=f"folder of the FMI 2.0 FMUs (default {dest})")
     parser.add_argument("--fmi", nargs="+", choices=sorted(FMI_VERSIONS), default=sorted(FMI_VERSIONS),
@@ -43,7 +45,8 @@ def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Pa
     except toolchain.NoCompiler as missing:
         print(f"native FMUs not built: {missing}", file=sys.stderr)
         natives = []
-    paths += natives
+    for fmu in natives:
+        paths += [fmu] + ([] if args.no_references else crosscheck.write(fmu))
     driveline = system.driveline()
     for variant in (None, args.dest) if natives else (None,):  # the Python system, then its native variant
         if all(fmu.exists() for fmu in system.component_fmus(driveline, args.dest, variant).values()):
