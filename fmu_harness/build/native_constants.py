@@ -1,7 +1,9 @@
 """The constants the Python core and its C port share, declared once: the names below are the Python
 modules' own constants, and the native build writes their values into the generated header
 ``driveline_constants.h`` that every native FMU carries (next to ``model_variables.h``), as
-``<PACKAGE>_<MODULE>_<NAME>`` (``driveline.rotor.roots.SUBGRID`` is ``ROTOR_ROOTS_SUBGRID``).
+``<PACKAGE>_<MODULE>_<NAME>`` (``driveline.rotor.roots.SUBGRID`` is ``ROTOR_ROOTS_SUBGRID``). The header
+also holds the kinds of failure (:data:`ERROR_KINDS`) as the enum ``ErrorKind``: a C function that
+fails returns its kind with the message, so no C code tells kinds apart by their text.
 
 A C file defines none of these numbers itself (tests/test_native_constants.py checks every
 ``#define`` and ``static const`` of ``fmu_src/native``). Numbers only the C port has (the Arnoldi
@@ -12,6 +14,7 @@ from __future__ import annotations
 
 import importlib
 import math
+import re
 
 #: Python module -> the names of its constants that the C port uses.
 SHARED = {
@@ -33,6 +36,11 @@ SHARED = {
     "driveline.tripod.plane_solver": ("FD_STEP", "LAST_UPDATE", "MAX_ITERATIONS"),
     "driveline.tripod.reactions": ("FRICTION_TOLERANCE", "MAX_FRICTION_ITERATIONS"),
 }
+
+#: The kinds of failure the C port tells apart: the exceptions the Python core raises. ``ErrorKind``
+#: numbers them -1, -2, ... in this order (a failing C function returns its kind; -1, the usual
+#: ``return -1``, is a ValueError), ``ERROR_NONE`` (0) is success.
+ERROR_KINDS = (ValueError, ZeroDivisionError, OverflowError, ArithmeticError, RuntimeError)
 
 HEADER = "driveline_constants.h"
 
@@ -61,11 +69,31 @@ def _literal(value: int | float) -> str:
     return f"({text})" if value < 0 else text
 
 
+def error_kind_name(kind: type[Exception]) -> str:
+    """``ZeroDivisionError`` -> ``ERROR_ZERO_DIVISION``."""
+    return "ERROR_" + re.sub(r"(?<=[a-z])(?=[A-Z])", "_", kind.__name__.removesuffix("Error")).upper()
+
+
+def _error_kinds() -> str:
+    """The enum ``ErrorKind``, each kind's Python name and which kinds are ArithmeticErrors."""
+    kinds = [f"{error_kind_name(kind)} = {-number}" for number, kind in enumerate(ERROR_KINDS, 1)]
+    names = "".join(f"(kind) == {error_kind_name(kind)} ? \"{kind.__name__}\" : " for kind in ERROR_KINDS)
+    arithmetic = " || ".join(f"(kind) == {error_kind_name(kind)}" for kind in ERROR_KINDS
+                             if issubclass(kind, ArithmeticError))
+    return f"""/* The kinds of failure (fmu_harness/build/native_constants.py ERROR_KINDS): the Python exception
+ * a failure of the C port stands for; a failing function returns its kind, a negative number. */
+typedef enum {{ ERROR_NONE = 0, {", ".join(kinds)} }} ErrorKind;
+/* Python's name of a kind ("ValueError"); "" for ERROR_NONE */
+#define ERROR_KIND_NAME(kind) ({names}"")
+/* Whether a kind is one of Python's ArithmeticErrors */
+#define ERROR_IS_ARITHMETIC(kind) ({arithmetic})"""
+
+
 def constants_header() -> str:
     """The text of ``driveline_constants.h``."""
     lines = [f"#define {name} {_literal(value)} /* {python} */" for name, (python, value) in shared_constants().items()]
-    body = "\n".join(lines)
-    return f"""/* The constants the Python core and its C port share, generated from the Python modules by the
+    body = "\n".join(lines) + "\n\n" + _error_kinds()
+    return f"""/* The constants and kinds of failure the Python core and its C port share, generated from the Python modules by the
  * native build (fmu_harness/build/native_constants.py): do not edit. */
 #ifndef DRIVELINE_CONSTANTS_H
 #define DRIVELINE_CONSTANTS_H

@@ -154,36 +154,36 @@ static void free_analysis(void *derived)
 /* ---- Python's arithmetic ----------------------------------------------------------------------- */
 
 /* Python's float ``x ** y``: finite operands with an infinite result raise OverflowError. */
-static int python_pow(double x, double y, double *out, char *error)
+static ErrorKind python_pow(double x, double y, double *out, char *error)
 {
     *out = pow(x, y);
     if (isinf(*out) && isfinite(x) && isfinite(y)) {
         snprintf(error, ERROR_SIZE, "(34, 'Numerical result out of range')");
-        return -1;
+        return ERROR_OVERFLOW;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* Python's float ``x / y``: a zero divisor raises ZeroDivisionError. */
-static int python_divide(double x, double y, double *out, char *error)
+static ErrorKind python_divide(double x, double y, double *out, char *error)
 {
     if (y == 0.0) {
         snprintf(error, ERROR_SIZE, "float division by zero");
-        return -1;
+        return ERROR_ZERO_DIVISION;
     }
     *out = x / y;
-    return 0;
+    return ERROR_NONE;
 }
 
-/* math.fsum; -1 with Python's message on its failures. */
-static int fsum(const double *values, int n, double *sum, char *error)
+/* math.fsum; its failure's kind with Python's message. */
+static ErrorKind fsum(const double *values, int n, double *sum, char *error)
 {
-    const char *failure = python_fsum(values, n, sum);
-    if (failure != NULL) {
+    const char *failure;
+    ErrorKind kind = python_fsum(values, n, sum, &failure);
+    if (kind != ERROR_NONE) {
         snprintf(error, ERROR_SIZE, "%s", failure);
-        return -1;
     }
-    return 0;
+    return kind;
 }
 
 /* Python's format(value, spec) for 'g' specs: C's, but for the spelling of inf and nan. */
@@ -196,22 +196,6 @@ static void python_g(double value, int digits, char *out, size_t size)
     } else {
         snprintf(out, size, "%.*g", digits, value);
     }
-}
-
-/* The texts of Python's ArithmeticError (ZeroDivisionError, OverflowError) that the core raises;
- * any other failure is a ValueError. */
-static int arithmetic(const char *message)
-{
-    static const char *const texts[] = {"float division by zero", "division by zero",
-                                        "(34, 'Numerical result out of range')", "math range error",
-                                        "intermediate overflow in fsum", "float modulo", "integer division or modulo by zero"};
-    size_t i;
-    for (i = 0; i < sizeof texts / sizeof texts[0]; i++) {
-        if (strcmp(message, texts[i]) == 0) {
-            return 1;
-        }
-    }
-    return 0;
 }
 
 /* ---- parse_orders ------------------------------------------------------------------------------ */
@@ -329,33 +313,34 @@ static int build_one_piece(const ModelData *data, Driveline *out, char *error);
 /* build_driveline: the one-piece tube of the parameters, or the layout (a file or a shipped name);
  * refused when shear = false meets a layout segment with shear, or when the supports leave the
  * shaft a mechanism (mechanism.py). */
-static int build_driveline(const ModelData *data, Driveline *out, char *error)
+static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *error)
 {
     const char *layout = data->string_value[V_layout];
-    int failed, hinge = 0, node = 0, i;
+    int hinge = 0, node = 0, i;
+    ErrorKind failed;
     if (layout[0] != '\0') {
-        failed = driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
+        failed = (ErrorKind)driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
         for (i = 0; !failed && !data->int_value[V_shear] && i < out->n_segments; i++) {
             if (out->segments[i].shear) {
                 snprintf(error, ERROR_SIZE, "%s", SHEAR_CONFLICT);
-                failed = -1;
+                failed = ERROR_VALUE;
             }
         }
     } else {
-        failed = build_one_piece(data, out, error);
+        failed = (ErrorKind)build_one_piece(data, out, error);
     }
     switch (failed ? MECHANISM_NONE : driveline_mechanism(out, &hinge, &node)) {
     case MECHANISM_NONE:
         return failed;
     case MECHANISM_HINGE_FOLDS:
         snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node);
-        return -1;
+        return ERROR_VALUE;
     case MECHANISM_RIGID_BODY:
         snprintf(error, ERROR_SIZE, "%s", MECHANISM_RIGID);
-        return -1;
+        return ERROR_VALUE;
     default:
         snprintf(error, ERROR_SIZE, "out of memory");
-        return -1;
+        return ERROR_VALUE;
     }
 }
 
@@ -379,11 +364,12 @@ static int build_one_piece(const ModelData *data, Driveline *out, char *error)
 
 /* searched_modes: bare-shaft bending modes below the frequencies the order-resonance searches scan,
  * times the stations a determinant evaluation passes. */
-static int searched_modes(const Driveline *driveline, const int *orders, int n_orders, double omega_max, double *work,
+static ErrorKind searched_modes(const Driveline *driveline, const int *orders, int n_orders, double omega_max, double *work,
                           char *error)
 {
     double *terms, kappa, scanned, squared_outer, squared_inner, fourth_outer, fourth_inner, ratio, root;
-    int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, i, n = 0, failed = 0;
+    int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, i, n = 0;
+    ErrorKind failed = ERROR_NONE;
     terms = malloc(((size_t)driveline->n_segments + ROTOR_MODEL_MAX_ORDERS + 1) * sizeof *terms);
     if (terms == NULL) {
         snprintf(error, ERROR_SIZE, "out of memory");
@@ -392,27 +378,28 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
     for (i = 0; i < driveline->n_segments && !failed; i++) {
         const RotorSegment *s = &driveline->segments[i];
         double mass_per_length, bending_stiffness;
-        failed = python_pow(s->outer_diameter, 2.0, &squared_outer, error) || /* rho A */
-                 python_pow(s->inner_diameter, 2.0, &squared_inner, error);
+        failed = python_pow(s->outer_diameter, 2.0, &squared_outer, error); /* rho A */
+        failed = failed ? failed : python_pow(s->inner_diameter, 2.0, &squared_inner, error);
         if (failed) {
             break;
         }
         mass_per_length = s->density * (FMU_PI / 4.0 * (squared_outer - squared_inner));
-        failed = python_pow(s->outer_diameter, 4.0, &fourth_outer, error) || /* E J */
-                 python_pow(s->inner_diameter, 4.0, &fourth_inner, error);
+        failed = python_pow(s->outer_diameter, 4.0, &fourth_outer, error); /* E J */
+        failed = failed ? failed : python_pow(s->inner_diameter, 4.0, &fourth_inner, error);
         if (failed) {
             break;
         }
         bending_stiffness = s->youngs_modulus * (FMU_PI / 64.0 * (fourth_outer - fourth_inner));
-        failed = python_divide(mass_per_length, bending_stiffness, &ratio, error) ||
-                 python_pow(ratio, 0.25, &root, error);
+        failed = python_divide(mass_per_length, bending_stiffness, &ratio, error);
+        failed = failed ? failed : python_pow(ratio, 0.25, &root, error);
         if (!failed) {
             terms[n++] = s->length * root;
         }
     }
-    if (failed || fsum(terms, n, &kappa, error)) {
+    failed = failed ? failed : fsum(terms, n, &kappa, error);
+    if (failed) {
         free(terms);
-        return -1;
+        return failed;
     }
     n = 0;
     seen[1] = 1; /* {1, *orders} */
@@ -426,10 +413,10 @@ static int searched_modes(const Driveline *driveline, const int *orders, int n_o
     failed = fsum(terms, n, &scanned, error);
     free(terms);
     if (failed) {
-        return -1;
+        return failed;
     }
     *work = kappa * scanned / FMU_PI * (driveline->n_segments + 1);
-    return 0;
+    return ERROR_NONE;
 }
 
 /* ---- work.py: the estimate of every stage, before any stage starts ------------------------------ */
@@ -440,8 +427,9 @@ static double work_grid(double per_pi, double phase)
     return per_pi * phase / FMU_PI + 8.0;
 }
 
-/* work.estimate, then Work.refusal: 0, or -1 with the refusal (or a failure) in ``error``. */
-static int work_refusal(const Driveline *driveline, const int *orders, int n_orders, double omega_max, char *error)
+/* work.estimate, then Work.refusal: ERROR_NONE, or the refusal (ERROR_VALUE) or a failure's kind
+ * with its message in ``error``. */
+static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int n_orders, double omega_max, char *error)
 {
     static const char *const names[WORK_STAGE_COUNT] = {WORK_STAGE_0, WORK_STAGE_1, WORK_STAGE_2,
                                                    WORK_STAGE_3, WORK_STAGE_4, WORK_STAGE_5};
@@ -450,6 +438,7 @@ static int work_refusal(const Driveline *driveline, const int *orders, int n_ord
         response = 0;
     char shown[40], stage[80];
     size_t used;
+    ErrorKind failed;
     Chain *chain = chain_new(driveline, error, ERROR_SIZE);
     counts = malloc(((size_t)driveline->n_segments + 1) * sizeof *counts);
     if (chain == NULL || counts == NULL) {
@@ -489,8 +478,9 @@ static int work_refusal(const Driveline *driveline, const int *orders, int n_ord
         response += counts[i];
     }
     free(counts);
-    if (fsum(terms, n, &resonances, error)) {
-        return -1;
+    failed = fsum(terms, n, &resonances, error);
+    if (failed) {
+        return failed;
     }
     check = planes * pow(2.0 * (ROTOR_MODEL_FE_ELEMENTS * driveline->n_segments + 1 + driveline->n_hinges), 3.0);
     search = ROTOR_WORK_RATE_SEARCH * stations;
@@ -500,8 +490,9 @@ static int work_refusal(const Driveline *driveline, const int *orders, int n_ord
     seconds[3] = ROTOR_WORK_RATE_DENSE * check;
     seconds[4] = ROTOR_WORK_RATE_BANDED * (ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 4.0 * (table + 1));
     seconds[5] = ROTOR_WORK_RATE_BANDED * (4.0 * (response + 1));
-    if (fsum(seconds, WORK_STAGE_COUNT, &total, error)) {
-        return -1;
+    failed = fsum(seconds, WORK_STAGE_COUNT, &total, error);
+    if (failed) {
+        return failed;
     }
     if (total <= ROTOR_WORK_MAX_ANALYSIS_SECONDS) {
         return 0;
@@ -523,24 +514,25 @@ static int work_refusal(const Driveline *driveline, const int *orders, int n_ord
 
 /* analyse_structure: the chain, the critical speeds (missing ones read as the search limit) and the
  * finite-element check's natural frequencies. */
-static int analyse_structure(Analysis *analysis, char *error)
+static ErrorKind analyse_structure(Analysis *analysis, char *error)
 {
     double spins[3];
     int count = 0, i;
+    ErrorKind failed;
     analysis->chain = chain_new(&analysis->driveline, error, ERROR_SIZE);
     if (analysis->chain == NULL) {
-        return -1;
+        return ERROR_VALUE;
     }
-    if (rotor_critical_speeds(analysis->chain, 3, spins, &count, error, ERROR_SIZE)) {
-        return -1;
+    failed = rotor_critical_speeds(analysis->chain, 3, spins, &count, error, ERROR_SIZE);
+    if (failed) {
+        return failed;
     }
     for (i = 0; i < 3; i++) {
         analysis->critical[i] = i < count ? spins[i] : ROTOR_DRIVELINE_SEARCH_LIMIT;
     }
     analysis->critical_count = count;
-    return fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural,
-                                  &analysis->natural_count,
-                                  error, ERROR_SIZE);
+    return (ErrorKind)fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural,
+                                             &analysis->natural_count, error, ERROR_SIZE);
 }
 
 /* implausibility: the first two whirl frequencies at standstill must each match a natural
@@ -638,9 +630,10 @@ static int unbalance_outputs(Analysis *analysis, const ModelData *data, char *er
 }
 
 /* One part: kept when its key is unchanged, else dropped and computed anew (kept on success only). */
-static int part(Analysis *analysis, const ModelData *data, Part which, const int *orders, int n_orders, char *error)
+static ErrorKind part(Analysis *analysis, const ModelData *data, Part which, const int *orders, int n_orders,
+                      char *error)
 {
-    int failed;
+    ErrorKind failed;
     if (key_matches(&analysis->keys[which], data, which, orders, n_orders)) {
         return 0;
     }
@@ -656,24 +649,23 @@ static int part(Analysis *analysis, const ModelData *data, Part which, const int
         analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
                                           ROTOR_MODEL_WHIRL_MODES, error,
                                           ERROR_SIZE);
-        failed = analysis->whirl == NULL || implausibility(analysis, error);
+        failed = analysis->whirl == NULL ? ERROR_VALUE : (ErrorKind)implausibility(analysis, error);
         break;
     case PART_RESONANCES:
-        failed = resonances(analysis, orders, n_orders, VALUE(omega_max), error);
+        failed = (ErrorKind)resonances(analysis, orders, n_orders, VALUE(omega_max), error);
         break;
     default:
-        failed = unbalance_outputs(analysis, data, error);
+        failed = (ErrorKind)unbalance_outputs(analysis, data, error);
         break;
     }
     if (!failed && !key_store(&analysis->keys[which], data, which, orders, n_orders)) {
         snprintf(error, ERROR_SIZE, "out of memory");
-        failed = 1;
+        failed = ERROR_VALUE;
     }
     if (failed) {
         drop_part(analysis, which);
-        return -1;
     }
-    return 0;
+    return failed;
 }
 
 /* Whether every part holds for these parameters: the last analysis succeeded for exactly them, work
@@ -692,9 +684,12 @@ static int analysed_for(const Analysis *analysis, const ModelData *data, const i
 /* CriticalSpeedsModel.extra_parameter_errors: analyse what a changed parameter affects. */
 static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
+    static const Part later[] = {PART_STRUCTURE, PART_WHIRL, PART_RESONANCES, PART_UNBALANCE};
     ModelCache *cache = data->cache;
     Analysis *analysis = cache->derived;
-    int orders[ROTOR_MODEL_MAX_ORDERS], n_orders = 0, failed;
+    int orders[ROTOR_MODEL_MAX_ORDERS], n_orders = 0;
+    size_t i;
+    ErrorKind failed;
     double work = 0.0;
     char error[ERROR_SIZE] = "", shown[40];
     if (analysis == NULL) {
@@ -705,27 +700,26 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
         }
         cache->derived = analysis;
     }
-    failed = parse_orders(data->string_value[V_orders], orders, &n_orders, error);
+    failed = (ErrorKind)parse_orders(data->string_value[V_orders], orders, &n_orders, error);
     if (!failed && analysed_for(analysis, data, orders, n_orders)) {
         return;
     }
-    failed = failed || part(analysis, data, PART_DRIVELINE, orders, n_orders, error) ||
-             searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
+    failed = failed ? failed : part(analysis, data, PART_DRIVELINE, orders, n_orders, error);
+    failed = failed ? failed : searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
     if (!failed && !(work <= ROTOR_MODEL_MAX_SEARCHED_MODES)) {
         python_g(work, 3, shown, sizeof shown);
         snprintf(error, sizeof error,
                  "the analysis would scan %s shaft modes, more than the %.0f accepted (shorter or stiffer shaft, "
                  "fewer or lower orders, or a smaller omega_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);
-        failed = 1;
+        failed = ERROR_VALUE;
     }
-    failed = failed || work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), error) ||
-             part(analysis, data, PART_STRUCTURE, orders, n_orders, error) ||
-             part(analysis, data, PART_WHIRL, orders, n_orders, error) ||
-             part(analysis, data, PART_RESONANCES, orders, n_orders, error) ||
-             part(analysis, data, PART_UNBALANCE, orders, n_orders, error);
+    failed = failed ? failed : work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), error);
+    for (i = 0; !failed && i < sizeof later / sizeof later[0]; i++) {
+        failed = part(analysis, data, later[i], orders, n_orders, error);
+    }
     if (failed) {
         messages_add(out, "driveline: ", error,
-                     arithmetic(error) ? " (a structural parameter is too large or small to analyse)" : "",
+                     ERROR_IS_ARITHMETIC(failed) ? " (a structural parameter is too large or small to analyse)" : "",
                      (const char *)NULL);
     }
 }

@@ -183,6 +183,7 @@ static SumOutcome fsum_outcome(const double values[], int count)
 {
     double magnitude = 0.0, sum = 0.0;
     const char *failure;
+    ErrorKind kind;
     int i;
     for (i = 0; i < count; i++) {
         magnitude += fabs(values[i]);
@@ -190,9 +191,9 @@ static SumOutcome fsum_outcome(const double values[], int count)
     if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
         return SUM_FINITE;
     }
-    failure = python_fsum(values, count, &sum);
-    if (failure != NULL) {
-        return failure[0] == 'i' ? SUM_OVERFLOW : SUM_OPPOSITE_INFINITIES;
+    kind = python_fsum(values, count, &sum, &failure);
+    if (kind != ERROR_NONE) {
+        return kind == ERROR_OVERFLOW ? SUM_OVERFLOW : SUM_OPPOSITE_INFINITIES;
     }
     return isfinite(sum) ? SUM_FINITE : SUM_NOT_FINITE;
 }

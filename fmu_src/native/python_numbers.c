@@ -142,12 +142,12 @@ void python_float_repr(double value, char *out, size_t size)
  * (ValueError), else NULL with the sum in ``*sum``. Each value adds at most one partial: exact for
  * up to FSUM_VALUES values (the Real outputs, a layout's segments). */
 #define FSUM_VALUES 256
-const char *python_fsum(const double values[], int count, double *sum)
+ErrorKind python_fsum(const double values[], int count, double *sum, const char **message)
 {
-    return python_fsum_strided(values, count, 1, sum);
+    return python_fsum_strided(values, count, 1, sum, message);
 }
 
-const char *python_fsum_strided(const double *first, int count, size_t stride, double *sum)
+ErrorKind python_fsum_strided(const double *first, int count, size_t stride, double *sum, const char **message)
 {
     double partials[FSUM_VALUES], special = 0.0, infinities = 0.0, high = 0.0, low = 0.0, x, y;
     int used = 0, i, j;
@@ -173,7 +173,8 @@ const char *python_fsum_strided(const double *first, int count, size_t stride, d
         if (x != 0.0) {
             if (!isfinite(x)) {
                 if (isfinite(original)) {
-                    return "intermediate overflow in fsum";
+                    *message = "intermediate overflow in fsum";
+                    return ERROR_OVERFLOW;
                 }
                 if (isinf(original)) {
                     infinities += original;
@@ -187,10 +188,11 @@ const char *python_fsum_strided(const double *first, int count, size_t stride, d
     }
     if (special != 0.0 || isnan(special)) {
         if (isnan(infinities)) {
-            return "-inf + inf in fsum";
+            *message = "-inf + inf in fsum";
+            return ERROR_VALUE;
         }
         *sum = special;
-        return NULL;
+        return ERROR_NONE;
     }
     high = 0.0;
     if (used > 0) { /* add the partials from the top until the sum is inexact, then round half even */
@@ -213,5 +215,5 @@ const char *python_fsum_strided(const double *first, int count, size_t stride, d
         }
     }
     *sum = high;
-    return NULL;
+    return ERROR_NONE;
 }

@@ -523,7 +523,7 @@ int fe_natural_frequencies(const Driveline *d, int elements, double **frequencie
     *count = 0;
     if (elements < 1) { /* ShaftSegment.fe_matrices: length / n_elements */
         set_error(error, size, "float division by zero");
-        return -1;
+        return ERROR_ZERO_DIVISION;
     }
     int n_bearings = d->n_bearings, planes = 1, total = 2 + d->n_hinges;
     for (int i = 0; i < n_bearings; i++) {

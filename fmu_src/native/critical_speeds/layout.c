@@ -236,10 +236,11 @@ static int check_unbalance(const Loader *loader, const RotorUnbalance *u)
     return 0;
 }
 
-/* Driveline.length: math.fsum of the segment lengths; NULL, or the text of Python's exception */
-static const char *segments_length(const Driveline *d, double *sum)
+/* Driveline.length: math.fsum of the segment lengths; ERROR_NONE, or Python's exception */
+static ErrorKind segments_length(const Driveline *d, double *sum, const char **message)
 {
-    return python_fsum_strided(&d->segments[0].length, d->n_segments, sizeof(RotorSegment) / sizeof(double), sum);
+    return python_fsum_strided(&d->segments[0].length, d->n_segments, sizeof(RotorSegment) / sizeof(double), sum,
+                               message);
 }
 
 /* Driveline.__post_init__'s checks on the nodes and the unbalances. */
@@ -272,9 +273,11 @@ static int check_driveline(const Loader *loader, const Driveline *d)
                         n_nodes - 2);
         }
     }
-    const char *failure = segments_length(d, &length);
-    if (failure != NULL) {
-        return layout_error(loader->error, loader->size, "%s", failure);
+    const char *failure;
+    ErrorKind kind = segments_length(d, &length, &failure);
+    if (kind != ERROR_NONE) {
+        layout_error(loader->error, loader->size, "%s", failure);
+        return kind;
     }
     for (i = 0; i < d->n_unbalances; i++) {
         if (d->unbalances[i].position > length) {
@@ -1008,7 +1011,8 @@ int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error,
 double driveline_length(const Driveline *driveline)
 {
     double sum;
-    return segments_length(driveline, &sum) == NULL ? sum : HUGE_VAL;
+    const char *failure;
+    return segments_length(driveline, &sum, &failure) == ERROR_NONE ? sum : HUGE_VAL;
 }
 
 /* Driveline.is_isotropic (the chain's: every bearing with kxx == kyy) */

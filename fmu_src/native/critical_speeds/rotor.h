@@ -13,8 +13,9 @@
  *   campbell.c   whirl branches over the speed and the Campbell table
  *   fem.c        finite-element model: the plausibility check's natural frequencies
  *   damped.c     damped finite-element model: damped modes, unbalance response, bearing forces
- * Every function that can fail returns 0 on success, or -1 with a message in ``error`` (``size``
- * bytes, always terminated) worded as the Python core's exception text. No global state.
+ * Every function that can fail returns 0 (ERROR_NONE) on success, or the kind of the failure (a
+ * negative ErrorKind of driveline_constants.h; -1 is ERROR_VALUE) with a message in ``error``
+ * (``size`` bytes, always terminated) worded as the Python core's exception text. No global state.
  */
 #ifndef ROTOR_H
 #define ROTOR_H
