@@ -57,12 +57,17 @@ class Mesh:
         return np.setdiff1d(np.arange(self.n_dof), self.fixed)
 
 
+#: What a segment's share of elements may exceed a whole number by and still round down to it (a
+#: segment of exactly half the length, summed in floating point, keeps ``most``).
+SHARE_SLACK = 1e-9
+
+
 def elements_by_length(d: Driveline, most: int) -> list[int]:
     """Beam elements per segment: ``most`` on a segment of half the driveline's length or longer,
     proportionally fewer (at least one) on a shorter one, so that many short segments cost no more
     than a two-span shaft."""
     half = 0.5 * math.fsum(s.length for s in d.segments)
-    return [min(most, max(1, math.ceil(most * s.length / half - 1e-9))) for s in d.segments]
+    return [min(most, max(1, math.ceil(most * s.length / half - SHARE_SLACK))) for s in d.segments]
 
 
 def mesh(d: Driveline, elements_per_segment: int | Sequence[int] = 40, undamped: bool = True) -> Mesh:

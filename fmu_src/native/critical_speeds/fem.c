@@ -24,7 +24,7 @@ void fe_elements_by_length(const Driveline *driveline, int most, int *counts)
 {
     double half = 0.5 * driveline_length(driveline);
     for (int k = 0; k < driveline->n_segments; k++) {
-        double share = ceil(most * driveline->segments[k].length / half - 1e-9);
+        double share = ceil(most * driveline->segments[k].length / half - ROTOR_FEM_SHARE_SLACK);
         int count = share >= most ? most : (int)share;
         counts[k] = count < 1 ? 1 : count;
     }
