@@ -6,7 +6,7 @@
  */
 #include "fmu_instance.h"
 
-static const char *copy_first_input(ModelData *data, double time)
+static Failure copy_first_input(ModelData *data, double time)
 {
     double value = time;
     int i, found = 0;
@@ -21,7 +21,7 @@ static const char *copy_first_input(ModelData *data, double time)
             data->real_value[i] = value;
         }
     }
-    return NULL;
+    return NO_FAILURE;
 }
 
-const ModelHooks model_hooks = {NULL, copy_first_input, NULL, NULL, NULL, NULL, NULL};
+const ModelHooks model_hooks = {.at_time = copy_first_input};

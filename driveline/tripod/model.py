@@ -50,7 +50,7 @@ class TripodCouplingModel(DrivenShaftModel):
             raise ValueError(f"the saved warm start of the solver is not {len(Solution._fields)} floats")
         return {"_solution": Solution(*saved)}
 
-    native_constants = {"RATES_FROM_SAMPLES": RATES_FROM_SAMPLES, "BETA_LEAVES_RANGE": f"ValueError: {BETA_LEAVES_RANGE}"}
+    native_constants = {"RATES_FROM_SAMPLES": RATES_FROM_SAMPLES, "BETA_LEAVES_RANGE": BETA_LEAVES_RANGE}
 
     extra_parameter_probes = {"friction_needs_exact": {"mu": 0.05, "kinematics": CLOSED_FORM}}
 

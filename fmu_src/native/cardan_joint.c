@@ -20,7 +20,7 @@ static void reset_internal(ModelData *data)
 }
 
 /* Outputs at the current phi_in; input_time is the communication point of the inputs. */
-static const char *evaluate(ModelData *data, double input_time)
+static Failure evaluate(ModelData *data, double input_time)
 {
     double elapsed = HAS_SAMPLE != 0.0 ? input_time - SAMPLE_TIME : 0.0;
     double alpha_in = elapsed > 0.0 ? (VALUE(omega_in) - OMEGA_SAMPLE) / elapsed : 0.0;
@@ -42,7 +42,7 @@ static const char *evaluate(ModelData *data, double input_time)
                                                                (denominator * denominator);
     VALUE(T_in) = VALUE(T_load) * ratio;
     VALUE(speed_fluctuation) = tan(beta) * sin(beta); /* (C5) */
-    return NULL;
+    return NO_FAILURE;
 }
 
 DRIVEN_SHAFT_HOOKS(evaluate)

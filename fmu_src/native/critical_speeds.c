@@ -727,14 +727,14 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
 /* ---- per step ------------------------------------------------------------------------------------ */
 
 /* CriticalSpeedsModel.evaluate: lookups in the analysis at |omega|. */
-static const char *evaluate(ModelData *data)
+static Failure evaluate(ModelData *data)
 {
     const Analysis *analysis = data->cache->derived;
     double speed = fabs(VALUE(omega)), whirl[2 * ROTOR_MODEL_WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
     int closest = 0, count = 0, i;
     if (analysis == NULL || analysis->whirl == NULL || analysis->resonance_count == 0 ||
         analysis->unbalance == NULL) { /* the parameter check builds it before every step */
-        return "RuntimeError: the driveline was not analysed";
+        return FAILURE(ERROR_RUNTIME, "the driveline was not analysed");
     }
     VALUE(omega_crit_1) = analysis->critical[0];
     VALUE(omega_crit_2) = analysis->critical[1];
@@ -746,7 +746,7 @@ static const char *evaluate(ModelData *data)
     VALUE(whirl_backward_1) = whirl[2];
     VALUE(whirl_backward_2) = whirl[3];
     if (VALUE(omega_crit_1) == 0.0) {
-        return "ZeroDivisionError: float division by zero";
+        return FAILURE(ERROR_ZERO_DIVISION, "float division by zero");
     }
     VALUE(speed_ratio) = speed / VALUE(omega_crit_1);
     for (i = 0; i < analysis->resonance_count; i++) { /* np.argmin of |margins|: the first smallest, a NaN first */
@@ -769,15 +769,15 @@ static const char *evaluate(ModelData *data)
     VALUE(unbalance_response) = unbalance[0];
     VALUE(bearing_force_max) = unbalance[1];
     VALUE(damping_ratio) = unbalance[2];
-    return NULL;
+    return NO_FAILURE;
 }
 
-static const char *start(ModelData *data, double start_time UNUSED)
+static Failure start(ModelData *data, double start_time UNUSED)
 {
     return evaluate(data);
 }
 
-static const char *advance(ModelData *data, double current_time UNUSED, double step_size UNUSED)
+static Failure advance(ModelData *data, double current_time UNUSED, double step_size UNUSED)
 {
     return evaluate(data);
 }

@@ -175,14 +175,14 @@ void input_errors(const ModelData *data, Messages *out)
     }
 }
 
-typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_OVERFLOW, SUM_OPPOSITE_INFINITIES } SumOutcome;
+typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_FAILED } SumOutcome;
 
 /* What Python's math.fsum does with these values (output_errors sums the Real outputs with it);
  * exactly only where a partial sum could come near overflow. */
-static SumOutcome fsum_outcome(const double values[], int count)
+static SumOutcome fsum_outcome(const double values[], int count, Failure *failure)
 {
     double magnitude = 0.0, sum = 0.0;
-    const char *failure;
+    const char *message;
     ErrorKind kind;
     int i;
     for (i = 0; i < count; i++) {
@@ -191,16 +191,17 @@ static SumOutcome fsum_outcome(const double values[], int count)
     if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
         return SUM_FINITE;
     }
-    kind = python_fsum(values, count, &sum, &failure);
+    kind = python_fsum(values, count, &sum, &message);
     if (kind != ERROR_NONE) {
-        return kind == ERROR_OVERFLOW ? SUM_OVERFLOW : SUM_OPPOSITE_INFINITIES;
+        *failure = FAILURE(kind, message);
+        return SUM_FAILED;
     }
     return isfinite(sum) ? SUM_FINITE : SUM_NOT_FINITE;
 }
 
 /* SteppedModel.output_errors (not finite, then beyond the declared bounds); an arithmetic failure
  * of the sum itself becomes ``failure``. */
-void output_errors(const ModelData *data, Messages *out, const char **failure)
+void output_errors(const ModelData *data, Messages *out, Failure *failure)
 {
     double values[MODEL_VARIABLE_COUNT];
     int names[MODEL_VARIABLE_COUNT], count = 0, i;
@@ -212,12 +213,8 @@ void output_errors(const ModelData *data, Messages *out, const char **failure)
             values[count++] = data->real_value[i];
         }
     }
-    outcome = fsum_outcome(values, count);
-    if (outcome == SUM_OVERFLOW) {
-        *failure = "OverflowError: intermediate overflow in fsum";
-    } else if (outcome == SUM_OPPOSITE_INFINITIES) {
-        *failure = "ValueError: -inf + inf in fsum";
-    } else if (outcome == SUM_FINITE) {
+    outcome = fsum_outcome(values, count, failure);
+    if (outcome == SUM_FINITE) {
         range_errors(data, CAUSALITY_OUTPUT, out);
     } else if (outcome == SUM_NOT_FINITE) {
         for (i = 0; i < count; i++) {

@@ -26,7 +26,7 @@ static void undoable(Instance *instance, Action action, double time, double step
     Messages *out = &instance->messages;
     int before = out->count;
     char shown[40];
-    const char *failure;
+    Failure failure;
     if (model_hooks.at_time != NULL) {
         failure = model_hooks.at_time(&instance->data, action == ACTION_START ? time : time + step_size);
     } else if (action == ACTION_START) {
@@ -34,14 +34,16 @@ static void undoable(Instance *instance, Action action, double time, double step
     } else {
         failure = model_hooks.advance(&instance->data, time, step_size);
     }
-    if (failure == NULL) {
+    if (failure.kind == ERROR_NONE) {
         output_errors(&instance->data, out, &failure);
     }
-    if (failure != NULL && action == ACTION_START) {
-        messages_add(out, "the start values could not be computed (", failure, ")", (const char *)NULL);
-    } else if (failure != NULL) {
+    if (failure.kind != ERROR_NONE && action == ACTION_START) {
+        messages_add(out, "the start values could not be computed (", ERROR_KIND_NAME(failure.kind), ": ",
+                     failure.message, ")", (const char *)NULL);
+    } else if (failure.kind != ERROR_NONE) {
         python_float_repr(time, shown, sizeof shown);
-        messages_add(out, "the step from t = ", shown, " s could not be computed (", failure, ")", (const char *)NULL);
+        messages_add(out, "the step from t = ", shown, " s could not be computed (", ERROR_KIND_NAME(failure.kind),
+                     ": ", failure.message, ")", (const char *)NULL);
     }
     if (out->count != before) {
         instance->data = snapshot;

@@ -152,9 +152,19 @@ struct Instance {
     char refusal[FMU_MESSAGE_SIZE]; /* the first reason of the last refusal or misuse: a repeat is not logged */
 };
 
+/* A failure of a model's physics: its kind (ERROR_NONE: none) and Python's message of it
+ * (ERROR_ZERO_DIVISION, "float division by zero"), logged as Python names it
+ * ("ZeroDivisionError: float division by zero"). */
+typedef struct {
+    ErrorKind kind;
+    const char *message;
+} Failure;
+
+#define FAILURE(kind, message) ((Failure){(kind), (message)})
+#define NO_FAILURE FAILURE(ERROR_NONE, NULL)
+
 /* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
- * The physics returns NULL, or the arithmetic failure as Python names it ("ZeroDivisionError:
- * float division by zero"). A model whose outputs are functions of time alone gives ``at_time``
+ * The physics returns NO_FAILURE, or the arithmetic failure Python raises. A model whose outputs are functions of time alone gives ``at_time``
  * (start: at the start time, step: at its end); the others give ``start`` and ``advance``.
  * A NULL ``reset_internal`` or ``extra_*_errors`` means none. A model with derived data builds it
  * in ``extra_parameter_errors`` (run before every initialisation and step, once the declared
@@ -162,9 +172,9 @@ struct Instance {
  * ``free_derived``; NULL: the model has none. */
 typedef struct {
     void (*reset_internal)(ModelData *data);
-    const char *(*at_time)(ModelData *data, double time);
-    const char *(*start)(ModelData *data, double start_time);
-    const char *(*advance)(ModelData *data, double current_time, double step_size);
+    Failure (*at_time)(ModelData *data, double time);
+    Failure (*start)(ModelData *data, double start_time);
+    Failure (*advance)(ModelData *data, double current_time, double step_size);
     void (*extra_parameter_errors)(const ModelData *data, Messages *out);
     void (*extra_input_errors)(const ModelData *data, Messages *out);
     void (*free_derived)(void *derived);
@@ -180,12 +190,12 @@ extern const ModelHooks model_hooks;
  * ``evaluate(data, input_time)`` gives the outputs at the current phi_in, input_time being the
  * communication point at which the host set the inputs. */
 #define DRIVEN_SHAFT_HOOKS(evaluate)                                                                            \
-    static const char *start(ModelData *data, double start_time)                                                \
+    static Failure start(ModelData *data, double start_time)                                                    \
     {                                                                                                           \
         data->real_value[V_phi_in] = data->real_value[V_phi_in_start];                                          \
         return evaluate(data, start_time);                                                                      \
     }                                                                                                           \
-    static const char *advance(ModelData *data, double current_time, double step_size)                          \
+    static Failure advance(ModelData *data, double current_time, double step_size)                              \
     {                                                                                                           \
         data->real_value[V_phi_in] = data->real_value[V_phi_in] + data->real_value[V_omega_in] * step_size;     \
         return evaluate(data, current_time);                                                                    \

@@ -5,17 +5,17 @@
 
 
 /* omega(t) = omega_start + ramp_rate t + a sin(w t), alpha = d(omega)/dt, phi its exact integral. */
-static const char *evaluate(ModelData *data, double t)
+static Failure evaluate(ModelData *data, double t)
 {
     double w = 2.0 * FMU_PI * VALUE(sine_frequency), a = VALUE(sine_amplitude);
     if (isinf(w * t)) {
-        return "ValueError: math domain error"; /* what Python's math.sin says of an infinite angle */
+        return FAILURE(ERROR_VALUE, "math domain error"); /* what Python's math.sin says of an infinite angle */
     }
     VALUE(omega) = VALUE(omega_start) + VALUE(ramp_rate) * t + a * sin(w * t);
     VALUE(alpha) = VALUE(ramp_rate) + a * w * cos(w * t);
     VALUE(phi) = VALUE(phi_start) + VALUE(omega_start) * t + 0.5 * VALUE(ramp_rate) * t * t +
                  (w > 0.0 ? a * (1.0 - cos(w * t)) / w : 0.0);
-    return NULL;
+    return NO_FAILURE;
 }
 
 const ModelHooks model_hooks = {.at_time = evaluate};

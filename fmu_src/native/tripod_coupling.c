@@ -23,47 +23,47 @@
 #define SAMPLE_COUNT (data->internal[6])
 #define SAMPLES (data->internal + 7)
 
-static const char MATH_DOMAIN[] = "ValueError: math domain error";
-static const char ZERO_DIVISION[] = "ZeroDivisionError: float division by zero";
+static const char MATH_DOMAIN[] = "math domain error";           /* ValueError */
+static const char ZERO_DIVISION[] = "float division by zero";      /* ZeroDivisionError */
 
 /* The first arithmetic failure of an evaluation, as Python would raise it. */
 typedef struct {
-    const char *failure;
+    Failure failure;
 } Guard;
 
 /* Python's float division, math.sqrt, math.cos, math.sin and math.asin: where those raise, the
  * first failure is kept and the evaluation goes on with 0 (its results are then discarded). */
-static double refuse(Guard *guard, const char *why)
+static double refuse(Guard *guard, ErrorKind kind, const char *why)
 {
-    if (guard->failure == NULL) {
-        guard->failure = why;
+    if (guard->failure.kind == ERROR_NONE) {
+        guard->failure = FAILURE(kind, why);
     }
     return 0.0;
 }
 
 static double divide(Guard *guard, double a, double b)
 {
-    return b != 0.0 ? a / b : refuse(guard, ZERO_DIVISION);
+    return b != 0.0 ? a / b : refuse(guard, ERROR_ZERO_DIVISION, ZERO_DIVISION);
 }
 
 static double root(Guard *guard, double a)
 {
-    return a < 0.0 ? refuse(guard, MATH_DOMAIN) : sqrt(a);
+    return a < 0.0 ? refuse(guard, ERROR_VALUE, MATH_DOMAIN) : sqrt(a);
 }
 
 static double cosine(Guard *guard, double a)
 {
-    return isinf(a) ? refuse(guard, MATH_DOMAIN) : cos(a);
+    return isinf(a) ? refuse(guard, ERROR_VALUE, MATH_DOMAIN) : cos(a);
 }
 
 static double sine(Guard *guard, double a)
 {
-    return isinf(a) ? refuse(guard, MATH_DOMAIN) : sin(a);
+    return isinf(a) ? refuse(guard, ERROR_VALUE, MATH_DOMAIN) : sin(a);
 }
 
 static double arcsine(Guard *guard, double a)
 {
-    return fabs(a) > 1.0 ? refuse(guard, MATH_DOMAIN) : asin(a);
+    return fabs(a) > 1.0 ? refuse(guard, ERROR_VALUE, MATH_DOMAIN) : asin(a);
 }
 
 /* ---- exact kinematics, tripod-plane formulation (plane_solver.py) ------------------------- */
@@ -122,7 +122,7 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
     }
     turn3[0] = cosine(guard, 3.0 * phi_in);
     turn3[1] = sine(guard, 3.0 * phi_in);
-    for (i = 0; i < TRIPOD_PLANE_SOLVER_MAX_ITERATIONS && guard->failure == NULL; i++) {
+    for (i = 0; i < TRIPOD_PLANE_SOLVER_MAX_ITERATIONS && guard->failure.kind == ERROR_NONE; i++) {
         f = star_centre(guard, x, y, turn3, cb, sb, r, l);
         fx = star_centre(guard, x + TRIPOD_PLANE_SOLVER_FD_STEP, y, turn3, cb, sb, r, l);
         fy = star_centre(guard, x, y + TRIPOD_PLANE_SOLVER_FD_STEP, turn3, cb, sb, r, l);
@@ -140,9 +140,9 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
         }
     }
     if (i == TRIPOD_PLANE_SOLVER_MAX_ITERATIONS) {
-        refuse(guard, "ArithmeticError: tripod closure: plane iteration did not converge");
+        refuse(guard, ERROR_ARITHMETIC, "tripod closure: plane iteration did not converge");
     }
-    if (guard->failure != NULL) {
+    if (guard->failure.kind != ERROR_NONE) {
         return;
     }
     /* the last update moved (x, y) by (-dx, -dy): carry arg(alpha) along to first order */
@@ -202,7 +202,7 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
         signs[j][0] = slip_sign(guard, a->zdot, load->slip_speed);
         signs[j][1] = slip_sign(guard, a->sigma * root(guard, a->exy2 + a->ez * a->ez), load->slip_speed);
     }
-    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure == NULL; iteration++) {
+    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE; iteration++) {
         double Mx = load_moment[0], My = load_moment[1], Mz = load_moment[2], change = 0.0, scale = 0.0;
         for (j = 0; j < 3; j++) {
             const Arm *a = &arm[j];
@@ -238,7 +238,7 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
         }
     }
     if (iteration == TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS) {
-        refuse(guard, "ArithmeticError: tripod friction balance did not converge (friction coefficient too large?)");
+        refuse(guard, ERROR_ARITHMETIC, "tripod friction balance did not converge (friction coefficient too large?)");
     }
     *power = 0.0;
     for (j = 0; j < 3; j++) {
@@ -348,7 +348,7 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     for (j = 0; j < 3; j++) {
         lams[j] = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det;
     }
-    if (load->friction != 0.0 && guard->failure == NULL) {
+    if (load->friction != 0.0 && guard->failure.kind == ERROR_NONE) {
         frictional_balance(guard, arm, (const double(*)[3])adj, inv_det, moment, load, lams, mus, slips, grooves,
                            &power);
     }
@@ -439,9 +439,9 @@ static void sampled_rates(const double *samples, int count, double *rate, double
 
 /* Outputs ``elapsed`` after ``input_time`` (TripodCouplingModel._evaluate), with the speed and the
  * bend moved on by their rates. */
-static const char *evaluate(ModelData *data, double input_time, double elapsed)
+static Failure evaluate(ModelData *data, double input_time, double elapsed)
 {
-    Guard guard = {NULL};
+    Guard guard = {{ERROR_NONE, NULL}};
     Load load;
     Reactions forces;
     double beta_dot = VALUE(beta_dot), beta_ddot = VALUE(beta_ddot), beta, omega;
@@ -468,7 +468,7 @@ static const char *evaluate(ModelData *data, double input_time, double elapsed)
     }
     beta = VALUE(beta) + (beta_dot + 0.5 * beta_ddot * elapsed) * elapsed;
     if (!(0.0 <= beta && beta <= VALUE(beta_max))) {
-        return BETA_LEAVES_RANGE;
+        return FAILURE(ERROR_VALUE, BETA_LEAVES_RANGE);
     }
     omega = VALUE(omega_in) + VALUE(alpha_in) * elapsed;
     cos_beta = cos(beta);
@@ -490,7 +490,7 @@ static const char *evaluate(ModelData *data, double input_time, double elapsed)
     pin = divide(&guard, T_load, 3.0 * (r + rho));              /* eq 24 with the corrected eq 21 */
     if (INTEGER(kinematics) == TRIPOD_SPEC_EXACT) {
         plane_solve(&guard, phi_in, cos_beta, sin_beta, r, l, HAS_SOLUTION != 0.0, SOLUTION, &phi_out, &ratio);
-        if (guard.failure != NULL) {
+        if (guard.failure.kind != ERROR_NONE) {
             return guard.failure;
         }
         HAS_SOLUTION = 1.0;
@@ -559,7 +559,7 @@ static const char *evaluate(ModelData *data, double input_time, double elapsed)
 
 /* The warm start and the bend samples are empty at the start, as TripodCouplingModel.start leaves
  * them: reset clears them and a refused start is undone. */
-static const char *start(ModelData *data, double start_time)
+static Failure start(ModelData *data, double start_time)
 {
     HAS_SOLUTION = 0.0;
     SAMPLE_COUNT = 0.0;
@@ -568,7 +568,7 @@ static const char *start(ModelData *data, double start_time)
 }
 
 /* phi_in advances by omega_in h + alpha_in h^2 / 2 (TripodCouplingModel.advance). */
-static const char *advance(ModelData *data, double current_time, double step_size)
+static Failure advance(ModelData *data, double current_time, double step_size)
 {
     VALUE(phi_in) = VALUE(phi_in) + (VALUE(omega_in) + 0.5 * VALUE(alpha_in) * step_size) * step_size;
     return evaluate(data, current_time, step_size);

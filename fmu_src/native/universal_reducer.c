@@ -30,13 +30,13 @@ static void connecting_shaft(const ModelData *data, double M_in, double i, doubl
     loads->sigma_eq = sqrt(loads->sigma * loads->sigma + 4.0 * (loads->tau * loads->tau));
 }
 
-static const char *evaluate(ModelData *data, double input_time UNUSED)
+static Failure evaluate(ModelData *data, double input_time UNUSED)
 {
     double i = (double)INTEGER(z1) / (double)(INTEGER(z1) - INTEGER(z2)); /* eqs 4, 17 */
     double half = 0.5 * VALUE(alpha), cube = pow(VALUE(r_shaft), 3.0);
     Loads loads, unit;
     if (isinf(cube)) {
-        return "OverflowError: (34, 'Numerical result out of range')"; /* Python's float ** says so */
+        return FAILURE(ERROR_OVERFLOW, "(34, 'Numerical result out of range')"); /* Python's float ** says so */
     }
     VALUE(speed_ratio) = 1.0 / i;
     VALUE(phi_out) = VALUE(phi_in) / i;
@@ -54,10 +54,10 @@ static const char *evaluate(ModelData *data, double input_time UNUSED)
     VALUE(utilisation) = loads.sigma_eq / VALUE(sigma_allow);
     connecting_shaft(data, 1.0, i, cube, &unit);
     if (unit.sigma_eq == 0.0) {
-        return "ZeroDivisionError: float division by zero";
+        return FAILURE(ERROR_ZERO_DIVISION, "float division by zero");
     }
     VALUE(T_in_allow) = VALUE(sigma_allow) / unit.sigma_eq;
-    return NULL;
+    return NO_FAILURE;
 }
 
 DRIVEN_SHAFT_HOOKS(evaluate)
