@@ -265,7 +265,7 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
     for (at = 0; at < length; at++) {
         commas += text[at] == ',';
     }
-    if (commas >= ROTOR_MODEL_MAX_ORDERS) { /* text.split(",", ROTOR_MODEL_MAX_ORDERS) gives more than ROTOR_MODEL_MAX_ORDERS entries */
+    if (commas >= ROTOR_MODEL_MAX_ORDERS) { /* text.split(",", MAX_ORDERS) gives more than MAX_ORDERS entries */
         snprintf(error, ERROR_SIZE, "parameter orders lists more than %d orders", ROTOR_MODEL_MAX_ORDERS);
         return -1;
     }
@@ -298,7 +298,8 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
             memcpy(prefix, text + first, cut - first);
             prefix[cut - first] = '\0';
             python_str_repr(prefix, 20, shown, sizeof shown);
-            snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown, ROTOR_MODEL_MAX_ORDER);
+            snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown,
+                     ROTOR_MODEL_MAX_ORDER);
             return -1;
         }
         orders[(*count)++] = value;
@@ -537,12 +538,13 @@ static int analyse_structure(Analysis *analysis, char *error)
         analysis->critical[i] = i < count ? spins[i] : ROTOR_DRIVELINE_SEARCH_LIMIT;
     }
     analysis->critical_count = count;
-    return fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural, &analysis->natural_count,
+    return fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural,
+                                  &analysis->natural_count,
                                   error, ERROR_SIZE);
 }
 
 /* implausibility: the first two whirl frequencies at standstill must each match a natural
- * frequency of the finite-element check within ROTOR_MODEL_PLAUSIBLE_DEVIATION. */
+ * frequency of the finite-element check within PLAUSIBLE_DEVIATION. */
 static int implausibility(const Analysis *analysis, char *error)
 {
     double at_rest[2 * ROTOR_MODEL_WHIRL_MODES], nearest, deviation, best = 0.0;
@@ -597,7 +599,8 @@ static int resonances(Analysis *analysis, const int *orders, int n_orders, doubl
     if (analysis->resonance_count == 0) {
         free(analysis->resonances);
         analysis->resonances = NULL;
-        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT,
+        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0,
+                                   ROTOR_DRIVELINE_SEARCH_LIMIT,
                                    &analysis->resonances, &analysis->resonance_count, error, ERROR_SIZE)) {
             return -1;
         }
@@ -650,7 +653,8 @@ static int part(Analysis *analysis, const ModelData *data, Part which, const int
         failed = analyse_structure(analysis, error);
         break;
     case PART_WHIRL:
-        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS, ROTOR_MODEL_WHIRL_MODES, error,
+        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
+                                          ROTOR_MODEL_WHIRL_MODES, error,
                                           ERROR_SIZE);
         failed = analysis->whirl == NULL || implausibility(analysis, error);
         break;

@@ -334,7 +334,7 @@ static double *side_by_side(const Branches branches[2], int speeds, int pad, dou
 }
 
 /* campbell._spline_error: the relative error of the branches' splines at the middle of every knot
- * interval (largest of all branches) by one Newton step on the determinant there, zero within ROTOR_CAMPBELL_NOISE
+ * interval (largest of all branches) by one Newton step on the determinant there, zero within NOISE
  * times the same step at the interval's ends; ``error_of`` has count - 1 entries. A branch missing at
  * some speed (NaN) has no spline and contributes no error. */
 static int spline_error(const Chain *chain, const Found *found, const Branches branches[2], double *error_of,
@@ -618,7 +618,8 @@ static int sorted_table(const Chain *chain, const double *spins, int points, int
         cases[i].s = 0.0;
         cases[i].o = spins[i];
     }
-    if (rotor_roots_by_whirl(chain, cases, points, n_modes, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT, roots[0], roots[1], error,
+    if (rotor_roots_by_whirl(chain, cases, points, n_modes, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT, roots[0], roots[1],
+                             error,
                              size)) {
         goto done;
     }

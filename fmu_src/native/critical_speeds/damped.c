@@ -1,5 +1,5 @@
 /* Damped finite-element model of a driveline (damped.DampedRotor) and what the FMU reports of it
- * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver up to ROTOR_DAMPED_DENSE_SIZE
+ * (unbalance_outputs.UnbalanceOutputs): damped modes from a dense complex eigensolver up to DENSE_SIZE
  * first-order unknowns and by shift-invert Arnoldi on a banded factorisation above, the synchronous
  * unbalance response from a banded complex LU solve (the linear algebra in linalg.c). */
 #include "rotor.h"
@@ -228,12 +228,12 @@ static int by_frequency(const void *a, const void *b)
     return (x->place > y->place) - (x->place < y->place);
 }
 
-/* ---- shift-invert Arnoldi (DampedRotor.modes above ROTOR_DAMPED_DENSE_SIZE) ------------------------------
- * The eigenvalues nu of (A - ROTOR_DAMPED_SHIFT B)^-1 B are 1 / (lam - ROTOR_DAMPED_SHIFT): the largest |nu| are the lam nearest
- * ROTOR_DAMPED_SHIFT. With y = [y1, y2] and v = [v1, v2] (x and x'/s blocks, each in the interleaved order),
- * (A - ROTOR_DAMPED_SHIFT B) y = B v reads -ROTOR_DAMPED_SHIFT y1 + s y2 = v1 and -K2 y1 / s - (C2 + spin Gv + ROTOR_DAMPED_SHIFT M2) y2 = M2 v2,
- * so that Q(ROTOR_DAMPED_SHIFT) y1 = -s M2 v2 - (C2 + spin Gv + ROTOR_DAMPED_SHIFT M2) v1 with the banded
- * Q(ROTOR_DAMPED_SHIFT) = K2 + ROTOR_DAMPED_SHIFT (C2 + spin Gv) + ROTOR_DAMPED_SHIFT^2 M2, and y2 = (v1 + ROTOR_DAMPED_SHIFT y1) / s. */
+/* ---- shift-invert Arnoldi (DampedRotor.modes above DENSE_SIZE) ------------------------------
+ * The eigenvalues nu of (A - SHIFT B)^-1 B are 1 / (lam - SHIFT): the largest |nu| are the lam nearest
+ * SHIFT. With y = [y1, y2] and v = [v1, v2] (x and x'/s blocks, each in the interleaved order),
+ * (A - SHIFT B) y = B v reads -SHIFT y1 + s y2 = v1 and -K2 y1 / s - (C2 + spin Gv + SHIFT M2) y2 = M2 v2,
+ * so that Q(SHIFT) y1 = -s M2 v2 - (C2 + spin Gv + SHIFT M2) v1 with the banded
+ * Q(SHIFT) = K2 + SHIFT (C2 + spin Gv) + SHIFT^2 M2, and y2 = (v1 + SHIFT y1) / s. */
 /* most Krylov vectors: memory 2 size (KRYLOV_CAP + 1) complex numbers */
 #define KRYLOV_CAP 400
 /* a Ritz value has converged when its residual estimate is below this times the largest |nu| */
@@ -241,7 +241,7 @@ static int by_frequency(const void *a, const void *b)
 
 typedef struct {
     int cap, steps;        /* most Krylov vectors (0: the dense path); vectors of the last run */
-    cplx *q, *coupling;    /* Q(ROTOR_DAMPED_SHIFT) factorised and C2 + spin Gv + ROTOR_DAMPED_SHIFT M2, band storage */
+    cplx *q, *coupling;    /* Q(SHIFT) factorised and C2 + spin Gv + SHIFT M2, band storage */
     int *pivots, *place;   /* Q's row swaps; place[order[i]] = i */
     cplx *basis;           /* cap + 1 orthonormal vectors of 2 size */
     cplx *hess;            /* (cap + 1) x cap Hessenberg matrix of the Arnoldi relation, by rows */
@@ -293,7 +293,7 @@ static int krylov_init(Krylov *krylov, const Rotor *rotor)
     return 0;
 }
 
-/* y = (A - ROTOR_DAMPED_SHIFT B)^-1 B v (2 size each, blocks in the interleaved order) */
+/* y = (A - SHIFT B)^-1 B v (2 size each, blocks in the interleaved order) */
 static void krylov_apply(const Rotor *rotor, const Krylov *krylov, const cplx *v, cplx *y)
 {
     Band band = rotor->band;
@@ -304,11 +304,12 @@ static void krylov_apply(const Rotor *rotor, const Krylov *krylov, const cplx *v
     for (int i = 0; i < m; i++) {
         y1[i] = cplx_real(0.0);
     }
-    for (int j = 0; j < m; j++) { /* -s M2 v2 - (C2 + spin Gv + ROTOR_DAMPED_SHIFT M2) v1, column by column */
+    for (int j = 0; j < m; j++) { /* -s M2 v2 - (C2 + spin Gv + SHIFT M2) v1, column by column */
         int first = j - band.ku > 0 ? j - band.ku : 0, last = j + band.kl < m ? j + band.kl : m - 1;
         cplx a = cplx_scale(-s, v2[j]), b = v1[j];
         for (int i = first; i <= last; i++) {
-            y1[i] = cplx_add(y1[i], cplx_sub(cplx_mul(AB(band, mass, i, j), a), cplx_mul(AB(band, krylov->coupling, i, j), b)));
+            y1[i] = cplx_add(y1[i], cplx_sub(cplx_mul(AB(band, mass, i, j), a), cplx_mul(AB(band, krylov->coupling, i,
+                                                                                            j), b)));
         }
     }
     band_substitute(band, krylov->q, krylov->pivots, y1);
@@ -362,7 +363,7 @@ static int krylov_converged(Krylov *krylov, int steps, int order, int wanted)
     return 1;
 }
 
-/* The ``wanted`` eigenvalues lam nearest ROTOR_DAMPED_SHIFT at ``spin`` into ``lambda`` (ranked by descending
+/* The ``wanted`` eigenvalues lam nearest SHIFT at ``spin`` into ``lambda`` (ranked by descending
  * |nu|); afterwards ritz[rank[k]] is the Ritz value of lambda[k] and small the Hessenberg matrix */
 static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wanted, cplx *lambda, char *error,
                         size_t size)
@@ -457,7 +458,7 @@ typedef struct {
     unsigned char *swapped;
     Mode *modes;
     int *index;
-    Krylov krylov;                     /* above ROTOR_DAMPED_DENSE_SIZE (krylov.cap > 0): none of the dense arrays */
+    Krylov krylov;                     /* above DENSE_SIZE (krylov.cap > 0): none of the dense arrays */
 } Dense;
 
 static void dense_free(Dense *dense)
@@ -583,7 +584,7 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
                        size_t size)
 {
     int order = dense->order, count, *index = dense->index;
-    if (dense->krylov.cap) { /* above ROTOR_DAMPED_DENSE_SIZE: the 2 n + ROTOR_DAMPED_EXTRA_EIGENVALUES nearest ROTOR_DAMPED_SHIFT by Arnoldi */
+    if (dense->krylov.cap) { /* above DENSE_SIZE: the 2 n + EXTRA_EIGENVALUES nearest SHIFT by Arnoldi */
         count = 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES < dense->krylov.cap ? 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES : dense->krylov.cap;
         if (krylov_modes(rotor, &dense->krylov, spin, count, dense->lambda, error, size)) {
             return -1;
@@ -655,10 +656,10 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
 
 /* ---- unbalance_outputs.UnbalanceOutputs ------------------------------------------------------ */
 struct UnbalanceOutputs {
-    Rotor rotor;        /* the response model (ROTOR_UNBALANCE_OUTPUTS_FE_ELEMENTS), its band matrices only */
+    Rotor rotor;        /* the response model (FE_ELEMENTS), its band matrices only */
     cplx *load;         /* DampedRotor.load per unit Omega^2, rotor.size */
     cplx *row;          /* DampedRotor.shape_rows at the response position, rotor.n */
-    CubicSpline modes;  /* ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES damped frequencies, then their damping ratios */
+    CubicSpline modes;  /* DAMPED_MODES damped frequencies, then their damping ratios */
     cplx *ab, *x;       /* evaluate's work: one object is evaluated by one caller at a time */
     int *pivots;
 };
@@ -712,7 +713,7 @@ void unbalance_outputs_free(UnbalanceOutputs *outputs)
     free(outputs);
 }
 
-/* The mode table of UnbalanceOutputs.build: ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS rows of 2 ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES */
+/* The mode table of UnbalanceOutputs.build: DAMPING_POINTS rows of 2 DAMPED_MODES */
 static int mode_table(const Driveline *d, const int *counts, const double *spins, double *table, char *error,
                       size_t size)
 {
@@ -729,7 +730,8 @@ static int mode_table(const Driveline *d, const int *counts, const double *spins
     Mode modes[4 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
     for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS && !status; i++) {
         int found = 0, excited = 0;
-        status = rotor_modes(&coarse, &dense, spins[i], 4 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, modes, &found, error, size);
+        status = rotor_modes(&coarse, &dense, spins[i], 4 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, modes, &found,
+                             error, size);
         double *out = table + (size_t)i * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES;
         for (int k = 0; k < found && excited < ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES && !status; k++) {
             if (modes[k].forward_share >= ROTOR_DRIVELINE_EXCITED_SHARE) {
@@ -825,7 +827,8 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         refused = i > 0 && !(spins[i] > spins[i - 1]) && !refused ? "`x` must be strictly increasing sequence." : refused;
     }
     refused = isfinite(omega_max) ? refused : "`x` must contain only finite values.";
-    if (refused || cubic_spline_build(&outputs->modes, ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS, spins, 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, table)) {
+    if (refused || cubic_spline_build(&outputs->modes, ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS, spins,
+                                      2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, table)) {
         memset(&outputs->modes, 0, sizeof outputs->modes);
         unbalance_outputs_free(outputs);
         set_error(error, size, refused ? refused : OUT_OF_MEMORY);
@@ -834,7 +837,8 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
     return outputs;
 }
 
-void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed, double out[2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES])
+void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed,
+                             double out[2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES])
 {
     cubic_spline_evaluate(&outputs->modes, speed, out);
 }

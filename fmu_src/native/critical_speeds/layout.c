@@ -189,7 +189,8 @@ static int check_segment(const Loader *loader, const RotorSegment *s)
         return -1;
     }
     if (!(-1.0 < s->poisson_ratio && s->poisson_ratio < 0.5)) {
-        return layout_error(loader->error, loader->size, "poisson_ratio must lie in (-1, 0.5), got %g", s->poisson_ratio);
+        return layout_error(loader->error, loader->size, "poisson_ratio must lie in (-1, 0.5), got %g",
+                            s->poisson_ratio);
     }
     return 0;
 }
@@ -254,7 +255,8 @@ static int check_driveline(const Loader *loader, const Driveline *d)
     }
     for (i = 0; i < d->n_bearings; i++) {
         if (d->bearings[i].node >= n_nodes) {
-            return layout_error(loader->error, loader->size, "bearings[%d].node = %d is out of range: nodes are 0..%d", i,
+            return layout_error(loader->error, loader->size,
+                                "bearings[%d].node = %d is out of range: nodes are 0..%d", i,
                         d->bearings[i].node, n_nodes - 1);
         }
     }
@@ -279,7 +281,8 @@ static int check_driveline(const Loader *loader, const Driveline *d)
             char position[32], end[32];
             python_float_repr(d->unbalances[i].position, position, sizeof position);
             python_float_repr(length, end, sizeof end);
-            return layout_error(loader->error, loader->size, "unbalances[%d].position = %s m lies beyond the right end (%s m)",
+            return layout_error(loader->error, loader->size,
+                                "unbalances[%d].position = %s m lies beyond the right end (%s m)",
                         i, position, end);
         }
     }
@@ -298,7 +301,8 @@ static int materials(const Loader *loader, const Value *data, Material **out, in
         return 0;
     }
     if (table->kind != V_TABLE) {
-        return layout_error(loader->error, loader->size, "materials must be a table of named materials ([materials.NAME])");
+        return layout_error(loader->error, loader->size,
+                            "materials must be a table of named materials ([materials.NAME])");
     }
     *out = arena_alloc(loader->arena, (table->count + 1) * sizeof **out);
     if (*out == NULL) {
@@ -406,7 +410,8 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
         return -1;
     }
     if ((get(t, "outer_diameter") == NULL) == (get(t, "outer_radius") == NULL)) {
-        return layout_error(loader->error, loader->size, "%s: give exactly one of 'outer_diameter' or 'outer_radius'", where);
+        return layout_error(loader->error, loader->size, "%s: give exactly one of 'outer_diameter' or 'outer_radius'",
+                            where);
     }
     outer_key = get(t, "outer_diameter") != NULL ? "outer_diameter" : "outer_radius";
     if (number(loader, where, outer_key, get(t, outer_key), 1, 0, &d_out) != 0) {
@@ -462,7 +467,8 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
             if (known == NULL) {
                 return layout_error(loader->error, loader->size, "out of memory");
             }
-            return layout_error(loader->error, loader->size, "%s.material %v is not a defined material (%s)", where, value,
+            return layout_error(loader->error, loader->size, "%s.material %v is not a defined material (%s)", where,
+                                value,
                         known);
         }
         s->youngs_modulus = mats[m].E;
@@ -495,7 +501,8 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
         double x = nu->kind == V_INTEGER ? (double)nu->integer : nu->kind == V_FLOAT ? nu->number : NAN;
         /* an integer is in (-1, 0.5) just when it is 0, its double too */
         if (!(-1.0 < x && x < 0.5)) {
-            return layout_error(loader->error, loader->size, "%s.poisson_ratio must be a number in (-1, 0.5), got %v", where,
+            return layout_error(loader->error, loader->size, "%s.poisson_ratio must be a number in (-1, 0.5), got %v",
+                                where,
                         nu);
         }
         s->poisson_ratio = x;
@@ -518,7 +525,8 @@ static int station(const Loader *loader, const char *where, const Value *t, int 
         if (node->integer >= n_nodes) {
             char shown[32];
             snprintf(shown, sizeof shown, "%lld", node->integer);
-            return layout_error(loader->error, loader->size, "%s.node = %s is out of range: nodes are 0..%d", where, shown,
+            return layout_error(loader->error, loader->size, "%s.node = %s is out of range: nodes are 0..%d", where,
+                                shown,
                         n_nodes - 1);
         }
         out->node = (int)node->integer;
@@ -589,7 +597,8 @@ static int cut(const Loader *loader, const RotorSegment *old, int n_old, Station
                 continue;
             }
             if (value > ends[n_old] + ROTOR_LOADER_NODE_SNAP) {
-                return layout_error(loader->error, loader->size, "%s[%d].position = %g m lies beyond the right end (%g m)",
+                return layout_error(loader->error, loader->size,
+                                    "%s[%d].position = %g m lies beyond the right end (%g m)",
                             kinds[kind], i, value, ends[n_old]);
             }
             for (k = 0; k < n_old && !(ends[k] <= value && value <= ends[k + 1]); k++) {
@@ -669,7 +678,8 @@ static int pair(const Loader *loader, const char *where, const Value *t, const c
     const Value *iso = get(t, key), *vx = get(t, xx), *vy = get(t, yy);
     if (iso != NULL) {
         if (vx != NULL || vy != NULL) {
-            return layout_error(loader->error, loader->size, "%s: give either %r or %r/%r, not both", where, key, xx, yy);
+            return layout_error(loader->error, loader->size, "%s: give either %r or %r/%r, not both", where, key, xx,
+                                yy);
         }
         if (number(loader, where, key, iso, positive, 0, x) != 0) {
             return -1;
@@ -739,10 +749,12 @@ static int point_element(const Loader *loader, Driveline *d, int kind, int i, co
             if (at != NULL) {
                 char shown[32];
                 snprintf(shown, sizeof shown, "%lld", at->integer);
-                return layout_error(loader->error, loader->size, "%s.node = %s must be an inner node (1..%d), not an end",
+                return layout_error(loader->error, loader->size,
+                                    "%s.node = %s must be an inner node (1..%d), not an end",
                             where, shown, n_nodes - 2);
             }
-            return layout_error(loader->error, loader->size, "%s.position = %v m must be an inner node (1..%d), not an end",
+            return layout_error(loader->error, loader->size,
+                                "%s.position = %v m must be an inner node (1..%d), not an end",
                         where, get(t, "position"), n_nodes - 2);
         }
         h->node = node;
@@ -776,7 +788,8 @@ static int end_condition(const Loader *loader, const Value *data, const char *ke
 static int load(const Loader *loader, const Value *data, Driveline *d)
 {
     static const char *const kinds[] = {"masses", "bearings", "hinges"};
-    static const int limits[] = {ROTOR_LOADER_MAX_POINT_ELEMENTS, ROTOR_LOADER_MAX_POINT_ELEMENTS, ROTOR_LOADER_MAX_POINT_ELEMENTS};
+    static const int limits[] = {ROTOR_LOADER_MAX_POINT_ELEMENTS, ROTOR_LOADER_MAX_POINT_ELEMENTS,
+                                 ROTOR_LOADER_MAX_POINT_ELEMENTS};
     const Value *name = get(data, "name"), *segs, *unbs, *tables[3];
     const Item *item;
     Material *mats;
@@ -797,7 +810,8 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
     }
     n_old = list_count(segs);
     if (n_old == 0) {
-        return layout_error(loader->error, loader->size, "%s: at least one [[segments]] table is required", loader->source);
+        return layout_error(loader->error, loader->size, "%s: at least one [[segments]] table is required",
+                            loader->source);
     }
     old = arena_alloc(loader->arena, (size_t)n_old * sizeof *old);
     ends = arena_alloc(loader->arena, ((size_t)n_old + 1) * sizeof *ends);
@@ -872,7 +886,8 @@ static int nesting_errors(const char *text, size_t length, const char *source, c
     for (i = 0; i < length; i++) {
         if (text[i] == '[' || text[i] == '{') {
             if (++depth > ROTOR_LOADER_MAX_NESTING) {
-                return layout_error(error, size, "%s: brackets nest deeper than %d levels", source, ROTOR_LOADER_MAX_NESTING);
+                return layout_error(error, size, "%s: brackets nest deeper than %d levels", source,
+                                    ROTOR_LOADER_MAX_NESTING);
             }
         } else if ((text[i] == ']' || text[i] == '}') && depth > 0) {
             depth--;
@@ -954,7 +969,8 @@ int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error,
         }
     }
     if (shaft->D_inner >= shaft->D_outer) {
-        return layout_error(error, size, "D_inner (%g) must be smaller than D_outer (%g)", shaft->D_inner, shaft->D_outer);
+        return layout_error(error, size, "D_inner (%g) must be smaller than D_outer (%g)", shaft->D_inner,
+                            shaft->D_outer);
     }
     out->segments = malloc(sizeof *out->segments);
     out->masses = malloc(2 * sizeof *out->masses);

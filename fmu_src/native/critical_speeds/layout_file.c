@@ -180,7 +180,8 @@ static int read_regular_file(const char *path, char **data, size_t *length, char
     if (used > ROTOR_LOADER_MAX_FILE_BYTES) {
         free(*data);
         *data = NULL;
-        return layout_error(error, size, "driveline file %r is larger than %d bytes", path, ROTOR_LOADER_MAX_FILE_BYTES);
+        return layout_error(error, size, "driveline file %r is larger than %d bytes", path,
+                            ROTOR_LOADER_MAX_FILE_BYTES);
     }
     *length = used;
     return 0;

@@ -162,8 +162,10 @@ int hessenberg_eigenvalues(cplx *h, int n, cplx *lambda)
             mu = cplx_make(H(hi, hi).re + 0.75 * cplx_abs1(H(hi, hi - 1)), H(hi, hi).im);
         } else { /* the eigenvalue of the trailing 2 x 2 nearer its last diagonal entry */
             cplx a = H(hi - 1, hi - 1), b = H(hi - 1, hi), c = H(hi, hi - 1), d = H(hi, hi);
-            cplx p = cplx_scale(0.5, cplx_sub(a, d)), bc = cplx_mul(b, c), root = cplx_sqrt(cplx_add(cplx_mul(p, p), bc));
-            cplx plus = cplx_add(p, root), minus = cplx_sub(p, root), den = cplx_abs(plus) >= cplx_abs(minus) ? plus : minus;
+            cplx p = cplx_scale(0.5, cplx_sub(a, d)), bc = cplx_mul(b, c), root = cplx_sqrt(cplx_add(cplx_mul(p, p),
+                                                                                                     bc));
+            cplx plus = cplx_add(p, root), minus = cplx_sub(p,
+                                                            root), den = cplx_abs(plus) >= cplx_abs(minus) ? plus : minus;
             mu = cplx_is_zero(den) ? d : cplx_sub(d, cplx_div(bc, den));
         }
         cplx x = cplx_sub(H(lo, lo), mu), y = H(lo + 1, lo);
@@ -485,14 +487,16 @@ void mass_solve(const double *lu, const int *pivots, int n, cplx *x, int columns
         for (int i = 0; i < n; i++) {
             cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
             for (int k = 0; k < i; k++) {
-                sum = cplx_sub(sum, cplx_scale(lu[(size_t)i * (size_t)n + (size_t)k], x[(size_t)k * (size_t)stride + (size_t)c]));
+                sum = cplx_sub(sum, cplx_scale(lu[(size_t)i * (size_t)n + (size_t)k],
+                                               x[(size_t)k * (size_t)stride + (size_t)c]));
             }
             x[(size_t)i * (size_t)stride + (size_t)c] = sum;
         }
         for (int i = n - 1; i >= 0; i--) {
             cplx sum = x[(size_t)i * (size_t)stride + (size_t)c];
             for (int k = i + 1; k < n; k++) {
-                sum = cplx_sub(sum, cplx_scale(lu[(size_t)i * (size_t)n + (size_t)k], x[(size_t)k * (size_t)stride + (size_t)c]));
+                sum = cplx_sub(sum, cplx_scale(lu[(size_t)i * (size_t)n + (size_t)k],
+                                               x[(size_t)k * (size_t)stride + (size_t)c]));
             }
             x[(size_t)i * (size_t)stride + (size_t)c] = cplx_div_real(sum, lu[(size_t)i * (size_t)n + (size_t)i]);
         }

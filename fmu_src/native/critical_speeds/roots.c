@@ -130,7 +130,7 @@ static int refine(Search *st, double a, double b, double fa, double fb)
 }
 
 /* roots._scan for one sampled sequence: its zeros and sign changes, then its dips re-scanned on
- * sub-grids of ROTOR_ROOTS_SUBGRID steps (a dip that persists down to the root tolerance is a double root). */
+ * sub-grids of SUBGRID steps (a dip that persists down to the root tolerance is a double root). */
 static int scan(Search *st, const double *x, const double *fx, int n, int depth)
 {
     int i, j;
@@ -163,7 +163,7 @@ static int scan(Search *st, const double *x, const double *fx, int n, int depth)
         sx[0] = lo;
         sf[0] = fx[i - 1];
         for (j = 1; j < ROTOR_ROOTS_SUBGRID; j++) {
-            sx[j] = lo + (hi - lo) * (j * (1.0 / ROTOR_ROOTS_SUBGRID)); /* numpy.linspace(0, 1, ROTOR_ROOTS_SUBGRID + 1) */
+            sx[j] = lo + (hi - lo) * (j * (1.0 / ROTOR_ROOTS_SUBGRID)); /* numpy.linspace(0, 1, SUBGRID + 1) */
             sf[j] = line_f(st, sx[j]);
         }
         sx[ROTOR_ROOTS_SUBGRID] = hi;
@@ -201,7 +201,7 @@ static int find_roots(Search *st, const double *grid, int n)
     return status;
 }
 
-/* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with ROTOR_DRIVELINE_POINTS_PER_ROOT points per
+/* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with POINTS_PER_ROOT points per
  * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] 1e-4, x[0], 9)[:-1]). */
 static double *grid_new(const Chain *chain, double x_max, double ratio, int coarse, int *count, char *error,
                         size_t size)
@@ -573,7 +573,8 @@ int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, 
         }
     } else {
         Share *shares;
-        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD | WHIRL_BACKWARD, n + 1, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT,
+        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD | WHIRL_BACKWARD, n + 1, 0.0,
+                             ROTOR_DRIVELINE_SEARCH_LIMIT,
                              &found_list, &found_count, error, size)) {
             return -1;
         }

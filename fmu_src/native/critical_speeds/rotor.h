@@ -177,7 +177,7 @@ void cubic_spline_free(CubicSpline *spline);
 /* ---- campbell.c: model.whirl_table (campbell.whirl_branches + WhirlTable) ------------------ */
 typedef struct WhirlTable WhirlTable;
 /* The first ``n_modes`` forward and backward whirl frequencies over ``points`` equal speeds on
- * [0, omega_max], refined where a branch bends; missing values read as ROTOR_DRIVELINE_SEARCH_LIMIT. */
+ * [0, omega_max], refined where a branch bends; missing values read as SEARCH_LIMIT. */
 WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, char *error, size_t size);
 /* WhirlTable.__call__: forward_1..n, backward_1..n at ``speed`` */
 void whirl_table_evaluate(const WhirlTable *table, double speed, double *out);
