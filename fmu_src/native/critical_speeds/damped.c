@@ -12,15 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define OUT_OF_MEMORY "out of memory"
-
-static void set_error(char *error, size_t size, const char *message)
-{
-    if (error && size) {
-        snprintf(error, size, "%s", message);
-    }
-}
-
 /* ---- damped.DampedRotor ---------------------------------------------------------------------- */
 typedef struct {
     FeModel fe;                /* fem.assemble_damped's mesh and real K, M, G (bearings left out) */
@@ -206,7 +197,7 @@ out_of_memory:
     free(Ca);
     free(Cb);
     rotor_free(rotor);
-    set_error(error, size, OUT_OF_MEMORY);
+    ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
     return -1;
 }
 
@@ -370,7 +361,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
 {
     int m = rotor->size, order = 2 * m, cap = krylov->cap;
     if (!isfinite(spin)) {
-        set_error(error, size, "Array must not contain infs or NaNs");
+        ROTOR_ERROR(error, size, "Array must not contain infs or NaNs");
         return -1;
     }
     size_t cells = (size_t)rotor->band.rows * (size_t)m;
@@ -380,7 +371,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
         krylov->q[i] = cplx_add(rotor->banded[0][i], cplx_scale(ROTOR_DAMPED_SHIFT, krylov->coupling[i]));
     }
     if (band_factor(rotor->band, krylov->q, krylov->pivots)) {
-        set_error(error, size, "the damped model is singular at the Arnoldi shift");
+        ROTOR_ERROR(error, size, "the damped model is singular at the Arnoldi shift");
         return -1;
     }
     memset(krylov->hess, 0, ((size_t)cap + 1) * (size_t)cap * sizeof(cplx));
@@ -392,7 +383,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
         krylov_apply(rotor, krylov, krylov->basis + (size_t)steps * (size_t)order, w);
         double before = vector_norm(w, order);
         if (!isfinite(before)) {
-            set_error(error, size, "the Arnoldi iteration met infs or NaNs");
+            ROTOR_ERROR(error, size, "the Arnoldi iteration met infs or NaNs");
             return -1;
         }
         orthogonalize(krylov->basis, steps + 1, order, w, krylov->hess + steps, cap);
@@ -409,7 +400,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
         if (steps == order || steps == cap || steps >= next) {
             status = krylov_converged(krylov, steps, order, wanted < steps ? wanted : steps);
             if (status < 0) {
-                set_error(error, size, "Eigenvalues did not converge");
+                ROTOR_ERROR(error, size, "Eigenvalues did not converge");
                 return -1;
             }
             if (status == 0 && steps == cap) {
@@ -488,7 +479,7 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
         dense->index = malloc((size_t)cap * sizeof(int));
         if (!dense->lambda || !dense->modes || !dense->index || krylov_init(&dense->krylov, rotor)) {
             dense_free(dense);
-            set_error(error, size, OUT_OF_MEMORY);
+            ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
             return -1;
         }
         return 0;
@@ -516,7 +507,7 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
         free(l);
         free(pivots);
         dense_free(dense);
-        set_error(error, size, OUT_OF_MEMORY);
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     memcpy(l, rotor->fe.M, (size_t)n * (size_t)n * sizeof *l);
@@ -524,7 +515,7 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
         free(l);
         free(pivots);
         dense_free(dense);
-        set_error(error, size, "Singular matrix");
+        ROTOR_ERROR(error, size, "Singular matrix");
         return -1;
     }
     for (size_t i = 0; i < block; i++) {
@@ -562,7 +553,7 @@ static int dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char
     }
     for (size_t i = 0; i < (size_t)order * (size_t)order; i++) {
         if (!isfinite(a[i].re) || !isfinite(a[i].im)) { /* numpy.linalg's check */
-            set_error(error, size, "Array must not contain infs or NaNs");
+            ROTOR_ERROR(error, size, "Array must not contain infs or NaNs");
             return -1;
         }
     }
@@ -573,7 +564,7 @@ static int dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char
         memcpy(dense->saved, dense->h, (size_t)order * (size_t)order * sizeof(cplx));
     }
     if (hessenberg_eigenvalues(dense->h, order, dense->lambda)) {
-        set_error(error, size, "Eigenvalues did not converge");
+        ROTOR_ERROR(error, size, "Eigenvalues did not converge");
         return -1;
     }
     return 0;
@@ -760,7 +751,7 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
     if (!counts || !outputs) {
         free(counts);
         free(outputs);
-        set_error(error, size, OUT_OF_MEMORY);
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return NULL;
     }
     double spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS], table[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
@@ -797,7 +788,7 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
     if (!outputs->load || !outputs->row || !outputs->ab || !outputs->x || !outputs->pivots || !rows) {
         free(rows);
         unbalance_outputs_free(outputs);
-        set_error(error, size, OUT_OF_MEMORY);
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return NULL;
     }
     /* DampedRotor.load: the unbalances' phasors times their shape rows */
@@ -831,7 +822,7 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
                                       2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, table)) {
         memset(&outputs->modes, 0, sizeof outputs->modes);
         unbalance_outputs_free(outputs);
-        set_error(error, size, refused ? refused : OUT_OF_MEMORY);
+        ROTOR_ERROR(error, size, refused ? refused : ROTOR_OUT_OF_MEMORY);
         return NULL;
     }
     return outputs;

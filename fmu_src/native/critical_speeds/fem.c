@@ -10,15 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define OUT_OF_MEMORY "out of memory"
-
-static void set_error(char *error, size_t size, const char *message)
-{
-    if (error && size) {
-        snprintf(error, size, "%s", message);
-    }
-}
-
 /* fem.elements_by_length */
 void fe_elements_by_length(const Driveline *driveline, int most, int *counts)
 {
@@ -193,7 +184,7 @@ int fe_model_build(const Driveline *d, const int *counts, int with_bearings, FeM
     }
     for (int i = 0; with_bearings && i < d->n_bearings; i++) {
         if (d->bearings[i].kxx != d->bearings[i].kyy) { /* Bearing.fe_matrices */
-            set_error(error, size, "the finite-element check covers isotropic bearings only");
+            ROTOR_ERROR(error, size, "the finite-element check covers isotropic bearings only");
             return -1;
         }
     }
@@ -230,7 +221,7 @@ int fe_model_build(const Driveline *d, const int *counts, int with_bearings, FeM
     free(dofs);
     return 0;
 out_of_memory:
-    set_error(error, size, OUT_OF_MEMORY);
+    ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
     fe_model_free(model);
     free(fixed);
     free(segment);
@@ -434,7 +425,7 @@ static int generalized_eigenvalues(double *K, double *M, int n, double *values, 
 {
     int *first_nonzero = malloc((size_t)(n + 1) * sizeof *first_nonzero);
     if (!first_nonzero) {
-        set_error(error, size, OUT_OF_MEMORY);
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     int minor = cholesky(M, n, first_nonzero);
@@ -450,7 +441,7 @@ static int generalized_eigenvalues(double *K, double *M, int n, double *values, 
     double *work = malloc(3 * (size_t)(n + 1) * sizeof *work);
     if (!work) {
         free(first_nonzero);
-        set_error(error, size, OUT_OF_MEMORY);
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     reduce_to_standard(K, M, n, first_nonzero);
@@ -478,7 +469,7 @@ static int generalized_eigenvalues(double *K, double *M, int n, double *values, 
     }
     free(work);
     if (status) {
-        set_error(error, size, "the eigenvalue iteration did not converge");
+        ROTOR_ERROR(error, size, "the eigenvalue iteration did not converge");
         return -1;
     }
     qsort(values, (size_t)n, sizeof *values, ascending);
@@ -498,7 +489,7 @@ static int plane_frequencies(const Driveline *d, const int *counts, RotorBearing
     int n = model.n_kept;
     for (size_t i = 0; i < (size_t)n * (size_t)n; i++) {
         if (!isfinite(model.K[i]) || !isfinite(model.M[i])) { /* scipy.linalg.eigh's check_finite */
-            set_error(error, size, "array must not contain infs or NaNs");
+            ROTOR_ERROR(error, size, "array must not contain infs or NaNs");
             fe_model_free(&model);
             return -1;
         }
@@ -522,7 +513,7 @@ int fe_natural_frequencies(const Driveline *d, int elements, double **frequencie
     *frequencies = NULL;
     *count = 0;
     if (elements < 1) { /* ShaftSegment.fe_matrices: length / n_elements */
-        set_error(error, size, "float division by zero");
+        ROTOR_ERROR(error, size, "float division by zero");
         return ERROR_ZERO_DIVISION;
     }
     int n_bearings = d->n_bearings, planes = 1, total = 2 + d->n_hinges;
@@ -539,7 +530,7 @@ int fe_natural_frequencies(const Driveline *d, int elements, double **frequencie
         free(counts);
         free(plane);
         free(out);
-        set_error(error, size, OUT_OF_MEMORY);
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     for (int k = 0; k < d->n_segments; k++) {

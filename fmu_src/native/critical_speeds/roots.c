@@ -33,13 +33,6 @@ static void free_all(void *a, void *b, void *c)
     free(c);
 }
 
-static void set_error(char *error, size_t size, const char *text)
-{
-    if (error != NULL && size > 0) {
-        snprintf(error, size, "%s", text);
-    }
-}
-
 /* driveline._speed's message */
 static int speed_error(const char *name, double value, char *error, size_t size)
 {
@@ -64,7 +57,7 @@ static int found(Search *st, double x)
         int capacity = st->capacity ? 2 * st->capacity : 16;
         double *grown = realloc(st->x, (size_t)capacity * sizeof *grown);
         if (grown == NULL) {
-            set_error(st->error, st->size, "out of memory");
+            ROTOR_ERROR(st->error, st->size, ROTOR_OUT_OF_MEMORY);
             return -1;
         }
         st->x = grown;
@@ -125,7 +118,7 @@ static int refine(Search *st, double a, double b, double fa, double fb)
         t = t > tlim ? t : tlim;
         t = t < 1.0 - tlim ? t : 1.0 - tlim;
     }
-    set_error(st->error, st->size, "root refinement did not converge");
+    ROTOR_ERROR(st->error, st->size, "root refinement did not converge");
     return -1;
 }
 
@@ -187,7 +180,7 @@ static int find_roots(Search *st, const double *grid, int n)
     double *fx = malloc((size_t)n * sizeof *fx);
     int i, status;
     if (fx == NULL) {
-        set_error(st->error, st->size, "out of memory");
+        ROTOR_ERROR(st->error, st->size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     for (i = 0; i < n; i++) {
@@ -212,13 +205,13 @@ static double *grid_new(const Chain *chain, double x_max, double ratio, int coar
     theta_max = kappa * sqrt(x_max);
     steps = ceil(theta_max / FMU_PI * per_pi);
     if (!(steps < (double)(INT_MAX / 2))) {
-        set_error(error, size, "out of memory");
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return NULL;
     }
     n = steps > 8.0 ? (int)steps : 8;
     x = malloc((size_t)(ROTOR_DRIVELINE_LEAD_POINTS - 1 + n + 1) * sizeof *x);
     if (x == NULL) {
-        set_error(error, size, "out of memory");
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return NULL;
     }
     step = theta_max / n;
@@ -345,7 +338,7 @@ static int take(const RotorRoots *from, const unsigned char *keep, int n, RotorR
     to->count = 0;
     to->x = malloc((size_t)(from->count > 0 ? from->count : 1) * sizeof *to->x);
     if (to->x == NULL) {
-        set_error(error, size, "out of memory");
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     for (i = 0; i < from->count && (n == N_NONE || to->count < n); i++) {
@@ -373,7 +366,7 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
     }
     if (lines == NULL || first == NULL || found_roots == NULL) {
         free_all(lines, first, found_roots);
-        set_error(error, size, "out of memory");
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     for (c = 0; c < m; c++) {
@@ -401,7 +394,7 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
         } else {
             kinds = malloc((size_t)(2 * roots->count + 2));
             if (kinds == NULL) {
-                set_error(error, size, "out of memory");
+                ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
                 status = -1;
                 break;
             }
@@ -479,7 +472,7 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
     backward = malloc((size_t)n_orders * sizeof *backward);
     if (cases == NULL || forward == NULL || backward == NULL) {
         free_all(cases, forward, backward);
-        set_error(error, size, "out of memory");
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return -1;
     }
     for (k = 0; k < n_orders; k++) {
@@ -500,7 +493,7 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
         free(ranked);
         free(*out);
         *out = NULL;
-        set_error(error, size, "out of memory");
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         total = -1;
     }
     for (k = 0; k < n_orders && total >= 0; k++) {
@@ -581,7 +574,7 @@ int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, 
         shares = malloc((size_t)(found_count > 0 ? found_count : 1) * sizeof *shares);
         if (shares == NULL) {
             free(found_list);
-            set_error(error, size, "out of memory");
+            ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
             return -1;
         }
         for (i = 0; i < found_count; i++) {
