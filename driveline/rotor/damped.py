@@ -57,6 +57,9 @@ EXTRA_EIGENVALUES = 6
 DENSE_SIZE = 160
 #: Shift of the Arnoldi iteration [1/s]: off zero, where a free rotor has its rigid-body modes.
 SHIFT = -1.0
+#: Smallest whirl frequency of a mode, as a share of the largest eigenvalue: below it the mode is
+#: overdamped or static and whirls not.
+WHIRL_SHARE = 1e-9
 
 
 
@@ -265,7 +268,7 @@ class DampedRotor:
             lam = SHIFT + 1.0 / nu
         if self.conservative:
             lam = 1j * lam.imag
-        whirling = np.isfinite(lam) & (np.abs(lam.imag) > 1e-9 * np.max(np.abs(lam)))  # not overdamped or static
+        whirling = np.isfinite(lam) & (np.abs(lam.imag) > WHIRL_SHARE * np.max(np.abs(lam)))  # not overdamped or static
         if not self.doubled:  # u = p exp(lam t): Im lam < 0 whirls backward
             out = [DampedMode(complex(v.real, abs(v.imag)), float(v.imag > 0)) for v in lam[whirling]]
         else:  # each mode also appears conjugated, at -w_d

@@ -30,6 +30,8 @@ SEARCH_LIMIT = 1.0e5
 GRID_OFFSET = 0.6180339887498949
 #: Points of the logarithmic lead-in below the scan's first point (the last of them is that point).
 LEAD_POINTS = 9
+#: How far below the scan's first point the lead-in starts (a ratio of squared frequencies).
+LEAD_RATIO = 1e-4
 #: Points per segment of the mode shape whose forward fraction tells a whirl's direction.
 DIRECTION_POINTS = 4
 
@@ -229,7 +231,7 @@ class Driveline:
         theta = (np.arange(n) + GRID_OFFSET) * (theta_max / n)
         theta = np.append(theta, theta_max)  # the scan must reach x_max itself
         x = (theta / kappa) ** 2
-        lead = np.geomspace(x[0] * 1e-4, x[0], LEAD_POINTS)[:-1]
+        lead = np.geomspace(x[0] * LEAD_RATIO, x[0], LEAD_POINTS)[:-1]
         return np.concatenate([lead, x])
 
     def _line_roots(

@@ -19,14 +19,14 @@ import re
 #: Python module -> the names of its constants that the C port uses.
 SHARED = {
     "driveline.rotor.driveline": ("SEARCH_LIMIT", "EXCITED_SHARE", "POINTS_PER_ROOT", "GRID_OFFSET", "LEAD_POINTS",
-                                  "DIRECTION_POINTS"),
+                                  "DIRECTION_POINTS", "LEAD_RATIO"),
     "driveline.rotor.loader": ("MAX_FILE_BYTES", "MAX_NESTING", "MAX_SEGMENTS", "MAX_POINT_ELEMENTS", "NODE_SNAP"),
     "driveline.rotor.elements": ("_SERIES_LIMIT",),
     "driveline.rotor.transfer": ("MAX_PIECE_PHASE", "LOG_SCALE_CLIP"),
     "driveline.rotor.fem": ("SHARE_SLACK",),
     "driveline.rotor.roots": ("SUBGRID", "MAX_DEPTH", "DIP_RATIO", "MAX_ITERATIONS", "XTOL", "RTOL"),
     "driveline.rotor.campbell": ("SLOPE_STEP", "SPLINE_RTOL", "REFINEMENTS", "MAX_KNOTS", "NOISE"),
-    "driveline.rotor.damped": ("EXTRA_EIGENVALUES", "DENSE_SIZE", "SHIFT"),
+    "driveline.rotor.damped": ("EXTRA_EIGENVALUES", "DENSE_SIZE", "SHIFT", "WHIRL_SHARE"),
     "driveline.rotor.unbalance_outputs": ("FE_ELEMENTS", "TABLE_ELEMENTS", "DAMPING_POINTS", "DAMPED_MODES"),
     "driveline.rotor.work": ("MAX_ANALYSIS_SECONDS", "RATE_SEARCH", "RATE_DENSE", "RATE_BANDED"),
     "driveline.rotor.model": ("MAX_ORDERS", "MAX_ORDER", "MAX_SEARCHED_MODES", "FE_ELEMENTS", "PLAUSIBLE_DEVIATION",

@@ -605,7 +605,7 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
     int kept = 0;
     for (int k = 0; k < count; k++) {
         cplx value = dense->lambda[index[k]];
-        if (!isfinite(value.re) || !isfinite(value.im) || !(fabs(value.im) > 1e-9 * largest)) {
+        if (!isfinite(value.re) || !isfinite(value.im) || !(fabs(value.im) > ROTOR_DAMPED_WHIRL_SHARE * largest)) {
             continue;
         }
         Mode *mode = &dense->modes[kept];

@@ -195,7 +195,7 @@ static int find_roots(Search *st, const double *grid, int n)
 }
 
 /* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with POINTS_PER_ROOT points per
- * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] 1e-4, x[0], 9)[:-1]). */
+ * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] LEAD_RATIO, x[0], LEAD_POINTS)[:-1]). */
 static double *grid_new(const Chain *chain, double x_max, double ratio, int coarse, int *count, char *error,
                         size_t size)
 {
@@ -220,7 +220,7 @@ static double *grid_new(const Chain *chain, double x_max, double ratio, int coar
         x[ROTOR_DRIVELINE_LEAD_POINTS - 1 + i] = t * t;
     }
     x[ROTOR_DRIVELINE_LEAD_POINTS - 1 + n] = (theta_max / kappa) * (theta_max / kappa);
-    x[0] = x[ROTOR_DRIVELINE_LEAD_POINTS - 1] * 1e-4;
+    x[0] = x[ROTOR_DRIVELINE_LEAD_POINTS - 1] * ROTOR_DRIVELINE_LEAD_RATIO;
     log_start = log10(x[0]);
     log_stop = log10(x[ROTOR_DRIVELINE_LEAD_POINTS - 1]);
     for (i = 1; i < ROTOR_DRIVELINE_LEAD_POINTS - 1; i++) {
