@@ -74,6 +74,14 @@ CASES = {"a_uniform": uniform_shaft, "b_tube": tube_propshaft, "b_tube_shear": t
          "c_two_piece": two_piece_propshaft}
 
 
+@pytest.fixture(scope="module", autouse=True)
+def ross_started() -> None:
+    """ROSS's first damped modal analysis in a process costs about 9 s of CPU of its own
+    start-up (the second about 0.5 s): paid once per module here, so that each test's measured
+    cost, which counts its module's fixtures, is what running it alone costs."""
+    ross_damped_modes(FORCED["anisotropic_cross_coupled"](), 600.0)
+
+
 @pytest.fixture(scope="module")
 def ross_cs():
     """ROSS critical speeds per case, computed at most once per module."""
