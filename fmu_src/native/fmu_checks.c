@@ -151,28 +151,29 @@ static void relation_errors(const ModelData *data, int inputs, Messages *out)
 #endif
 }
 
-void parameter_errors(const ModelData *data, Messages *out)
+/* The checks of one causality in the core's order: bounds, then relations, then the model's own
+ * (each only if the ones before found nothing). */
+static void causality_errors(const ModelData *data, Causality causality, int inputs,
+                             void (*extra)(const ModelData *, Messages *), Messages *out)
 {
     int before = out->count;
-    range_errors(data, CAUSALITY_PARAMETER, out);
+    range_errors(data, causality, out);
     if (out->count == before) {
-        relation_errors(data, 0, out);
+        relation_errors(data, inputs, out);
     }
-    if (out->count == before && model_hooks.extra_parameter_errors != NULL) {
-        model_hooks.extra_parameter_errors(data, out);
+    if (out->count == before && extra != NULL) {
+        extra(data, out);
     }
+}
+
+void parameter_errors(const ModelData *data, Messages *out)
+{
+    causality_errors(data, CAUSALITY_PARAMETER, 0, model_hooks.extra_parameter_errors, out);
 }
 
 void input_errors(const ModelData *data, Messages *out)
 {
-    int before = out->count;
-    range_errors(data, CAUSALITY_INPUT, out);
-    if (out->count == before) {
-        relation_errors(data, 1, out);
-    }
-    if (out->count == before && model_hooks.extra_input_errors != NULL) {
-        model_hooks.extra_input_errors(data, out);
-    }
+    causality_errors(data, CAUSALITY_INPUT, 1, model_hooks.extra_input_errors, out);
 }
 
 typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_FAILED } SumOutcome;
