@@ -34,8 +34,10 @@ SPEC = ModelSpec(
         Variable("k_bearing", "parameter", 1e7, f"{STRUCTURE}: stiffness of the bearing at each end", "N/m",
                  min=0.0, min_exclusive=True, variability="tunable"),
         Variable("c_bearing", "parameter", 500.0, f"{STRUCTURE}: damping of the bearing at each end (the "
-                 "unbalance response and damping_ratio; the critical speeds are those of the undamped shaft)",
-                 "N.s/m", min=0.0, variability="tunable"),
+                 "unbalance response and damping_ratio; the critical speeds are those of the undamped shaft; "
+                 "at most 1e9 N.s/m, far beyond any bearing or squeeze-film damper: the damped eigenproblem "
+                 "of 1e300 spans more than double precision)",
+                 "N.s/m", min=0.0, max=1e9, variability="tunable"),
         Variable("shear", "parameter", True, f"{STRUCTURE}: shear deformation of the tube (Timoshenko beam, "
                  "Cowper's coefficient); false: Rayleigh beam", type="Boolean", variability="tunable"),
         Variable("unbalance", "parameter", 1e-4, "Unbalance of the one-piece tube (mass x eccentricity; a "
