@@ -1,7 +1,7 @@
 """The bound on one CriticalSpeeds analysis: every stage on the worst inputs the limits allow.
 
 ``python -m benchmarks.analysis_work [NATIVE_FMU]`` (default ``models/native/CriticalSpeeds.fmu``, built by
-``python build_fmu.py``): the cases of :mod:`fmu_harness.analysis_work`, each in a process of its own
+``python build_fmu.py``): the cases of :mod:`fmu_harness.checks.analysis_work`, each in a process of its own
 under a limit of CPU time and address space, the Python analysis stage by stage and the native FMU's
 whole analysis; prints the table and exits 1 if an accepted case exceeds its budget (Python 30 s and
 2 GB, native 5 s and 500 MB) or the issue's layout is accepted.
@@ -14,7 +14,7 @@ import tempfile
 from pathlib import Path
 
 from benchmarks.timing import machine
-from fmu_harness.analysis_work import NATIVE_BUDGET, PYTHON_BUDGET, measure, table
+from fmu_harness.checks.analysis_work import NATIVE_BUDGET, PYTHON_BUDGET, measure, table
 
 
 def over_budget(results: dict[str, dict]) -> list[str]:

@@ -33,9 +33,9 @@ from driveline.rotor import (
     one_piece_shaft,
 )
 from driveline.rotor.model import analyse, analyse_structure, resonances, whirl_table
-from fmu_harness.build import build as build_fmu
-from fmu_harness.build import native
-from fmu_harness.runner import FmuInstance
+from fmu_harness.packaging import build as build_fmu
+from fmu_harness.packaging import native
+from fmu_harness.runs.runner import FmuInstance
 
 ORDERS, OMEGA_MAX = (1, 2, 3), 1500.0
 MODEL = "CriticalSpeeds"

@@ -2,7 +2,7 @@
 
 Each twin has its model's variables (same names, ranges, start values, so the same generic
 validation and FMI traffic) and does no physics: every output takes the first input's
-value. Shipped inside the twin FMUs; the benchmark builds them with :func:`fmu_harness.build.build`.
+value. Shipped inside the twin FMUs; the benchmark builds them with :func:`fmu_harness.packaging.build`.
 """
 
 from __future__ import annotations

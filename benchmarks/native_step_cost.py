@@ -22,7 +22,7 @@ from fmpy import extract, read_model_description
 from benchmarks.step_cost import VARIANTS, Stepper, best_alternating
 from benchmarks.timing import machine
 from driveline.catalog import MODELS
-from fmu_harness.build import build, native, toolchain
+from fmu_harness.packaging import build, native, toolchain
 
 HERE = Path(__file__).resolve().parent
 C_STEPS, C_ROUNDS = 200_000, 7

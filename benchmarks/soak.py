@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from benchmarks.timing import machine, resident_set_bytes
-from fmu_harness.runner import FmuInstance
+from fmu_harness.runs.runner import FmuInstance
 
 WARM_UP = 10_000
 

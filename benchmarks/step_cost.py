@@ -3,9 +3,9 @@ cost against the plain batched fmpy loop.
 
 ``python -m benchmarks.step_cost``: for each catalog model and FMI version, the FMU and a twin
 with the same variables but no physics (:mod:`minimal_models`) are built with
-:func:`fmu_harness.build.build`; both are stepped through fmpy's low-level API (set the Real inputs, doStep,
+:func:`fmu_harness.packaging.build`; both are stepped through fmpy's low-level API (set the Real inputs, doStep,
 get the Real outputs, each one batched call) at their default inputs. The FMU is also stepped
-by :meth:`fmu_harness.runner.FmuInstance.run` for the same Real outputs, with the inputs given
+by :meth:`fmu_harness.runs.runner.FmuInstance.run` for the same Real outputs, with the inputs given
 as constants (set once) and as functions of time (sampled and set at every step). All run in
 alternating rounds within one run; the best round of each gives microseconds per step, in
 CPU time of this process (the FMUs run inside it), which other work on the machine disturbs
@@ -21,8 +21,8 @@ from pathlib import Path
 from benchmarks import minimal_models
 from benchmarks.timing import machine
 from driveline.catalog import MODELS
-from fmu_harness.build import build
-from fmu_harness.runner import Fmi3Instance, FmuInstance
+from fmu_harness.packaging import build
+from fmu_harness.runs.runner import Fmi3Instance, FmuInstance
 
 STEPS, ROUNDS = 2000, 7
 VARIANTS = {"TripodCoupling": {"closed form": {"kinematics": 0}, "exact": {"kinematics": 1}}}

@@ -2,7 +2,7 @@
 
 Usage: ``python -m benchmarks.sweep_scaling [--fmu models/TripodCoupling.fmu] [--repeat 3]``
 after ``python build_fmu.py``. Not part of the test suite. Each measurement starts a fresh
-cluster first and times :func:`fmu_harness.sweep.sweep` from shipping the FMU to the finished
+cluster first and times :func:`fmu_harness.runs.sweep.sweep` from shipping the FMU to the finished
 table (so each worker's first extraction and imports count); the best of ``--repeat``
 alternating measurements is printed, which damps the noise of other load on the machine.
 """
@@ -13,7 +13,7 @@ import argparse
 import time
 from pathlib import Path
 
-from fmu_harness.sweep import Timing, grid, open_client, sweep
+from fmu_harness.runs.sweep import Timing, grid, open_client, sweep
 
 AXES = {
     "beta": [0.05 * k for k in range(1, 13)],

@@ -16,7 +16,7 @@ import numpy as np
 
 from benchmarks.timing import best_of, machine
 from driveline.tripod.outputs import coupling_outputs
-from fmu_harness.runner import FmuInstance
+from fmu_harness.runs.runner import FmuInstance
 
 OMEGA, T_LOAD, R, L, M = 2000 * math.pi / 30, 100.0, 0.026, 0.700, 0.2
 BETAS = np.radians(np.linspace(1.0, 45.0, 10))

@@ -12,10 +12,10 @@ import importlib
 import sys
 
 COMMANDS = {
-    "build": ("fmu_harness.build.command", "build the FMUs (FMI 2.0 and 3.0), their reference results and the SSP system"),
+    "build": ("fmu_harness.build_command", "build the FMUs (FMI 2.0 and 3.0), their reference results and the SSP system"),
     "run": ("fmu_harness.main", "the main job: simulate the FMUs, write CSV files and figures"),
-    "sweep": ("fmu_harness.sweep", "a parameter sweep of one FMU on Dask"),
-    "interop": ("fmu_harness.interop", "every FMU in every importer: the interoperability matrix"),
+    "sweep": ("fmu_harness.runs.sweep", "a parameter sweep of one FMU on Dask"),
+    "interop": ("fmu_harness.checks.interop", "every FMU in every importer: the interoperability matrix"),
 }
 
 

@@ -2,7 +2,7 @@
 
 Usage: ``python -m fmu_harness.main [--models models] [--out results]`` after
 ``python build_fmu.py``. The studies run the native FMUs (``models/native/``); the Python FMUs
-are compared with them in a process of their own (:mod:`fmu_harness.python_fmu_check`), so that
+are compared with them in a process of their own (:mod:`fmu_harness.checks.python_fmu_check`), so that
 the pythonfmu wrapper's exit-time defect cannot end the main job.
 """
 
@@ -11,8 +11,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from . import coupling_comparison, critical_speed_study, python_fmu_check, tripod_study
-from .build import native
+from .checks import python_fmu_check
+from .packaging import native
+from .studies import coupling_comparison, critical_speed_study, tripod_study
 
 
 def simulate(models: Path, out: Path) -> list[Path]:

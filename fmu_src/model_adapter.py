@@ -25,8 +25,10 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any, Callable, ClassVar
 
-from driveline import __version__, saved_state
+from driveline import __version__
 from driveline.model import SteppedModel
+
+from . import saved_state
 
 #: Kinds of value per getter/setter name of both FMI versions.
 _KIND_OF = {"real": "Real", "float64": "Real", "integer": "Integer", "int32": "Integer",
@@ -312,7 +314,7 @@ class ModelAdapter:
 
     @classmethod
     def _fmu_state_to_bytes(cls, state: Any) -> bytes:
-        """Plain values, versioned and checksummed (:mod:`driveline.saved_state`); no pickle."""
+        """Plain values, versioned and checksummed (:mod:`fmu_src.saved_state`); no pickle."""
         try:
             model = cls.model_class()
             adapter = {"start_time": state.start_time, "stepped": state.stepped, "phase": state.phase.value}

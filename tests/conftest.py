@@ -5,8 +5,8 @@ folder: FMI 2.0 in it, FMI 3.0 in its ``fmi3/``. Markers are assigned here, from
 uses, so that test files carry none:
 
 * ``fmu``: the test uses a built FMU, Python or native (a fixture of this file);
-* ``importers``: its module drives the external importers (imports ``fmu_harness.importers``
-  or ``fmu_harness.interop``: libcosim, Ecos, fmutool);
+* ``importers``: its module drives the external importers (imports ``fmu_harness.checks.importers``
+  or ``fmu_harness.checks.interop``: libcosim, Ecos, fmutool);
 * ``core``: neither, the FMI-free core and tools;
 * ``slow``: measured at :data:`SLOW_SECONDS` of CPU time or more in ``tests/durations.json``
   (:func:`pytest_runtest_call`: the test's call and fixtures, with the subprocesses they waited
@@ -39,14 +39,14 @@ import pytest
 from fmpy import extract
 
 from driveline.catalog import MODELS
-from fmu_harness import build
-from fmu_harness.build import native, toolchain
-from fmu_harness.runner import FmuInstance
+from fmu_harness import packaging
+from fmu_harness.packaging import native, toolchain
+from fmu_harness.runs.runner import FmuInstance
 
 FmuPath = Callable[..., Path]
 
 FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir"}
-IMPORTER_MODULES = ("fmu_harness.importers", "fmu_harness.interop")
+IMPORTER_MODULES = ("fmu_harness.checks.importers", "fmu_harness.checks.interop")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
 DURATIONS = Path(__file__).with_name("durations.json")
@@ -60,7 +60,7 @@ QUICK_VERSIONS = ["2"]
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
-    parser.addoption("--fmi", action="append", choices=sorted(build.FMI_VERSIONS),
+    parser.addoption("--fmi", action="append", choices=sorted(packaging.FMI_VERSIONS),
                      help="FMI version to build and test (repeat for several; default: all)")
     parser.addoption("--quick", action="store_true",
                      help='the quick run: -m "not slow and not importers" --fmi 2, slow-only modules not imported')
@@ -82,7 +82,7 @@ def slow_modules(durations: dict[str, float]) -> set[str]:
 
 
 def selected_versions(config: pytest.Config) -> list[str]:
-    return config.getoption("fmi") or (QUICK_VERSIONS if config.getoption("quick") else list(build.FMI_VERSIONS))
+    return config.getoption("fmi") or (QUICK_VERSIONS if config.getoption("quick") else list(packaging.FMI_VERSIONS))
 
 
 def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
@@ -108,9 +108,9 @@ def fmu_path(fmu_store: Path, pytestconfig: pytest.Config) -> FmuPath:
     def path(name: str, version: str = "2") -> Path:
         if version not in versions:
             pytest.skip(f"FMI {version}.0 is not among the selected versions (--fmi)")
-        built = build.fmu_path(fmu_store, name, version)
+        built = packaging.fmu_path(fmu_store, name, version)
         if not built.exists():
-            build.build(name, fmu_store, version)
+            packaging.build(name, fmu_store, version)
         return built
 
     return path

@@ -19,9 +19,9 @@ from pathlib import Path
 from driveline.rotor import Driveline
 from driveline.rotor.elements import Hinge
 
-from fmu_harness.build import native, toolchain
-from fmu_harness.build.native_constants import HEADER as CONSTANTS_HEADER
-from fmu_harness.build.native_constants import constants_header
+from fmu_harness.packaging import native, toolchain
+from fmu_harness.packaging.native_constants import HEADER as CONSTANTS_HEADER
+from fmu_harness.packaging.native_constants import constants_header
 
 ROTOR_SOURCES = native.NATIVE_SRC / "critical_speeds"
 TEST_FLAGS = (*(flag for flag in toolchain.CFLAGS if not flag.startswith("-fvisibility")), "-fPIC")

@@ -12,9 +12,9 @@ from benchmarks.analysis_work import over_budget
 from driveline.rotor.loader import example_path, load_driveline, loads_driveline
 from driveline.rotor.model import CAMPBELL_POINTS, FE_ELEMENTS, CriticalSpeedsModel
 from driveline.rotor.work import MAX_ANALYSIS_SECONDS, estimate
-from fmu_harness.analysis_work import layout_text, measure, worst_cases
-from fmu_harness.build import native
-from fmu_harness.runner import FmuInstance, StepRefused
+from fmu_harness.checks.analysis_work import layout_text, measure, worst_cases
+from fmu_harness.packaging import native
+from fmu_harness.runs.runner import FmuInstance, StepRefused
 
 ISSUE_LAYOUT = layout_text(100, 1.4, 202, 202, 200)  # every loader limit kept; once 566 s native, 16 GB Python
 
@@ -47,7 +47,7 @@ def test_the_issues_layout_is_refused_at_initialisation_by_both_cores_alike(nati
 
 
 def test_the_worst_inputs_the_limits_allow_stay_within_the_budgets(native_dir, tmp_path):
-    """Every worst case of fmu_harness.analysis_work (most stations of every kind, most segments,
+    """Every worst case of fmu_harness.checks.analysis_work (most stations of every kind, most segments,
     shortest segments, stations between nodes, most and highest orders, smallest and largest
     omega_max): each Python stage within 30 s and 2 GB, the native analysis within 5 s and 500 MB,
     each in a process under a limit of time and address space; the issue's layout refused."""

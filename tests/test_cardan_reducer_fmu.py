@@ -9,7 +9,7 @@ import pytest
 
 from driveline.cardan import kinematics
 from driveline.reducer.mechanics import transmission_ratio
-from fmu_harness.runner import StepRefused, simulate
+from fmu_harness.runs.runner import StepRefused, simulate
 
 
 @pytest.mark.parametrize("beta_deg", [0.0, 10.0, 30.0, 44.0])

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from driveline.cardan.kinematics import speed_fluctuation
-from fmu_harness import coupling_comparison as comparison
+from fmu_harness.studies import coupling_comparison as comparison
 
 
 def test_fluctuation_and_dominant_order_of_each_coupling(fmu_dir):

@@ -13,7 +13,7 @@ from driveline.rotor.driveline import EXCITED_SHARE
 from driveline.rotor.fem import elements_by_length
 from driveline.rotor.model import CriticalSpeedsModel
 from driveline.rotor.unbalance_outputs import DAMPED_MODES, DAMPING_POINTS, FE_ELEMENTS, TABLE_ELEMENTS
-from fmu_harness.runner import FmuInstance, StepRefused, simulate
+from fmu_harness.runs.runner import FmuInstance, StepRefused, simulate
 
 import model_checks
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 from fmpy import read_model_description
 
-from fmu_harness import crosscheck
-from fmu_harness.build import native
+from fmu_harness.checks import crosscheck
+from fmu_harness.packaging import native
 
 
 def test_rerun_from_the_reference_files_matches(model_name, fmi, fmu_path, tmp_path):

@@ -12,7 +12,7 @@ from fmpy import simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from driveline.catalog import MODELS
-from fmu_harness.scenario import scenario, standard_run
+from fmu_harness.runs.scenario import scenario, standard_run
 
 
 def test_fmi2_and_fmi3_give_identical_outputs(model_name, open_fmu):

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from driveline.catalog import MODELS
 from driveline.model import SteppedModel
 from driveline.variables import Variable
-from fmu_harness.runner import FmuInstance, StepRefused
+from fmu_harness.runs.runner import FmuInstance, StepRefused
 
 INT32 = (-(2**31), 2**31 - 1)
 NON_FINITE = (math.nan, math.inf, -math.inf)

@@ -8,7 +8,7 @@ import pytest
 from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
-from fmu_harness.runner import FmuInstance, StepRefused
+from fmu_harness.runs.runner import FmuInstance, StepRefused
 
 INPUTS = [(name, v.name) for name, model in MODELS.items() for v in model.spec.of("input") if v.type == "Real"]
 PARAMETERS = [(name, v.name) for name, model in MODELS.items() for v in model.spec.of("parameter") if v.type == "Real"]

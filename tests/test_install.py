@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 from driveline.catalog import MODELS
-from fmu_harness.build import command, fmu_path, native, toolchain
+from fmu_harness import build_command
+from fmu_harness.packaging import fmu_path, native, toolchain
 
 ROOT = Path(__file__).resolve().parents[1]
 PROJECT = ("pyproject.toml", "README.md", "LICENSE", "driveline", "fmu_src", "fmu_harness", "docs")
@@ -90,7 +91,7 @@ def _no_compiler(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def test_without_a_compiler_the_python_fmus_and_system_are_built(tmp_path, monkeypatch, capsys):
     _no_compiler(monkeypatch)
-    command.main(["--dest", str(tmp_path), "--fmi", "2", "--no-references"])
+    build_command.main(["--dest", str(tmp_path), "--fmi", "2", "--no-references"])
     errors = capsys.readouterr().err.splitlines()
     assert errors[0] == f"native FMUs not built: {toolchain.NO_COMPILER}" and "pip install ziglang" in errors[0]
     assert len(errors) == 1
@@ -101,7 +102,7 @@ def test_without_a_compiler_the_python_fmus_and_system_are_built(tmp_path, monke
 def test_without_a_compiler_asking_for_native_fmus_fails(tmp_path, monkeypatch, capsys):
     _no_compiler(monkeypatch)
     with pytest.raises(SystemExit) as stopped:
-        command.main(["--dest", str(tmp_path), "--fmi", "2", "--no-references", "--native", "SpeedSource"])
+        build_command.main(["--dest", str(tmp_path), "--fmi", "2", "--no-references", "--native", "SpeedSource"])
     assert stopped.value.code == 1
     assert "pip install ziglang" in capsys.readouterr().err
     assert set(tmp_path.rglob("*.fmu")) == {fmu_path(tmp_path, "SpeedSource")}

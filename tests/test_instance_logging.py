@@ -3,7 +3,7 @@
 fmpy formats FMI 2.0 messages in a native proxy that forwards them to the Python logger
 registered last, so with plain fmpy every message of every FMI 2.0 instance reaches the
 instance created last; the harness gives each instance its own callbacks and routes by the
-``componentEnvironment`` the FMU passes back (``fmu_harness.runner.Fmi2LogRouter``). FMI 3.0
+``componentEnvironment`` the FMU passes back (``fmu_harness.runs.runner.Fmi2LogRouter``). FMI 3.0
 passes each instance its own callback; both versions are checked.
 """
 
@@ -13,8 +13,8 @@ import math
 
 import pytest
 
-from fmu_harness import coupling_comparison
-from fmu_harness.runner import StepRefused
+from fmu_harness.studies import coupling_comparison
+from fmu_harness.runs.runner import StepRefused
 
 TOO_BENT = 1.5  # rad: beyond beta_max of CardanJoint (45 deg) and TripodCoupling (at most 60 deg)
 

@@ -1,5 +1,5 @@
 """Every FMU, Python and native, in the real importers (fmpy validate, fmutool -check, libcosimpy,
-ecospy) through ``fmu_harness.interop``, and the interoperability page's matrix matches what they
+ecospy) through ``fmu_harness.checks.interop``, and the interoperability page's matrix matches what they
 give here."""
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from driveline.catalog import MODELS
-from fmu_harness import interop
-from fmu_harness.build import native
-from fmu_harness.doc_sections import section
+from fmu_harness.checks import interop
+from fmu_harness.packaging import native
+from fmu_harness.doc_pages.sections import section
 
 PAGE = Path(__file__).resolve().parents[1] / "docs" / "interoperability.md"
 
@@ -41,5 +41,5 @@ def test_every_fmu_passes_every_importer_that_supports_its_fmi_version(matrix):
 
 def test_docs_hold_the_generated_matrix(matrix):
     assert section(PAGE, "interop") == interop.markdown(matrix), (
-        "regenerate: python -m fmu_harness.interop --update docs/interoperability.md"
+        "regenerate: python -m fmu_harness.checks.interop --update docs/interoperability.md"
     )

@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from driveline.catalog import MODELS
-from fmu_harness import critical_speed_study, python_fmu_check
-from fmu_harness.build import native
+from fmu_harness.checks import python_fmu_check
+from fmu_harness.studies import critical_speed_study
+from fmu_harness.packaging import native
 
 FIRST_COLUMNS = {"time [s]", "beta [deg]", "mode [1]"}  # time, the swept bend angle, the mode number
 HEADED = re.compile(r"^\w+( \w+)* \[[^\]]+\]$")  # name [unit]

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from fmu_harness.build import native
+from fmu_harness.packaging import native
 
 CHECK_SOURCE = Path(__file__).with_name("native_complex_check.c")
 REFERENCE = platform.system() == "Linux" and platform.machine() == "x86_64" and platform.libc_ver()[0] == "glibc"

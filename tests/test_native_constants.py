@@ -1,5 +1,5 @@
 """The constants both cores use exist once, in the Python modules: the native build writes them into
-``driveline_constants.h`` (fmu_harness/build/native_constants.py), and no C file of
+``driveline_constants.h`` (fmu_harness/packaging/native_constants.py), and no C file of
 ``fmu_src/native`` defines one of them itself, by its name or by its value."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import math
 import re
 import sys
 
-from fmu_harness.build import native
-from fmu_harness.build.native_constants import SHARED, constants_header, shared_constants
+from fmu_harness.packaging import native
+from fmu_harness.packaging.native_constants import SHARED, constants_header, shared_constants
 
 DEFINE = re.compile(r"^[ \t]*#[ \t]*define[ \t]+(\w+)[ \t]+(.+?)[ \t]*(?:/\*.*)?$", re.MULTILINE)
 STATIC_CONST = re.compile(r"\bstatic\s+const\s+(?:unsigned\s+|signed\s+)?(?:double|float|int|long|size_t)\s+(\w+)\s*=\s*([^;{]+);")

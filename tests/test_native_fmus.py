@@ -23,10 +23,10 @@ import test_cardan_reducer_fmu as reducer_and_cardan
 import test_fmu_behaviour as behaviour
 import test_fmus_common as common
 from driveline.catalog import MODELS
-from fmu_harness import interop
-from fmu_harness.build import native, toolchain
-from fmu_harness.runner import FmuInstance, StepRefused
-from fmu_harness.scenario import scenario
+from fmu_harness.checks import interop
+from fmu_harness.packaging import native, toolchain
+from fmu_harness.runs.runner import FmuInstance, StepRefused
+from fmu_harness.runs.scenario import scenario
 from test_fmu_properties import Run, _runs, expect_refused_parameters, run_alongside_the_core
 
 NATIVE = native.native_models()

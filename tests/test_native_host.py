@@ -14,9 +14,9 @@ import pytest
 from fmpy import extract, read_model_description
 
 from driveline.catalog import MODELS
-from fmu_harness.build import native, toolchain
-from fmu_harness.runner import FmuInstance
-from fmu_harness.scenario import scenario
+from fmu_harness.packaging import native, toolchain
+from fmu_harness.runs.runner import FmuInstance
+from fmu_harness.runs.scenario import scenario
 
 HOST_SOURCE = Path(__file__).with_name("native_host.c")
 VALGRIND = ("valgrind", "--error-exitcode=99", "--leak-check=full", "--show-leak-kinds=definite,indirect,possible",

@@ -1,5 +1,5 @@
 """The native FMUs as released, a binary for each of five platforms, built once per session with
-zig (:mod:`fmu_harness.build.toolchain`): the Linux binaries need glibc 2.17 at most; the Windows
+zig (:mod:`fmu_harness.packaging.toolchain`): the Linux binaries need glibc 2.17 at most; the Windows
 binaries run under wine and the aarch64 Linux ones under qemu-aarch64, through builds of
 ``tests/native_host.c`` for those platforms, and reproduce the x86_64 Linux binary's outputs on the
 standard scenarios; the macOS binaries, which cannot run here, are checked structurally (lief)."""
@@ -17,7 +17,7 @@ import pytest
 from fmpy.validation import validate_fmu
 from test_native_host import HOST_SOURCE, RUNS, TOLERANCES, _host_command
 
-from fmu_harness.build import native, toolchain
+from fmu_harness.packaging import native, toolchain
 
 lief = pytest.importorskip("lief", reason="the binaries' structural checks need lief (pip install lief)")
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 
-from fmu_harness.build import native, toolchain
+from fmu_harness.packaging import native, toolchain
 
 MODELS = ("CardanJoint", "SpeedSource")
 

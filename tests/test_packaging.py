@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from fmu_harness import cli
-from fmu_harness.build import FMI_VERSIONS, fmu_path, native
+from fmu_harness.packaging import FMI_VERSIONS, fmu_path, native
 
 from conftest import SLOW_SECONDS, measured
 

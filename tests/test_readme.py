@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 
 from driveline.catalog import MODELS
-from fmu_harness import system
-from fmu_harness.doc_sections import model_page, replace_section, section
-from fmu_harness.variable_table import markdown
+from fmu_harness.runs import system
+from fmu_harness.doc_pages.sections import model_page, replace_section, section
+from fmu_harness.doc_pages.variable_table import markdown
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
@@ -22,7 +22,7 @@ PAGES = sorted((ROOT / "docs").glob("*.md"))
 def test_each_model_page_ends_with_its_generated_variable_table(name):
     page = model_page(name, ROOT / "docs")
     assert section(page, "variables") == markdown(MODELS[name].spec), (
-        f"regenerate {page.name}: python -m fmu_harness.variable_table --update docs"
+        f"regenerate {page.name}: python -m fmu_harness.doc_pages.variable_table --update docs"
     )
     assert page.read_text().rstrip().endswith("<!-- variables:end -->")
 

@@ -1,4 +1,4 @@
-"""The robustness suite (fmu_harness.robustness): every hostile input and misuse of issue 14's
+"""The robustness suite (fmu_harness.checks.robustness): every hostile input and misuse of issue 14's
 classes, each in its own host process with a time limit, through fmpy (FMI 2.0 and 3.0) and a
 subset in libcosim and Ecos, on the Python FMUs and on the native ones. Every column of the table
 must stay at zero; a departure that the Python wrappers force is a defined outcome of the Python
@@ -12,9 +12,10 @@ from pathlib import Path
 import pytest
 
 from driveline.catalog import MODELS
-from fmu_harness import build, robustness
-from fmu_harness.build import native
-from fmu_harness.failing_model import FailingModel
+from fmu_harness import packaging
+from fmu_harness.checks import robustness
+from fmu_harness.packaging import native
+from fmu_harness.checks.failing_model import FailingModel
 
 CLASSES = {"non-finite values", "out-of-range values", "step sizes", "call sequence misuse",
            "state round trips and corrupt state", "instances and threads", "hostile layout values",
@@ -36,7 +37,7 @@ def paths(family: str, fmu_dir: Path, native_dir: Path, tmp_path_factory: pytest
     """The native FMUs, or the catalog's Python FMUs and those of the failing model in a folder of their own."""
     if family == "native":
         return lambda model, fmi: native.fmu_path(native_dir, model, fmi)
-    return robustness.with_failing_model(lambda model, fmi: build.fmu_path(fmu_dir, model, fmi),
+    return robustness.with_failing_model(lambda model, fmi: packaging.fmu_path(fmu_dir, model, fmi),
                                          tmp_path_factory.mktemp("failing"))
 
 

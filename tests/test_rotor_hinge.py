@@ -16,7 +16,7 @@ from driveline.rotor import (
     fem,
     load_driveline,
 )
-from fmu_harness.runner import simulate
+from fmu_harness.runs.runner import simulate
 
 from rotor_checks import rayleigh
 

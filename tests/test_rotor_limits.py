@@ -8,7 +8,7 @@ import pytest
 from driveline.rotor import load_driveline, loads_driveline
 from driveline.rotor.loader import MAX_FILE_BYTES, MAX_NESTING, MAX_SEGMENTS
 from driveline.rotor.model import MAX_ORDER, MAX_ORDERS, CriticalSpeedsModel, parse_orders
-from fmu_harness.robustness_probe import SEGMENT_TABLE, hostile_file
+from fmu_harness.checks.robustness_probe import SEGMENT_TABLE, hostile_file
 
 
 def _refusal(**parameters) -> list[str]:

@@ -13,8 +13,8 @@ from driveline.rotor import example_path, load_driveline
 from driveline.rotor.loader import loads_driveline
 from driveline.rotor.mechanism import MECHANISM_HINGE, MECHANISM_RIGID, mechanism_error
 from driveline.rotor.model import SHEAR_CONFLICT, natural_frequencies
-from fmu_harness.build import native
-from fmu_harness.runner import StepRefused, simulate
+from fmu_harness.packaging import native
+from fmu_harness.runs.runner import StepRefused, simulate
 
 TUBE = """
 [[segments]]

@@ -10,9 +10,9 @@ import pickle
 
 import pytest
 
-from driveline import saved_state
 from driveline.catalog import MODELS
-from driveline.saved_state import StateRefused
+from fmu_src import saved_state
+from fmu_src.saved_state import StateRefused
 
 
 def _stepped(model_name: str):

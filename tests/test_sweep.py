@@ -11,8 +11,8 @@ import pyarrow.parquet
 import pytest
 
 from driveline.catalog import MODELS
-from fmu_harness.runner import simulate
-from fmu_harness.sweep import MARGIN, Timing, grid, main, open_client, parse_axis, sweep, write_table
+from fmu_harness.runs.runner import simulate
+from fmu_harness.runs.sweep import MARGIN, Timing, grid, main, open_client, parse_axis, sweep, write_table
 
 STEPS = 36
 TIMING = Timing(steps_per_turn=STEPS)

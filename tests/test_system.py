@@ -14,8 +14,9 @@ import pytest
 from fmpy import read_model_description
 
 from driveline.catalog import MODELS
-from fmu_harness import importers, system
-from fmu_harness.build import fmu_path, native
+from fmu_harness.checks import importers
+from fmu_harness.runs import system
+from fmu_harness.packaging import fmu_path, native
 
 import test_native_fmus as native_fmus
 

@@ -12,7 +12,7 @@ from fmpy.validation import validate_fmu
 from driveline.tripod import closed_form, dynamics, geometry
 from driveline.tripod.exact import exact_pose
 from driveline.tripod.outputs import coupling_outputs
-from fmu_harness.runner import FmuInstance, StepRefused, simulate
+from fmu_harness.runs.runner import FmuInstance, StepRefused, simulate
 
 R, L, M = 0.026, 0.700, 0.2
 OMEGA = 2000.0 * math.pi / 30.0

@@ -14,7 +14,7 @@ from scipy.optimize import fsolve
 from driveline.tripod import exact, plane_solver
 from driveline.tripod.outputs import efficiency
 from driveline.tripod.reactions import exact_reactions, slip_sign
-from fmu_harness.runner import StepRefused, simulate
+from fmu_harness.runs.runner import StepRefused, simulate
 from test_tripod_reactions import EZ, OMEGA, PHI, Mechanism, R, L, M, spectral_derivatives
 
 MU = 0.05

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import tripod_multibody
-from fmu_harness.build import native
-from fmu_harness.runner import FmuInstance
+from fmu_harness.packaging import native
+from fmu_harness.runs.runner import FmuInstance
 
 RPM = math.pi / 30.0
 FORCES = ("Rx_in", "Ry_in", "Rx_out", "Ry_out", "Rz_out", "F_arm1", "F_arm2", "F_arm3",

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import tripod_multibody
-from fmu_harness.runner import simulate
+from fmu_harness.runs.runner import simulate
 
 RPM = math.pi / 30.0
 REACTIONS = ("Rx_in", "Ry_in", "Mx_in", "My_in", "T_in", "Rx_out", "Ry_out", "Rz_out",

@@ -12,7 +12,7 @@ from driveline.model import SteppedModel
 from driveline.rotor.model import CriticalSpeedsModel
 from driveline.tripod.model import TripodCouplingModel
 from driveline.variables import DefaultExperiment, ModelSpec, Relation, Variable
-from fmu_harness.variable_table import markdown
+from fmu_harness.doc_pages.variable_table import markdown
 
 
 def spec_with(*relations: Relation) -> ModelSpec:

@@ -32,7 +32,7 @@ from .unbalance_outputs import DAMPING_POINTS, FE_ELEMENTS, TABLE_ELEMENTS
 #: (three times as long in wall time on the two busy cores of the project's machine, still within
 #: its budget of 5 s), the Python one about as long (its budget: 30 s).
 MAX_ANALYSIS_SECONDS = 1.5
-#: Native CPU seconds per unit of each stage, fitted to the worst layouts (fmu_harness/analysis_work.py)
+#: Native CPU seconds per unit of each stage, fitted to the worst layouts (fmu_harness/checks/analysis_work.py)
 #: on the project's machine; the search rate to a layout whose Campbell table takes the full grid at
 #: every speed (30 segments with 62 masses and 62 bearings: 4.5 s estimated, 4.5 s measured).
 RATE_SEARCH = 1.35e-9  # per determinant evaluation and station
@@ -44,7 +44,7 @@ STAGES = ("critical speeds", "order resonances", "Campbell table", "FE check", "
 ADVICE = "(fewer stations or segments, fewer or lower orders)"
 
 #: The texts the C port of :func:`estimate` reads (``CriticalSpeedsModel.native_constants``); its
-#: numbers come from the shared constants header (``fmu_harness.build.native_constants``).
+#: numbers come from the shared constants header (``fmu_harness.packaging.native_constants``).
 NATIVE_CONSTANTS = {"WORK_ADVICE": ADVICE, "WORK_STAGE_COUNT": len(STAGES),
                     **{f"WORK_STAGE_{i}": name for i, name in enumerate(STAGES)}}
 

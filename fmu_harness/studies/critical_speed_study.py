@@ -21,8 +21,8 @@ from driveline.rotor.campbell import whirl_branches  # noqa: E402
 from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline  # noqa: E402
 from driveline.rotor.spec import SPEC  # noqa: E402
 
+from ..runs.runner import FmuInstance  # noqa: E402
 from .result_table import column, write_csv  # noqa: E402
-from .runner import FmuInstance  # noqa: E402
 
 RPM = 30.0 / math.pi
 ORDERS = (1, 2, 3)  # unbalance; Cardan joints; the tripod coupling (docs/tripod_coupling.md)

@@ -1,13 +1,13 @@
 """Interoperability matrix: every built FMU (Python and native, FMI 2.0 and 3.0) in every importer.
 
-Usage: ``python -m fmu_harness.interop [--models models] [--update docs/interoperability.md]``
+Usage: ``python -m fmu_harness.checks.interop [--models models] [--update docs/interoperability.md]``
 after ``python build_fmu.py``. Prints the matrix as markdown; with ``--update`` it also rewrites
-that page's ``interop`` section (:mod:`fmu_harness.doc_sections`). The native FMUs are those
-under ``models/native/`` (:mod:`fmu_harness.build.native`).
+that page's ``interop`` section (:mod:`fmu_harness.doc_pages.sections`). The native FMUs are those
+under ``models/native/`` (:mod:`fmu_harness.packaging.native`).
 
 Importers: ``fmpy validate``, ``fmutool -input X.fmu -check`` (FMU Manipulation Toolbox),
 and two co-simulation engines, libcosimpy and ecospy, that run the model's standard scenario
-(:mod:`fmu_harness.scenario`): a run passes if every compared output stays within
+(:mod:`fmu_harness.runs.scenario`): a run passes if every compared output stays within
 :data:`TOLERANCE` times the output's largest magnitude of the fmpy run of the model's Python FMU
 (same FMI version) at t_1 ... t_N, for a native FMU too: the equivalence a host relies on when
 it swaps one for the other. Each engine run is a subprocess of its own, so an importer that
@@ -34,11 +34,11 @@ from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
 
+from ..doc_pages.sections import replace_section
+from ..packaging import fmu_path, native
+from ..runs.runner import FmuInstance
+from ..runs.scenario import scenario, standard_run
 from . import importers
-from .build import fmu_path, native
-from .doc_sections import replace_section
-from .runner import FmuInstance
-from .scenario import scenario, standard_run
 
 TOLERANCE = 1e-9
 RESULT = "interop result: "
@@ -94,7 +94,7 @@ def _engine(name: str) -> Callable[[Path, Path], Outcome]:
     """Run the scenario in engine ``name`` in a subprocess (see :func:`simulate_in`)."""
 
     def check(fmu: Path, reference: Path) -> Outcome:
-        command = [sys.executable, "-m", "fmu_harness.interop", "--worker", name, str(fmu), str(reference)]
+        command = [sys.executable, "-m", "fmu_harness.checks.interop", "--worker", name, str(fmu), str(reference)]
         done = subprocess.run(command, capture_output=True, text=True, timeout=300, cwd=Path(__file__).parents[1])
         if done.returncode:
             last = (done.stderr.strip().splitlines() or [""])[-1]

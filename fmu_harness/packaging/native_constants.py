@@ -81,7 +81,7 @@ def _error_kinds() -> str:
     names = "".join(f"(kind) == {error_kind_name(kind)} ? \"{kind.__name__}\" : " for kind in ERROR_KINDS)
     arithmetic = " || ".join(f"(kind) == {error_kind_name(kind)}" for kind in ERROR_KINDS
                              if issubclass(kind, ArithmeticError))
-    return f"""/* The kinds of failure (fmu_harness/build/native_constants.py ERROR_KINDS): the Python exception
+    return f"""/* The kinds of failure (fmu_harness/packaging/native_constants.py ERROR_KINDS): the Python exception
  * a failure of the C port stands for; a failing function returns its kind, a negative number. */
 typedef enum {{ ERROR_NONE = 0, {", ".join(kinds)} }} ErrorKind;
 /* Python's name of a kind ("ValueError"); "" for ERROR_NONE */
@@ -95,7 +95,7 @@ def constants_header() -> str:
     lines = [f"#define {name} {_literal(value)} /* {python} */" for name, (python, value) in shared_constants().items()]
     body = "\n".join(lines) + "\n\n" + _error_kinds()
     return f"""/* The constants and kinds of failure the Python core and its C port share, generated from the Python modules by the
- * native build (fmu_harness/build/native_constants.py): do not edit. */
+ * native build (fmu_harness/packaging/native_constants.py): do not edit. */
 #ifndef DRIVELINE_CONSTANTS_H
 #define DRIVELINE_CONSTANTS_H
 

@@ -1,9 +1,9 @@
 """The main job's cross-check of the Python FMUs against the native ones, in a process of its own.
 
-Usage: ``python -m fmu_harness.python_fmu_check [--models models] [--native models] [--out results]
+Usage: ``python -m fmu_harness.checks.python_fmu_check [--models models] [--native models] [--out results]
 [NAME ...]``; the main job runs it as a subprocess (:func:`run`). Each model's (default: every
 catalog model's) FMI 2.0 Python FMU in ``--models`` and its native FMU below ``--native`` run the
-standard scenario (:mod:`fmu_harness.scenario`); ``python_fmus.md`` in ``--out`` lists the largest
+standard scenario (:mod:`fmu_harness.runs.scenario`); ``python_fmus.md`` in ``--out`` lists the largest
 difference of any output, relative to that output's largest magnitude.
 
 Why a process of its own: a process that has loaded a pythonfmu FMI 2.0 FMU reads and writes freed
@@ -28,9 +28,9 @@ import numpy as np
 
 from driveline.catalog import MODELS
 
-from .build import native
-from .runner import FmuInstance
-from .scenario import standard_run
+from ..packaging import native
+from ..runs.runner import FmuInstance
+from ..runs.scenario import standard_run
 
 REPORT = "python_fmus.md"
 

@@ -19,8 +19,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..runs.runner import FmuInstance, simulate  # noqa: E402
 from .result_table import write_csv  # noqa: E402
-from .runner import FmuInstance, simulate  # noqa: E402
 
 SPEED = 1500.0 * math.pi / 30.0  # rad/s
 SAMPLES_PER_TURN = 360

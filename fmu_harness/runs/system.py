@@ -1,10 +1,10 @@
 """The driveline system: an SSP 1.0 package of the project's FMUs and a small fmpy master for it.
 
-Usage: ``python -m fmu_harness.system [--models models] [--native]`` after ``python build_fmu.py``
+Usage: ``python -m fmu_harness.runs.system [--models models] [--native]`` after ``python build_fmu.py``
 (which also writes both packages): writes ``models/Driveline.ssp`` and prints the last values of
 the system's outputs from the fmpy master. With ``--native`` the same for the native variant,
 ``models/native/Driveline.ssp``: each component's native (C) FMU where its model has one
-(:func:`fmu_harness.build.native.native_models`), its Python FMU otherwise; each component's
+(:func:`fmu_harness.packaging.native.native_models`), its Python FMU otherwise; each component's
 ``description`` in the package says which.
 
 The system: ``SpeedSource`` (a speed ramp with a superposed sine) drives ``TripodCoupling``'s
@@ -34,7 +34,7 @@ import numpy as np
 from driveline.catalog import MODELS
 from driveline.variables import UNITS, ModelSpec, Variable
 
-from .build import fmu_path, native
+from ..packaging import fmu_path, native
 from .runner import FmuInstance
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"

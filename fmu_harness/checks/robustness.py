@@ -1,14 +1,14 @@
 """Robustness suite: hostile inputs and misuse of the FMUs, each case in a process of its own with a
 time limit, through fmpy (FMI 2.0 and 3.0) and, for a subset, libcosim and Ecos.
 
-Usage: ``python -m fmu_harness.robustness [--models models] [--family python|native] [--slow]
+Usage: ``python -m fmu_harness.checks.robustness [--models models] [--family python|native] [--slow]
 [--workers 2]`` after building the FMUs (``python build_fmu.py``). Prints per family of FMUs
 (the Python FMUs, the native ones; both unless ``--family`` names one) and class of case: cases,
 crashes (the host process died), hangs (it did not end within the time limit), wrong statuses
 and wrong outputs (outputs wrong with status OK), the cases whose defined outcome is a
 documented departure from the standard (the Python wrappers', or a host's; docs/robustness.md)
 and the cases skipped because an FMU they need was not built (a model without a C port has no
-native FMU). The procedures are in :mod:`fmu_harness.robustness_probe`.
+native FMU). The procedures are in :mod:`fmu_harness.checks.robustness_probe`.
 
 The cases are described once: :func:`cases` takes a function ``(model name, FMI version) -> FMU
 path`` and the family, which decides the defined outcomes (the native FMUs have none of the
@@ -268,7 +268,7 @@ def _model_failures(fmu_path: FmuPath, fmi: str) -> list[Case]:
 
 def with_failing_model(fmu_path: FmuPath, folder: Path) -> FmuPath:
     """``fmu_path`` plus the failing model's FMUs, built into ``folder``."""
-    from .build import fmu_path as built_path
+    from ..packaging import fmu_path as built_path
 
     build_failing_fmus(folder)
     return lambda model, fmi: built_path(folder, model, fmi) if model == FailingModel.spec.name else fmu_path(model, fmi)
@@ -310,7 +310,7 @@ def run(case: Case) -> Result:
     if missing:
         return Result(case, "skipped", f"no {case.family} FMU of {', '.join(missing)}", 0.0)
     time_limit = case.time_limit
-    command = [sys.executable, "-m", "fmu_harness.robustness_probe",
+    command = [sys.executable, "-m", "fmu_harness.checks.robustness_probe",
                json.dumps({"procedure": case.procedure, "arguments": list(case.arguments),
                            "departures": list(case.departures)})]
     started = time.perf_counter()
@@ -361,7 +361,7 @@ def skipped(results: list[Result]) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .build import fmu_path, native
+    from ..packaging import fmu_path, native
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=ROOT / "models",

@@ -2,9 +2,9 @@
 
 Usage::
 
-    python -m fmu_harness.sweep --grid beta=0:0.7:8 omega_in=100,200,300 r=0.02,0.026
-    python -m fmu_harness.sweep --model CardanJoint --points points.csv --out cardan.parquet
-    python -m fmu_harness.sweep --grid beta=0.1,0.3 --scheduler tcp://host:8786
+    python -m fmu_harness.runs.sweep --grid beta=0:0.7:8 omega_in=100,200,300 r=0.02,0.026
+    python -m fmu_harness.runs.sweep --model CardanJoint --points points.csv --out cardan.parquet
+    python -m fmu_harness.runs.sweep --grid beta=0.1,0.3 --scheduler tcp://host:8786
 
 A grid axis is ``name=v1,v2,...`` or ``name=start:stop:count`` (``count`` values, both ends
 included); the grid is the cartesian product of its axes. A points file is CSV (a header of
@@ -12,7 +12,7 @@ names) or JSON (a list of objects). Each name must be a parameter (set as a star
 input (held constant) of the FMU. A run lasts ``--turns`` input turns at the point's
 ``omega_in`` in ``--steps-per-turn`` steps unless ``--duration`` / ``--step`` are given.
 
-Every point is one :func:`fmu_harness.runner.simulate` call on a worker. The FMU's bytes are
+Every point is one :func:`fmu_harness.runs.runner.simulate` call on a worker. The FMU's bytes are
 scattered to the workers once, extracted and their model description parsed once per worker
 process, so workers need no shared file system. A refused or crashed run becomes a ``failed``
 row with its reason.

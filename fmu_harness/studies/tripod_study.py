@@ -17,8 +17,8 @@ from driveline.tripod import closed_form  # noqa: E402
 from driveline.tripod.exact import exact_pose  # noqa: E402
 from driveline.tripod.spec import SPEC  # noqa: E402
 
+from ..runs.runner import simulate  # noqa: E402
 from . import result_table  # noqa: E402
-from .runner import simulate  # noqa: E402
 
 SPEED = 2000.0 * math.pi / 30.0  # rad/s, the seed's 2000 rpm
 BETAS_DEG = (5, 10, 15, 20, 25, 30, 35, 40, 45)

@@ -51,7 +51,7 @@ class FailingModel(SteppedModel):
 
 def build_failing_fmus(dest: Path) -> None:
     """FMI 2.0 and 3.0 FMUs of :class:`FailingModel` under ``dest`` (where ``build.fmu_path`` finds them)."""
-    from .build import build
+    from ..packaging import build
 
     for fmi in ("2", "3"):
         build(FailingModel.spec.name, dest, fmi, FailingModel)

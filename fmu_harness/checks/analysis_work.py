@@ -1,6 +1,6 @@
 """The worst CriticalSpeeds inputs the limits allow, and what each analysis stage costs on them.
 
-Usage: ``python -m fmu_harness.analysis_work [--native models/native/CriticalSpeeds.fmu]`` prints, per
+Usage: ``python -m fmu_harness.checks.analysis_work [--native models/native/CriticalSpeeds.fmu]`` prints, per
 layout, the work estimate (:mod:`driveline.rotor.work`) and the time and peak memory of every stage of
 the Python analysis, each layout in a process of its own under a limit of time and address space; with
 a native FMU, the time and peak memory of its whole analysis (``ExitInitializationMode``) too.
@@ -173,7 +173,7 @@ def run_limited(function: str, arguments: list, budget: tuple[float, int]) -> di
         resource.setrlimit(resource.RLIMIT_CPU, (int(2 * seconds) + 5, int(2 * seconds) + 6))
         resource.setrlimit(resource.RLIMIT_AS, (memory + 1024**3, memory + 1024**3))
 
-    command = [sys.executable, "-c", f"import json, sys; from fmu_harness.analysis_work import {function} as f; "
+    command = [sys.executable, "-c", f"import json, sys; from fmu_harness.checks.analysis_work import {function} as f; "
                f"print(json.dumps(f(*json.loads(sys.argv[1]))))", json.dumps(arguments)]
     try:
         done = subprocess.run(command, capture_output=True, text=True, preexec_fn=limit, timeout=10 * budget[0] + 60)

@@ -1,4 +1,4 @@
-"""One robustness case, run in a process of its own: ``python -m fmu_harness.robustness_probe CASE_JSON``.
+"""One robustness case, run in a process of its own: ``python -m fmu_harness.checks.robustness_probe CASE_JSON``.
 
 The case names a procedure of this module, its arguments and the departures from the standard
 its outcome is checked with (none for the native FMUs; the wrappers' for the Python FMUs,

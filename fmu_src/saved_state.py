@@ -18,7 +18,7 @@ import hashlib
 import json
 from typing import Any
 
-from .variables import ModelSpec
+from driveline.variables import ModelSpec
 
 MAGIC = b"driveline-fmus state\n"
 FORMAT = 1

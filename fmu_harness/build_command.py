@@ -8,9 +8,9 @@ Python FMU per FMI version (:mod:`.fmu`). The native (C) FMUs of the models with
 platforms when ziglang is installed (``--host-only``: this machine's alone). Without a C compiler
 the build says what to install in one line and builds the rest; it fails only with ``--native``.
 Then the FMI Cross-Check reference results are written next to each FMU, Python and native
-(:mod:`fmu_harness.crosscheck`), and, once its FMI 2.0 FMUs are there, the driveline system's SSP
+(:mod:`fmu_harness.checks.crosscheck`), and, once its FMI 2.0 FMUs are there, the driveline system's SSP
 packages, ``Driveline.ssp`` with the Python FMUs and ``native/Driveline.ssp`` with the native ones
-(:mod:`fmu_harness.system`).
+(:mod:`fmu_harness.runs.system`).
 """
 
 from __future__ import annotations
@@ -21,9 +21,10 @@ from pathlib import Path
 
 from driveline.catalog import MODELS
 
-from .. import crosscheck, system
-from . import native, toolchain
-from .fmu import FMI_VERSIONS, build_all
+from .checks import crosscheck
+from .packaging import native, toolchain
+from .packaging.fmu import FMI_VERSIONS, build_all
+from .runs import system
 
 
 def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Path("models")) -> None:

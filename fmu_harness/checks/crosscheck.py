@@ -1,11 +1,11 @@
 """Reference results in the FMI Cross-Check layout, next to every built FMU.
 
-Usage: ``python -m fmu_harness.crosscheck [--models models]`` (``python build_fmu.py`` runs it).
+Usage: ``python -m fmu_harness.checks.crosscheck [--models models]`` (``python build_fmu.py`` runs it).
 For each ``<Model>.fmu`` (Python FMUs: FMI 2.0 in ``models/``, FMI 3.0 in ``models/fmi3/``; native
 ones in ``models/native/`` and ``models/native/fmi3/``) it writes
 
 * ``<Model>_ref.csv``: time and at most ten outputs of the model's standard run
-  (:mod:`fmu_harness.scenario`), header names quoted as in the model description;
+  (:mod:`fmu_harness.runs.scenario`), header names quoted as in the model description;
 * ``<Model>_in.csv``: the input table (breakpoints, interpolated linearly), if the model has inputs;
 * ``<Model>_ref.opt``: StartTime, StopTime, StepSize and RelTol of the run.
 
@@ -23,8 +23,8 @@ from fmpy.util import read_csv
 
 from driveline.catalog import MODELS
 
-from .runner import FmuInstance
-from .scenario import scenario, standard_run
+from ..runs.runner import FmuInstance
+from ..runs.scenario import scenario, standard_run
 
 REL_TOL = 1e-9
 

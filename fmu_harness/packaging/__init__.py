@@ -1,5 +1,5 @@
 """Building the project's FMUs: :func:`build` one model for one FMI version, :func:`build_all`
-the catalog, :func:`fmu_path` where they go; :mod:`.command` is ``python build_fmu.py``."""
+the catalog, :func:`fmu_path` where they go; :mod:`.native` the native (C) FMUs."""
 
 from .fmu import FMI_VERSIONS, build, build_all, fmu_path
 

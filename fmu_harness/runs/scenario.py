@@ -42,7 +42,7 @@ class Scenario:
         return {name: float(np.interp(time, self.breakpoints, values)) for name, values in self.inputs.items()}
 
     def signals(self) -> dict[str, Callable[[float], float]]:
-        """The inputs as functions of time (for :meth:`fmu_harness.runner.FmuInstance.run`)."""
+        """The inputs as functions of time (for :meth:`fmu_harness.runs.runner.FmuInstance.run`)."""
         return {name: (lambda t, v=values: float(np.interp(t, self.breakpoints, v))) for name, values in self.inputs.items()}
 
     @property

@@ -1,7 +1,7 @@
 """Markdown tables of the models' variables, from their specs.
 
-``python -m fmu_harness.variable_table`` prints them; ``--update docs`` rewrites the part of each
-model's page (:func:`fmu_harness.doc_sections.model_page`) between its ``variables:start`` and
+``python -m fmu_harness.doc_pages.variable_table`` prints them; ``--update docs`` rewrites the part of each
+model's page (:func:`fmu_harness.doc_pages.sections.model_page`) between its ``variables:start`` and
 ``variables:end`` markers.
 """
 
@@ -13,7 +13,7 @@ from pathlib import Path
 from driveline.catalog import MODELS
 from driveline.variables import ModelSpec
 
-from .doc_sections import DOCS, model_page, replace_section
+from .sections import DOCS, model_page, replace_section
 
 
 def _escaped(text: str) -> str:
