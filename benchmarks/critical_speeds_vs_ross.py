@@ -13,7 +13,7 @@ import numpy as np
 
 from benchmarks.timing import best_of, machine
 from driveline.rotor import Driveline, one_piece_shaft
-from fmu_harness.ross_reference import E, RHO, ross_forward_critical_speeds
+from tests.support.ross_reference import E, RHO, ross_forward_critical_speeds
 
 AGREEMENT = 5e-3
 

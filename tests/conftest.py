@@ -42,10 +42,11 @@ from driveline.catalog import MODELS
 from fmu_harness import packaging
 from fmu_harness.packaging import native, toolchain
 from fmu_harness.runs.runner import FmuInstance
+from support.families import Family, NativeFamily, PythonFamily
 
 FmuPath = Callable[..., Path]
 
-FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir"}
+FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir", "family"}
 IMPORTER_MODULES = ("fmu_harness.checks.importers", "fmu_harness.checks.interop")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
@@ -53,7 +54,7 @@ DURATIONS = Path(__file__).with_name("durations.json")
 SLOW_SECONDS = 0.5  # CPU seconds of a test at which it is slow
 RELEASE_FIXTURE = "release_dir"  # the five-platform build: its cost depends on ziglang's cache
 #: The session's FMU builds, which every FMU test shares: charged to no test when measuring.
-SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "fmu_unzipdir", "open_fmu", "tripod_fmu", "native_dir"}
+SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "fmu_unzipdir", "open_fmu", "tripod_fmu", "native_dir", "family"}
 
 
 QUICK_VERSIONS = ["2"]
@@ -87,7 +88,7 @@ def selected_versions(config: pytest.Config) -> list[str]:
 
 def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
     """With ``--quick``, a module whose tests are all slow is not imported."""
-    if config.getoption("quick") and f"tests/{collection_path.name}" in slow_modules(measured()):
+    if config.getoption("quick") and collection_path.relative_to(config.rootpath).as_posix() in slow_modules(measured()):
         return True
     return None
 
@@ -133,6 +134,25 @@ def release_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     dest = tmp_path_factory.mktemp("release_models")
     native.build_all(dest, release=True)
     return dest
+
+
+@pytest.fixture(scope="session", params=[PythonFamily, NativeFamily], ids=lambda family: family.name)
+def family(request: pytest.FixtureRequest, fmu_path: FmuPath, tmp_path_factory: pytest.TempPathFactory) -> Family:
+    """A test taking ``family`` runs on the Python FMUs and on the native ones (built when first
+    asked for); a model without a C port, or an FMI version not selected, skips the native run."""
+    if request.param is PythonFamily:
+        return PythonFamily(fmu_path, tmp_path_factory.mktemp("python_family"))
+    native_dir = request.getfixturevalue("native_dir")
+    versions, ported = selected_versions(request.config), native.native_models()
+
+    def path(name: str, version: str = "2") -> Path:
+        if version not in versions:
+            pytest.skip(f"FMI {version}.0 is not among the selected versions (--fmi)")
+        if name not in ported:
+            pytest.skip(f"{name} has no C port")
+        return native.fmu_path(native_dir, name, version)
+
+    return NativeFamily(path, tmp_path_factory.mktemp("native_family"))
 
 
 @pytest.fixture(scope="session")

@@ -4,7 +4,7 @@ Usage: ``python -m fmu_harness.checks.analysis_work [--native models/native/Crit
 layout, the work estimate (:mod:`driveline.rotor.work`) and the time and peak memory of every stage of
 the Python analysis, each layout in a process of its own under a limit of time and address space; with
 a native FMU, the time and peak memory of its whole analysis (``ExitInitializationMode``) too.
-``benchmarks/analysis_work.py`` checks the bounds; ``tests/test_analysis_work.py`` runs the same cases.
+``benchmarks/analysis_work.py`` checks the bounds; ``tests/fmu/test_analysis_work.py`` runs the same cases.
 """
 
 from __future__ import annotations

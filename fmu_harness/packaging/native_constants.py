@@ -5,7 +5,7 @@ modules' own constants, and the native build writes their values into the genera
 also holds the kinds of failure (:data:`ERROR_KINDS`) as the enum ``ErrorKind``: a C function that
 fails returns its kind with the message, so no C code tells kinds apart by their text.
 
-A C file defines none of these numbers itself (tests/test_native_constants.py checks every
+A C file defines none of these numbers itself (tests/native/test_native_constants.py checks every
 ``#define`` and ``static const`` of ``fmu_src/native``). Numbers only the C port has (the Arnoldi
 iteration's cap and tolerance, which scipy's ARPACK holds for Python; buffer sizes) stay in C.
 """

@@ -1,0 +1,36 @@
+"""Property test: random parameters, inputs and step sizes, bad ones included, driven through
+fmpy into every FMU (both FMI versions, both families) and, in step, into the FMI-free physics core
+(:mod:`support.alongside_the_core`).
+
+The host must never crash or hang; a step is refused exactly when the core refuses it, with
+the core's reasons logged; every accepted step gives the core's outputs. The Python FMUs run
+the core's own code on the same float64 values, so their outputs must agree bit for bit; the
+native ones within each output's tolerance, their reasons word for word up to what the C port
+words its own way (:class:`support.families.NativeFamily`).
+"""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings
+
+from driveline.catalog import MODELS
+from support.alongside_the_core import Run, random_runs, run_alongside_the_core
+
+#: Examples per model and FMI version: the native FMUs are cheap enough for more.
+EXAMPLES = {"python": 40, "native": 60}
+
+
+# huge but finite values overflow to inf inside numpy on the way to a refused step
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_random_runs_match_the_core_and_bad_values_are_refused(family, model_name, fmi):
+    outputs = [v.name for v in MODELS[model_name].spec.of("output")]
+
+    @settings(max_examples=EXAMPLES[family.name], deadline=None)
+    @given(run=random_runs(model_name))
+    def check(run: Run) -> None:
+        with family.open(model_name, fmi) as fmu:
+            fmu_rows, core_rows = run_alongside_the_core(fmu, MODELS[model_name], run, family.reason)
+        family.assert_outputs_agree(outputs, fmu_rows, core_rows)
+
+    check()

@@ -1,0 +1,70 @@
+"""What the native FMUs promise against the Python core and FMUs: each output within its tolerance
+of its largest magnitude over a run, and the refusals' words up to what a second implementation
+words its own way."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+# Both sides evaluate the same formulas in float64, but numpy's and libm's sin, cos, atan2 may
+# differ in the last bit: outputs must agree within this fraction of each signal's largest magnitude.
+TOLERANCE = 1e-12
+# The critical speeds come from root searches that stop within a tolerance of their own. The damping
+# ratio is the small real part of an eigenvalue, which a backward-stable eigensolver fixes to about
+# eps max|lambda| only, where max|lambda| is the finite-element model's highest mode, 100 to 1000
+# times the first: 1e-10 to 1e-9 of zeta's own size (measured between the two implementations: 6.8e-11
+# in the standard scenario, 1.5e-9 in the property test; numpy's own error against a 40-digit
+# reference is of the same order). The unbalance response and the bearing force carry the banded
+# solve's rounding amplified by the resonance, up to 1 / (2 zeta) = 330 (measured up to 2.6e-12 here,
+# 1.1e-10 at 0.07 % from the resonance in the rotor library's own test).
+SIGNAL_TOLERANCE = {"omega_crit_1": 1e-10, "omega_crit_2": 1e-10, "omega_crit_3": 1e-10, "damping_ratio": 1e-8,
+                    "unbalance_response": 1e-9, "bearing_force_max": 1e-9}
+# The resonance margin is omega / omega_res - 1, a quotient near 1 less 1: its rounding is the
+# quotient's, so it is measured against a scale of at least 1 (a drawn margin of 4.5e-4 differed by
+# 1.1e-15 between the cores: 2.5e-12 of its own size, 1.1e-15 of the quotient's).
+SCALE_FLOOR = {"resonance_margin": 1.0}
+
+
+def scale(name: str, values: np.ndarray) -> float:
+    """An output's largest magnitude, the scale its tolerance is relative to (at least its
+    :data:`SCALE_FLOOR`; 1 for an output that stays zero)."""
+    return max(float(np.abs(values).max()), SCALE_FLOOR.get(name, 0.0)) or 1.0
+
+
+def deviations(reference: np.ndarray, other: np.ndarray) -> dict[str, float]:
+    """Largest difference of each output, relative to that output's largest magnitude."""
+    return {n: float(np.abs(reference[n] - other[n]).max() / scale(n, reference[n])) for n in reference.dtype.names}
+
+
+def deviation(reference: np.ndarray, other: np.ndarray) -> float:
+    """Largest difference of any output, relative to that output's largest magnitude."""
+    return max(deviations(reference, other).values())
+
+
+def beyond_tolerance(reference: np.ndarray, other: np.ndarray) -> dict[str, float]:
+    """The outputs that differ by more than their tolerance (:data:`SIGNAL_TOLERANCE`, else TOLERANCE)."""
+    return {n: d for n, d in deviations(reference, other).items() if not d <= SIGNAL_TOLERANCE.get(n, TOLERANCE)}
+
+
+#: Where tomllib's and the C reader's words for a malformed TOML text begin.
+MALFORMED = "malformed TOML: "
+
+
+def up_to_the_toml_reason(message: str) -> str:
+    """A message up to the reason of a malformed TOML text, which tomllib words in its own way, and
+    without the nearest finite-element frequency of a failed plausibility check: that check fails
+    where the eigenproblem is beyond double precision, and its lowest eigenvalues are round-off."""
+    message = re.sub(r"\(nearest \S+ rad/s\)", "(nearest ... rad/s)", message)
+    return message[:message.index(MALFORMED) + len(MALFORMED)] if MALFORMED in message else message
+
+
+def rows_beyond_tolerance(outputs: list[str], reference_rows: list[list[float]], rows: list[list[float]]) -> np.ndarray:
+    """Rows of outputs (one row per step) against reference rows: each difference relative to its
+    output's largest magnitude over the run, zeroed where it is within that output's tolerance."""
+    reference, values = np.array(reference_rows, dtype=float), np.array(rows, dtype=float)
+    scales = np.array([scale(n, reference[:, i]) for i, n in enumerate(outputs)])
+    tolerances = np.array([SIGNAL_TOLERANCE.get(n, TOLERANCE) for n in outputs])
+    relative = (values - reference) / scales
+    return np.where(np.abs(values - reference) <= tolerances * scales, 0.0, relative)
