@@ -1,8 +1,10 @@
-"""Shared fixtures and the suite's markers.
+"""Shared fixtures and the suite's markers, for the tests in ``core/``, ``fmu/``, ``native/`` and
+``project/`` (what they share besides fixtures is in ``support/``, imported as ``support``).
 
 FMUs are built on demand, once per test session (per worker with pytest-xdist), into one
-folder: FMI 2.0 in it, FMI 3.0 in its ``fmi3/``. Markers are assigned here, from what a test
-uses, so that test files carry none:
+folder: FMI 2.0 in it, FMI 3.0 in its ``fmi3/``. A test taking ``family`` runs on the Python FMUs
+and on the native ones (:class:`support.families.Family`). Markers are assigned here, from what a
+test uses, so that test files carry none:
 
 * ``fmu``: the test uses a built FMU, Python or native (a fixture of this file);
 * ``importers``: its module drives the external importers (imports ``fmu_harness.checks.importers``
