@@ -13,7 +13,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from benchmarks.timing import machine
+from benchmarks import report
 from fmu_harness.checks.analysis_work import NATIVE_BUDGET, PYTHON_BUDGET, measure, table
 
 
@@ -36,11 +36,15 @@ def over_budget(results: dict[str, dict]) -> list[str]:
 
 
 def main() -> None:
-    fmu = Path(sys.argv[1] if len(sys.argv) > 1 else "models/native/CriticalSpeeds.fmu")
+    arguments = report.parser(__doc__.splitlines()[0])
+    arguments.add_argument("fmu", nargs="?", type=Path, default=Path("models/native/CriticalSpeeds.fmu"),
+                           help="the native CriticalSpeeds FMU")
+    args = arguments.parse_args()
+    measurement = report.Measurement()
     with tempfile.TemporaryDirectory() as folder:
-        results = measure(Path(folder), fmu if fmu.exists() else None)
-    print(table(results))
-    print(f"\n{machine()}; CPU seconds of each process")
+        results = measure(Path(folder), args.fmu if args.fmu.exists() else None)
+    report.publish("benchmark-analysis-work", measurement.stamp("CPU seconds of each process"), table(results),
+                   args.update_docs)
     over = over_budget(results)
     for line in over:
         print(f"over budget: {line}")

@@ -15,14 +15,14 @@ as the FMU's one-piece parameters or as a ``layout`` (the native target: 20 ms f
 
 from __future__ import annotations
 
-import os
 import tempfile
 import time
 from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from benchmarks.timing import best_of, machine
+from benchmarks import report
+from benchmarks.timing import best_of
 from driveline.rotor import (
     Bearing,
     ConcentratedMass,
@@ -58,11 +58,10 @@ CASES = {
 }
 
 
-def main() -> None:
-    print(f"One structural analysis of CriticalSpeeds (CPU time [s]); {machine()}, "
-          f"load average {os.getloadavg()[0]:.1f}")
-    print("| driveline | structure | whirl table | resonances | analysis | target |")
-    print("|---|---|---|---|---|---|")
+def analysis_table(update_docs: bool) -> None:
+    measurement = report.Measurement()
+    lines = ["| driveline | structure [s] | whirl table [s] | resonances [s] | analysis [s] | target [s] |",
+             "|---|---|---|---|---|---|"]
     for name, (build, target) in CASES.items():
         driveline = build()
         structure = analyse_structure(driveline)
@@ -72,7 +71,9 @@ def main() -> None:
         for part in parts:
             part()  # warm-up
             seconds.append(best_of(part, repeats=5, clock=time.process_time))
-        print(f"| {name} | " + " | ".join(f"{s:.3f}" for s in seconds) + f" | {'' if target is None else target} |")
+        lines.append(f"| {name} | " + " | ".join(f"{s:.3f}" for s in seconds) + f" | {target or ''} |")
+    report.publish("benchmark-critical-speeds-analysis", measurement.stamp("CPU time, best of five after a warm-up"),
+                   "\n".join(lines), update_docs)
 
 
 #: The drivelines above as FMU parameters: the defaults, a shipped layout, a layout file (20 segments).
@@ -116,23 +117,27 @@ def initialisation_seconds(path: Path, parameters: dict[str, object], work: Path
     return best_of(initialise, repeats=5, clock=time.process_time)
 
 
-def fmu_table() -> None:
+def fmu_table(update_docs: bool) -> None:
+    measurement = report.Measurement()
     with tempfile.TemporaryDirectory() as folder:
         work = Path(folder)
         layout = work / "twenty_segments.toml"
         layout.write_text(TWENTY_SEGMENTS_TOML)
-        families = {"native": native.build(MODEL, work / "models", release=False), "Python": build_fmu(MODEL, work / "models")}
-        cases = {"one-piece tube": {}, "two-piece example": {"layout": "two_piece_propshaft"},
-                 "20 segments (layout file)": {"layout": str(layout)}}
-        print(f"\nInitialisation of the CriticalSpeeds FMUs, FMI 2.0 (CPU time [s]); {machine()}, "
-              f"load average {os.getloadavg()[0]:.1f}")
-        print("| driveline | native FMU | Python FMU | Python / native |")
-        print("|---|---|---|---|")
+        families = {"native": native.build(MODEL, work / "models", release=False),
+                    "Python": build_fmu(MODEL, work / "models")}
+        cases = {"one-piece tube (the defaults)": {},
+                 "two-piece example (`layout = \"two_piece_propshaft\"`)": {"layout": "two_piece_propshaft"},
+                 "20 segments with 21 joint masses (a layout file)": {"layout": str(layout)}}
+        lines = ["| driveline | native FMU [ms] | Python FMU [ms] | Python / native |", "|---|---|---|---|"]
         for name, parameters in cases.items():
             native_s, python_s = (initialisation_seconds(path, parameters, work) for path in families.values())
-            print(f"| {name} | {native_s:.4f} | {python_s:.3f} | {python_s / native_s:.0f} |")
+            lines.append(f"| {name} | {native_s * 1e3:.1f} | {python_s * 1e3:.0f} | {python_s / native_s:.1f} |")
+    report.publish("benchmark-critical-speeds-initialisation", measurement.stamp(
+        "FMI 2.0, CPU time, best of five after a warm-up"), "\n".join(lines), update_docs)
 
 
 if __name__ == "__main__":
-    main()
-    fmu_table()
+    update_docs = report.parser(__doc__.splitlines()[0]).parse_args().update_docs
+    analysis_table(update_docs)
+    print()
+    fmu_table(update_docs)

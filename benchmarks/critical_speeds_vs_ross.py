@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from benchmarks.timing import best_of, machine
+from benchmarks import report
+from benchmarks.timing import best_of
 from driveline.rotor import Driveline, one_piece_shaft
 from tests.support.ross_reference import E, RHO, ross_forward_critical_speeds
 
@@ -32,17 +33,20 @@ def ross() -> np.ndarray:
 
 
 def main() -> None:
+    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    measurement = report.Measurement()
     reference, result = ross(), ours()  # warm-up, and the agreement check
     difference = np.abs(result - reference) / reference
     if difference.max() > AGREEMENT:
         raise SystemExit(f"results disagree: ours {result}, ROSS {reference}")
     ours_time, ross_time = best_of(ours, repeats=20), best_of(ross, repeats=3)
-    print(f"First three forward critical speeds of the tube propshaft; {machine()}")
-    print("| method | time [ms] | critical speeds [rad/s] |")
-    print("|---|---|---|")
-    print(f"| transfer matrix (ours) | {ours_time * 1e3:.1f} | {', '.join(f'{w:.2f}' for w in result)} |")
-    print(f"| ROSS run_critical_speed | {ross_time * 1e3:.0f} | {', '.join(f'{w:.2f}' for w in reference)} |")
-    print(f"ratio {ross_time / ours_time:.0f}x, largest relative difference {difference.max():.1e}")
+    lines = ["| method | time [ms] | critical speeds [rad/s] |", "|---|---|---|",
+             f"| transfer matrix (ours) | {ours_time * 1e3:.1f} | {', '.join(f'{w:.2f}' for w in result)} |",
+             f"| ROSS run_critical_speed | {ross_time * 1e3:.0f} | {', '.join(f'{w:.2f}' for w in reference)} |",
+             f"\nROSS takes {ross_time / ours_time:.0f} times as long; the largest relative difference is "
+             f"{difference.max():.1e}."]
+    report.publish("benchmark-critical-speeds-vs-ross", measurement.stamp(
+        "wall time after a warm-up, ours best of 20, ROSS best of 3"), "\n".join(lines), args.update_docs)
 
 
 if __name__ == "__main__":

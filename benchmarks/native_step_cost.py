@@ -19,13 +19,14 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from benchmarks.step_cost import VARIANTS, Stepper, best_alternating
-from benchmarks.timing import machine
+from benchmarks import report
+from benchmarks.step_cost import ROUNDS, STEPS, VARIANTS, Stepper, best_alternating
 from driveline.catalog import MODELS
 from fmu_harness.packaging import build, native, toolchain
 
 HERE = Path(__file__).resolve().parent
 C_STEPS, C_ROUNDS = 200_000, 7
+ANALYSIS = "CriticalSpeeds"  # its step solves the damped model's response: apart in the summary
 
 
 def compile_timer(folder: Path) -> Path:
@@ -54,10 +55,12 @@ def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path, integers: dict[str
 
 
 def main() -> None:
-    print(f"Per-step cost (set inputs, doStep, get outputs); {machine()}")
-    print("| FMU | FMI | variant | native via fmpy us | no-physics twin via fmpy us | ratio | Python FMU via fmpy us "
-          "| native from C ns | no-physics twin from C ns |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    measurement = report.Measurement()
+    lines = ["| FMU | FMI | variant | native via fmpy µs | no-physics twin via fmpy µs | ratio | Python FMU via fmpy µs "
+             "| Python / native | native from C ns | no-physics twin from C ns |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    ratios: dict[str, list[float]] = {"twin": [], "analysis twin": [], "Python": [], "C": []}
     with tempfile.TemporaryDirectory() as folder:
         dest = Path(folder)
         timer = compile_timer(dest)
@@ -67,13 +70,24 @@ def main() -> None:
                 fmu = native.build(name, dest, fmi, release=False)
                 twin = native.build(name, dest / "twin", fmi, HERE / "native_minimal.c", release=False)
                 python_fmu = build(name, dest / "python", fmi)
-                for variant, values in VARIANTS.get(name, {"default": {}}).items():
+                for variant, values in VARIANTS.get(name, {"": {}}).items():
                     ours, floor, python = best_alternating([Stepper(path, values, inputs)
                                                             for path in (fmu, twin, python_fmu)])
                     c_ours = c_host_cost(timer, fmu, fmi, dest / f"c_{name}_{fmi}_{variant}", values)
                     c_floor = c_host_cost(timer, twin, fmi, dest / f"c_twin_{name}_{fmi}_{variant}", values)
-                    print(f"| {name} | {fmi}.0 | {variant} | {ours:.2f} | {floor:.2f} | {ours / floor:.2f} "
-                          f"| {python:.1f} | {c_ours:.0f} | {c_floor:.0f} |", flush=True)
+                    ratios["analysis twin" if name == ANALYSIS else "twin"].append(ours / floor)
+                    ratios["Python"].append(python / ours)
+                    ratios["C"].append(c_ours)
+                    lines.append(f"| {name} | {fmi}.0 | {variant} | {ours:.2f} | {floor:.2f} | {ours / floor:.2f} "
+                                 f"| {python:.1f} | {python / ours:.1f} | {c_ours:.0f} | {c_floor:.0f} |")
+    span = lambda values, digits: f"{min(values):.{digits}f} to {max(values):.{digits}f}"  # noqa: E731
+    lines.append(f"\nThrough fmpy a native step costs {span(ratios['twin'], 2)} times its no-physics twin's, "
+                 f"{ANALYSIS} {span(ratios['analysis twin'], 2)} times, and the Python FMU's "
+                 f"{span(ratios['Python'], 1)} times the native one's; from C a step costs "
+                 f"{span([ns / 1e3 for ns in ratios['C']], 2)} µs.")
+    report.publish("benchmark-native-step-cost", measurement.stamp(
+        f"CPU time, via fmpy best of {ROUNDS} alternating rounds of {STEPS} steps, from C best of {C_ROUNDS} rounds "
+        f"of {C_STEPS} steps"), "\n".join(lines), args.update_docs)
 
 
 if __name__ == "__main__":

@@ -7,11 +7,11 @@ API. The resident set is read after a warm-up of 10^4 steps and at the end.
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
-from benchmarks.timing import machine, resident_set_bytes
+from benchmarks import report
+from benchmarks.timing import resident_set_bytes
 from fmu_harness.runs.runner import FmuInstance
 
 WARM_UP = 10_000
@@ -35,16 +35,21 @@ def soak(path: Path, steps: int) -> tuple[float, int, int]:
         return time.perf_counter() - start, warm, resident_set_bytes()
 
 
-def main(steps: int = 1_000_000, models: Path = Path("models")) -> None:
-    print(f"Soak: {steps} steps per FMU, one process; {machine()}")
-    print("| FMU | FMI | wall time [s] | us/step | RSS after warm-up [MiB] | RSS growth [KiB] |")
-    print("|---|---|---|---|---|---|")
-    for folder, version in ((models, "2.0"), (models / "fmi3", "3.0")):
+def main() -> None:
+    arguments = report.parser(__doc__.splitlines()[0])
+    arguments.add_argument("steps", nargs="?", type=int, default=1_000_000, help="steps per FMU")
+    arguments.add_argument("models", nargs="?", type=Path, default=Path("models"), help="folder of the FMUs")
+    args = arguments.parse_args()
+    measurement = report.Measurement()
+    lines = ["| FMU | FMI | wall time [s] | µs/step | RSS after warm-up [MiB] | RSS growth [KiB] |", "|---|---|---|---|---|---|"]
+    for folder, version in ((args.models, "2.0"), (args.models / "fmi3", "3.0")):
         for path in sorted(folder.glob("*.fmu")):
-            seconds, warm, end = soak(path, steps)
-            print(f"| {path.stem} | {version} | {seconds:.1f} | {seconds / steps * 1e6:.1f} | "
-                  f"{warm / 2**20:.1f} | {(end - warm) / 2**10:.0f} |", flush=True)
+            seconds, warm, end = soak(path, args.steps)
+            lines.append(f"| {path.stem} | {version} | {seconds:.1f} | {seconds / args.steps * 1e6:.1f} | "
+                         f"{warm / 2**20:.1f} | {(end - warm) / 2**10:.0f} |")
+    report.publish("benchmark-soak", measurement.stamp(f"{args.steps} steps per FMU after {WARM_UP} warm-up steps, "
+                                                       "one process"), "\n".join(lines), args.update_docs)
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 1_000_000, Path(sys.argv[2]) if len(sys.argv) > 2 else Path("models"))
+    main()

@@ -18,8 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from benchmarks import minimal_models
-from benchmarks.timing import machine
+from benchmarks import minimal_models, report
 from driveline.catalog import MODELS
 from fmu_harness.packaging import build
 from fmu_harness.runs.runner import Fmi3Instance, FmuInstance
@@ -104,10 +103,12 @@ def best_alternating(steppers: list[Stepper | HarnessStepper]) -> list[float]:
 
 
 def main() -> None:
-    print(f"Per-step cost (set inputs, doStep, get outputs) via fmpy and via the harness; {machine()}")
-    print("| FMU | FMI | variant | fmpy batched us/step | minimal twin us/step | model/twin | "
-          "harness, constant inputs us/step | harness/fmpy | harness, inputs f(t) us/step | harness/fmpy |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    measurement = report.Measurement()
+    lines = ["| FMU | FMI | variant | fmpy batched µs/step | minimal twin µs/step | model/twin | "
+             "harness, constant inputs µs/step | harness/fmpy | harness, inputs f(t) µs/step | harness/fmpy |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    twin_ratios, harness_ratios = [], []
     with tempfile.TemporaryDirectory() as folder:
         dest = Path(folder)
         for fmi in ("2", "3"):
@@ -116,10 +117,16 @@ def main() -> None:
                 twin_name = f"Minimal{name}"
                 twin = build(twin_name, dest, fmi, getattr(minimal_models, twin_name))
                 inputs = [v.name for v in model.spec.of("input")]
-                for variant, start_values in VARIANTS.get(name, {"default": {}}).items():
+                for variant, start_values in VARIANTS.get(name, {"": {}}).items():
                     ours, floor, constant, varying = compare(fmu, twin, start_values, inputs)
-                    print(f"| {name} | {fmi}.0 | {variant} | {ours:.1f} | {floor:.1f} | {ours / floor:.2f} | "
-                          f"{constant:.1f} | {constant / ours:.2f} | {varying:.1f} | {varying / ours:.2f} |", flush=True)
+                    twin_ratios.append(ours / floor)
+                    harness_ratios += [constant / ours, varying / ours]
+                    lines.append(f"| {name} | {fmi}.0 | {variant} | {ours:.1f} | {floor:.1f} | {ours / floor:.2f} | "
+                                 f"{constant:.1f} | {constant / ours:.2f} | {varying:.1f} | {varying / ours:.2f} |")
+    lines.append(f"\nA step costs {min(twin_ratios):.2f} to {max(twin_ratios):.2f} times the minimal twin's; through "
+                 f"the harness {min(harness_ratios):.2f} to {max(harness_ratios):.2f} times the batched fmpy loop.")
+    report.publish("benchmark-step-cost", measurement.stamp(f"CPU time, best of {ROUNDS} alternating rounds "
+                                                            f"of {STEPS} steps"), "\n".join(lines), args.update_docs)
 
 
 if __name__ == "__main__":

@@ -9,10 +9,10 @@ alternating measurements is printed, which damps the noise of other load on the 
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path
 
+from benchmarks import report
 from fmu_harness.runs.sweep import Timing, grid, open_client, sweep
 
 AXES = {
@@ -39,16 +39,18 @@ def wall_time(fmu: Path, workers: int) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = report.parser(__doc__.splitlines()[0])
     parser.add_argument("--fmu", type=Path, default=Path("models") / "TripodCoupling.fmu")
     parser.add_argument("--repeat", type=int, default=3, help="measurements per cluster size")
     args = parser.parse_args()
+    measurement = report.Measurement()
     times = [(wall_time(args.fmu, 1), wall_time(args.fmu, 2)) for _ in range(args.repeat)]
     one, two = (min(column) for column in zip(*times))
-    print(f"{len(grid(AXES))} runs of {args.fmu.stem}, best of {args.repeat}")
-    print(f"1 worker : {one:.2f} s")
-    print(f"2 workers: {two:.2f} s")
-    print(f"speed-up : {one / two:.2f}x")
+    lines = ["| workers | wall time [s] |", "|---|---|", f"| 1 | {one:.2f} |", f"| 2 | {two:.2f} |",
+             f"\nSpeed-up with 2 workers: {one / two:.2f}x."]
+    report.publish("benchmark-sweep-scaling", measurement.stamp(
+        f"{len(grid(AXES))} runs of {args.fmu.stem}, best of {args.repeat} alternating measurements"),
+        "\n".join(lines), args.update_docs)
 
 
 if __name__ == "__main__":

@@ -9,12 +9,12 @@ difference between the two results.
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from benchmarks.timing import best_of, machine
+from benchmarks import report
+from benchmarks.timing import best_of
 from driveline.tripod.outputs import coupling_outputs
 from fmu_harness.runs.runner import FmuInstance
 
@@ -48,21 +48,24 @@ def vectorised(kinematics: int) -> np.ndarray:
     return np.column_stack([values["phi_out"], values["omega_out"], values["Rz_out"]])
 
 
-def main(models: Path = Path("models")) -> list[tuple[str, float, float, float, float]]:
-    rows = []
+def main() -> None:
+    arguments = report.parser(__doc__.splitlines()[0])
+    arguments.add_argument("models", nargs="?", type=Path, default=Path("models"), help="folder of the FMI 2.0 FMUs")
+    args = arguments.parse_args()
+    measurement = report.Measurement()
+    fmu = args.models / "TripodCoupling.fmu"
+    lines = ["| kinematics | FMU stepping [s] | vectorised core [s] | ratio | max difference |",
+             "|---|---|---|---|---|"]
     for kinematics, label in ((0, "closed form"), (1, "exact")):
-        fmu_time = best_of(lambda: stepped(models / "TripodCoupling.fmu", kinematics), repeats=2)
+        fmu_time = best_of(lambda: stepped(fmu, kinematics), repeats=2)
         array_time = best_of(lambda: vectorised(kinematics), repeats=5)
-        difference = np.abs(stepped(models / "TripodCoupling.fmu", kinematics) - vectorised(kinematics)).max()
-        rows.append((label, fmu_time, array_time, fmu_time / array_time, difference))
-    points = len(BETAS) * STEPS
-    print(f"TripodCoupling, {points} points ({len(BETAS)} bend angles x {STEPS} per turn); {machine()}")
-    print("| kinematics | FMU stepping [s] | vectorised core [s] | ratio | max difference |")
-    print("|---|---|---|---|---|")
-    for label, fmu_time, array_time, ratio, difference in rows:
-        print(f"| {label} | {fmu_time:.3f} | {array_time:.4f} | {ratio:.0f}x | {difference:.1e} |")
-    return rows
+        difference = np.abs(stepped(fmu, kinematics) - vectorised(kinematics)).max()
+        ratio = fmu_time / array_time
+        lines.append(f"| {label} | {fmu_time:.3f} | {array_time:.4f} | {ratio:.0f}x | {difference:.1e} |")
+    report.publish("benchmark-vectorised", measurement.stamp(
+        f"TripodCoupling, {len(BETAS) * STEPS} points ({len(BETAS)} bend angles x {STEPS} steps of one turn), "
+        "wall time, FMU best of 2, core best of 5"), "\n".join(lines), args.update_docs)
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("models"))
+    main()
