@@ -13,9 +13,12 @@
  *   campbell.c   whirl branches over the speed and the Campbell table
  *   fem.c        finite-element model: the plausibility check's natural frequencies
  *   damped.c     damped finite-element model: damped modes, unbalance response, bearing forces
- * Every function that can fail returns 0 (ERROR_NONE) on success, or the kind of the failure (a
- * negative ErrorKind of driveline_constants.h; -1 is ERROR_VALUE) with a message in ``error``
- * (``size`` bytes, always terminated) worded as the Python core's exception text. No global state.
+ * Every function that fails with a message returns ErrorKind (driveline_constants.h): ERROR_NONE on
+ * success, else the kind of the failure, the exception the Python core raises there (ERROR_VALUE for
+ * its ValueErrors, and for out of memory), with the message in ``error`` (``size`` bytes, always
+ * terminated) worded as the Python core's exception text; a constructor returns NULL with the
+ * message instead (a ValueError's). A function whose int result means something else (an index, a
+ * pivot test) says so. No global state.
  */
 #ifndef ROTOR_H
 #define ROTOR_H
@@ -92,15 +95,17 @@ typedef struct {
 
 /* ---- layout.c ------------------------------------------------------------------------------ */
 void driveline_free(Driveline *driveline);
-/* loader.one_piece_shaft */
-int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error, size_t size);
+/* loader.one_piece_shaft; ERROR_NONE, or ERROR_VALUE with the message */
+ErrorKind driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error, size_t size);
 /* model.build_driveline for a non-empty ``layout``: a file path ending in ".toml" (any case; relative
  * to the working directory; messages name it by its absolute path, as pathlib's absolute()) or the
- * name of a description shipped in ``resources`` (the FMU's resources folder: loader.example_path). */
-int driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size);
-/* loader.loads_driveline: TOML text (``length`` bytes, not necessarily terminated) from ``source``. */
-int driveline_from_text(const char *text, size_t length, const char *source, Driveline *out, char *error,
-                        size_t size);
+ * name of a description shipped in ``resources`` (the FMU's resources folder: loader.example_path).
+ * ERROR_NONE, or the failure's kind (ERROR_VALUE; the length's math.fsum its own) with the message. */
+ErrorKind driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size);
+/* loader.loads_driveline: TOML text (``length`` bytes, not necessarily terminated) from ``source``;
+ * returns as driveline_from_layout. */
+ErrorKind driveline_from_text(const char *text, size_t length, const char *source, Driveline *out, char *error,
+                              size_t size);
 /* Driveline.length (math.fsum of the segment lengths) */
 double driveline_length(const Driveline *driveline);
 /* Driveline.is_isotropic: every bearing has kxx == kyy */
@@ -145,13 +150,14 @@ typedef struct {
 
 void rotor_roots_free(RotorRoots *roots, int m);
 /* Driveline._line_roots: ``x_max`` > 0: every root up to x_max (``coarse`` per line, NULL: none
- * coarse); x_max = 0: the first ``n`` below ``limit``. ``roots`` has ``m`` entries. */
-int rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
-                     const unsigned char *coarse, RotorRoots *roots, char *error, size_t size);
+ * coarse); x_max = 0: the first ``n`` below ``limit``. ``roots`` has ``m`` entries. ERROR_NONE, or
+ * ERROR_VALUE with the message (a bad n, x_max or limit; the refinement not converging; out of memory). */
+ErrorKind rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
+                           const unsigned char *coarse, RotorRoots *roots, char *error, size_t size);
 /* Driveline._roots_by_whirl for both senses: ``forward`` and ``backward`` have ``m`` entries;
- * n = 0 means all up to x_max. */
-int rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
-                         RotorRoots *forward, RotorRoots *backward, char *error, size_t size);
+ * n = 0 means all up to x_max. Returns as rotor_line_roots. */
+ErrorKind rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
+                               RotorRoots *forward, RotorRoots *backward, char *error, size_t size);
 
 /* driveline.OrderResonance; whirl 1 forward, -1 backward */
 typedef struct {
@@ -162,11 +168,14 @@ typedef struct {
 #define WHIRL_FORWARD 1
 #define WHIRL_BACKWARD 2
 /* Driveline.order_resonances(orders, whirls (WHIRL_* bits, forward first), n (0: all up to
- * spin_max), spin_max (0: none), limit), sorted by (spin, order); *found is owned (free()). */
-int rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n, double spin_max,
-                           double limit, OrderResonance **found, int *count, char *error, size_t size);
-/* Driveline.critical_speeds(n) (forward: unbalance_critical_speeds); ``spins`` holds n. */
-int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size);
+ * spin_max), spin_max (0: none), limit), sorted by (spin, order); *found is owned (free()).
+ * Returns as rotor_line_roots (an order < 1 is a ValueError too). */
+ErrorKind rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n,
+                                 double spin_max, double limit, OrderResonance **found, int *count, char *error,
+                                 size_t size);
+/* Driveline.critical_speeds(n) (forward: unbalance_critical_speeds); ``spins`` holds n. Returns as
+ * rotor_line_roots. */
+ErrorKind rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size);
 
 /* ---- spline.c: scipy.interpolate.CubicSpline(x, y) (not-a-knot), y of shape (n, m) -------- */
 typedef struct {
@@ -175,6 +184,7 @@ typedef struct {
     double *c; /* (n - 1) intervals x 4 powers x m columns */
 } CubicSpline;
 
+/* 0, or -1 (no message) for fewer than two knots, knots not finite and increasing, or out of memory */
 int cubic_spline_build(CubicSpline *spline, int n, const double *x, int m, const double *y);
 /* All m columns at ``x`` (extrapolated beyond the ends, as scipy's). */
 void cubic_spline_evaluate(const CubicSpline *spline, double x, double *out);
@@ -207,16 +217,18 @@ typedef struct {
 
 /* fem.elements_by_length: ``counts`` has n_segments entries */
 void fe_elements_by_length(const Driveline *driveline, int most, int *counts);
-/* fem.mesh(driveline, counts, undamped = with_bearings) and its kept K, M, G (fem.assemble) */
-int fe_model_build(const Driveline *driveline, const int *counts, int with_bearings, FeModel *model, char *error,
-                   size_t size);
+/* fem.mesh(driveline, counts, undamped = with_bearings) and its kept K, M, G (fem.assemble); ERROR_NONE,
+ * or ERROR_VALUE with the message (anisotropic bearings with ``with_bearings``, out of memory) */
+ErrorKind fe_model_build(const Driveline *driveline, const int *counts, int with_bearings, FeModel *model, char *error,
+                         size_t size);
 void fe_model_free(FeModel *model);
 
 /* model.natural_frequencies: sqrt|eigenvalues| of the undamped FE model with ``elements``
  * elements per segment (both planes for anisotropic bearings: the kxx plane first, each plane
- * ascending); *frequencies is owned (free()). */
-int fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count, char *error,
-                           size_t size);
+ * ascending); *frequencies is owned (free()). ERROR_NONE; ERROR_ZERO_DIVISION for no elements; else
+ * ERROR_VALUE with the message (scipy.linalg.eigh's LinAlgError and its checks, out of memory). */
+ErrorKind fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count,
+                                 char *error, size_t size);
 
 typedef struct UnbalanceOutputs UnbalanceOutputs;
 /* unbalance_outputs.UnbalanceOutputs.build; the mode table from the dense eigensolver up to DENSE_SIZE

@@ -67,8 +67,8 @@ void text_put_str_repr(Text *text, const char *bytes, size_t count);
 void text_put_float(Text *text, double value);
 void text_put_repr(Text *text, const Value *value);
 /* The message into ``error``: ``format`` with %s (C string), %d (int), %v (a Value's repr), %g (a
- * double's repr), %r (a C string's repr). Returns -1. */
-int layout_error(char *error, size_t size, const char *format, ...);
+ * double's repr), %r (a C string's repr). Returns ERROR_VALUE: the loader raises ValueError only. */
+ErrorKind layout_error(char *error, size_t size, const char *format, ...);
 
 /* tomllib.loads of ``text`` (``length`` bytes of UTF-8): the document's table, built in ``arena``
  * (which the caller frees, also on failure), or NULL with the message ``source``: malformed TOML: ... */

@@ -717,22 +717,24 @@ void chain_free(Chain *chain)
     }
 }
 
-static int check_node(const char *kind, int i, int node, int n_nodes, int inner, char *error, size_t size)
+/* Driveline.__post_init__'s check of a point element's node (``inner``: a hinge's); ERROR_NONE, or
+ * ERROR_VALUE with the message */
+static ErrorKind check_node(const char *kind, int i, int node, int n_nodes, int inner, char *error, size_t size)
 {
     if (node < 0 || node >= n_nodes) {
         if (error != NULL && size > 0) {
             snprintf(error, size, "%s[%d].node = %d is out of range: nodes are 0..%d", kind, i, node, n_nodes - 1);
         }
-        return -1;
+        return ERROR_VALUE;
     }
     if (inner && (node == 0 || node == n_nodes - 1)) {
         if (error != NULL && size > 0) {
             snprintf(error, size, "%s[%d].node = %d: a hinge must sit at an inner node (1..%d), not at an end", kind,
                      i, node, n_nodes - 2);
         }
-        return -1;
+        return ERROR_VALUE;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* ShaftSegment's derived constants the transfer matrices use */
