@@ -438,16 +438,17 @@ static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int
         response = 0;
     char shown[40], stage[80];
     size_t used;
-    ErrorKind failed;
-    Chain *chain = chain_new(driveline, error, ERROR_SIZE);
+    Chain *chain;
+    ErrorKind failed = chain_new(driveline, &chain, error, ERROR_SIZE);
     counts = malloc(((size_t)driveline->n_segments + 1) * sizeof *counts);
-    if (chain == NULL || counts == NULL) {
+    if (failed != ERROR_NONE || counts == NULL) {
         chain_free(chain);
         free(counts);
-        if (chain != NULL) {
+        if (failed == ERROR_NONE) {
             snprintf(error, ERROR_SIZE, "out of memory");
+            failed = ERROR_VALUE;
         }
-        return ERROR_VALUE; /* chain_new's refusal or out of memory */
+        return failed;
     }
     isotropic = chain_isotropic(chain);
     freedoms = chain_freedoms(chain);
@@ -519,9 +520,9 @@ static ErrorKind analyse_structure(Analysis *analysis, char *error)
     double spins[3];
     int count = 0, i;
     ErrorKind failed;
-    analysis->chain = chain_new(&analysis->driveline, error, ERROR_SIZE);
-    if (analysis->chain == NULL) {
-        return ERROR_VALUE;
+    failed = chain_new(&analysis->driveline, &analysis->chain, error, ERROR_SIZE);
+    if (failed) {
+        return failed;
     }
     failed = rotor_critical_speeds(analysis->chain, 3, spins, &count, error, ERROR_SIZE);
     if (failed) {
@@ -610,7 +611,7 @@ static ErrorKind resonances(Analysis *analysis, const int *orders, int n_orders,
 }
 
 /* The unbalance outputs: a layout's own unbalances, or the one-piece tube's single unbalance;
- * ERROR_NONE, else ERROR_VALUE with the message (a ValueError's: unbalance_outputs_new's NULL). */
+ * ERROR_NONE, else the failure's kind with the message (ERROR_VALUE for a position off the shaft). */
 static ErrorKind unbalance_outputs(Analysis *analysis, const ModelData *data, char *error)
 {
     RotorUnbalance single;
@@ -629,9 +630,8 @@ static ErrorKind unbalance_outputs(Analysis *analysis, const ModelData *data, ch
         unbalances = &single;
         count = 1;
     }
-    analysis->unbalance = unbalance_outputs_new(&analysis->driveline, unbalances, count, VALUE(response_position),
-                                                VALUE(omega_max), error, ERROR_SIZE);
-    return analysis->unbalance != NULL ? ERROR_NONE : ERROR_VALUE;
+    return unbalance_outputs_new(&analysis->driveline, unbalances, count, VALUE(response_position), VALUE(omega_max),
+                                 &analysis->unbalance, error, ERROR_SIZE);
 }
 
 /* One part: kept when its key is unchanged, else dropped and computed anew (kept on success only). */
@@ -651,10 +651,9 @@ static ErrorKind part(Analysis *analysis, const ModelData *data, Part which, con
         failed = analyse_structure(analysis, error);
         break;
     case PART_WHIRL:
-        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
-                                          ROTOR_MODEL_WHIRL_MODES, error,
-                                          ERROR_SIZE);
-        failed = analysis->whirl == NULL ? ERROR_VALUE : implausibility(analysis, error);
+        failed = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
+                                 ROTOR_MODEL_WHIRL_MODES, &analysis->whirl, error, ERROR_SIZE);
+        failed = failed ? failed : implausibility(analysis, error);
         break;
     case PART_RESONANCES:
         failed = resonances(analysis, orders, n_orders, VALUE(omega_max), error);

@@ -101,8 +101,8 @@ def test_the_rule_of_which_parameter_redoes_which_analysis_part_is_generated_fro
 #: A comment, a string or a character literal of C (blanked before the functions are looked for).
 C_NOISE = re.compile(r"/\*.*?\*/|//[^\n]*|\"(?:\\.|[^\"\\\n])*\"|'(?:\\.|[^'\\\n])*'", re.DOTALL)
 #: A function definition's head: its return type, name and parameters, up to the opening brace.
-C_FUNCTION = re.compile(r"^(?:static\s+)?(?P<type>[A-Za-z_][\w \t*]*?)\s*\b(?P<name>\w+)\((?P<parameters>[^;{}()]*)\)\s*\{",
-                        re.MULTILINE)
+C_FUNCTION = re.compile(r"^(?:static\s+)?(?P<type>[A-Za-z_][\w \t*]*?)\s*\b(?P<name>\w+)"
+                        r"\((?P<parameters>[^;{}()]*)\)\s*\{", re.MULTILINE)
 
 
 def _c_functions(text: str) -> list[tuple[str, str, str, str]]:
@@ -122,7 +122,8 @@ def _c_functions(text: str) -> list[tuple[str, str, str, str]]:
 def _kind_seams(sources: dict[str, str]) -> list[tuple[str, str, str]]:
     """(file, function, what) of every failure that is not returned as its ErrorKind: a ``return -1``
     in a function returning ErrorKind, an int function that writes a message (it takes ``char *error``,
-    or calls ROTOR_ERROR or a function that writes one), a cast to ErrorKind."""
+    or calls ROTOR_ERROR or a function that writes one), another type of function that takes ``char
+    *error`` (a constructor returning NULL), a cast to ErrorKind."""
     functions = [(path, *function) for path, text in sources.items() for function in _c_functions(text)]
     writers = {"ROTOR_ERROR"} | {name for _, _, name, parameters, _ in functions
                                  if re.search(r"\bchar\s*\*\s*error\b", parameters)}
@@ -133,11 +134,13 @@ def _kind_seams(sources: dict[str, str]) -> list[tuple[str, str, str]]:
             break
         writers |= more
     seams = []
-    for path, kind, name, _, body in functions:
+    for path, kind, name, parameters, body in functions:
         if kind == "ErrorKind" and re.search(r"\breturn\s*\(?\s*-\s*1\s*\)?\s*;", body):
             seams.append((path, name, "returns -1"))
         if kind == "int" and name in writers:
             seams.append((path, name, "int with a message"))
+        elif kind != "ErrorKind" and re.search(r"\bchar\s*\*\s*error\b", parameters):
+            seams.append((path, name, f"{kind} with a message"))
     seams += [(path, "", "casts to ErrorKind") for path, text in sources.items()
               if re.search(r"\(\s*ErrorKind\s*\)", C_NOISE.sub(" ", text))]
     return seams
@@ -191,8 +194,14 @@ static ErrorKind part(char *error)
 {
     return (ErrorKind)fe_natural_frequencies(error); /* return -1; */
 }
+
+Chain *chain_new(const Driveline *driveline, char *error, size_t size)
+{
+    return NULL;
+}
 """
     assert _kind_seams({"model.c": written}) == [("model.c", "layout_error", "int with a message"),
                                                  ("model.c", "number", "int with a message"),
                                                  ("model.c", "searched_modes", "returns -1"),
+                                                 ("model.c", "chain_new", "Chain * with a message"),
                                                  ("model.c", "", "casts to ErrorKind")]

@@ -90,8 +90,8 @@ def library(tmp_path_factory):
     declare(lib, {
         "fe_natural_frequencies": (ErrorKind, [driveline_p, ctypes.c_int, P(DOUBLE_P), P(ctypes.c_int), error,
                                                size]),
-        "unbalance_outputs_new": (outputs_p, [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double,
-                                              ctypes.c_double, error, size]),
+        "unbalance_outputs_new": (ErrorKind, [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double,
+                                              ctypes.c_double, P(outputs_p), error, size]),
         "unbalance_outputs_evaluate": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
         "unbalance_outputs_modes": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
         "unbalance_outputs_free": (None, [outputs_p]),
@@ -115,9 +115,11 @@ def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds,
     also its mode table (the damped frequencies, then the damping ratios)."""
     c = c_driveline(d)
     excited = unbalances(items)
-    error = ctypes.create_string_buffer(512)
-    handle = lib.unbalance_outputs_new(ctypes.byref(c), excited, len(items), fraction, omega_max, error, 512)
-    assert handle, error.value
+    error, made = ctypes.create_string_buffer(512), ctypes.c_void_p()
+    kind = lib.unbalance_outputs_new(ctypes.byref(c), excited, len(items), fraction, omega_max, ctypes.byref(made),
+                                     error, 512)
+    assert kind == ERROR_KIND["ERROR_NONE"], error.value
+    handle = made.value
     try:
         out, modes = (ctypes.c_double * 3)(), (ctypes.c_double * (2 * DAMPED_MODES))()
         rows = []
@@ -264,6 +266,6 @@ def test_refusals_are_worded_as_pythons(library, omega_max):
         UnbalanceOutputs.build(DEFAULT, excitation(DEFAULT), 0.5, omega_max)
     c = c_driveline(DEFAULT)
     excited = unbalances(excitation(DEFAULT))
-    error = ctypes.create_string_buffer(512)
-    assert not library.unbalance_outputs_new(ctypes.byref(c), excited, 1, 0.5, omega_max, error, 512)
-    assert error.value.decode() == str(refused.value)
+    error, made = ctypes.create_string_buffer(512), ctypes.c_void_p()
+    kind = library.unbalance_outputs_new(ctypes.byref(c), excited, 1, 0.5, omega_max, ctypes.byref(made), error, 512)
+    assert (kind, made.value, error.value.decode()) == (ERROR_KIND["ERROR_VALUE"], None, str(refused.value))

@@ -94,10 +94,12 @@ class NativeChain:
     def __init__(self, lib: ctypes.CDLL, driveline: Driveline) -> None:
         self.lib = lib
         self.struct = c_driveline(driveline)
-        error = ctypes.create_string_buffer(ERROR_SIZE)
-        self.pointer = lib.chain_new(ctypes.byref(self.struct), error, ERROR_SIZE)
-        if not self.pointer:
-            raise ValueError(error.value.decode())
+        error, chain = ctypes.create_string_buffer(ERROR_SIZE), ctypes.c_void_p()
+        kind = lib.chain_new(ctypes.byref(self.struct), ctypes.byref(chain), error, ERROR_SIZE)
+        if kind != ERROR_KIND["ERROR_NONE"]:
+            assert not chain
+            raise raised(kind, error.value.decode())
+        self.pointer = chain.value
 
     def __del__(self) -> None:
         if getattr(self, "pointer", None):

@@ -116,7 +116,7 @@ class OnePieceShaft(ctypes.Structure):
 
 #: The signatures of the chain functions (transfer.c) that take a driveline.
 CHAIN_SIGNATURES = {
-    "chain_new": (ctypes.c_void_p, [P(CDriveline), ctypes.c_char_p, ctypes.c_size_t]),
+    "chain_new": (ErrorKind, [P(CDriveline), P(ctypes.c_void_p), ctypes.c_char_p, ctypes.c_size_t]),
     "chain_free": (None, [ctypes.c_void_p]),
 }
 

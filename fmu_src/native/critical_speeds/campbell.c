@@ -121,7 +121,8 @@ static ErrorKind roots_over_speeds(const Chain *chain, const double *spin, int c
     if (failed) {
         rotor_roots_free(roots, total);
         memset(roots, 0, (size_t)total * sizeof *roots);
-        status = rotor_line_roots(chain, lines, lines_n, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, NULL, roots, error, size);
+        status = rotor_line_roots(chain, lines, lines_n, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, NULL, roots, error,
+                                  size);
         if (status != ERROR_NONE) {
             goto done;
         }
@@ -658,23 +659,24 @@ done:
 
 /* model.whirl_table without the plausibility check: WhirlTable(whirl_branches(driveline,
  * linspace(0, omega_max, points), n_modes), n_modes, SEARCH_LIMIT). */
-WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, char *error, size_t size)
+ErrorKind whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, WhirlTable **out, char *error,
+                          size_t size)
 {
+    *out = NULL;
     if (n_modes < 1) {
         snprintf(error, size, "n_modes must be a positive integer, got %d", n_modes);
-        return NULL;
+        return ERROR_VALUE;
     }
     if (points < 2 || !isfinite(omega_max)) {
         snprintf(error, size, "spins must be at least two increasing finite speeds >= 0 rad/s");
-        return NULL;
+        return ERROR_VALUE;
     }
     double *spins = malloc((size_t)points * sizeof *spins);
     WhirlTable *table = calloc(1, sizeof *table);
     if (!spins || !table) {
         free(spins);
         free(table);
-        out_of_memory(error, size);
-        return NULL;
+        return out_of_memory(error, size);
     }
     double step = omega_max / (points - 1); /* np.linspace: start + i step, the end exact */
     for (int i = 0; i < points; ++i) {
@@ -685,7 +687,7 @@ WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, in
             snprintf(error, size, "spins must be at least two increasing finite speeds >= 0 rad/s");
             free(spins);
             free(table);
-            return NULL;
+            return ERROR_VALUE;
         }
     }
     Found found = {0, NULL, {NULL, NULL}};
@@ -714,9 +716,10 @@ WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, in
     free(spins);
     if (status != ERROR_NONE) {
         free(table);
-        return NULL;
+        return status;
     }
-    return table;
+    *out = table;
+    return ERROR_NONE;
 }
 
 /* The first ``n`` of columns [first, end) at ``speed``, ascending (np.sort(...)[:n], NaN last). */

@@ -752,16 +752,19 @@ static ErrorKind mode_table(const Driveline *d, const int *counts, const double 
 }
 
 /* UnbalanceOutputs.build */
-UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbalances, int n_unbalances,
-                                        double response_fraction, double omega_max, char *error, size_t size)
+ErrorKind unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbalances, int n_unbalances,
+                                double response_fraction, double omega_max, UnbalanceOutputs **out, char *error,
+                                size_t size)
 {
     int *counts = malloc((size_t)(d->n_segments + 1) * sizeof *counts);
     UnbalanceOutputs *outputs = calloc(1, sizeof *outputs);
+    ErrorKind failed;
+    *out = NULL;
     if (!counts || !outputs) {
         free(counts);
         free(outputs);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     double spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS], table[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
     double step = omega_max / (ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS - 1); /* numpy.linspace */
@@ -770,17 +773,17 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
     }
     spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS - 1] = omega_max;
     fe_elements_by_length(d, ROTOR_UNBALANCE_OUTPUTS_TABLE_ELEMENTS, counts);
-    if (mode_table(d, counts, spins, table, error, size)) {
+    if ((failed = mode_table(d, counts, spins, table, error, size)) != ERROR_NONE) {
         free(counts);
         free(outputs);
-        return NULL;
+        return failed;
     }
     fe_elements_by_length(d, ROTOR_UNBALANCE_OUTPUTS_FE_ELEMENTS, counts);
     Rotor *rotor = &outputs->rotor;
-    if (rotor_init(rotor, d, counts, error, size)) {
+    if ((failed = rotor_init(rotor, d, counts, error, size)) != ERROR_NONE) {
         free(counts);
         free(outputs);
-        return NULL;
+        return failed;
     }
     free(counts);
     free(rotor->K); /* the response needs the band matrices only */
@@ -798,15 +801,15 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         free(rows);
         unbalance_outputs_free(outputs);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     /* DampedRotor.load: the unbalances' phasors times their shape rows */
     double length = driveline_length(d);
     for (int u = 0; u < n_unbalances; u++) {
-        if (shape_row(rotor, unbalances[u].position, length, rows, error, size)) {
+        if ((failed = shape_row(rotor, unbalances[u].position, length, rows, error, size)) != ERROR_NONE) {
             free(rows);
             unbalance_outputs_free(outputs);
-            return NULL;
+            return failed;
         }
         cplx phasor = cplx_scale(unbalances[u].amount, cplx_expi(unbalances[u].phase));
         for (int i = 0; i < rotor->n; i++) {
@@ -814,9 +817,9 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         }
     }
     free(rows);
-    if (shape_row(rotor, response_fraction * length, length, outputs->row, error, size)) {
+    if ((failed = shape_row(rotor, response_fraction * length, length, outputs->row, error, size)) != ERROR_NONE) {
         unbalance_outputs_free(outputs);
-        return NULL;
+        return failed;
     }
     /* CubicSpline(spins, table) and its checks */
     const char *refused = NULL;
@@ -831,10 +834,11 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
                                       2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, table)) {
         memset(&outputs->modes, 0, sizeof outputs->modes);
         unbalance_outputs_free(outputs);
-        ROTOR_ERROR(error, size, refused ? refused : ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        ROTOR_ERROR(error, size, refused ? refused : ROTOR_OUT_OF_MEMORY); /* scipy's ValueError */
+        return ERROR_VALUE;
     }
-    return outputs;
+    *out = outputs;
+    return ERROR_NONE;
 }
 
 void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed,

@@ -860,10 +860,9 @@ ErrorKind driveline_from_text(const char *text, size_t length, const char *sourc
     if (toml_utf8_error((const unsigned char *)text, length, &reason) >= 0) {
         return layout_error(error, size, "%s: malformed TOML: the text is not UTF-8 (%s)", source, reason);
     }
-    root = toml_read(text, length, source, &arena, error, size);
-    if (root == NULL) { /* malformed TOML (tomllib's TOMLDecodeError, a ValueError) or out of memory */
+    if ((status = toml_read(text, length, source, &arena, &root, error, size)) != ERROR_NONE) {
         arena_free(&arena);
-        return ERROR_VALUE;
+        return status;
     }
     loader.error = error;
     loader.size = size;

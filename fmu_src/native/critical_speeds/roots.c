@@ -202,24 +202,26 @@ static ErrorKind find_roots(Search *st, const double *grid, int n)
 }
 
 /* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with POINTS_PER_ROOT points per
- * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] LEAD_RATIO, x[0], LEAD_POINTS)[:-1]). */
-static double *grid_new(const Chain *chain, double x_max, double ratio, int coarse, int *count, char *error,
-                        size_t size)
+ * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] LEAD_RATIO, x[0], LEAD_POINTS)[:-1]),
+ * into *grid (owned) and *count; ERROR_NONE, or ERROR_VALUE out of memory (*grid NULL). */
+static ErrorKind grid_new(const Chain *chain, double x_max, double ratio, int coarse, double **grid, int *count,
+                          char *error, size_t size)
 {
     int extra = coarse ? 0 : chain_freedoms(chain), per_pi, n, i;
     double kappa = chain_kappa(chain) * sqrt(fabs(ratio)), theta_max, steps, step, log_start, log_stop, *x;
     per_pi = ROTOR_DRIVELINE_POINTS_PER_ROOT * (1 + extra) * (chain_isotropic(chain) ? 1 : 2);
     theta_max = kappa * sqrt(x_max);
     steps = ceil(theta_max / FMU_PI * per_pi);
+    *grid = NULL;
     if (!(steps < (double)(INT_MAX / 2))) {
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     n = steps > 8.0 ? (int)steps : 8;
     x = malloc((size_t)(ROTOR_DRIVELINE_LEAD_POINTS - 1 + n + 1) * sizeof *x);
     if (x == NULL) {
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     step = theta_max / n;
     for (i = 0; i < n; i++) { /* offset by an irrational fraction of a step */
@@ -234,7 +236,8 @@ static double *grid_new(const Chain *chain, double x_max, double ratio, int coar
         x[i] = pow(10.0, i * ((log_stop - log_start) / (ROTOR_DRIVELINE_LEAD_POINTS - 1)) + log_start);
     }
     *count = ROTOR_DRIVELINE_LEAD_POINTS + n;
-    return x;
+    *grid = x;
+    return ERROR_NONE;
 }
 
 /* The roots on one line over its grid (x_max, ratio |w|, coarse) into *roots; ERROR_NONE, or the
@@ -244,10 +247,10 @@ static ErrorKind search_line(const Chain *chain, const RotorLine *line, double x
 {
     Search st;
     int n;
-    ErrorKind status;
-    double *grid = grid_new(chain, x_max, line->w, coarse, &n, error, size);
-    if (grid == NULL) { /* out of memory, its message written */
-        return ERROR_VALUE;
+    double *grid;
+    ErrorKind status = grid_new(chain, x_max, line->w, coarse, &grid, &n, error, size);
+    if (status != ERROR_NONE) {
+        return status;
     }
     st.chain = chain;
     st.w = line->w;

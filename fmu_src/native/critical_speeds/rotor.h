@@ -16,9 +16,9 @@
  * Every function that fails with a message returns ErrorKind (driveline_constants.h): ERROR_NONE on
  * success, else the kind of the failure, the exception the Python core raises there (ERROR_VALUE for
  * its ValueErrors, and for out of memory), with the message in ``error`` (``size`` bytes, always
- * terminated) worded as the Python core's exception text; a constructor returns NULL with the
- * message instead (a ValueError's). A function whose int result means something else (an index, a
- * pivot test) says so. No global state.
+ * terminated) worded as the Python core's exception text; a constructor (``*_new``) puts the object
+ * in its last argument before ``error`` (NULL on failure). A function whose int result means
+ * something else (an index, a pivot test) says so. No global state.
  */
 #ifndef ROTOR_H
 #define ROTOR_H
@@ -122,8 +122,9 @@ void text_append(char *out, size_t size, size_t *used, const char *bytes, size_t
 
 /* ---- transfer.c: the scaled frequency determinant (transfer.py) ---------------------------- */
 typedef struct Chain Chain; /* transfer.Chain of a driveline (it keeps no pointer to it) */
-/* transfer.Chain.build; fails with elements.Bearing._undamped_stiffness's message on cross-coupling */
-Chain *chain_new(const Driveline *driveline, char *error, size_t size);
+/* transfer.Chain.build into *out; ERROR_NONE, or ERROR_VALUE with the message (Driveline's checks,
+ * elements.Bearing._undamped_stiffness's on cross-coupling, out of memory) */
+ErrorKind chain_new(const Driveline *driveline, Chain **out, char *error, size_t size);
 void chain_free(Chain *chain);
 int chain_isotropic(const Chain *chain);
 /* Driveline._kappa: sum of L (m'/EI)^(1/4) */
@@ -195,8 +196,10 @@ void cubic_spline_free(CubicSpline *spline);
 /* ---- campbell.c: model.whirl_table (campbell.whirl_branches + WhirlTable) ------------------ */
 typedef struct WhirlTable WhirlTable;
 /* The first ``n_modes`` forward and backward whirl frequencies over ``points`` equal speeds on
- * [0, omega_max], refined where a branch bends; missing values read as SEARCH_LIMIT. */
-WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, char *error, size_t size);
+ * [0, omega_max], refined where a branch bends, into *out; missing values read as SEARCH_LIMIT.
+ * ERROR_NONE, or the failure's kind with the message (ERROR_VALUE for bad speeds or n_modes). */
+ErrorKind whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, WhirlTable **out,
+                          char *error, size_t size);
 /* WhirlTable.__call__: forward_1..n, backward_1..n at ``speed`` */
 void whirl_table_evaluate(const WhirlTable *table, double speed, double *out);
 /* The speeds the splines pass through (whirl_branches' knots: ``points`` and those added). */
@@ -234,9 +237,11 @@ typedef struct UnbalanceOutputs UnbalanceOutputs;
 /* unbalance_outputs.UnbalanceOutputs.build; the mode table from the dense eigensolver up to DENSE_SIZE
  * first-order unknowns, above from shift-invert Arnoldi (as Python) on one banded factorisation per
  * speed: O(unknowns (band^2 + vectors^2)) with at most 400 Krylov vectors, an error if the wanted
- * eigenvalues have not converged by then */
-UnbalanceOutputs *unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
-                                        double response_fraction, double omega_max, char *error, size_t size);
+ * eigenvalues have not converged by then. Into *out; ERROR_NONE, or the failure's kind with the message
+ * (ERROR_VALUE: a position off the shaft, numpy's and scipy's refusals, no convergence). */
+ErrorKind unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
+                                double response_fraction, double omega_max, UnbalanceOutputs **out, char *error,
+                                size_t size);
 /* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio (an exactly singular
  * dynamic stiffness: infinite response and force). It allocates nothing: the object holds the
  * solve's work arrays, so one object is evaluated by one caller at a time. */

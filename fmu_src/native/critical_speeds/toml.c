@@ -15,8 +15,8 @@
 
 /* ---- the reader (tomllib.loads) -----------------------------------------------------------
  * A function of the reader that returns ErrorKind gives ERROR_NONE, or ERROR_VALUE with the message
- * in reader->error: the loader raises tomllib's TOMLDecodeError as a ValueError (and out of memory
- * as one too, as the FMU reports it). */
+ * in reader->error (one that returns a Value gives NULL with it): the loader raises tomllib's
+ * TOMLDecodeError as a ValueError (and out of memory as one too, as the FMU reports it). */
 
 typedef struct Pending {
     Value *table;
@@ -874,17 +874,17 @@ static Value *read_document(Reader *reader, const char *text, size_t length)
     return root;
 }
 
-Value *toml_read(const char *text, size_t length, const char *source, Arena *arena, char *error, size_t size)
+ErrorKind toml_read(const char *text, size_t length, const char *source, Arena *arena, Value **root, char *error,
+                    size_t size)
 {
     Reader reader;
-    Value *root;
     memset(&reader, 0, sizeof reader);
     reader.source = source;
     reader.error = error;
     reader.size = size;
-    root = read_document(&reader, text, length);
+    *root = read_document(&reader, text, length);
     *arena = reader.arena;
-    return root;
+    return *root != NULL ? ERROR_NONE : ERROR_VALUE;
 }
 
 /* The first invalid UTF-8 sequence (CPython's decoder: its reason and start), -1 if none. */
