@@ -38,12 +38,10 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 import pytest
-from fmpy import extract
 
 from driveline.catalog import MODELS
 from fmu_harness import packaging
 from fmu_harness.packaging import native, toolchain
-from fmu_harness.runs.runner import FmuInstance
 from support.families import Family, NativeFamily, PythonFamily
 
 FmuPath = Callable[..., Path]
@@ -56,7 +54,7 @@ DURATIONS = Path(__file__).with_name("durations.json")
 SLOW_SECONDS = 0.5  # CPU seconds of a test at which it is slow
 RELEASE_FIXTURE = "release_dir"  # the five-platform build: its cost depends on ziglang's cache
 #: The session's FMU builds, which every FMU test shares: charged to no test when measuring.
-SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "fmu_unzipdir", "open_fmu", "tripod_fmu", "native_dir", "family"}
+SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "tripod_fmu", "native_dir", "family"}
 
 
 QUICK_VERSIONS = ["2"]
@@ -88,6 +86,12 @@ def selected_versions(config: pytest.Config) -> list[str]:
     return config.getoption("fmi") or (QUICK_VERSIONS if config.getoption("quick") else list(packaging.FMI_VERSIONS))
 
 
+def skip_unless_selected(version: str, versions: list[str]) -> None:
+    """Skip the test asking for an FMU of FMI ``version`` when the run did not select it (``--fmi``)."""
+    if version not in versions:
+        pytest.skip(f"FMI {version}.0 is not among the selected versions (--fmi)")
+
+
 def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool | None:
     """With ``--quick``, a module whose tests are all slow is not imported."""
     if config.getoption("quick") and collection_path.relative_to(config.rootpath).as_posix() in slow_modules(measured()):
@@ -109,8 +113,7 @@ def fmu_path(fmu_store: Path, pytestconfig: pytest.Config) -> FmuPath:
     versions = selected_versions(pytestconfig)
 
     def path(name: str, version: str = "2") -> Path:
-        if version not in versions:
-            pytest.skip(f"FMI {version}.0 is not among the selected versions (--fmi)")
+        skip_unless_selected(version, versions)
         built = packaging.fmu_path(fmu_store, name, version)
         if not built.exists():
             packaging.build(name, fmu_store, version)
@@ -148,8 +151,7 @@ def family(request: pytest.FixtureRequest, fmu_path: FmuPath, tmp_path_factory: 
     versions, ported = selected_versions(request.config), native.native_models()
 
     def path(name: str, version: str = "2") -> Path:
-        if version not in versions:
-            pytest.skip(f"FMI {version}.0 is not among the selected versions (--fmi)")
+        skip_unless_selected(version, versions)
         if name not in ported:
             pytest.skip(f"{name} has no C port")
         return native.fmu_path(native_dir, name, version)
@@ -164,29 +166,6 @@ def fmu_dir(fmu_store: Path, fmu_path: FmuPath, pytestconfig: pytest.Config) -> 
         for name in MODELS:
             fmu_path(name, version)
     return fmu_store
-
-
-@pytest.fixture(scope="session")
-def fmu_unzipdir(fmu_path: FmuPath, tmp_path_factory: pytest.TempPathFactory) -> FmuPath:
-    """``fmu_unzipdir(name, version="2")``: the FMU extracted once per session (for ``FmuInstance``)."""
-    extracted: dict[tuple[str, str], Path] = {}
-
-    def unzipdir(name: str, version: str = "2") -> Path:
-        if (name, version) not in extracted:
-            target = tmp_path_factory.mktemp(f"{name}_fmi{version}")
-            extracted[name, version] = Path(extract(str(fmu_path(name, version)), unzipdir=str(target)))
-        return extracted[name, version]
-
-    return unzipdir
-
-
-@pytest.fixture(scope="session")
-def open_fmu(fmu_path: FmuPath, fmu_unzipdir: FmuPath) -> Callable[..., FmuInstance]:
-    """``open_fmu(name, version="2", instance_name="instance")``: a new :class:`FmuInstance` of the
-    session's extracted copy (use it as a context manager)."""
-    return lambda name, version="2", instance_name="instance": FmuInstance(
-        fmu_path(name, version), instance_name, unzipdir=str(fmu_unzipdir(name, version))
-    )
 
 
 @pytest.fixture(scope="session")

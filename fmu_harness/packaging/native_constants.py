@@ -39,8 +39,9 @@ SHARED = {
 }
 
 #: The kinds of failure the C port tells apart: the exceptions the Python core raises. ``ErrorKind``
-#: numbers them -1, -2, ... in this order (a failing C function returns its kind; -1, the usual
-#: ``return -1``, is a ValueError), ``ERROR_NONE`` (0) is success.
+#: numbers them -1, -2, ... in this order, ``ERROR_NONE`` (0) is success; a failing C function returns
+#: its kind by name, never a number (tests/native/test_native_constants.py holds the CriticalSpeeds
+#: port to it), so the order is no convention the C relies on.
 ERROR_KINDS = (ValueError, ZeroDivisionError, OverflowError, ArithmeticError, RuntimeError)
 
 HEADER = "driveline_constants.h"

@@ -239,8 +239,8 @@ static size_t previous_point(const unsigned char *text, size_t start, size_t end
     return at;
 }
 
-/* parse_orders: "1,2,3,6" -> 1, 2, 3, 6; else -1 with the Python message. */
-static int parse_orders(const char *text, int *orders, int *count, char *error)
+/* parse_orders: "1,2,3,6" -> 1, 2, 3, 6; ERROR_NONE, else ERROR_VALUE with the Python message. */
+static ErrorKind parse_orders(const char *text, int *orders, int *count, char *error)
 {
     const unsigned char *bytes = (const unsigned char *)text;
     size_t length = strlen(text), start = 0, end, at, size, cut;
@@ -251,7 +251,7 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
     }
     if (commas >= ROTOR_MODEL_MAX_ORDERS) { /* text.split(",", MAX_ORDERS) gives more than MAX_ORDERS entries */
         snprintf(error, ERROR_SIZE, "parameter orders lists more than %d orders", ROTOR_MODEL_MAX_ORDERS);
-        return -1;
+        return ERROR_VALUE;
     }
     *count = 0;
     while (start <= length) {
@@ -284,12 +284,12 @@ static int parse_orders(const char *text, int *orders, int *count, char *error)
             python_str_repr(prefix, 20, shown, sizeof shown);
             snprintf(error, ERROR_SIZE, "parameter orders: %s is not an integer from 1 to %d", shown,
                      ROTOR_MODEL_MAX_ORDER);
-            return -1;
+            return ERROR_VALUE;
         }
         orders[(*count)++] = value;
         start = stop + 1;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* A tuple of ints as Python prints it: "(1, 2, 3)", "(1,)". */
@@ -308,7 +308,7 @@ static void orders_tuple(const int *orders, int count, char *out, size_t size)
 
 /* ---- the analysis ------------------------------------------------------------------------------ */
 
-static int build_one_piece(const ModelData *data, Driveline *out, char *error);
+static ErrorKind build_one_piece(const ModelData *data, Driveline *out, char *error);
 
 /* build_driveline: the one-piece tube of the parameters, or the layout (a file or a shipped name);
  * refused when shear = false meets a layout segment with shear, or when the supports leave the
@@ -319,7 +319,7 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
     int hinge = 0, node = 0, i;
     ErrorKind failed;
     if (layout[0] != '\0') {
-        failed = (ErrorKind)driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
+        failed = driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
         for (i = 0; !failed && !data->int_value[V_shear] && i < out->n_segments; i++) {
             if (out->segments[i].shear) {
                 snprintf(error, ERROR_SIZE, "%s", SHEAR_CONFLICT);
@@ -327,7 +327,7 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
             }
         }
     } else {
-        failed = (ErrorKind)build_one_piece(data, out, error);
+        failed = build_one_piece(data, out, error);
     }
     switch (failed ? MECHANISM_NONE : driveline_mechanism(out, &hinge, &node)) {
     case MECHANISM_NONE:
@@ -344,8 +344,8 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
     }
 }
 
-/* loader.one_piece_shaft of the parameters. */
-static int build_one_piece(const ModelData *data, Driveline *out, char *error)
+/* loader.one_piece_shaft of the parameters; returns as driveline_one_piece. */
+static ErrorKind build_one_piece(const ModelData *data, Driveline *out, char *error)
 {
     OnePieceShaft shaft;
     shaft.L_shaft = VALUE(L_shaft);
@@ -373,7 +373,7 @@ static ErrorKind searched_modes(const Driveline *driveline, const int *orders, i
     terms = malloc(((size_t)driveline->n_segments + ROTOR_MODEL_MAX_ORDERS + 1) * sizeof *terms);
     if (terms == NULL) {
         snprintf(error, ERROR_SIZE, "out of memory");
-        return -1;
+        return ERROR_VALUE;
     }
     for (i = 0; i < driveline->n_segments && !failed; i++) {
         const RotorSegment *s = &driveline->segments[i];
@@ -438,16 +438,17 @@ static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int
         response = 0;
     char shown[40], stage[80];
     size_t used;
-    ErrorKind failed;
-    Chain *chain = chain_new(driveline, error, ERROR_SIZE);
+    Chain *chain;
+    ErrorKind failed = chain_new(driveline, &chain, error, ERROR_SIZE);
     counts = malloc(((size_t)driveline->n_segments + 1) * sizeof *counts);
-    if (chain == NULL || counts == NULL) {
+    if (failed != ERROR_NONE || counts == NULL) {
         chain_free(chain);
         free(counts);
-        if (chain != NULL) {
+        if (failed == ERROR_NONE) {
             snprintf(error, ERROR_SIZE, "out of memory");
+            failed = ERROR_VALUE;
         }
-        return -1;
+        return failed;
     }
     isotropic = chain_isotropic(chain);
     freedoms = chain_freedoms(chain);
@@ -495,7 +496,7 @@ static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int
         return failed;
     }
     if (total <= ROTOR_WORK_MAX_ANALYSIS_SECONDS) {
-        return 0;
+        return ERROR_NONE;
     }
     python_g(total, 3, shown, sizeof shown);
     snprintf(error, ERROR_SIZE, "the analysis would take about %s s (", shown);
@@ -509,7 +510,7 @@ static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int
     snprintf(stage, sizeof stage, "), more than the %s s accepted ", shown);
     text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
     text_append(error, ERROR_SIZE, &used, WORK_ADVICE, strlen(WORK_ADVICE));
-    return -1;
+    return ERROR_VALUE;
 }
 
 /* analyse_structure: the chain, the critical speeds (missing ones read as the search limit) and the
@@ -519,9 +520,9 @@ static ErrorKind analyse_structure(Analysis *analysis, char *error)
     double spins[3];
     int count = 0, i;
     ErrorKind failed;
-    analysis->chain = chain_new(&analysis->driveline, error, ERROR_SIZE);
-    if (analysis->chain == NULL) {
-        return ERROR_VALUE;
+    failed = chain_new(&analysis->driveline, &analysis->chain, error, ERROR_SIZE);
+    if (failed) {
+        return failed;
     }
     failed = rotor_critical_speeds(analysis->chain, 3, spins, &count, error, ERROR_SIZE);
     if (failed) {
@@ -531,13 +532,14 @@ static ErrorKind analyse_structure(Analysis *analysis, char *error)
         analysis->critical[i] = i < count ? spins[i] : ROTOR_DRIVELINE_SEARCH_LIMIT;
     }
     analysis->critical_count = count;
-    return (ErrorKind)fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural,
-                                             &analysis->natural_count, error, ERROR_SIZE);
+    return fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural,
+                                  &analysis->natural_count, error, ERROR_SIZE);
 }
 
 /* implausibility: the first two whirl frequencies at standstill must each match a natural
- * frequency of the finite-element check within PLAUSIBLE_DEVIATION. */
-static int implausibility(const Analysis *analysis, char *error)
+ * frequency of the finite-element check within PLAUSIBLE_DEVIATION; ERROR_NONE, else ERROR_VALUE with
+ * the message (np.argmin's ValueError for no natural frequency, whirl_table's refusal). */
+static ErrorKind implausibility(const Analysis *analysis, char *error)
 {
     double at_rest[2 * ROTOR_MODEL_WHIRL_MODES], nearest, deviation, best = 0.0;
     char frequency_shown[40], nearest_shown[40];
@@ -550,7 +552,7 @@ static int implausibility(const Analysis *analysis, char *error)
         }
         if (analysis->natural_count == 0) {
             snprintf(error, ERROR_SIZE, "attempt to get argmin of an empty sequence");
-            return -1;
+            return ERROR_VALUE;
         }
         found = 0;
         for (j = 0; j < analysis->natural_count; j++) { /* np.argmin: the first smallest (a NaN first) */
@@ -572,41 +574,45 @@ static int implausibility(const Analysis *analysis, char *error)
                      "the whirl frequency %s rad/s at standstill has no counterpart in the finite-element check "
                      "(nearest %s rad/s): the parameters are beyond what double precision resolves",
                      frequency_shown, nearest_shown);
-            return -1;
+            return ERROR_VALUE;
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* resonances: every order resonance of ``orders`` (both senses) up to 2 omega_max, or the first
- * forward one of each order when none lies there. */
-static int resonances(Analysis *analysis, const int *orders, int n_orders, double omega_max, char *error)
+ * forward one of each order when none lies there; ERROR_NONE, else the failure's kind with the message
+ * (ERROR_VALUE for none found). */
+static ErrorKind resonances(Analysis *analysis, const int *orders, int n_orders, double omega_max, char *error)
 {
     char tuple[4 * ROTOR_MODEL_MAX_ORDERS + 8];
-    if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD | WHIRL_BACKWARD, 0, 2.0 * omega_max,
-                               ROTOR_DRIVELINE_SEARCH_LIMIT, &analysis->resonances, &analysis->resonance_count, error,
-                               ERROR_SIZE)) {
-        return -1;
+    ErrorKind failed = rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD | WHIRL_BACKWARD, 0,
+                                              2.0 * omega_max, ROTOR_DRIVELINE_SEARCH_LIMIT, &analysis->resonances,
+                                              &analysis->resonance_count, error, ERROR_SIZE);
+    if (failed != ERROR_NONE) {
+        return failed;
     }
     if (analysis->resonance_count == 0) {
         free(analysis->resonances);
         analysis->resonances = NULL;
-        if (rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0,
-                                   ROTOR_DRIVELINE_SEARCH_LIMIT,
-                                   &analysis->resonances, &analysis->resonance_count, error, ERROR_SIZE)) {
-            return -1;
+        failed = rotor_order_resonances(analysis->chain, orders, n_orders, WHIRL_FORWARD, 1, 0.0,
+                                        ROTOR_DRIVELINE_SEARCH_LIMIT, &analysis->resonances,
+                                        &analysis->resonance_count, error, ERROR_SIZE);
+        if (failed != ERROR_NONE) {
+            return failed;
         }
     }
     if (analysis->resonance_count == 0) {
         orders_tuple(orders, n_orders, tuple, sizeof tuple);
         snprintf(error, ERROR_SIZE, "no order resonance of the orders %s below the search limit 100000 rad/s", tuple);
-        return -1;
+        return ERROR_VALUE;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
-/* The unbalance outputs: a layout's own unbalances, or the one-piece tube's single unbalance. */
-static int unbalance_outputs(Analysis *analysis, const ModelData *data, char *error)
+/* The unbalance outputs: a layout's own unbalances, or the one-piece tube's single unbalance;
+ * ERROR_NONE, else the failure's kind with the message (ERROR_VALUE for a position off the shaft). */
+static ErrorKind unbalance_outputs(Analysis *analysis, const ModelData *data, char *error)
 {
     RotorUnbalance single;
     const RotorUnbalance *unbalances = analysis->driveline.unbalances;
@@ -619,14 +625,13 @@ static int unbalance_outputs(Analysis *analysis, const ModelData *data, char *er
         if (!isfinite(single.position) || single.position < 0.0) { /* elements._non_negative */
             python_float_repr(single.position, shown, sizeof shown);
             snprintf(error, ERROR_SIZE, "position must be a finite number >= 0, got %s", shown);
-            return -1;
+            return ERROR_VALUE;
         }
         unbalances = &single;
         count = 1;
     }
-    analysis->unbalance = unbalance_outputs_new(&analysis->driveline, unbalances, count, VALUE(response_position),
-                                                VALUE(omega_max), error, ERROR_SIZE);
-    return analysis->unbalance != NULL ? 0 : -1;
+    return unbalance_outputs_new(&analysis->driveline, unbalances, count, VALUE(response_position), VALUE(omega_max),
+                                 &analysis->unbalance, error, ERROR_SIZE);
 }
 
 /* One part: kept when its key is unchanged, else dropped and computed anew (kept on success only). */
@@ -635,7 +640,7 @@ static ErrorKind part(Analysis *analysis, const ModelData *data, Part which, con
 {
     ErrorKind failed;
     if (key_matches(&analysis->keys[which], data, which, orders, n_orders)) {
-        return 0;
+        return ERROR_NONE;
     }
     drop_part(analysis, which);
     switch (which) {
@@ -646,16 +651,15 @@ static ErrorKind part(Analysis *analysis, const ModelData *data, Part which, con
         failed = analyse_structure(analysis, error);
         break;
     case PART_WHIRL:
-        analysis->whirl = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
-                                          ROTOR_MODEL_WHIRL_MODES, error,
-                                          ERROR_SIZE);
-        failed = analysis->whirl == NULL ? ERROR_VALUE : (ErrorKind)implausibility(analysis, error);
+        failed = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
+                                 ROTOR_MODEL_WHIRL_MODES, &analysis->whirl, error, ERROR_SIZE);
+        failed = failed ? failed : implausibility(analysis, error);
         break;
     case PART_RESONANCES:
-        failed = (ErrorKind)resonances(analysis, orders, n_orders, VALUE(omega_max), error);
+        failed = resonances(analysis, orders, n_orders, VALUE(omega_max), error);
         break;
     default:
-        failed = (ErrorKind)unbalance_outputs(analysis, data, error);
+        failed = unbalance_outputs(analysis, data, error);
         break;
     }
     if (!failed && !key_store(&analysis->keys[which], data, which, orders, n_orders)) {
@@ -700,7 +704,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
         }
         cache->derived = analysis;
     }
-    failed = (ErrorKind)parse_orders(data->string_value[V_orders], orders, &n_orders, error);
+    failed = parse_orders(data->string_value[V_orders], orders, &n_orders, error);
     if (!failed && analysed_for(analysis, data, orders, n_orders)) {
         return;
     }

@@ -4,7 +4,7 @@ fmpy formats FMI 2.0 messages in a native proxy that forwards them to the Python
 registered last, so with plain fmpy every message of every FMI 2.0 instance reaches the
 instance created last; the harness gives each instance its own callbacks and routes by the
 ``componentEnvironment`` the FMU passes back (``fmu_harness.runs.runner.Fmi2LogRouter``). FMI 3.0
-passes each instance its own callback; both versions are checked.
+passes each instance its own callback; both versions and both families are checked.
 """
 
 from __future__ import annotations
@@ -13,15 +13,15 @@ import math
 
 import pytest
 
-from fmu_harness.studies import coupling_comparison
 from fmu_harness.runs.runner import StepRefused
+from fmu_harness.studies import coupling_comparison
 
 TOO_BENT = 1.5  # rad: beyond beta_max of CardanJoint (45 deg) and TripodCoupling (at most 60 deg)
 
 
 @pytest.mark.parametrize("pair", [("CardanJoint", "CardanJoint"), ("CardanJoint", "TripodCoupling")])
-def test_each_refusal_is_logged_to_the_instance_that_refused(pair, fmi, open_fmu):
-    with open_fmu(pair[0], fmi, "first") as first, open_fmu(pair[1], fmi, "second") as second:
+def test_each_refusal_is_logged_to_the_instance_that_refused(family, pair, fmi):
+    with family.open(pair[0], fmi, "first") as first, family.open(pair[1], fmi, "second") as second:
         first.initialize()
         second.initialize()
         for refusing, other in ((first, second), (second, first)):

@@ -94,3 +94,114 @@ def test_the_rule_of_which_parameter_redoes_which_analysis_part_is_generated_fro
         r"^    (PART_\w+),$", generated["model_variables.h"], re.MULTILINE)
     c_model = (native.NATIVE_SRC / "critical_speeds.c").read_text()
     assert "model_part_values" in c_model and not re.search(r"\bPART_\w+\s*[,=]", c_model.split("typedef int Part;")[0])
+
+
+# ---- the kinds of failure: returned as ErrorKind, never a bare -1 or a cast ------------------------
+
+#: A comment, a string or a character literal of C (blanked before the functions are looked for).
+C_NOISE = re.compile(r"/\*.*?\*/|//[^\n]*|\"(?:\\.|[^\"\\\n])*\"|'(?:\\.|[^'\\\n])*'", re.DOTALL)
+#: A function definition's head: its return type, name and parameters, up to the opening brace.
+C_FUNCTION = re.compile(r"^(?:static\s+)?(?P<type>[A-Za-z_][\w \t*]*?)\s*\b(?P<name>\w+)"
+                        r"\((?P<parameters>[^;{}()]*)\)\s*\{", re.MULTILINE)
+
+
+def _c_functions(text: str) -> list[tuple[str, str, str, str]]:
+    """(return type, name, parameters, body) of every function defined in the C ``text``."""
+    text = C_NOISE.sub(lambda match: " " if match.group().startswith("/") else match.group()[0] * 2, text)
+    found = []
+    for head in C_FUNCTION.finditer(text):
+        depth, end = 0, head.end() - 1
+        for end in range(head.end() - 1, len(text)):
+            depth += {"{": 1, "}": -1}.get(text[end], 0)
+            if depth == 0:
+                break
+        found.append((" ".join(head["type"].split()), head["name"], head["parameters"], text[head.end():end]))
+    return found
+
+
+def _kind_seams(sources: dict[str, str]) -> list[tuple[str, str, str]]:
+    """(file, function, what) of every failure that is not returned as its ErrorKind: a ``return -1``
+    in a function returning ErrorKind, an int function that writes a message (it takes ``char *error``,
+    or calls ROTOR_ERROR or a function that writes one), another type of function that takes ``char
+    *error`` (a constructor returning NULL), a cast to ErrorKind."""
+    functions = [(path, *function) for path, text in sources.items() for function in _c_functions(text)]
+    writers = {"ROTOR_ERROR"} | {name for _, _, name, parameters, _ in functions
+                                 if re.search(r"\bchar\s*\*\s*error\b", parameters)}
+    while True:
+        calls = re.compile(rf"\b(?:{'|'.join(sorted(writers))})\s*\(") if writers else None
+        more = {name for _, _, name, _, body in functions if calls and calls.search(body)} - writers
+        if not more:
+            break
+        writers |= more
+    seams = []
+    for path, kind, name, parameters, body in functions:
+        if kind == "ErrorKind" and re.search(r"\breturn\s*\(?\s*-\s*1\s*\)?\s*;", body):
+            seams.append((path, name, "returns -1"))
+        if kind == "int" and name in writers:
+            seams.append((path, name, "int with a message"))
+        elif kind != "ErrorKind" and re.search(r"\bchar\s*\*\s*error\b", parameters):
+            seams.append((path, name, f"{kind} with a message"))
+    seams += [(path, "", "casts to ErrorKind") for path, text in sources.items()
+              if re.search(r"\(\s*ErrorKind\s*\)", C_NOISE.sub(" ", text))]
+    return seams
+
+
+def test_the_rotor_library_returns_its_failures_as_error_kinds():
+    """A function of the CriticalSpeeds C port that fails with a message returns the failure's kind
+    (the Python exception, ErrorKind of the generated header), not an int that the model casts: -1
+    would be ERROR_VALUE only by the order of ERROR_KINDS."""
+    sources = {path.relative_to(native.NATIVE_SRC).as_posix(): path.read_text()
+               for path in [native.NATIVE_SRC / "critical_speeds.c",
+                            *sorted((native.NATIVE_SRC / "critical_speeds").glob("*.c"))]}
+    assert _kind_seams(sources) == []
+
+
+def test_the_error_kind_check_finds_a_seam():
+    """The check sees each seam as it was written before the kinds were returned, and not a -1 in a
+    comment, a string or a function that returns an index."""
+    written = """
+int layout_error(char *error, size_t size, const char *format, ...)
+{
+    va_list args;
+    return -1;
+}
+
+static int number(const Loader *loader, const char *where, double *out)
+{
+    if (!(*out > 0.0)) { /* a brace in a comment: { */
+        return layout_error(loader->error, loader->size, "%s must be > 0 {", where);
+    }
+    return 0;
+}
+
+static ErrorKind searched_modes(const Driveline *driveline, double *work,
+                                char *error)
+{
+    if (work == NULL) {
+        snprintf(error, ERROR_SIZE, "out of memory");
+        return -1;
+    }
+    return ERROR_NONE;
+}
+
+static int unheld_piece(const Driveline *d, int plane)
+{
+    char c = '}';
+    return c == '{' ? 0 : -1;
+}
+
+static ErrorKind part(char *error)
+{
+    return (ErrorKind)fe_natural_frequencies(error); /* return -1; */
+}
+
+Chain *chain_new(const Driveline *driveline, char *error, size_t size)
+{
+    return NULL;
+}
+"""
+    assert _kind_seams({"model.c": written}) == [("model.c", "layout_error", "int with a message"),
+                                                 ("model.c", "number", "int with a message"),
+                                                 ("model.c", "searched_modes", "returns -1"),
+                                                 ("model.c", "chain_new", "Chain * with a message"),
+                                                 ("model.c", "", "casts to ErrorKind")]

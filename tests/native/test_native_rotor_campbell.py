@@ -14,7 +14,8 @@ from driveline.rotor import Bearing, Driveline, example_path, load_driveline, on
 from driveline.rotor.campbell import whirl_branches
 from driveline.rotor.model import CAMPBELL_POINTS, WHIRL_MODES, analyse_structure, whirl_table
 
-from support.native_rotor import CHAIN_SIGNATURES, DOUBLE_P, ROTOR_SOURCES, c_driveline, compile_rotor, declare
+from support.native_rotor import (CHAIN_SIGNATURES, DOUBLE_P, ERROR_KIND, ROTOR_SOURCES, ErrorKind, P, c_driveline,
+                                  compile_rotor, declare)
 
 #: Agreement of every whirl frequency, relative to the largest magnitude of its column over the speeds
 #: compared. The C port evaluates the same determinant at the same points, follows the same branches
@@ -38,8 +39,8 @@ def library(tmp_path_factory):
     table = ctypes.c_void_p
     return declare(lib, {
         **CHAIN_SIGNATURES,
-        "whirl_table_new": (table, [ctypes.c_void_p, ctypes.c_double, ctypes.c_int, ctypes.c_int, ctypes.c_char_p,
-                                    ctypes.c_size_t]),
+        "whirl_table_new": (ErrorKind, [ctypes.c_void_p, ctypes.c_double, ctypes.c_int, ctypes.c_int, P(table),
+                                        ctypes.c_char_p, ctypes.c_size_t]),
         "whirl_table_evaluate": (None, [table, ctypes.c_double, DOUBLE_P]),
         "whirl_table_knots": (ctypes.c_int, [table]),
         "whirl_table_free": (None, [table]),
@@ -53,13 +54,14 @@ class NativeTable:
                  points: int = CAMPBELL_POINTS) -> None:
         self._lib, self._n = lib, n_modes
         self._driveline = driveline = c_driveline(d)
-        error = ctypes.create_string_buffer(512)
-        self._chain = lib.chain_new(ctypes.byref(driveline), error, len(error))
-        assert self._chain, error.value.decode()
+        error, chain, table = ctypes.create_string_buffer(512), ctypes.c_void_p(), ctypes.c_void_p()
+        assert lib.chain_new(ctypes.byref(driveline), ctypes.byref(chain), error, len(error)) == ERROR_KIND[
+            "ERROR_NONE"], error.value.decode()
+        self._chain = chain.value
         start = time.process_time()
-        self._table = lib.whirl_table_new(self._chain, omega_max, points, n_modes, error, len(error))
+        self.kind = lib.whirl_table_new(self._chain, omega_max, points, n_modes, ctypes.byref(table), error, len(error))
         self.seconds = time.process_time() - start
-        self.error = error.value.decode()
+        self._table, self.error = table.value, error.value.decode()
 
     def close(self) -> None:
         if self._table:
@@ -150,6 +152,6 @@ def test_bad_speed_ranges_are_refused(library):
         native = NativeTable(library, tube(), omega_max, points=points)
         try:
             assert native.error == "spins must be at least two increasing finite speeds >= 0 rad/s"
-            assert not native._table
+            assert native.kind == ERROR_KIND["ERROR_VALUE"] and not native._table
         finally:
             native.close()

@@ -19,11 +19,12 @@ from scipy.interpolate import CubicSpline
 from driveline.rotor import Bearing, ConcentratedMass, Driveline, ShaftSegment, Unbalance, model, one_piece_shaft
 from driveline.rotor.damped import DENSE_SIZE, DampedRotor
 from driveline.rotor.driveline import EXCITED_SHARE
-from driveline.rotor.fem import elements_by_length
+from driveline.rotor.fem import assemble, elements_by_length
 from driveline.rotor.loader import example_path, load_driveline, loads_driveline
 from driveline.rotor.unbalance_outputs import DAMPED_MODES, FE_ELEMENTS, TABLE_ELEMENTS, UnbalanceOutputs
 
-from support.native_rotor import DOUBLE_P, CDriveline, P, c_driveline, compile_rotor, declare, unbalances
+from support.native_rotor import (DOUBLE_P, ERROR_KIND, CDriveline, ErrorKind, P, c_driveline, compile_rotor, declare,
+                                  unbalances)
 
 EPS = np.finfo(float).eps
 #: Natural frequencies, relative: scipy's and the C Cholesky reduction both lose the lowest
@@ -87,10 +88,10 @@ def library(tmp_path_factory):
     lib = compile_rotor(tmp_path_factory.mktemp("damped"), ["fem", "damped", "spline", "layout", "pyrepr"])
     driveline_p, outputs_p, error, size = P(CDriveline), ctypes.c_void_p, ctypes.c_char_p, ctypes.c_size_t
     declare(lib, {
-        "fe_natural_frequencies": (ctypes.c_int, [driveline_p, ctypes.c_int, P(DOUBLE_P), P(ctypes.c_int), error,
-                                                  size]),
-        "unbalance_outputs_new": (outputs_p, [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double,
-                                              ctypes.c_double, error, size]),
+        "fe_natural_frequencies": (ErrorKind, [driveline_p, ctypes.c_int, P(DOUBLE_P), P(ctypes.c_int), error,
+                                               size]),
+        "unbalance_outputs_new": (ErrorKind, [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double,
+                                              ctypes.c_double, P(outputs_p), error, size]),
         "unbalance_outputs_evaluate": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
         "unbalance_outputs_modes": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
         "unbalance_outputs_free": (None, [outputs_p]),
@@ -103,7 +104,7 @@ def natural_frequencies(lib, d: Driveline, elements: int = model.FE_ELEMENTS) ->
     c = c_driveline(d)
     values, count, error = ctypes.POINTER(ctypes.c_double)(), ctypes.c_int(), ctypes.create_string_buffer(512)
     assert lib.fe_natural_frequencies(ctypes.byref(c), elements, ctypes.byref(values), ctypes.byref(count), error,
-                                      512) == 0, error.value
+                                      512) == ERROR_KIND["ERROR_NONE"], error.value
     out = np.array(values[:count.value])
     lib.free(ctypes.cast(values, ctypes.c_void_p))
     return out
@@ -114,9 +115,11 @@ def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds,
     also its mode table (the damped frequencies, then the damping ratios)."""
     c = c_driveline(d)
     excited = unbalances(items)
-    error = ctypes.create_string_buffer(512)
-    handle = lib.unbalance_outputs_new(ctypes.byref(c), excited, len(items), fraction, omega_max, error, 512)
-    assert handle, error.value
+    error, made = ctypes.create_string_buffer(512), ctypes.c_void_p()
+    kind = lib.unbalance_outputs_new(ctypes.byref(c), excited, len(items), fraction, omega_max, ctypes.byref(made),
+                                     error, 512)
+    assert kind == ERROR_KIND["ERROR_NONE"], error.value
+    handle = made.value
     try:
         out, modes = (ctypes.c_double * 3)(), (ctypes.c_double * (2 * DAMPED_MODES))()
         rows = []
@@ -160,6 +163,17 @@ def test_natural_frequencies_take_each_plane_of_anisotropic_bearings(library):
         expected = model.natural_frequencies(plane)
         part, got = got[:half], got[half:]
         np.testing.assert_allclose(part, expected, rtol=FREQUENCY_RTOL)
+
+
+def test_no_elements_fail_as_pythons_zero_division(library):
+    """Elements of length / 0: fem's ZeroDivisionError, its kind (not a ValueError) and its message."""
+    with pytest.raises(ZeroDivisionError) as python:
+        assemble(DEFAULT, 0)
+    c, values, count = c_driveline(DEFAULT), ctypes.POINTER(ctypes.c_double)(), ctypes.c_int()
+    error = ctypes.create_string_buffer(512)
+    kind = library.fe_natural_frequencies(ctypes.byref(c), 0, ctypes.byref(values), ctypes.byref(count), error, 512)
+    assert (kind, error.value.decode(), count.value, bool(values)) == (ERROR_KIND["ERROR_ZERO_DIVISION"],
+                                                                       str(python.value), 0, False)
 
 
 @pytest.mark.parametrize("name", OUTPUTS)
@@ -252,6 +266,6 @@ def test_refusals_are_worded_as_pythons(library, omega_max):
         UnbalanceOutputs.build(DEFAULT, excitation(DEFAULT), 0.5, omega_max)
     c = c_driveline(DEFAULT)
     excited = unbalances(excitation(DEFAULT))
-    error = ctypes.create_string_buffer(512)
-    assert not library.unbalance_outputs_new(ctypes.byref(c), excited, 1, 0.5, omega_max, error, 512)
-    assert error.value.decode() == str(refused.value)
+    error, made = ctypes.create_string_buffer(512), ctypes.c_void_p()
+    kind = library.unbalance_outputs_new(ctypes.byref(c), excited, 1, 0.5, omega_max, ctypes.byref(made), error, 512)
+    assert (kind, made.value, error.value.decode()) == (ERROR_KIND["ERROR_VALUE"], None, str(refused.value))

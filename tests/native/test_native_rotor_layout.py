@@ -16,8 +16,8 @@ from driveline.rotor import loader
 from driveline.rotor.loader import load_driveline, loads_driveline, one_piece_shaft
 from driveline.rotor.model import load_layout
 
-from support.native_rotor import (CDriveline, OnePieceShaft, P, RotorBearing, RotorHinge, RotorMass, RotorSegment,
-                          RotorUnbalance, compile_rotor, declare)
+from support.native_rotor import (ERROR_KIND, CDriveline, ErrorKind, OnePieceShaft, P, RotorBearing, RotorHinge,
+                                  RotorMass, RotorSegment, RotorUnbalance, compile_rotor, declare)
 
 DATA = Path(loader.__file__).parent / "data"
 ERROR_SIZE = 8192
@@ -29,9 +29,9 @@ def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
     driveline_p, error, size = P(CDriveline), ctypes.c_char_p, ctypes.c_size_t
     return declare(library, {
         "driveline_length": (ctypes.c_double, [driveline_p]),
-        "driveline_from_text": (ctypes.c_int, [ctypes.c_char_p, size, ctypes.c_char_p, driveline_p, error, size]),
-        "driveline_from_layout": (ctypes.c_int, [ctypes.c_char_p, ctypes.c_char_p, driveline_p, error, size]),
-        "driveline_one_piece": (ctypes.c_int, [P(OnePieceShaft), driveline_p, error, size]),
+        "driveline_from_text": (ErrorKind, [ctypes.c_char_p, size, ctypes.c_char_p, driveline_p, error, size]),
+        "driveline_from_layout": (ErrorKind, [ctypes.c_char_p, ctypes.c_char_p, driveline_p, error, size]),
+        "driveline_one_piece": (ErrorKind, [P(OnePieceShaft), driveline_p, error, size]),
         "python_str_repr_n": (None, [ctypes.c_char_p, size, size, ctypes.c_char_p, size]),
         "python_float_repr": (None, [ctypes.c_double, ctypes.c_char_p, size]),
     })
@@ -74,11 +74,11 @@ def python_fields(drv) -> dict:
 
 
 def native_result(lib: ctypes.CDLL, call, *args):
-    """(fields, length) or the message of a native call."""
+    """(fields, length) or the message of a native call (refused as a ValueError, as Python's)."""
     d, error = CDriveline(), ctypes.create_string_buffer(ERROR_SIZE)
     status = call(*args, ctypes.byref(d), error, ERROR_SIZE)
-    if status != 0:
-        assert not d.segments and d.n_segments == 0
+    if status != ERROR_KIND["ERROR_NONE"]:
+        assert status == ERROR_KIND["ERROR_VALUE"] and not d.segments and d.n_segments == 0
         return error.value.decode("utf-8", "surrogateescape")
     try:
         return native_fields(lib, d), lib.driveline_length(ctypes.byref(d))

@@ -40,7 +40,8 @@ from driveline.rotor.driveline import Driveline
 from driveline.rotor.elements import Bearing, ConcentratedMass, Hinge, ShaftSegment
 from driveline.rotor.loader import example_path, one_piece_shaft
 
-from support.native_rotor import CHAIN_SIGNATURES, DOUBLE_P, P, c_array, c_driveline, compile_rotor, declare
+from support.native_rotor import (CHAIN_SIGNATURES, DOUBLE_P, ERROR_KIND, ErrorKind, P, c_array, c_driveline,
+                                  compile_rotor, declare, raised)
 
 
 class CLine(ctypes.Structure):
@@ -69,14 +70,14 @@ def _declare(lib: ctypes.CDLL) -> ctypes.CDLL:
         "chain_determinant": (None, [chain, size, DOUBLE_P, DOUBLE_P, DOUBLE_P]),
         "chain_forward_fraction": (ctypes.c_double, [chain, ctypes.c_double, ctypes.c_double]),
         "rotor_roots_free": (None, [P(CRoots), ctypes.c_int]),
-        "rotor_line_roots": (ctypes.c_int, [chain, P(CLine), ctypes.c_int, ctypes.c_int, ctypes.c_double,
-                                            ctypes.c_double, P(ctypes.c_ubyte), P(CRoots), error, size]),
-        "rotor_roots_by_whirl": (ctypes.c_int, [chain, P(CLine), ctypes.c_int, ctypes.c_int, ctypes.c_double,
-                                                ctypes.c_double, P(CRoots), P(CRoots), error, size]),
-        "rotor_order_resonances": (ctypes.c_int, [chain, P(ctypes.c_int), ctypes.c_int, ctypes.c_int, ctypes.c_int,
-                                                  ctypes.c_double, ctypes.c_double, P(P(COrderResonance)),
-                                                  P(ctypes.c_int), error, size]),
-        "rotor_critical_speeds": (ctypes.c_int, [chain, ctypes.c_int, DOUBLE_P, P(ctypes.c_int), error, size]),
+        "rotor_line_roots": (ErrorKind, [chain, P(CLine), ctypes.c_int, ctypes.c_int, ctypes.c_double,
+                                         ctypes.c_double, P(ctypes.c_ubyte), P(CRoots), error, size]),
+        "rotor_roots_by_whirl": (ErrorKind, [chain, P(CLine), ctypes.c_int, ctypes.c_int, ctypes.c_double,
+                                             ctypes.c_double, P(CRoots), P(CRoots), error, size]),
+        "rotor_order_resonances": (ErrorKind, [chain, P(ctypes.c_int), ctypes.c_int, ctypes.c_int, ctypes.c_int,
+                                               ctypes.c_double, ctypes.c_double, P(P(COrderResonance)),
+                                               P(ctypes.c_int), error, size]),
+        "rotor_critical_speeds": (ErrorKind, [chain, ctypes.c_int, DOUBLE_P, P(ctypes.c_int), error, size]),
     }
     return declare(lib, signatures)
 
@@ -93,19 +94,23 @@ class NativeChain:
     def __init__(self, lib: ctypes.CDLL, driveline: Driveline) -> None:
         self.lib = lib
         self.struct = c_driveline(driveline)
-        error = ctypes.create_string_buffer(ERROR_SIZE)
-        self.pointer = lib.chain_new(ctypes.byref(self.struct), error, ERROR_SIZE)
-        if not self.pointer:
-            raise ValueError(error.value.decode())
+        error, chain = ctypes.create_string_buffer(ERROR_SIZE), ctypes.c_void_p()
+        kind = lib.chain_new(ctypes.byref(self.struct), ctypes.byref(chain), error, ERROR_SIZE)
+        if kind != ERROR_KIND["ERROR_NONE"]:
+            assert not chain
+            raise raised(kind, error.value.decode())
+        self.pointer = chain.value
 
     def __del__(self) -> None:
         if getattr(self, "pointer", None):
             self.lib.chain_free(self.pointer)
 
     def _call(self, name: str, *args) -> None:
+        """The library function ``name``; a failure raised as the Python exception its kind stands for."""
         error = ctypes.create_string_buffer(ERROR_SIZE)
-        if getattr(self.lib, name)(self.pointer, *args, error, ERROR_SIZE):
-            raise ValueError(error.value.decode())
+        kind = getattr(self.lib, name)(self.pointer, *args, error, ERROR_SIZE)
+        if kind != ERROR_KIND["ERROR_NONE"]:
+            raise raised(kind, error.value.decode())
 
     def _roots(self, roots: ctypes.Array, m: int) -> list[np.ndarray]:
         out = [np.array(roots[i].x[:roots[i].count], dtype=float) for i in range(m)]

@@ -13,6 +13,7 @@ from a Python :class:`~driveline.rotor.Driveline`, and :func:`declare` for the f
 from __future__ import annotations
 
 import ctypes
+import re
 import subprocess
 from pathlib import Path
 
@@ -20,6 +21,7 @@ from driveline.rotor import Driveline
 from driveline.rotor.elements import Hinge
 
 from fmu_harness.packaging import native, toolchain
+from fmu_harness.packaging.native_constants import ERROR_KINDS, error_kind_name
 from fmu_harness.packaging.native_constants import HEADER as CONSTANTS_HEADER
 from fmu_harness.packaging.native_constants import constants_header
 
@@ -28,12 +30,22 @@ TEST_FLAGS = (*(flag for flag in toolchain.CFLAGS if not flag.startswith("-fvisi
 
 P = ctypes.POINTER
 DOUBLE_P = P(ctypes.c_double)
+#: The generated enum ErrorKind, which a function that fails with a message returns (a C int).
+ErrorKind = ctypes.c_int
+#: The value of each kind's name in the generated header (ERROR_NONE is 0).
+ERROR_KIND = {name: int(value) for name, value in re.findall(r"\b(ERROR_[A-Z_]+) = (-?\d+)", constants_header())}
 
 
-#: The modules a module calls into besides itself (the layout reader's parts with the loader, the
-#: linear algebra with the damped model, the shaft elements with both models).
-NEEDS = {"layout": ("layout_file", "toml", "messages", "arena"), "damped": ("linalg",), "transfer": ("elements",),
-         "fem": ("elements",)}
+def raised(kind: int, message: str) -> Exception:
+    """The Python exception that the ErrorKind value ``kind`` stands for, with ``message``."""
+    exceptions = {ERROR_KIND[error_kind_name(exception)]: exception for exception in ERROR_KINDS}
+    return exceptions[kind](message)
+
+
+#: The modules a module calls into besides itself (the layout reader's parts and the elements' checks
+#: with the loader, the linear algebra with the damped model, the shaft elements with both models).
+NEEDS = {"layout": ("layout_file", "toml", "messages", "arena", "elements"), "damped": ("linalg",),
+         "transfer": ("elements",), "fem": ("elements",)}
 
 
 def compile_rotor(folder: Path, modules: list[str], shims: list[Path] = ()) -> ctypes.CDLL:
@@ -104,7 +116,7 @@ class OnePieceShaft(ctypes.Structure):
 
 #: The signatures of the chain functions (transfer.c) that take a driveline.
 CHAIN_SIGNATURES = {
-    "chain_new": (ctypes.c_void_p, [P(CDriveline), ctypes.c_char_p, ctypes.c_size_t]),
+    "chain_new": (ErrorKind, [P(CDriveline), P(ctypes.c_void_p), ctypes.c_char_p, ctypes.c_size_t]),
     "chain_free": (None, [ctypes.c_void_p]),
 }
 

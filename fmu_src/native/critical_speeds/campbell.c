@@ -30,10 +30,11 @@ typedef struct {
     double *value;
 } Branches;
 
-static int out_of_memory(char *error, size_t size)
+/* The message of a failed allocation; ERROR_VALUE, as the FMU reports it */
+static ErrorKind out_of_memory(char *error, size_t size)
 {
     snprintf(error, size, "out of memory");
-    return -1;
+    return ERROR_VALUE;
 }
 
 static void found_free(Found *found)
@@ -50,6 +51,7 @@ static void found_free(Found *found)
     found->count = 0;
 }
 
+/* 0, or -1 without memory (the caller writes the message) */
 static int found_alloc(Found *found, int count)
 {
     found->count = count;
@@ -72,16 +74,18 @@ static int found_alloc(Found *found, int count)
  * ``spin``, searched on bare-shaft grids; with ``neighbours`` NULL checked against the full grid at
  * the first speed and between consecutive speeds, otherwise against the counts of the known speeds
  * below and above each new one, ``neighbours`` (count x 2 x 2: speed, below/above, sense). A failed
- * check searches every speed on the full grid. ``out`` gets the speeds and their roots. */
-static int roots_over_speeds(const Chain *chain, const double *spin, int count, double x_hi, const int *neighbours,
-                             Found *out, char *error, size_t size)
+ * check searches every speed on the full grid. ``out`` gets the speeds and their roots. ERROR_NONE,
+ * or the failure's kind with the message. */
+static ErrorKind roots_over_speeds(const Chain *chain, const double *spin, int count, double x_hi,
+                                   const int *neighbours, Found *out, char *error, size_t size)
 {
     int lines_n = 2 * count, total = lines_n + (neighbours ? 0 : 2);
     *out = (Found){0, NULL, {NULL, NULL}};
     RotorLine *lines = malloc((size_t)total * sizeof *lines);
     unsigned char *coarse = malloc((size_t)total);
     RotorRoots *roots = calloc((size_t)total, sizeof *roots);
-    int status = -1, failed = 0;
+    int failed = 0;
+    ErrorKind status;
     if (!lines || !coarse || !roots || found_alloc(out, count)) {
         free(lines);
         free(coarse);
@@ -97,7 +101,8 @@ static int roots_over_speeds(const Chain *chain, const double *spin, int count, 
         lines[i].o = spin[speed];
         coarse[i] = (unsigned char)(i < lines_n);
     }
-    if (rotor_line_roots(chain, lines, total, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, coarse, roots, error, size)) {
+    status = rotor_line_roots(chain, lines, total, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, coarse, roots, error, size);
+    if (status != ERROR_NONE) {
         goto done;
     }
     for (int i = 0; i < count && !failed; ++i) {
@@ -116,7 +121,9 @@ static int roots_over_speeds(const Chain *chain, const double *spin, int count, 
     if (failed) {
         rotor_roots_free(roots, total);
         memset(roots, 0, (size_t)total * sizeof *roots);
-        if (rotor_line_roots(chain, lines, lines_n, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, NULL, roots, error, size)) {
+        status = rotor_line_roots(chain, lines, lines_n, 0, x_hi, ROTOR_DRIVELINE_SEARCH_LIMIT, NULL, roots, error,
+                                  size);
+        if (status != ERROR_NONE) {
             goto done;
         }
         total = lines_n;
@@ -128,21 +135,20 @@ static int roots_over_speeds(const Chain *chain, const double *spin, int count, 
             roots[2 * i + s].x = NULL;
         }
     }
-    status = 0;
 done:
     rotor_roots_free(roots, total);
     free(roots);
     free(lines);
     free(coarse);
-    if (status) {
+    if (status != ERROR_NONE) {
         found_free(out);
     }
     return status;
 }
 
 /* campbell._slopes: dw/dOmega = -f_Omega / f_w of every root (central differences), 0 where undefined;
- * ``slopes[s]`` lists sense s's roots speed by speed. */
-static int slopes_of(const Chain *chain, const Found *found, double *slopes[2], char *error, size_t size)
+ * ``slopes[s]`` lists sense s's roots speed by speed. ERROR_NONE, or ERROR_VALUE out of memory. */
+static ErrorKind slopes_of(const Chain *chain, const Found *found, double *slopes[2], char *error, size_t size)
 {
     size_t n[2] = {0, 0};
     for (int s = 0; s < 2; ++s) {
@@ -196,7 +202,7 @@ static int slopes_of(const Chain *chain, const Found *found, double *slopes[2], 
     free(w);
     free(spin);
     free(f);
-    return 0;
+    return ERROR_NONE;
 }
 
 /* numpy's float order: NaN after every number */
@@ -207,9 +213,10 @@ static int before(double a, double b)
 
 /* campbell._follow: the columns of the branches through one sense's roots, each root moved on by its
  * slope to the next speed, the predicted positions in their order taking the roots found there in
- * theirs; only branches among the first ``n_modes`` at some speed. */
-static int follow(const Found *found, int sense, const double *slopes, int n_modes, Branches *out, char *error,
-                  size_t size)
+ * theirs; only branches among the first ``n_modes`` at some speed. ERROR_NONE, or ERROR_VALUE out of
+ * memory. */
+static ErrorKind follow(const Found *found, int sense, const double *slopes, int n_modes, Branches *out, char *error,
+                        size_t size)
 {
     const RotorRoots *roots = found->roots[sense];
     int speeds = found->count;
@@ -301,7 +308,7 @@ static int follow(const Found *found, int sense, const double *slopes, int n_mod
     free(order);
     free(predicted);
     free(column);
-    return 0;
+    return ERROR_NONE;
 }
 
 /* Both senses' branches side by side, row-major over the speeds (forward columns first); NaN in a
@@ -336,16 +343,16 @@ static double *side_by_side(const Branches branches[2], int speeds, int pad, dou
 /* campbell._spline_error: the relative error of the branches' splines at the middle of every knot
  * interval (largest of all branches) by one Newton step on the determinant there, zero within NOISE
  * times the same step at the interval's ends; ``error_of`` has count - 1 entries. A branch missing at
- * some speed (NaN) has no spline and contributes no error. */
-static int spline_error(const Chain *chain, const Found *found, const Branches branches[2], double *error_of,
-                        char *error, size_t size)
+ * some speed (NaN) has no spline and contributes no error. ERROR_NONE, or ERROR_VALUE out of memory. */
+static ErrorKind spline_error(const Chain *chain, const Found *found, const Branches branches[2], double *error_of,
+                              char *error, size_t size)
 {
     int knots = found->count, m, forward;
     for (int i = 0; i + 1 < knots; ++i) {
         error_of[i] = 0.0;
     }
     if (branches[0].columns + branches[1].columns == 0) {
-        return 0;
+        return ERROR_NONE;
     }
     double *table = side_by_side(branches, knots, 0, NAN, &m, &forward);
     CubicSpline spline;
@@ -373,14 +380,15 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
     forward = kept_forward;
     if (m == 0) {
         free(table);
-        return 0;
+        return ERROR_NONE;
     }
     if (cubic_spline_build(&spline, knots, found->spin, m, table)) {
         free(table);
         return out_of_memory(error, size);
     }
     free(table);
-    int points = 2 * knots - 1, status = 0;
+    int points = 2 * knots - 1;
+    ErrorKind status = ERROR_NONE;
     size_t cells = (size_t)points * (size_t)m;
     double *w = malloc(cells * sizeof *w);
     double *step = malloc(cells * sizeof *step);
@@ -428,8 +436,8 @@ static int spline_error(const Chain *chain, const Found *found, const Branches b
 }
 
 /* campbell._insert (and np.insert of the speeds): ``added`` speed k after old speed ``rough[k]``;
- * the roots move into ``found`` and ``added`` is left empty. */
-static int insert_speeds(Found *found, Found *added, const int *rough, char *error, size_t size)
+ * the roots move into ``found`` and ``added`` is left empty. ERROR_NONE, or ERROR_VALUE out of memory. */
+static ErrorKind insert_speeds(Found *found, Found *added, const int *rough, char *error, size_t size)
 {
     Found merged;
     if (found_alloc(&merged, found->count + added->count)) {
@@ -456,7 +464,7 @@ static int insert_speeds(Found *found, Found *added, const int *rough, char *err
     added->spin = NULL;
     added->count = 0;
     *found = merged;
-    return 0;
+    return ERROR_NONE;
 }
 
 static void branches_free(Branches branches[2])
@@ -468,21 +476,22 @@ static void branches_free(Branches branches[2])
     }
 }
 
-/* Both senses' branches through ``found`` (campbell._slopes and _follow). */
-static int follow_both(const Chain *chain, const Found *found, int n_modes, Branches branches[2], char *error,
-                       size_t size)
+/* Both senses' branches through ``found`` (campbell._slopes and _follow); ERROR_NONE, or the failure's
+ * kind with the message */
+static ErrorKind follow_both(const Chain *chain, const Found *found, int n_modes, Branches branches[2], char *error,
+                             size_t size)
 {
     double *slopes[2] = {NULL, NULL};
-    if (slopes_of(chain, found, slopes, error, size)) {
-        return -1;
+    ErrorKind status = slopes_of(chain, found, slopes, error, size);
+    if (status != ERROR_NONE) {
+        return status;
     }
-    int status = 0;
-    for (int s = 0; s < 2 && !status; ++s) {
+    for (int s = 0; s < 2 && status == ERROR_NONE; ++s) {
         status = follow(found, s, slopes[s], n_modes, &branches[s], error, size);
     }
     free(slopes[0]);
     free(slopes[1]);
-    if (status) {
+    if (status != ERROR_NONE) {
         branches_free(branches);
     }
     return status;
@@ -502,11 +511,13 @@ static int branches_complete(const Branches branches[2], int knots)
 }
 
 /* One round of refinement (the body of whirl_branches' inner loop after _follow): the middles of the
- * intervals whose splines err searched and inserted; *refined 0 when no interval errs. */
-static int refine(const Chain *chain, Found *found, const Branches branches[2], double x_hi, int *refined,
-                  char *error, size_t size)
+ * intervals whose splines err searched and inserted; *refined 0 when no interval errs. ERROR_NONE, or
+ * the failure's kind with the message. */
+static ErrorKind refine(const Chain *chain, Found *found, const Branches branches[2], double x_hi, int *refined,
+                        char *error, size_t size)
 {
-    int knots = found->count, n_rough = 0, status = -1;
+    int knots = found->count, n_rough = 0;
+    ErrorKind status;
     double *error_of = malloc((size_t)knots * sizeof *error_of);
     int *rough = malloc((size_t)knots * sizeof *rough);
     double *middles = malloc((size_t)knots * sizeof *middles);
@@ -514,10 +525,10 @@ static int refine(const Chain *chain, Found *found, const Branches branches[2], 
     Found added = {0, NULL, {NULL, NULL}};
     *refined = 0;
     if (!error_of || !rough || !middles || !neighbours) {
-        out_of_memory(error, size);
+        status = out_of_memory(error, size);
         goto done;
     }
-    if (spline_error(chain, found, branches, error_of, error, size)) {
+    if ((status = spline_error(chain, found, branches, error_of, error, size)) != ERROR_NONE) {
         goto done;
     }
     for (int i = 0; i + 1 < knots; ++i) {
@@ -533,13 +544,13 @@ static int refine(const Chain *chain, Found *found, const Branches branches[2], 
         }
     }
     if (n_rough) {
-        if (roots_over_speeds(chain, middles, n_rough, x_hi, neighbours, &added, error, size) ||
-            insert_speeds(found, &added, rough, error, size)) {
+        if ((status = roots_over_speeds(chain, middles, n_rough, x_hi, neighbours, &added, error, size)) !=
+                ERROR_NONE ||
+            (status = insert_speeds(found, &added, rough, error, size)) != ERROR_NONE) {
             goto done;
         }
         *refined = 1;
     }
-    status = 0;
 done:
     found_free(&added);
     free(error_of);
@@ -549,22 +560,24 @@ done:
     return status;
 }
 
-/* campbell.whirl_branches for an isotropic chain: the branches over the refined speeds in ``found``. */
-static int isotropic_branches(const Chain *chain, const double *spins, int points, int n_modes, Found *found,
-                              Branches branches[2], char *error, size_t size)
+/* campbell.whirl_branches for an isotropic chain: the branches over the refined speeds in ``found``;
+ * ERROR_NONE, or the failure's kind with the message. */
+static ErrorKind isotropic_branches(const Chain *chain, const double *spins, int points, int n_modes, Found *found,
+                                    Branches branches[2], char *error, size_t size)
 {
     double reach = (n_modes + 2) * FMU_PI / chain_kappa(chain);
     double x_hi = fmin(reach * reach, ROTOR_DRIVELINE_SEARCH_LIMIT);
+    ErrorKind failed;
     for (;;) {
         int final = 0;
-        if (roots_over_speeds(chain, spins, points, x_hi, NULL, found, error, size)) {
-            return -1;
+        if ((failed = roots_over_speeds(chain, spins, points, x_hi, NULL, found, error, size)) != ERROR_NONE) {
+            return failed;
         }
         for (int round = 0; round <= ROTOR_CAMPBELL_REFINEMENTS; ++round) {
             int refined;
-            if (follow_both(chain, found, n_modes, branches, error, size)) {
+            if ((failed = follow_both(chain, found, n_modes, branches, error, size)) != ERROR_NONE) {
                 found_free(found);
-                return -1;
+                return failed;
             }
             int enough = 1;
             for (int s = 0; s < 2; ++s) {
@@ -576,10 +589,10 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
             if (round == ROTOR_CAMPBELL_REFINEMENTS || found->count > ROTOR_CAMPBELL_MAX_KNOTS || !final) {
                 break; /* a round to be widened restarts from ``spins``: refining it is wasted */
             }
-            if (refine(chain, found, branches, x_hi, &refined, error, size)) {
+            if ((failed = refine(chain, found, branches, x_hi, &refined, error, size)) != ERROR_NONE) {
                 branches_free(branches);
                 found_free(found);
-                return -1;
+                return failed;
             }
             if (!refined) {
                 break;
@@ -587,7 +600,7 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
             branches_free(branches);
         }
         if (final) {
-            return 0;
+            return ERROR_NONE;
         }
         branches_free(branches);
         found_free(found);
@@ -596,21 +609,21 @@ static int isotropic_branches(const Chain *chain, const double *spins, int point
 }
 
 /* Driveline.campbell: the first ``n_modes`` forward and backward whirl frequencies at every speed
- * (NaN where absent), one column per rank. */
-static int sorted_table(const Chain *chain, const double *spins, int points, int n_modes, Branches branches[2],
-                        char *error, size_t size)
+ * (NaN where absent), one column per rank. ERROR_NONE, or the failure's kind with the message. */
+static ErrorKind sorted_table(const Chain *chain, const double *spins, int points, int n_modes, Branches branches[2],
+                              char *error, size_t size)
 {
     RotorLine *cases = malloc((size_t)points * sizeof *cases);
     RotorRoots *roots[2];
     roots[0] = calloc((size_t)points, sizeof *roots[0]);
     roots[1] = calloc((size_t)points, sizeof *roots[1]);
-    int status = -1;
+    ErrorKind status;
     for (int s = 0; s < 2; ++s) {
         branches[s].columns = n_modes;
         branches[s].value = malloc((size_t)points * (size_t)n_modes * sizeof *branches[s].value);
     }
     if (!cases || !roots[0] || !roots[1] || !branches[0].value || !branches[1].value) {
-        out_of_memory(error, size);
+        status = out_of_memory(error, size);
         goto done;
     }
     for (int i = 0; i < points; ++i) {
@@ -618,9 +631,9 @@ static int sorted_table(const Chain *chain, const double *spins, int points, int
         cases[i].s = 0.0;
         cases[i].o = spins[i];
     }
-    if (rotor_roots_by_whirl(chain, cases, points, n_modes, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT, roots[0], roots[1],
-                             error,
-                             size)) {
+    status = rotor_roots_by_whirl(chain, cases, points, n_modes, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT, roots[0], roots[1],
+                                  error, size);
+    if (status != ERROR_NONE) {
         goto done;
     }
     for (int s = 0; s < 2; ++s) {
@@ -630,7 +643,6 @@ static int sorted_table(const Chain *chain, const double *spins, int points, int
             }
         }
     }
-    status = 0;
 done:
     for (int s = 0; s < 2; ++s) {
         if (roots[s]) {
@@ -639,7 +651,7 @@ done:
         free(roots[s]);
     }
     free(cases);
-    if (status) {
+    if (status != ERROR_NONE) {
         branches_free(branches);
     }
     return status;
@@ -647,23 +659,24 @@ done:
 
 /* model.whirl_table without the plausibility check: WhirlTable(whirl_branches(driveline,
  * linspace(0, omega_max, points), n_modes), n_modes, SEARCH_LIMIT). */
-WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, char *error, size_t size)
+ErrorKind whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, WhirlTable **out, char *error,
+                          size_t size)
 {
+    *out = NULL;
     if (n_modes < 1) {
         snprintf(error, size, "n_modes must be a positive integer, got %d", n_modes);
-        return NULL;
+        return ERROR_VALUE;
     }
     if (points < 2 || !isfinite(omega_max)) {
         snprintf(error, size, "spins must be at least two increasing finite speeds >= 0 rad/s");
-        return NULL;
+        return ERROR_VALUE;
     }
     double *spins = malloc((size_t)points * sizeof *spins);
     WhirlTable *table = calloc(1, sizeof *table);
     if (!spins || !table) {
         free(spins);
         free(table);
-        out_of_memory(error, size);
-        return NULL;
+        return out_of_memory(error, size);
     }
     double step = omega_max / (points - 1); /* np.linspace: start + i step, the end exact */
     for (int i = 0; i < points; ++i) {
@@ -674,13 +687,14 @@ WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, in
             snprintf(error, size, "spins must be at least two increasing finite speeds >= 0 rad/s");
             free(spins);
             free(table);
-            return NULL;
+            return ERROR_VALUE;
         }
     }
     Found found = {0, NULL, {NULL, NULL}};
     Branches branches[2] = {{0, NULL}, {0, NULL}};
     const double *knots = spins;
-    int count = points, status;
+    int count = points;
+    ErrorKind status;
     if (chain_isotropic(chain)) {
         status = isotropic_branches(chain, spins, points, n_modes, &found, branches, error, size);
         knots = found.spin;
@@ -688,12 +702,11 @@ WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, in
     } else {
         status = sorted_table(chain, spins, points, n_modes, branches, error, size);
     }
-    if (!status) { /* WhirlTable.__init__ */
+    if (status == ERROR_NONE) { /* WhirlTable.__init__ */
         int m;
         double *values = side_by_side(branches, count, n_modes, ROTOR_DRIVELINE_SEARCH_LIMIT, &m, &table->forward);
-        status = values ? cubic_spline_build(&table->spline, count, knots, m, values) : -1;
-        if (status) {
-            out_of_memory(error, size);
+        if (values == NULL || cubic_spline_build(&table->spline, count, knots, m, values) != 0) {
+            status = out_of_memory(error, size);
         }
         free(values);
     }
@@ -701,11 +714,12 @@ WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, in
     branches_free(branches);
     found_free(&found);
     free(spins);
-    if (status) {
+    if (status != ERROR_NONE) {
         free(table);
-        return NULL;
+        return status;
     }
-    return table;
+    *out = table;
+    return ERROR_NONE;
 }
 
 /* The first ``n`` of columns [first, end) at ``speed``, ascending (np.sort(...)[:n], NaN last). */

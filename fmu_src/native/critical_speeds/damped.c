@@ -50,12 +50,13 @@ static void components(double xx, double yy, double xy, double yx, cplx *a, cplx
     *b = cplx_make(0.5 * (xx - yy), 0.5 * (yx + xy));
 }
 
-/* DampedRotor.__init__ (with fem.assemble_damped) */
-static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char *error, size_t size)
+/* DampedRotor.__init__ (with fem.assemble_damped); ERROR_NONE, or the failure's kind with the message */
+static ErrorKind rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char *error, size_t size)
 {
     memset(rotor, 0, sizeof *rotor);
-    if (fe_model_build(d, counts, 0, &rotor->fe, error, size)) {
-        return -1;
+    ErrorKind failed = fe_model_build(d, counts, 0, &rotor->fe, error, size);
+    if (failed != ERROR_NONE) {
+        return failed;
     }
     const FeModel *fe = &rotor->fe;
     int n = fe->n_kept, nb = d->n_bearings;
@@ -190,7 +191,7 @@ static int rotor_init(Rotor *rotor, const Driveline *d, const int *counts, char 
         m_max = fmax(m_max, fe->M[(size_t)(i % n) * (size_t)n + (size_t)(i % n)]);
     }
     rotor->scale = sqrt(k_max / m_max);
-    return 0;
+    return ERROR_NONE;
 out_of_memory:
     free(Ka);
     free(Kb);
@@ -198,7 +199,7 @@ out_of_memory:
     free(Cb);
     rotor_free(rotor);
     ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-    return -1;
+    return ERROR_VALUE;
 }
 
 /* One damped mode (damped.DampedMode) */
@@ -252,6 +253,7 @@ static void krylov_free(Krylov *krylov)
     memset(krylov, 0, sizeof *krylov);
 }
 
+/* The Arnoldi work arrays: 0, or -1 without memory (the caller writes the message) */
 static int krylov_init(Krylov *krylov, const Rotor *rotor)
 {
     memset(krylov, 0, sizeof *krylov);
@@ -355,14 +357,15 @@ static int krylov_converged(Krylov *krylov, int steps, int order, int wanted)
 }
 
 /* The ``wanted`` eigenvalues lam nearest SHIFT at ``spin`` into ``lambda`` (ranked by descending
- * |nu|); afterwards ritz[rank[k]] is the Ritz value of lambda[k] and small the Hessenberg matrix */
-static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wanted, cplx *lambda, char *error,
-                        size_t size)
+ * |nu|); afterwards ritz[rank[k]] is the Ritz value of lambda[k] and small the Hessenberg matrix.
+ * ERROR_NONE, or ERROR_VALUE with the message (numpy's LinAlgError; no convergence in KRYLOV_CAP). */
+static ErrorKind krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wanted, cplx *lambda, char *error,
+                              size_t size)
 {
     int m = rotor->size, order = 2 * m, cap = krylov->cap;
     if (!isfinite(spin)) {
         ROTOR_ERROR(error, size, "Array must not contain infs or NaNs");
-        return -1;
+        return ERROR_VALUE;
     }
     size_t cells = (size_t)rotor->band.rows * (size_t)m;
     for (size_t i = 0; i < cells; i++) {
@@ -372,7 +375,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
     }
     if (band_factor(rotor->band, krylov->q, krylov->pivots)) {
         ROTOR_ERROR(error, size, "the damped model is singular at the Arnoldi shift");
-        return -1;
+        return ERROR_VALUE;
     }
     memset(krylov->hess, 0, ((size_t)cap + 1) * (size_t)cap * sizeof(cplx));
     unsigned long seed = 20240601UL;
@@ -384,7 +387,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
         double before = vector_norm(w, order);
         if (!isfinite(before)) {
             ROTOR_ERROR(error, size, "the Arnoldi iteration met infs or NaNs");
-            return -1;
+            return ERROR_VALUE;
         }
         orthogonalize(krylov->basis, steps + 1, order, w, krylov->hess + steps, cap);
         double beta = vector_norm(w, order);
@@ -401,13 +404,13 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
             status = krylov_converged(krylov, steps, order, wanted < steps ? wanted : steps);
             if (status < 0) {
                 ROTOR_ERROR(error, size, "Eigenvalues did not converge");
-                return -1;
+                return ERROR_VALUE;
             }
             if (status == 0 && steps == cap) {
                 if (error && size) {
                     snprintf(error, size, "the damped modes did not converge in %d Arnoldi vectors", cap);
                 }
-                return -1;
+                return ERROR_VALUE;
             }
             next = steps + (steps / 8 > 4 ? steps / 8 : 4);
         }
@@ -417,7 +420,7 @@ static int krylov_modes(const Rotor *rotor, Krylov *krylov, double spin, int wan
         cplx inverse = cplx_div(cplx_real(1.0), krylov->ritz[krylov->rank[k]]);
         lambda[k] = cplx_make(ROTOR_DAMPED_SHIFT + inverse.re, inverse.im);
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* The forward and backward sums sum |p_U|^2, sum |q_U|^2 of the Ritz vector of lambda[k] */
@@ -464,8 +467,9 @@ static void dense_free(Dense *dense)
     memset(dense, 0, sizeof *dense);
 }
 
-/* DampedRotor._dense_blocks and the eigen solver's arrays */
-static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size)
+/* DampedRotor._dense_blocks and the eigen solver's arrays; ERROR_NONE, or ERROR_VALUE with the message
+ * (a singular mass matrix: numpy's LinAlgError; out of memory) */
+static ErrorKind dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size)
 {
     memset(dense, 0, sizeof *dense);
     int m = rotor->size, n = rotor->n, order = 2 * m;
@@ -480,9 +484,9 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
         if (!dense->lambda || !dense->modes || !dense->index || krylov_init(&dense->krylov, rotor)) {
             dense_free(dense);
             ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-            return -1;
+            return ERROR_VALUE;
         }
-        return 0;
+        return ERROR_NONE;
     }
     dense->stiffness = malloc(block * sizeof(cplx));
     dense->damping = malloc(block * sizeof(cplx));
@@ -508,7 +512,7 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
         free(pivots);
         dense_free(dense);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     memcpy(l, rotor->fe.M, (size_t)n * (size_t)n * sizeof *l);
     if (lu_factor(l, n, pivots)) {
@@ -516,7 +520,7 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
         free(pivots);
         dense_free(dense);
         ROTOR_ERROR(error, size, "Singular matrix");
-        return -1;
+        return ERROR_VALUE;
     }
     for (size_t i = 0; i < block; i++) {
         dense->stiffness[i] = cplx_div_real(rotor->K[i], rotor->scale);
@@ -531,11 +535,12 @@ static int dense_init(Dense *dense, const Rotor *rotor, char *error, size_t size
     }
     free(l);
     free(pivots);
-    return 0;
+    return ERROR_NONE;
 }
 
-/* All eigenvalues of the first-order system at ``spin`` (numpy.linalg.eig) into dense->lambda */
-static int dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char *error, size_t size)
+/* All eigenvalues of the first-order system at ``spin`` (numpy.linalg.eig) into dense->lambda;
+ * ERROR_NONE, or ERROR_VALUE with numpy's LinAlgError's message */
+static ErrorKind dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char *error, size_t size)
 {
     int m = dense->size, order = dense->order;
     cplx *a = dense->a;
@@ -554,7 +559,7 @@ static int dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char
     for (size_t i = 0; i < (size_t)order * (size_t)order; i++) {
         if (!isfinite(a[i].re) || !isfinite(a[i].im)) { /* numpy.linalg's check */
             ROTOR_ERROR(error, size, "Array must not contain infs or NaNs");
-            return -1;
+            return ERROR_VALUE;
         }
     }
     balance(a, order, dense->d);
@@ -565,26 +570,28 @@ static int dense_eigenvalues(const Rotor *rotor, Dense *dense, double spin, char
     }
     if (hessenberg_eigenvalues(dense->h, order, dense->lambda)) {
         ROTOR_ERROR(error, size, "Eigenvalues did not converge");
-        return -1;
+        return ERROR_VALUE;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
-/* DampedRotor.modes(spin, n): the first ``n`` damped modes into ``out`` (n), their number in *found */
-static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mode *out, int *found, char *error,
-                       size_t size)
+/* DampedRotor.modes(spin, n): the first ``n`` damped modes into ``out`` (n), their number in *found;
+ * ERROR_NONE, or the failure's kind with the message */
+static ErrorKind rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mode *out, int *found, char *error,
+                             size_t size)
 {
     int order = dense->order, count, *index = dense->index;
+    ErrorKind failed;
     if (dense->krylov.cap) { /* above DENSE_SIZE: the 2 n + EXTRA_EIGENVALUES nearest SHIFT by Arnoldi */
         count = 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES < dense->krylov.cap ? 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES : dense->krylov.cap;
-        if (krylov_modes(rotor, &dense->krylov, spin, count, dense->lambda, error, size)) {
-            return -1;
+        if ((failed = krylov_modes(rotor, &dense->krylov, spin, count, dense->lambda, error, size)) != ERROR_NONE) {
+            return failed;
         }
         for (int i = 0; i < count; i++) {
             index[i] = i;
         }
-    } else if (dense_eigenvalues(rotor, dense, spin, error, size)) {
-        return -1;
+    } else if ((failed = dense_eigenvalues(rotor, dense, spin, error, size)) != ERROR_NONE) {
+        return failed;
     } else {
         count = order;
         for (int i = 0; i < order; i++) {
@@ -642,7 +649,7 @@ static int rotor_modes(const Rotor *rotor, Dense *dense, double spin, int n, Mod
         }
     }
     *found = take;
-    return 0;
+    return ERROR_NONE;
 }
 
 /* ---- unbalance_outputs.UnbalanceOutputs ------------------------------------------------------ */
@@ -655,8 +662,9 @@ struct UnbalanceOutputs {
     int *pivots;
 };
 
-/* DampedRotor.shape_rows for one position: ``row`` (rotor.n) */
-static int shape_row(const Rotor *rotor, double z, double length, cplx *row, char *error, size_t size)
+/* DampedRotor.shape_rows for one position: ``row`` (rotor.n); ERROR_NONE, or ERROR_VALUE with the
+ * message for a position off the shaft */
+static ErrorKind shape_row(const Rotor *rotor, double z, double length, cplx *row, char *error, size_t size)
 {
     const FeModel *fe = &rotor->fe;
     if (!isfinite(z) || z < 0.0 || z > length * (1 + 1e-12)) {
@@ -666,7 +674,7 @@ static int shape_row(const Rotor *rotor, double z, double length, cplx *row, cha
         if (error && size) {
             snprintf(error, size, "positions must lie on the shaft, 0 to %s m, got [%s]", shown, at);
         }
-        return -1;
+        return ERROR_VALUE;
     }
     int e = -1;
     while (e + 1 <= fe->n_elements && fe->z[e + 1] <= z) { /* searchsorted(side="right") - 1 */
@@ -686,7 +694,7 @@ static int shape_row(const Rotor *rotor, double z, double length, cplx *row, cha
             row[target].re += shape[k];
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 void unbalance_outputs_free(UnbalanceOutputs *outputs)
@@ -704,20 +712,21 @@ void unbalance_outputs_free(UnbalanceOutputs *outputs)
     free(outputs);
 }
 
-/* The mode table of UnbalanceOutputs.build: DAMPING_POINTS rows of 2 DAMPED_MODES */
-static int mode_table(const Driveline *d, const int *counts, const double *spins, double *table, char *error,
-                      size_t size)
+/* The mode table of UnbalanceOutputs.build: DAMPING_POINTS rows of 2 DAMPED_MODES; ERROR_NONE, or the
+ * failure's kind with the message */
+static ErrorKind mode_table(const Driveline *d, const int *counts, const double *spins, double *table, char *error,
+                            size_t size)
 {
     Rotor coarse;
     Dense dense;
-    if (rotor_init(&coarse, d, counts, error, size)) {
-        return -1;
+    ErrorKind status = rotor_init(&coarse, d, counts, error, size);
+    if (status != ERROR_NONE) {
+        return status;
     }
-    if (dense_init(&dense, &coarse, error, size)) {
+    if ((status = dense_init(&dense, &coarse, error, size)) != ERROR_NONE) {
         rotor_free(&coarse);
-        return -1;
+        return status;
     }
-    int status = 0;
     Mode modes[4 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
     for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS && !status; i++) {
         int found = 0, excited = 0;
@@ -743,16 +752,19 @@ static int mode_table(const Driveline *d, const int *counts, const double *spins
 }
 
 /* UnbalanceOutputs.build */
-UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbalances, int n_unbalances,
-                                        double response_fraction, double omega_max, char *error, size_t size)
+ErrorKind unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbalances, int n_unbalances,
+                                double response_fraction, double omega_max, UnbalanceOutputs **out, char *error,
+                                size_t size)
 {
     int *counts = malloc((size_t)(d->n_segments + 1) * sizeof *counts);
     UnbalanceOutputs *outputs = calloc(1, sizeof *outputs);
+    ErrorKind failed;
+    *out = NULL;
     if (!counts || !outputs) {
         free(counts);
         free(outputs);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     double spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS], table[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
     double step = omega_max / (ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS - 1); /* numpy.linspace */
@@ -761,17 +773,17 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
     }
     spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS - 1] = omega_max;
     fe_elements_by_length(d, ROTOR_UNBALANCE_OUTPUTS_TABLE_ELEMENTS, counts);
-    if (mode_table(d, counts, spins, table, error, size)) {
+    if ((failed = mode_table(d, counts, spins, table, error, size)) != ERROR_NONE) {
         free(counts);
         free(outputs);
-        return NULL;
+        return failed;
     }
     fe_elements_by_length(d, ROTOR_UNBALANCE_OUTPUTS_FE_ELEMENTS, counts);
     Rotor *rotor = &outputs->rotor;
-    if (rotor_init(rotor, d, counts, error, size)) {
+    if ((failed = rotor_init(rotor, d, counts, error, size)) != ERROR_NONE) {
         free(counts);
         free(outputs);
-        return NULL;
+        return failed;
     }
     free(counts);
     free(rotor->K); /* the response needs the band matrices only */
@@ -789,15 +801,15 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         free(rows);
         unbalance_outputs_free(outputs);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     /* DampedRotor.load: the unbalances' phasors times their shape rows */
     double length = driveline_length(d);
     for (int u = 0; u < n_unbalances; u++) {
-        if (shape_row(rotor, unbalances[u].position, length, rows, error, size)) {
+        if ((failed = shape_row(rotor, unbalances[u].position, length, rows, error, size)) != ERROR_NONE) {
             free(rows);
             unbalance_outputs_free(outputs);
-            return NULL;
+            return failed;
         }
         cplx phasor = cplx_scale(unbalances[u].amount, cplx_expi(unbalances[u].phase));
         for (int i = 0; i < rotor->n; i++) {
@@ -805,9 +817,9 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
         }
     }
     free(rows);
-    if (shape_row(rotor, response_fraction * length, length, outputs->row, error, size)) {
+    if ((failed = shape_row(rotor, response_fraction * length, length, outputs->row, error, size)) != ERROR_NONE) {
         unbalance_outputs_free(outputs);
-        return NULL;
+        return failed;
     }
     /* CubicSpline(spins, table) and its checks */
     const char *refused = NULL;
@@ -822,10 +834,11 @@ UnbalanceOutputs *unbalance_outputs_new(const Driveline *d, const RotorUnbalance
                                       2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES, table)) {
         memset(&outputs->modes, 0, sizeof outputs->modes);
         unbalance_outputs_free(outputs);
-        ROTOR_ERROR(error, size, refused ? refused : ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        ROTOR_ERROR(error, size, refused ? refused : ROTOR_OUT_OF_MEMORY); /* scipy's ValueError */
+        return ERROR_VALUE;
     }
-    return outputs;
+    *out = outputs;
+    return ERROR_NONE;
 }
 
 void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed,

@@ -1,9 +1,11 @@
 /* Shaft segment elements (driveline/rotor/elements.py): the section's constants, the finite element
  * (fe_matrices) and the Krylov functions of the transfer matrices (seed Eqs. 16-23), shared by the
- * transfer-matrix (transfer.c) and finite-element (fem.c) models. */
+ * transfer-matrix (transfer.c) and finite-element (fem.c) models; the elements' own checks, which the
+ * layout loader (layout.c) applies. */
 #include "elements.h"
 
 #include <math.h>
+#include <stdio.h>
 
 
 double segment_area(const RotorSegment *s)
@@ -179,4 +181,99 @@ void beam_field_matrix(double z, double EI, double c, double a, double b, double
         H[i][2] /= EI;
         H[i][3] /= EI;
     }
+}
+
+/* ---- the elements' checks (their __post_init__) ------------------------------------------------ */
+
+/* The message ``name`` ``rule``, got repr(value); ERROR_VALUE (Python's ValueError) */
+static ErrorKind refused(const char *name, const char *rule, double value, char *error, size_t size)
+{
+    char shown[40];
+    python_float_repr(value, shown, sizeof shown);
+    if (error != NULL && size > 0) {
+        snprintf(error, size, "%s%s, got %s", name, rule, shown);
+    }
+    return ERROR_VALUE;
+}
+
+/* elements._positive */
+static ErrorKind element_positive(const char *name, double value, char *error, size_t size)
+{
+    return isfinite(value) && value > 0.0 ? ERROR_NONE : refused(name, " must be a finite number > 0", value, error,
+                                                                   size);
+}
+
+ErrorKind element_non_negative(const char *name, double value, char *error, size_t size)
+{
+    return isfinite(value) && value >= 0.0 ? ERROR_NONE : refused(name, " must be a finite number >= 0", value, error,
+                                                                    size);
+}
+
+ErrorKind segment_check(const RotorSegment *s, char *error, size_t size)
+{
+    ErrorKind failed;
+    if ((failed = element_positive("length", s->length, error, size)) != ERROR_NONE ||
+        (failed = element_positive("outer_diameter", s->outer_diameter, error, size)) != ERROR_NONE ||
+        (failed = element_non_negative("inner_diameter", s->inner_diameter, error, size)) != ERROR_NONE) {
+        return failed;
+    }
+    if (s->inner_diameter >= s->outer_diameter) {
+        char inner[40], outer[40];
+        python_float_repr(s->inner_diameter, inner, sizeof inner);
+        python_float_repr(s->outer_diameter, outer, sizeof outer);
+        if (error != NULL && size > 0) {
+            snprintf(error, size, "inner_diameter (%s) must be smaller than outer_diameter (%s)", inner, outer);
+        }
+        return ERROR_VALUE;
+    }
+    if ((failed = element_positive("youngs_modulus", s->youngs_modulus, error, size)) != ERROR_NONE ||
+        (failed = element_positive("density", s->density, error, size)) != ERROR_NONE) {
+        return failed;
+    }
+    if (!(-1.0 < s->poisson_ratio && s->poisson_ratio < 0.5)) {
+        return refused("poisson_ratio", " must lie in (-1, 0.5)", s->poisson_ratio, error, size);
+    }
+    return ERROR_NONE;
+}
+
+/* element_non_negative of ``count`` values in turn: the first refusal's kind, or ERROR_NONE */
+static ErrorKind all_non_negative(const char *const names[], const double values[], int count, char *error,
+                                  size_t size)
+{
+    ErrorKind failed = ERROR_NONE;
+    for (int i = 0; i < count && failed == ERROR_NONE; i++) {
+        failed = element_non_negative(names[i], values[i], error, size);
+    }
+    return failed;
+}
+
+ErrorKind mass_check(const RotorMass *m, char *error, size_t size)
+{
+    static const char *const names[] = {"mass", "polar_inertia", "diametral_inertia"};
+    const double values[] = {m->mass, m->polar_inertia, m->diametral_inertia};
+    return all_non_negative(names, values, 3, error, size);
+}
+
+ErrorKind bearing_check(const RotorBearing *b, char *error, size_t size)
+{
+    static const char *const names[] = {"kxx", "kyy", "cxx", "cyy"}, *const cross[] = {"kxy", "kyx", "cxy", "cyx"};
+    const double values[] = {b->kxx, b->kyy, b->cxx, b->cyy}, coupling[] = {b->kxy, b->kyx, b->cxy, b->cyx};
+    ErrorKind failed = all_non_negative(names, values, 4, error, size);
+    for (int k = 0; k < 4 && failed == ERROR_NONE; k++) {
+        if (!isfinite(coupling[k])) {
+            failed = refused(cross[k], " must be a finite number", coupling[k], error, size);
+        }
+    }
+    return failed;
+}
+
+ErrorKind unbalance_check(const RotorUnbalance *u, char *error, size_t size)
+{
+    static const char *const names[] = {"position", "amount"};
+    const double values[] = {u->position, u->amount};
+    ErrorKind failed = all_non_negative(names, values, 2, error, size);
+    if (failed == ERROR_NONE && !isfinite(u->phase)) {
+        failed = refused("phase", " must be a finite angle in rad", u->phase, error, size);
+    }
+    return failed;
 }

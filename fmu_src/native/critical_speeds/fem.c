@@ -173,8 +173,8 @@ static int walk_mesh(const Driveline *d, const int *counts, int with_bearings, F
 }
 
 /* fem.mesh, Mesh.matrices and the kept rows (fem.assemble) */
-int fe_model_build(const Driveline *d, const int *counts, int with_bearings, FeModel *model, char *error,
-                   size_t size)
+ErrorKind fe_model_build(const Driveline *d, const int *counts, int with_bearings, FeModel *model, char *error,
+                         size_t size)
 {
     memset(model, 0, sizeof *model);
     int n_nodes = d->n_segments + 1, n_elements = 0, local = 0;
@@ -185,7 +185,7 @@ int fe_model_build(const Driveline *d, const int *counts, int with_bearings, FeM
     for (int i = 0; with_bearings && i < d->n_bearings; i++) {
         if (d->bearings[i].kxx != d->bearings[i].kyy) { /* Bearing.fe_matrices */
             ROTOR_ERROR(error, size, "the finite-element check covers isotropic bearings only");
-            return -1;
+            return ERROR_VALUE;
         }
     }
     int max_dof = 2 + 2 * n_elements + d->n_hinges, local_n = 2 * (local + 1);
@@ -219,14 +219,14 @@ int fe_model_build(const Driveline *d, const int *counts, int with_bearings, FeM
     free(fixed);
     free(segment);
     free(dofs);
-    return 0;
+    return ERROR_NONE;
 out_of_memory:
     ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
     fe_model_free(model);
     free(fixed);
     free(segment);
     free(dofs);
-    return -1;
+    return ERROR_VALUE;
 }
 
 /* ---- scipy.linalg.eigh(K, M, eigvals_only=True) ---------------------------------------------- */
@@ -420,13 +420,14 @@ static int ascending(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* eigh(K, M, eigvals_only=True) ascending into ``values``; K and M are overwritten */
-static int generalized_eigenvalues(double *K, double *M, int n, double *values, char *error, size_t size)
+/* eigh(K, M, eigvals_only=True) ascending into ``values``; K and M are overwritten. ERROR_NONE, or
+ * ERROR_VALUE with the message (scipy's LinAlgError, the iteration not converging, out of memory). */
+static ErrorKind generalized_eigenvalues(double *K, double *M, int n, double *values, char *error, size_t size)
 {
     int *first_nonzero = malloc((size_t)(n + 1) * sizeof *first_nonzero);
     if (!first_nonzero) {
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     int minor = cholesky(M, n, first_nonzero);
     if (minor) {
@@ -436,13 +437,13 @@ static int generalized_eigenvalues(double *K, double *M, int n, double *values, 
                      "The leading minor of order %d of B is not positive definite. The factorization of B could "
                      "not be completed and no eigenvalues or eigenvectors were computed.", minor);
         }
-        return -1;
+        return ERROR_VALUE;
     }
     double *work = malloc(3 * (size_t)(n + 1) * sizeof *work);
     if (!work) {
         free(first_nonzero);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     reduce_to_standard(K, M, n, first_nonzero);
     free(first_nonzero);
@@ -470,45 +471,47 @@ static int generalized_eigenvalues(double *K, double *M, int n, double *values, 
     free(work);
     if (status) {
         ROTOR_ERROR(error, size, "the eigenvalue iteration did not converge");
-        return -1;
+        return ERROR_VALUE;
     }
     qsort(values, (size_t)n, sizeof *values, ascending);
-    return 0;
+    return ERROR_NONE;
 }
 
-/* The natural frequencies of one plane: bearings isotropic with ``stiffness`` */
-static int plane_frequencies(const Driveline *d, const int *counts, RotorBearing *plane, double *out, int *count,
-                             char *error, size_t size)
+/* The natural frequencies of one plane: bearings isotropic with ``stiffness``; ERROR_NONE, or the
+ * failure's kind with the message */
+static ErrorKind plane_frequencies(const Driveline *d, const int *counts, RotorBearing *plane, double *out, int *count,
+                                   char *error, size_t size)
 {
     Driveline copy = *d;
     copy.bearings = plane;
     FeModel model;
-    if (fe_model_build(&copy, counts, 1, &model, error, size)) {
-        return -1;
+    ErrorKind failed = fe_model_build(&copy, counts, 1, &model, error, size);
+    if (failed != ERROR_NONE) {
+        return failed;
     }
     int n = model.n_kept;
     for (size_t i = 0; i < (size_t)n * (size_t)n; i++) {
         if (!isfinite(model.K[i]) || !isfinite(model.M[i])) { /* scipy.linalg.eigh's check_finite */
             ROTOR_ERROR(error, size, "array must not contain infs or NaNs");
             fe_model_free(&model);
-            return -1;
+            return ERROR_VALUE;
         }
     }
-    if (generalized_eigenvalues(model.K, model.M, n, out, error, size)) {
+    if ((failed = generalized_eigenvalues(model.K, model.M, n, out, error, size)) != ERROR_NONE) {
         fe_model_free(&model);
-        return -1;
+        return failed;
     }
     for (int i = 0; i < n; i++) {
         out[i] = sqrt(fabs(out[i]));
     }
     *count = n;
     fe_model_free(&model);
-    return 0;
+    return ERROR_NONE;
 }
 
 /* model.natural_frequencies: the kxx plane, then (anisotropic bearings) the kyy plane */
-int fe_natural_frequencies(const Driveline *d, int elements, double **frequencies, int *count, char *error,
-                           size_t size)
+ErrorKind fe_natural_frequencies(const Driveline *d, int elements, double **frequencies, int *count, char *error,
+                                 size_t size)
 {
     *frequencies = NULL;
     *count = 0;
@@ -531,7 +534,7 @@ int fe_natural_frequencies(const Driveline *d, int elements, double **frequencie
         free(plane);
         free(out);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     for (int k = 0; k < d->n_segments; k++) {
         counts[k] = elements;
@@ -544,11 +547,12 @@ int fe_natural_frequencies(const Driveline *d, int elements, double **frequencie
             plane[i] = isotropic;
         }
         int n = 0;
-        if (plane_frequencies(d, counts, plane, out + found, &n, error, size)) {
+        ErrorKind failed = plane_frequencies(d, counts, plane, out + found, &n, error, size);
+        if (failed != ERROR_NONE) {
             free(counts);
             free(plane);
             free(out);
-            return -1;
+            return failed;
         }
         found += n;
     }
@@ -556,5 +560,5 @@ int fe_natural_frequencies(const Driveline *d, int elements, double **frequencie
     free(plane);
     *frequencies = out;
     *count = found;
-    return 0;
+    return ERROR_NONE;
 }

@@ -1,6 +1,9 @@
 /* The driveline of a layout: the checks of driveline/rotor/loader.py on the TOML read (toml.c), the
- * element checks of elements.py and Driveline.__post_init__ (driveline.py), with their messages;
- * the one-piece tube. */
+ * element checks of elements.py (elements.c) and Driveline.__post_init__ (driveline.py), with their
+ * messages; the one-piece tube. A function of the loader that returns ErrorKind gives ERROR_NONE, or
+ * the failure's kind with its message in loader->error: ERROR_VALUE (loader.py raises ValueError, and
+ * the FMU reports out of memory as one), but for the length's math.fsum (its own kind). */
+#include "elements.h"
 #include "toml.h"
 
 #include <math.h>
@@ -58,7 +61,7 @@ static int key_before(const char *a, size_t na, const char *b, size_t nb)
 }
 
 /* loader._unknown: the first (sorted) key not in ``allowed``. */
-static int unknown(const Loader *loader, const char *where, const Value *table, const char *const *allowed)
+static ErrorKind unknown(const Loader *loader, const char *where, const Value *table, const char *const *allowed)
 {
     const Item *item, *first = NULL;
     char list[512] = "";
@@ -73,7 +76,7 @@ static int unknown(const Loader *loader, const char *where, const Value *table, 
         }
     }
     if (first == NULL) {
-        return 0;
+        return ERROR_NONE;
     }
     for (i = 0; allowed[i] != NULL; i++) {
         if (i > 0) {
@@ -90,8 +93,8 @@ static int unknown(const Loader *loader, const char *where, const Value *table, 
 }
 
 /* loader._number */
-static int number(const Loader *loader, const char *where, const char *key, const Value *value, int positive,
-                  int signed_, double *out)
+static ErrorKind number(const Loader *loader, const char *where, const char *key, const Value *value, int positive,
+                        int signed_, double *out)
 {
     double v;
     if (value->kind != V_INTEGER && value->kind != V_FLOAT) {
@@ -108,29 +111,29 @@ static int number(const Loader *loader, const char *where, const char *key, cons
         return layout_error(loader->error, loader->size, "%s.%s must be >= 0, got %v", where, key, value);
     }
     *out = v;
-    return 0;
+    return ERROR_NONE;
 }
 
 /* loader._number of an optional key (``fallback`` when absent, as t.get(key, 0.0)) */
-static int number_or(const Loader *loader, const char *where, const Value *table, const char *key, double fallback,
-                     int signed_, double *out)
+static ErrorKind number_or(const Loader *loader, const char *where, const Value *table, const char *key,
+                           double fallback, int signed_, double *out)
 {
     const Value *value = get(table, key);
     if (value == NULL) {
         *out = fallback;
-        return 0;
+        return ERROR_NONE;
     }
     return number(loader, where, key, value, 0, signed_, out);
 }
 
 /* loader._table_list and loader._counted: the tables of ``key`` (NULL with count 0 if absent). */
-static int counted(const Loader *loader, const Value *data, const char *key, int limit, const Value **list)
+static ErrorKind counted(const Loader *loader, const Value *data, const char *key, int limit, const Value **list)
 {
     const Value *items = get(data, key);
     const Item *item;
     *list = items;
     if (items == NULL) {
-        return 0;
+        return ERROR_NONE;
     }
     if (items->kind != V_ARRAY) {
         return layout_error(loader->error, loader->size, "%s must be an array of tables ([[%s]])", key, key);
@@ -146,94 +149,12 @@ static int counted(const Loader *loader, const Value *data, const char *key, int
         return layout_error(loader->error, loader->size, "%s [[%s]] tables are more than the %d accepted", count, key,
                     limit);
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 static int list_count(const Value *list)
 {
     return list == NULL ? 0 : (int)list->count;
-}
-
-/* elements._positive */
-static int check_positive(const Loader *loader, const char *name, double value)
-{
-    if (!isfinite(value) || value <= 0.0) {
-        return layout_error(loader->error, loader->size, "%s must be a finite number > 0, got %g", name, value);
-    }
-    return 0;
-}
-
-/* elements._non_negative */
-static int check_non_negative(const Loader *loader, const char *name, double value)
-{
-    if (!isfinite(value) || value < 0.0) {
-        return layout_error(loader->error, loader->size, "%s must be a finite number >= 0, got %g", name, value);
-    }
-    return 0;
-}
-
-/* ShaftSegment.__post_init__ */
-static int check_segment(const Loader *loader, const RotorSegment *s)
-{
-    if (check_positive(loader, "length", s->length) != 0 ||
-        check_positive(loader, "outer_diameter", s->outer_diameter) != 0 ||
-        check_non_negative(loader, "inner_diameter", s->inner_diameter) != 0) {
-        return -1;
-    }
-    if (s->inner_diameter >= s->outer_diameter) {
-        return layout_error(loader->error, loader->size, "inner_diameter (%g) must be smaller than outer_diameter (%g)",
-                    s->inner_diameter, s->outer_diameter);
-    }
-    if (check_positive(loader, "youngs_modulus", s->youngs_modulus) != 0 ||
-        check_positive(loader, "density", s->density) != 0) {
-        return -1;
-    }
-    if (!(-1.0 < s->poisson_ratio && s->poisson_ratio < 0.5)) {
-        return layout_error(loader->error, loader->size, "poisson_ratio must lie in (-1, 0.5), got %g",
-                            s->poisson_ratio);
-    }
-    return 0;
-}
-
-/* ConcentratedMass.__post_init__ */
-static int check_mass(const Loader *loader, const RotorMass *m)
-{
-    return check_non_negative(loader, "mass", m->mass) != 0 ||
-                   check_non_negative(loader, "polar_inertia", m->polar_inertia) != 0 ||
-                   check_non_negative(loader, "diametral_inertia", m->diametral_inertia) != 0
-               ? -1
-               : 0;
-}
-
-/* Bearing.__post_init__ (kyy and cyy resolved: checked again, as kxx and cxx before) */
-static int check_bearing(const Loader *loader, const RotorBearing *b)
-{
-    static const char *const cross[] = {"kxy", "kyx", "cxy", "cyx"};
-    const double values[] = {b->kxy, b->kyx, b->cxy, b->cyx};
-    int k;
-    if (check_non_negative(loader, "kxx", b->kxx) != 0 || check_non_negative(loader, "kyy", b->kyy) != 0 ||
-        check_non_negative(loader, "cxx", b->cxx) != 0 || check_non_negative(loader, "cyy", b->cyy) != 0) {
-        return -1;
-    }
-    for (k = 0; k < 4; k++) {
-        if (!isfinite(values[k])) {
-            return layout_error(loader->error, loader->size, "%s must be a finite number, got %g", cross[k], values[k]);
-        }
-    }
-    return 0;
-}
-
-/* Unbalance.__post_init__ */
-static int check_unbalance(const Loader *loader, const RotorUnbalance *u)
-{
-    if (check_non_negative(loader, "position", u->position) != 0 ||
-        check_non_negative(loader, "amount", u->amount) != 0) {
-        return -1;
-    }
-    if (!isfinite(u->phase)) {
-        return layout_error(loader->error, loader->size, "phase must be a finite angle in rad, got %g", u->phase);
-    }
-    return 0;
 }
 
 /* Driveline.length: math.fsum of the segment lengths; ERROR_NONE, or Python's exception */
@@ -244,7 +165,7 @@ static ErrorKind segments_length(const Driveline *d, double *sum, const char **m
 }
 
 /* Driveline.__post_init__'s checks on the nodes and the unbalances. */
-static int check_driveline(const Loader *loader, const Driveline *d)
+static ErrorKind check_driveline(const Loader *loader, const Driveline *d)
 {
     int n_nodes = d->n_segments + 1, i;
     double length;
@@ -275,7 +196,7 @@ static int check_driveline(const Loader *loader, const Driveline *d)
     }
     const char *failure;
     ErrorKind kind = segments_length(d, &length, &failure);
-    if (kind != ERROR_NONE) {
+    if (kind != ERROR_NONE) { /* math.fsum's OverflowError or ValueError */
         layout_error(loader->error, loader->size, "%s", failure);
         return kind;
     }
@@ -289,19 +210,20 @@ static int check_driveline(const Loader *loader, const Driveline *d)
                         i, position, end);
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* loader._materials */
-static int materials(const Loader *loader, const Value *data, Material **out, int *count)
+static ErrorKind materials(const Loader *loader, const Value *data, Material **out, int *count)
 {
     const Value *table = get(data, "materials");
     const Item *item;
     int n = 0;
+    ErrorKind failed;
     *out = NULL;
     *count = 0;
     if (table == NULL) {
-        return 0;
+        return ERROR_NONE;
     }
     if (table->kind != V_TABLE) {
         return layout_error(loader->error, loader->size,
@@ -324,8 +246,8 @@ static int materials(const Loader *loader, const Value *data, Material **out, in
         if (t->kind != V_TABLE) {
             return layout_error(loader->error, loader->size, "%s must be a table", where);
         }
-        if (unknown(loader, where, t, MATERIAL_KEYS) != 0) {
-            return -1;
+        if ((failed = unknown(loader, where, t, MATERIAL_KEYS)) != ERROR_NONE) {
+            return failed;
         }
         E = get(t, "youngs_modulus");
         rho = get(t, "density");
@@ -335,27 +257,27 @@ static int materials(const Loader *loader, const Value *data, Material **out, in
         }
         m->name = item->key;
         m->length = item->key_length;
-        if (number(loader, where, "youngs_modulus", E, 1, 0, &m->E) != 0 ||
-            number(loader, where, "density", rho, 1, 0, &m->rho) != 0) {
-            return -1;
+        if ((failed = number(loader, where, "youngs_modulus", E, 1, 0, &m->E)) != ERROR_NONE ||
+            (failed = number(loader, where, "density", rho, 1, 0, &m->rho)) != ERROR_NONE) {
+            return failed;
         }
         *count = n + 1;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* loader._flag */
-static int flag(const Loader *loader, const char *where, const Value *t, const char *key, int *out)
+static ErrorKind flag(const Loader *loader, const char *where, const Value *t, const char *key, int *out)
 {
     const Value *value = get(t, key);
     if (value == NULL) {
-        return 0;
+        return ERROR_NONE;
     }
     if (value->kind != V_BOOL) {
         return layout_error(loader->error, loader->size, "%s.%s must be true or false, got %v", where, key, value);
     }
     *out = (int)value->integer;
-    return 0;
+    return ERROR_NONE;
 }
 
 /* The known material names, sorted, joined by ", " (or "none defined"). */
@@ -394,7 +316,7 @@ static const char *material_names(const Loader *loader, const Material *mats, in
 }
 
 /* loader._segment and ShaftSegment.__post_init__ */
-static int segment(const Loader *loader, int i, const Value *t, const Material *mats, int n_mats, RotorSegment *s)
+static ErrorKind segment(const Loader *loader, int i, const Value *t, const Material *mats, int n_mats, RotorSegment *s)
 {
     static const char *const inner_keys[] = {"inner_diameter", "inner_radius", "wall_thickness"};
     char where[40];
@@ -402,23 +324,24 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
     const Value *value, *nu;
     double d_out, d_in = 0.0, v;
     int have_E = 0, have_rho = 0, k;
+    ErrorKind failed;
     snprintf(where, sizeof where, "segments[%d]", i);
-    if (unknown(loader, where, t, SEGMENT_KEYS) != 0) {
-        return -1;
+    if ((failed = unknown(loader, where, t, SEGMENT_KEYS)) != ERROR_NONE) {
+        return failed;
     }
     if (get(t, "length") == NULL) {
         return layout_error(loader->error, loader->size, "%s: missing key 'length'", where);
     }
-    if (number(loader, where, "length", get(t, "length"), 1, 0, &s->length) != 0) {
-        return -1;
+    if ((failed = number(loader, where, "length", get(t, "length"), 1, 0, &s->length)) != ERROR_NONE) {
+        return failed;
     }
     if ((get(t, "outer_diameter") == NULL) == (get(t, "outer_radius") == NULL)) {
         return layout_error(loader->error, loader->size, "%s: give exactly one of 'outer_diameter' or 'outer_radius'",
                             where);
     }
     outer_key = get(t, "outer_diameter") != NULL ? "outer_diameter" : "outer_radius";
-    if (number(loader, where, outer_key, get(t, outer_key), 1, 0, &d_out) != 0) {
-        return -1;
+    if ((failed = number(loader, where, outer_key, get(t, outer_key), 1, 0, &d_out)) != ERROR_NONE) {
+        return failed;
     }
     d_out *= outer_key[6] == 'r' ? 2.0 : 1.0;
     for (k = 0; k < 3; k++) {
@@ -432,8 +355,8 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
     }
     if (inner_key != NULL) {
         value = get(t, inner_key);
-        if (number(loader, where, inner_key, value, 0, 0, &v) != 0) {
-            return -1;
+        if ((failed = number(loader, where, inner_key, value, 0, 0, &v)) != ERROR_NONE) {
+            return failed;
         }
         if (inner_key[0] == 'w') {
             if (v <= 0.0) {
@@ -479,14 +402,14 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
         have_E = have_rho = 1;
     }
     if ((value = get(t, "youngs_modulus")) != NULL) {
-        if (number(loader, where, "youngs_modulus", value, 1, 0, &s->youngs_modulus) != 0) {
-            return -1;
+        if ((failed = number(loader, where, "youngs_modulus", value, 1, 0, &s->youngs_modulus)) != ERROR_NONE) {
+            return failed;
         }
         have_E = 1;
     }
     if ((value = get(t, "density")) != NULL) {
-        if (number(loader, where, "density", value, 1, 0, &s->density) != 0) {
-            return -1;
+        if ((failed = number(loader, where, "density", value, 1, 0, &s->density)) != ERROR_NONE) {
+            return failed;
         }
         have_rho = 1;
     }
@@ -495,9 +418,10 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
                     !have_E ? "youngs_modulus" : "density");
     }
     s->rotary_inertia = s->gyroscopic = s->shear = 1;
-    if (flag(loader, where, t, "rotary_inertia", &s->rotary_inertia) != 0 ||
-        flag(loader, where, t, "gyroscopic", &s->gyroscopic) != 0 || flag(loader, where, t, "shear", &s->shear) != 0) {
-        return -1;
+    if ((failed = flag(loader, where, t, "rotary_inertia", &s->rotary_inertia)) != ERROR_NONE ||
+        (failed = flag(loader, where, t, "gyroscopic", &s->gyroscopic)) != ERROR_NONE ||
+        (failed = flag(loader, where, t, "shear", &s->shear)) != ERROR_NONE) {
+        return failed;
     }
     s->poisson_ratio = 0.3;
     if ((nu = get(t, "poisson_ratio")) != NULL) {
@@ -510,11 +434,11 @@ static int segment(const Loader *loader, int i, const Value *t, const Material *
         }
         s->poisson_ratio = x;
     }
-    return check_segment(loader, s);
+    return segment_check(s, loader->error, loader->size);
 }
 
 /* loader._station */
-static int station(const Loader *loader, const char *where, const Value *t, int n_nodes, Station *out)
+static ErrorKind station(const Loader *loader, const char *where, const Value *t, int n_nodes, Station *out)
 {
     const Value *node = get(t, "node"), *position = get(t, "position");
     if ((node != NULL) == (position != NULL)) {
@@ -534,20 +458,23 @@ static int station(const Loader *loader, const char *where, const Value *t, int 
         }
         out->node = (int)node->integer;
         out->value = out->node;
-        return 0;
+        return ERROR_NONE;
     }
     return number(loader, where, "position", position, 0, 0, &out->value);
 }
 
 /* loader._unbalance */
-static int unbalance(const Loader *loader, int i, const Value *t, const double *ends, int n_ends, RotorUnbalance *u)
+static ErrorKind unbalance(const Loader *loader, int i, const Value *t, const double *ends, int n_ends,
+                           RotorUnbalance *u)
 {
     char where[40];
     Station at;
     double position, right = ends[n_ends - 1];
+    ErrorKind failed;
     snprintf(where, sizeof where, "unbalances[%d]", i);
-    if (unknown(loader, where, t, UNBALANCE_KEYS) != 0 || station(loader, where, t, n_ends, &at) != 0) {
-        return -1;
+    if ((failed = unknown(loader, where, t, UNBALANCE_KEYS)) != ERROR_NONE ||
+        (failed = station(loader, where, t, n_ends, &at)) != ERROR_NONE) {
+        return failed;
     }
     position = at.is_node ? ends[at.node] : at.value;
     if (position > right + ROTOR_LOADER_NODE_SNAP) {
@@ -558,10 +485,11 @@ static int unbalance(const Loader *loader, int i, const Value *t, const double *
         return layout_error(loader->error, loader->size, "%s: missing key 'amount'", where);
     }
     u->position = right < position ? right : position;
-    return number(loader, where, "amount", get(t, "amount"), 0, 0, &u->amount) != 0 ||
-                   number_or(loader, where, t, "phase", 0.0, 1, &u->phase) != 0
-               ? -1
-               : check_unbalance(loader, u);
+    if ((failed = number(loader, where, "amount", get(t, "amount"), 0, 0, &u->amount)) != ERROR_NONE ||
+        (failed = number_or(loader, where, t, "phase", 0.0, 1, &u->phase)) != ERROR_NONE) {
+        return failed;
+    }
+    return unbalance_check(u, loader->error, loader->size);
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -572,8 +500,8 @@ static int compare_doubles(const void *a, const void *b)
 
 /* loader._cut: the segments split at every position that is no node (into ``d``), and every
  * station's node (``nodes[kind][i]``). */
-static int cut(const Loader *loader, const RotorSegment *old, int n_old, Station *const stations[3],
-               const int counts[3], Driveline *d, int *const nodes[3])
+static ErrorKind cut(const Loader *loader, const RotorSegment *old, int n_old, Station *const stations[3],
+                     const int counts[3], Driveline *d, int *const nodes[3])
 {
     static const char *const kinds[] = {"masses", "bearings", "hinges"};
     double *ends, *cuts, *new_ends;
@@ -671,24 +599,25 @@ static int cut(const Loader *loader, const RotorSegment *old, int n_old, Station
             }
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* loader._pair: (xx, yy) of a bearing from the isotropic ``key`` or from ``xx`` [+ ``yy``]. */
-static int pair(const Loader *loader, const char *where, const Value *t, const char *key, const char *xx,
-                const char *yy, int positive, double *x, double *y)
+static ErrorKind pair(const Loader *loader, const char *where, const Value *t, const char *key, const char *xx,
+                      const char *yy, int positive, double *x, double *y)
 {
     const Value *iso = get(t, key), *vx = get(t, xx), *vy = get(t, yy);
+    ErrorKind failed;
     if (iso != NULL) {
         if (vx != NULL || vy != NULL) {
             return layout_error(loader->error, loader->size, "%s: give either %r or %r/%r, not both", where, key, xx,
                                 yy);
         }
-        if (number(loader, where, key, iso, positive, 0, x) != 0) {
-            return -1;
+        if ((failed = number(loader, where, key, iso, positive, 0, x)) != ERROR_NONE) {
+            return failed;
         }
         *y = *x;
-        return 0;
+        return ERROR_NONE;
     }
     if (vx == NULL) {
         if (positive) {
@@ -698,25 +627,27 @@ static int pair(const Loader *loader, const char *where, const Value *t, const c
             return layout_error(loader->error, loader->size, "%s: %r needs %r", where, yy, xx);
         }
         *x = *y = 0.0;
-        return 0;
+        return ERROR_NONE;
     }
-    if (number(loader, where, xx, vx, positive, 0, x) != 0) {
-        return -1;
+    if ((failed = number(loader, where, xx, vx, positive, 0, x)) != ERROR_NONE) {
+        return failed;
     }
     if (vy == NULL) {
         *y = *x;
-        return 0;
+        return ERROR_NONE;
     }
     return number(loader, where, yy, vy, positive, 0, y);
 }
 
 /* loader._mass, _bearing, _hinge of entry ``i`` of ``kind`` (0, 1, 2) at ``node`` */
-static int point_element(const Loader *loader, Driveline *d, int kind, int i, const Value *t, int node)
+static ErrorKind point_element(const Loader *loader, Driveline *d, int kind, int i, const Value *t, int node)
 {
     char where[40];
+    ErrorKind failed;
     snprintf(where, sizeof where, "%s[%d]", kind == 0 ? "masses" : kind == 1 ? "bearings" : "hinges", i);
-    if (unknown(loader, where, t, kind == 0 ? MASS_KEYS : kind == 1 ? BEARING_KEYS : HINGE_KEYS) != 0) {
-        return -1;
+    if ((failed = unknown(loader, where, t, kind == 0 ? MASS_KEYS : kind == 1 ? BEARING_KEYS : HINGE_KEYS)) !=
+        ERROR_NONE) {
+        return failed;
     }
     if (kind == 0) {
         RotorMass *m = &d->masses[d->n_masses];
@@ -724,26 +655,26 @@ static int point_element(const Loader *loader, Driveline *d, int kind, int i, co
         if (get(t, "mass") == NULL) {
             return layout_error(loader->error, loader->size, "%s: missing key 'mass'", where);
         }
-        if (number(loader, where, "mass", get(t, "mass"), 0, 0, &m->mass) != 0 ||
-            number_or(loader, where, t, "polar_inertia", 0.0, 0, &m->polar_inertia) != 0 ||
-            number_or(loader, where, t, "diametral_inertia", 0.0, 0, &m->diametral_inertia) != 0) {
-            return -1;
+        if ((failed = number(loader, where, "mass", get(t, "mass"), 0, 0, &m->mass)) != ERROR_NONE ||
+            (failed = number_or(loader, where, t, "polar_inertia", 0.0, 0, &m->polar_inertia)) != ERROR_NONE ||
+            (failed = number_or(loader, where, t, "diametral_inertia", 0.0, 0, &m->diametral_inertia)) != ERROR_NONE) {
+            return failed;
         }
         d->n_masses++;
-        return check_mass(loader, m);
+        return mass_check(m, loader->error, loader->size);
     } else if (kind == 1) {
         RotorBearing *b = &d->bearings[d->n_bearings];
         b->node = node;
-        if (pair(loader, where, t, "stiffness", "kxx", "kyy", 1, &b->kxx, &b->kyy) != 0 ||
-            pair(loader, where, t, "damping", "cxx", "cyy", 0, &b->cxx, &b->cyy) != 0 ||
-            number_or(loader, where, t, "kxy", 0.0, 1, &b->kxy) != 0 ||
-            number_or(loader, where, t, "kyx", 0.0, 1, &b->kyx) != 0 ||
-            number_or(loader, where, t, "cxy", 0.0, 1, &b->cxy) != 0 ||
-            number_or(loader, where, t, "cyx", 0.0, 1, &b->cyx) != 0) {
-            return -1;
+        if ((failed = pair(loader, where, t, "stiffness", "kxx", "kyy", 1, &b->kxx, &b->kyy)) != ERROR_NONE ||
+            (failed = pair(loader, where, t, "damping", "cxx", "cyy", 0, &b->cxx, &b->cyy)) != ERROR_NONE ||
+            (failed = number_or(loader, where, t, "kxy", 0.0, 1, &b->kxy)) != ERROR_NONE ||
+            (failed = number_or(loader, where, t, "kyx", 0.0, 1, &b->kyx)) != ERROR_NONE ||
+            (failed = number_or(loader, where, t, "cxy", 0.0, 1, &b->cxy)) != ERROR_NONE ||
+            (failed = number_or(loader, where, t, "cyx", 0.0, 1, &b->cyx)) != ERROR_NONE) {
+            return failed;
         }
         d->n_bearings++;
-        return check_bearing(loader, b);
+        return bearing_check(b, loader->error, loader->size);
     } else {
         RotorHinge *h = &d->hinges[d->n_hinges];
         int n_nodes = d->n_segments + 1;
@@ -761,34 +692,34 @@ static int point_element(const Loader *loader, Driveline *d, int kind, int i, co
                         where, get(t, "position"), n_nodes - 2);
         }
         h->node = node;
-        if (number_or(loader, where, t, "bending_stiffness", 0.0, 0, &h->bending_stiffness) != 0) {
-            return -1;
+        if ((failed = number_or(loader, where, t, "bending_stiffness", 0.0, 0, &h->bending_stiffness)) != ERROR_NONE) {
+            return failed;
         }
         d->n_hinges++;
-        return check_non_negative(loader, "bending_stiffness", h->bending_stiffness);
+        return element_non_negative("bending_stiffness", h->bending_stiffness, loader->error, loader->size);
     }
-    return 0;
 }
 
-static int end_condition(const Loader *loader, const Value *data, const char *key, EndCondition *out)
+/* loader's end condition of ``key`` (free when absent) */
+static ErrorKind end_condition(const Loader *loader, const Value *data, const char *key, EndCondition *out)
 {
     const Value *v = get(data, key);
     int i;
     *out = END_FREE;
     if (v == NULL) {
-        return 0;
+        return ERROR_NONE;
     }
     for (i = 0; i < 3 && v->kind == V_STRING; i++) {
         if (v->length == strlen(END_NAMES[i]) && memcmp(v->text, END_NAMES[i], v->length) == 0) {
             *out = (EndCondition)i;
-            return 0;
+            return ERROR_NONE;
         }
     }
     return layout_error(loader->error, loader->size, "%s = %v is not one of: free, pinned, clamped", key, v);
 }
 
 /* loader.loads_driveline after the parse: the driveline of the document ``data``. */
-static int load(const Loader *loader, const Value *data, Driveline *d)
+static ErrorKind load(const Loader *loader, const Value *data, Driveline *d)
 {
     static const char *const kinds[] = {"masses", "bearings", "hinges"};
     static const int limits[] = {ROTOR_LOADER_MAX_POINT_ELEMENTS, ROTOR_LOADER_MAX_POINT_ELEMENTS,
@@ -800,16 +731,18 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
     Station *stations[3];
     int *nodes[3], counts[3], n_mats, n_old, n_unb, i, kind;
     double *ends;
-    if (unknown(loader, loader->source, data, TOP_KEYS) != 0) {
-        return -1;
+    ErrorKind failed;
+    if ((failed = unknown(loader, loader->source, data, TOP_KEYS)) != ERROR_NONE) {
+        return failed;
     }
     if (name != NULL && name->kind != V_STRING) {
         return layout_error(loader->error, loader->size, "%s: name must be a string, got %v", loader->source, name);
     }
-    if (end_condition(loader, data, "left_end", &d->left) != 0 ||
-        end_condition(loader, data, "right_end", &d->right) != 0 || materials(loader, data, &mats, &n_mats) != 0 ||
-        counted(loader, data, "segments", ROTOR_LOADER_MAX_SEGMENTS, &segs) != 0) {
-        return -1;
+    if ((failed = end_condition(loader, data, "left_end", &d->left)) != ERROR_NONE ||
+        (failed = end_condition(loader, data, "right_end", &d->right)) != ERROR_NONE ||
+        (failed = materials(loader, data, &mats, &n_mats)) != ERROR_NONE ||
+        (failed = counted(loader, data, "segments", ROTOR_LOADER_MAX_SEGMENTS, &segs)) != ERROR_NONE) {
+        return failed;
     }
     n_old = list_count(segs);
     if (n_old == 0) {
@@ -823,13 +756,13 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
     }
     ends[0] = 0.0;
     for (i = 0, item = segs->first; item != NULL; item = item->next, i++) {
-        if (segment(loader, i, item->value, mats, n_mats, &old[i]) != 0) {
-            return -1;
+        if ((failed = segment(loader, i, item->value, mats, n_mats, &old[i])) != ERROR_NONE) {
+            return failed;
         }
         ends[i + 1] = ends[i] + old[i].length;
     }
-    if (counted(loader, data, "unbalances", ROTOR_LOADER_MAX_POINT_ELEMENTS, &unbs) != 0) {
-        return -1;
+    if ((failed = counted(loader, data, "unbalances", ROTOR_LOADER_MAX_POINT_ELEMENTS, &unbs)) != ERROR_NONE) {
+        return failed;
     }
     n_unb = list_count(unbs);
     d->unbalances = malloc(((size_t)n_unb + 1) * sizeof *d->unbalances);
@@ -837,14 +770,14 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
         return layout_error(loader->error, loader->size, "out of memory");
     }
     for (i = 0, item = unbs != NULL ? unbs->first : NULL; item != NULL; item = item->next, i++) {
-        if (unbalance(loader, i, item->value, ends, n_old + 1, &d->unbalances[i]) != 0) {
-            return -1;
+        if ((failed = unbalance(loader, i, item->value, ends, n_old + 1, &d->unbalances[i])) != ERROR_NONE) {
+            return failed;
         }
         d->n_unbalances = i + 1;
     }
     for (kind = 0; kind < 3; kind++) {
-        if (counted(loader, data, kinds[kind], limits[kind], &tables[kind]) != 0) {
-            return -1;
+        if ((failed = counted(loader, data, kinds[kind], limits[kind], &tables[kind])) != ERROR_NONE) {
+            return failed;
         }
         counts[kind] = list_count(tables[kind]);
         stations[kind] = arena_alloc(loader->arena, ((size_t)counts[kind] + 1) * sizeof *stations[kind]);
@@ -857,13 +790,13 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
         for (i = 0, item = tables[kind] != NULL ? tables[kind]->first : NULL; item != NULL; item = item->next, i++) {
             char where[40];
             snprintf(where, sizeof where, "%s[%d]", kinds[kind], i);
-            if (station(loader, where, item->value, n_old + 1, &stations[kind][i]) != 0) {
-                return -1;
+            if ((failed = station(loader, where, item->value, n_old + 1, &stations[kind][i])) != ERROR_NONE) {
+                return failed;
             }
         }
     }
-    if (cut(loader, old, n_old, stations, counts, d, nodes) != 0) {
-        return -1;
+    if ((failed = cut(loader, old, n_old, stations, counts, d, nodes)) != ERROR_NONE) {
+        return failed;
     }
     d->masses = malloc(((size_t)counts[0] + 1) * sizeof *d->masses);
     d->bearings = malloc(((size_t)counts[1] + 1) * sizeof *d->bearings);
@@ -873,8 +806,8 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
     }
     for (kind = 0; kind < 3; kind++) {
         for (i = 0, item = tables[kind] != NULL ? tables[kind]->first : NULL; item != NULL; item = item->next, i++) {
-            if (point_element(loader, d, kind, i, item->value, nodes[kind][i]) != 0) {
-                return -1;
+            if ((failed = point_element(loader, d, kind, i, item->value, nodes[kind][i])) != ERROR_NONE) {
+                return failed;
             }
         }
     }
@@ -882,7 +815,7 @@ static int load(const Loader *loader, const Value *data, Driveline *d)
 }
 
 /* loader._nesting_errors: brackets anywhere (strings too) nest at most MAX_NESTING deep. */
-static int nesting_errors(const char *text, size_t length, const char *source, char *error, size_t size)
+static ErrorKind nesting_errors(const char *text, size_t length, const char *source, char *error, size_t size)
 {
     size_t i;
     int depth = 0;
@@ -896,7 +829,7 @@ static int nesting_errors(const char *text, size_t length, const char *source, c
             depth--;
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 void driveline_free(Driveline *driveline)
@@ -909,28 +842,27 @@ void driveline_free(Driveline *driveline)
     memset(driveline, 0, sizeof *driveline);
 }
 
-int driveline_from_text(const char *text, size_t length, const char *source, Driveline *out, char *error,
-                        size_t size)
+ErrorKind driveline_from_text(const char *text, size_t length, const char *source, Driveline *out, char *error,
+                              size_t size)
 {
     Arena arena = {NULL};
     Loader loader;
     Value *root;
     const char *reason;
-    int status;
+    ErrorKind status;
     memset(out, 0, sizeof *out);
     if (size > 0) {
         error[0] = '\0';
     }
-    if (nesting_errors(text, length, source, error, size) != 0) {
-        return -1;
+    if ((status = nesting_errors(text, length, source, error, size)) != ERROR_NONE) {
+        return status;
     }
     if (toml_utf8_error((const unsigned char *)text, length, &reason) >= 0) {
         return layout_error(error, size, "%s: malformed TOML: the text is not UTF-8 (%s)", source, reason);
     }
-    root = toml_read(text, length, source, &arena, error, size);
-    if (root == NULL) {
+    if ((status = toml_read(text, length, source, &arena, &root, error, size)) != ERROR_NONE) {
         arena_free(&arena);
-        return -1;
+        return status;
     }
     loader.error = error;
     loader.size = size;
@@ -938,14 +870,14 @@ int driveline_from_text(const char *text, size_t length, const char *source, Dri
     loader.arena = &arena;
     status = load(&loader, root, out);
     arena_free(&arena);
-    if (status != 0) {
+    if (status != ERROR_NONE) {
         driveline_free(out);
     }
     return status;
 }
 
 /* loader.one_piece_shaft */
-int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error, size_t size)
+ErrorKind driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error, size_t size)
 {
     static const char *const names[] = {"L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", "Jp_joint",
                                         "Jd_joint", "k_bearing", "c_bearing"};
@@ -1004,7 +936,7 @@ int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error,
         b->kxy = b->kyx = b->cxy = b->cyx = 0.0;
     }
     out->left = out->right = END_FREE;
-    return 0;
+    return ERROR_NONE;
 }
 
 /* Driveline.length */

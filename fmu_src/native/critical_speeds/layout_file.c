@@ -140,8 +140,9 @@ static char *absolute_path(const char *path)
 }
 
 /* loader._read_regular_file: refuse what is not a regular file before opening it (a FIFO would block
- * fopen), read at most MAX_FILE_BYTES + 1 bytes. ``*data`` owned (free()). */
-static int read_regular_file(const char *path, char **data, size_t *length, char *error, size_t size)
+ * fopen), read at most MAX_FILE_BYTES + 1 bytes. ``*data`` owned (free()). ERROR_NONE, or ERROR_VALUE
+ * with the message (the loader raises the OSError as a ValueError). */
+static ErrorKind read_regular_file(const char *path, char **data, size_t *length, char *error, size_t size)
 {
     char reason[128];
     size_t used = 0;
@@ -184,17 +185,17 @@ static int read_regular_file(const char *path, char **data, size_t *length, char
                             ROTOR_LOADER_MAX_FILE_BYTES);
     }
     *length = used;
-    return 0;
+    return ERROR_NONE;
 }
 
-/* loader.load_driveline */
-static int load_driveline(const char *path, Driveline *out, char *error, size_t size)
+/* loader.load_driveline; returns as driveline_from_text */
+static ErrorKind load_driveline(const char *path, Driveline *out, char *error, size_t size)
 {
     char *p = absolute_path(path), *data, *message;
     size_t length = 0, p_length;
     const char *reason;
     long bad;
-    int status;
+    ErrorKind status;
     memset(out, 0, sizeof *out);
     if (p == NULL && errno == ENOMEM) {
         return layout_error(error, size, "out of memory");
@@ -204,23 +205,23 @@ static int load_driveline(const char *path, Driveline *out, char *error, size_t 
         error_text(errno, reason_text, sizeof reason_text);
         return layout_error(error, size, "cannot read driveline file %r: %s", path, reason_text);
     }
-    if (read_regular_file(p, &data, &length, error, size) != 0) {
+    if ((status = read_regular_file(p, &data, &length, error, size)) != ERROR_NONE) {
         free(p);
-        return -1;
+        return status;
     }
     bad = toml_utf8_error((const unsigned char *)data, length, &reason);
     if (bad >= 0) {
         char at[32];
         snprintf(at, sizeof at, "%ld", bad);
-        layout_error(error, size, "driveline file %r is not UTF-8 text (%s at byte %s)", p, reason, at);
+        status = layout_error(error, size, "driveline file %r is not UTF-8 text (%s at byte %s)", p, reason, at);
         free(data);
         free(p);
-        return -1;
+        return status;
     }
     status = driveline_from_text(data, length, p, out, error, size);
     free(data);
     p_length = strlen(p);
-    if (status != 0 && size > 0 && strncmp(error, p, p_length) != 0) {
+    if (status != ERROR_NONE && size > 0 && strncmp(error, p, p_length) != 0) {
         message = malloc(size);
         if (message == NULL) {
             layout_error(error, size, "out of memory");
@@ -236,11 +237,11 @@ static int load_driveline(const char *path, Driveline *out, char *error, size_t 
 }
 
 /* model.build_driveline for a layout: a ".toml" file or a shipped name (loader.example_path). */
-int driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size)
+ErrorKind driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size)
 {
     size_t n = strlen(layout), i;
     char *path;
-    int status;
+    ErrorKind status;
     memset(out, 0, sizeof *out);
     if (size > 0) {
         error[0] = '\0';
@@ -262,7 +263,7 @@ int driveline_from_layout(const char *layout, const char *resources, Driveline *
             text.used += strlen(error + text.used);
         }
         text_put(&text, " (names are letters, digits and '_')");
-        return -1;
+        return ERROR_VALUE;
     }
     if (resources == NULL) {
         return layout_error(error, size, "no shipped example named %r", layout);

@@ -90,8 +90,8 @@ void text_put_repr(Text *text, const Value *value)
 }
 
 /* The message into ``error``: ``format`` with %s (C string), %d (int), %v (a Value's repr), %g (a
- * double's repr), %r (a C string's repr). Returns -1. */
-int layout_error(char *error, size_t size, const char *format, ...)
+ * double's repr), %r (a C string's repr). Returns ERROR_VALUE: the loader raises ValueError only. */
+ErrorKind layout_error(char *error, size_t size, const char *format, ...)
 {
     Text text = {error, size, 0};
     va_list args;
@@ -131,5 +131,5 @@ int layout_error(char *error, size_t size, const char *format, ...)
         }
     }
     va_end(args);
-    return -1;
+    return ERROR_VALUE;
 }

@@ -33,15 +33,15 @@ static void free_all(void *a, void *b, void *c)
     free(c);
 }
 
-/* driveline._speed's message */
-static int speed_error(const char *name, double value, char *error, size_t size)
+/* driveline._speed's message; ERROR_VALUE */
+static ErrorKind speed_error(const char *name, double value, char *error, size_t size)
 {
     char text[64];
     python_float_repr(value, text, sizeof text);
     if (error != NULL && size > 0) {
         snprintf(error, size, "%s must be a finite speed > 0 rad/s, got %s", name, text);
     }
-    return -1;
+    return ERROR_VALUE;
 }
 
 static double line_f(const Search *st, double x)
@@ -51,20 +51,21 @@ static double line_f(const Search *st, double x)
     return f;
 }
 
-static int found(Search *st, double x)
+/* x appended to the roots found; ERROR_NONE, or ERROR_VALUE out of memory */
+static ErrorKind found(Search *st, double x)
 {
     if (st->count == st->capacity) {
         int capacity = st->capacity ? 2 * st->capacity : 16;
         double *grown = realloc(st->x, (size_t)capacity * sizeof *grown);
         if (grown == NULL) {
             ROTOR_ERROR(st->error, st->size, ROTOR_OUT_OF_MEMORY);
-            return -1;
+            return ERROR_VALUE;
         }
         st->x = grown;
         st->capacity = capacity;
     }
     st->x[st->count++] = x;
-    return 0;
+    return ERROR_NONE;
 }
 
 static double sign_of(double v)
@@ -73,8 +74,9 @@ static double sign_of(double v)
 }
 
 /* roots._refine for one bracket: Chandrupatla's method (inverse quadratic interpolation where safe,
- * else bisection); a converged point with |f| above both ends is a pole and is rejected. */
-static int refine(Search *st, double a, double b, double fa, double fb)
+ * else bisection); a converged point with |f| above both ends is a pole and is rejected. ERROR_NONE,
+ * or the failure's kind with the message in st->error. */
+static ErrorKind refine(Search *st, double a, double b, double fa, double fb)
 {
     double f_ends = fabs(fa) > fabs(fb) ? fabs(fa) : fabs(fb);
     double c, fc, t = 0.5;
@@ -102,7 +104,7 @@ static int refine(Search *st, double a, double b, double fa, double fb)
         tlim = (ROTOR_ROOTS_XTOL + ROTOR_ROOTS_RTOL * fabs(xm)) / fabs(b - a);
         if (fm == 0.0 || tlim > 0.5) {
             if (fabs(fm) > f_ends) { /* |f| grew towards the 'root': a pole */
-                return 0;
+                return ERROR_NONE;
             }
             return found(st, xm);
         }
@@ -119,22 +121,25 @@ static int refine(Search *st, double a, double b, double fa, double fb)
         t = t < 1.0 - tlim ? t : 1.0 - tlim;
     }
     ROTOR_ERROR(st->error, st->size, "root refinement did not converge");
-    return -1;
+    return ERROR_VALUE; /* Python's is an ArithmeticError; the FMU has reported a ValueError's message */
 }
 
 /* roots._scan for one sampled sequence: its zeros and sign changes, then its dips re-scanned on
- * sub-grids of SUBGRID steps (a dip that persists down to the root tolerance is a double root). */
-static int scan(Search *st, const double *x, const double *fx, int n, int depth)
+ * sub-grids of SUBGRID steps (a dip that persists down to the root tolerance is a double root).
+ * ERROR_NONE, or the failure's kind with the message in st->error. */
+static ErrorKind scan(Search *st, const double *x, const double *fx, int n, int depth)
 {
     int i, j;
+    ErrorKind failed;
     for (i = 0; i < n; i++) {
-        if (fx[i] == 0.0 && found(st, x[i])) {
-            return -1;
+        if (fx[i] == 0.0 && (failed = found(st, x[i])) != ERROR_NONE) {
+            return failed;
         }
     }
     for (i = 0; i + 1 < n; i++) {
-        if (sign_of(fx[i]) * sign_of(fx[i + 1]) < 0.0 && refine(st, x[i], x[i + 1], fx[i], fx[i + 1])) {
-            return -1;
+        if (sign_of(fx[i]) * sign_of(fx[i + 1]) < 0.0 &&
+            (failed = refine(st, x[i], x[i + 1], fx[i], fx[i + 1])) != ERROR_NONE) {
+            return failed;
         }
     }
     for (i = 1; i + 1 < n; i++) {
@@ -148,8 +153,8 @@ static int scan(Search *st, const double *x, const double *fx, int n, int depth)
             continue;
         }
         if (hi - lo <= 2.0 * (ROTOR_ROOTS_XTOL + ROTOR_ROOTS_RTOL * fabs(mid)) || depth >= ROTOR_ROOTS_MAX_DEPTH) {
-            if (found(st, mid) || found(st, mid)) {
-                return -1;
+            if ((failed = found(st, mid)) != ERROR_NONE || (failed = found(st, mid)) != ERROR_NONE) {
+                return failed;
             }
             continue;
         }
@@ -161,11 +166,11 @@ static int scan(Search *st, const double *x, const double *fx, int n, int depth)
         }
         sx[ROTOR_ROOTS_SUBGRID] = hi;
         sf[ROTOR_ROOTS_SUBGRID] = fx[i + 1];
-        if (scan(st, sx, sf, ROTOR_ROOTS_SUBGRID + 1, depth + 1)) {
-            return -1;
+        if ((failed = scan(st, sx, sf, ROTOR_ROOTS_SUBGRID + 1, depth + 1)) != ERROR_NONE) {
+            return failed;
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -174,45 +179,49 @@ static int compare_doubles(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* roots.find_roots_batch for one function: the roots on [grid[0], grid[n - 1]], ascending */
-static int find_roots(Search *st, const double *grid, int n)
+/* roots.find_roots_batch for one function: the roots on [grid[0], grid[n - 1]], ascending; ERROR_NONE,
+ * or the failure's kind with the message in st->error */
+static ErrorKind find_roots(Search *st, const double *grid, int n)
 {
     double *fx = malloc((size_t)n * sizeof *fx);
-    int i, status;
+    int i;
+    ErrorKind status;
     if (fx == NULL) {
         ROTOR_ERROR(st->error, st->size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     for (i = 0; i < n; i++) {
         fx[i] = line_f(st, grid[i]);
     }
     status = scan(st, grid, fx, n, 0);
     free(fx);
-    if (status == 0 && st->count > 1) {
+    if (status == ERROR_NONE && st->count > 1) {
         qsort(st->x, (size_t)st->count, sizeof *st->x, compare_doubles);
     }
     return status;
 }
 
 /* Driveline._grid: uniform in the bare-shaft phase kappa sqrt(|ratio| x) with POINTS_PER_ROOT points per
- * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] LEAD_RATIO, x[0], LEAD_POINTS)[:-1]). */
-static double *grid_new(const Chain *chain, double x_max, double ratio, int coarse, int *count, char *error,
-                        size_t size)
+ * expected root, plus a logarithmic lead-in (numpy.geomspace(x[0] LEAD_RATIO, x[0], LEAD_POINTS)[:-1]),
+ * into *grid (owned) and *count; ERROR_NONE, or ERROR_VALUE out of memory (*grid NULL). */
+static ErrorKind grid_new(const Chain *chain, double x_max, double ratio, int coarse, double **grid, int *count,
+                          char *error, size_t size)
 {
     int extra = coarse ? 0 : chain_freedoms(chain), per_pi, n, i;
     double kappa = chain_kappa(chain) * sqrt(fabs(ratio)), theta_max, steps, step, log_start, log_stop, *x;
     per_pi = ROTOR_DRIVELINE_POINTS_PER_ROOT * (1 + extra) * (chain_isotropic(chain) ? 1 : 2);
     theta_max = kappa * sqrt(x_max);
     steps = ceil(theta_max / FMU_PI * per_pi);
+    *grid = NULL;
     if (!(steps < (double)(INT_MAX / 2))) {
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     n = steps > 8.0 ? (int)steps : 8;
     x = malloc((size_t)(ROTOR_DRIVELINE_LEAD_POINTS - 1 + n + 1) * sizeof *x);
     if (x == NULL) {
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return NULL;
+        return ERROR_VALUE;
     }
     step = theta_max / n;
     for (i = 0; i < n; i++) { /* offset by an irrational fraction of a step */
@@ -227,18 +236,21 @@ static double *grid_new(const Chain *chain, double x_max, double ratio, int coar
         x[i] = pow(10.0, i * ((log_stop - log_start) / (ROTOR_DRIVELINE_LEAD_POINTS - 1)) + log_start);
     }
     *count = ROTOR_DRIVELINE_LEAD_POINTS + n;
-    return x;
+    *grid = x;
+    return ERROR_NONE;
 }
 
-/* The roots on one line over its grid (x_max, ratio |w|, coarse) into *roots */
-static int search_line(const Chain *chain, const RotorLine *line, double x_max, int coarse, RotorRoots *roots,
-                       char *error, size_t size)
+/* The roots on one line over its grid (x_max, ratio |w|, coarse) into *roots; ERROR_NONE, or the
+ * failure's kind with the message */
+static ErrorKind search_line(const Chain *chain, const RotorLine *line, double x_max, int coarse, RotorRoots *roots,
+                             char *error, size_t size)
 {
     Search st;
-    int n, status;
-    double *grid = grid_new(chain, x_max, line->w, coarse, &n, error, size);
-    if (grid == NULL) {
-        return -1;
+    int n;
+    double *grid;
+    ErrorKind status = grid_new(chain, x_max, line->w, coarse, &grid, &n, error, size);
+    if (status != ERROR_NONE) {
+        return status;
     }
     st.chain = chain;
     st.w = line->w;
@@ -250,14 +262,14 @@ static int search_line(const Chain *chain, const RotorLine *line, double x_max, 
     st.size = size;
     status = find_roots(&st, grid, n);
     free(grid);
-    if (status) {
+    if (status != ERROR_NONE) {
         free(st.x);
-        return -1;
+        return status;
     }
     free(roots->x);
     roots->x = st.x;
     roots->count = st.count;
-    return 0;
+    return ERROR_NONE;
 }
 
 void rotor_roots_free(RotorRoots *roots, int m)
@@ -270,11 +282,12 @@ void rotor_roots_free(RotorRoots *roots, int m)
     }
 }
 
-/* Driveline._line_roots with n = N_NONE for None */
-static int line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
-                      const unsigned char *coarse, RotorRoots *roots, char *error, size_t size)
+/* Driveline._line_roots with n = N_NONE for None; returns as rotor_line_roots */
+static ErrorKind line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
+                            const unsigned char *coarse, RotorRoots *roots, char *error, size_t size)
 {
     int j;
+    ErrorKind failed;
     for (j = 0; j < m; j++) {
         roots[j].count = 0;
         roots[j].x = NULL;
@@ -284,12 +297,13 @@ static int line_roots(const Chain *chain, const RotorLine *lines, int m, int n, 
             return speed_error("x_max", x_max, error, size);
         }
         for (j = 0; j < m; j++) {
-            if (search_line(chain, &lines[j], x_max, coarse != NULL && coarse[j], &roots[j], error, size)) {
+            if ((failed = search_line(chain, &lines[j], x_max, coarse != NULL && coarse[j], &roots[j], error, size)) !=
+                ERROR_NONE) {
                 rotor_roots_free(roots, m);
-                return -1;
+                return failed;
             }
         }
-        return 0;
+        return ERROR_NONE;
     }
     if (n == N_NONE || n < 1) {
         if (error != NULL && size > 0) {
@@ -299,7 +313,7 @@ static int line_roots(const Chain *chain, const RotorLine *lines, int m, int n, 
                 snprintf(error, size, "n must be a positive integer (or give an upper limit), got %d", n);
             }
         }
-        return -1;
+        return ERROR_VALUE;
     }
     if (!(limit > 0.0) || isinf(limit)) {
         return speed_error("limit", limit, error, size);
@@ -309,9 +323,9 @@ static int line_roots(const Chain *chain, const RotorLine *lines, int m, int n, 
         x_hi = x_hi * x_hi;
         x_hi = x_hi < limit ? x_hi : limit;
         for (;;) { /* a line short of n roots is searched again over a 4x wider range, until limit */
-            if (search_line(chain, &lines[j], x_hi, 0, &roots[j], error, size)) {
+            if ((failed = search_line(chain, &lines[j], x_hi, 0, &roots[j], error, size)) != ERROR_NONE) {
                 rotor_roots_free(roots, m);
-                return -1;
+                return failed;
             }
             if (roots[j].count >= n || !(x_hi < limit)) {
                 break;
@@ -322,40 +336,44 @@ static int line_roots(const Chain *chain, const RotorLine *lines, int m, int n, 
             roots[j].count = n;
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
-int rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
-                     const unsigned char *coarse, RotorRoots *roots, char *error, size_t size)
+ErrorKind rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
+                           const unsigned char *coarse, RotorRoots *roots, char *error, size_t size)
 {
     return line_roots(chain, lines, m, n, x_max, limit, coarse, roots, error, size);
 }
 
-/* a copy of the first ``n`` roots (all for N_NONE) of ``from`` that ``keep`` selects (NULL: all) */
-static int take(const RotorRoots *from, const unsigned char *keep, int n, RotorRoots *to, char *error, size_t size)
+/* a copy of the first ``n`` roots (all for N_NONE) of ``from`` that ``keep`` selects (NULL: all);
+ * ERROR_NONE, or ERROR_VALUE out of memory */
+static ErrorKind take(const RotorRoots *from, const unsigned char *keep, int n, RotorRoots *to, char *error,
+                      size_t size)
 {
     int i;
     to->count = 0;
     to->x = malloc((size_t)(from->count > 0 ? from->count : 1) * sizeof *to->x);
     if (to->x == NULL) {
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     for (i = 0; i < from->count && (n == N_NONE || to->count < n); i++) {
         if (keep == NULL || keep[i]) {
             to->x[to->count++] = from->x[i];
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* Driveline._roots_by_whirl: isotropic, forward at +w and backward at -w; anisotropic, the 2 n lowest
  * roots at w > 0 classified by their mode's forward fraction (>= 0.5 forward); standstill cases
- * (s = o = 0) are searched once and both senses get their roots. n = N_NONE: all up to x_max. */
-static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
-                          RotorRoots *forward, RotorRoots *backward, char *error, size_t size)
+ * (s = o = 0) are searched once and both senses get their roots. n = N_NONE: all up to x_max.
+ * Returns as rotor_roots_by_whirl. */
+static ErrorKind roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
+                                RotorRoots *forward, RotorRoots *backward, char *error, size_t size)
 {
-    int iso = chain_isotropic(chain), c, count = 0, status = 0, nn;
+    int iso = chain_isotropic(chain), c, count = 0, nn;
+    ErrorKind status;
     RotorLine *lines = malloc((size_t)(2 * m > 0 ? 2 * m : 1) * sizeof *lines);
     int *first = malloc((size_t)(m > 0 ? m : 1) * sizeof *first);
     RotorRoots *found_roots = malloc((size_t)(2 * m > 0 ? 2 * m : 1) * sizeof *found_roots);
@@ -367,7 +385,7 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
     if (lines == NULL || first == NULL || found_roots == NULL) {
         free_all(lines, first, found_roots);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     for (c = 0; c < m; c++) {
         int standstill = cases[c].s == 0.0 && cases[c].o == 0.0;
@@ -379,23 +397,24 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
         }
     }
     nn = n == N_NONE || iso ? n : 2 * n;
-    if (line_roots(chain, lines, count, nn, x_max, limit, NULL, found_roots, error, size)) {
+    if ((status = line_roots(chain, lines, count, nn, x_max, limit, NULL, found_roots, error, size)) != ERROR_NONE) {
         free_all(lines, first, found_roots);
-        return -1;
+        return status;
     }
-    for (c = 0; c < m && status == 0; c++) {
+    for (c = 0; c < m && status == ERROR_NONE; c++) {
         const RotorRoots *roots = &found_roots[first[c]];
         int standstill = cases[c].s == 0.0 && cases[c].o == 0.0, i;
         if (standstill) {
-            status = take(roots, NULL, n, &forward[c], error, size) || take(roots, NULL, n, &backward[c], error, size);
+            status = take(roots, NULL, n, &forward[c], error, size);
+            status = status != ERROR_NONE ? status : take(roots, NULL, n, &backward[c], error, size);
         } else if (iso) {
-            status = take(roots, NULL, n, &forward[c], error, size) ||
-                     take(roots + 1, NULL, n, &backward[c], error, size);
+            status = take(roots, NULL, n, &forward[c], error, size);
+            status = status != ERROR_NONE ? status : take(roots + 1, NULL, n, &backward[c], error, size);
         } else {
             kinds = malloc((size_t)(2 * roots->count + 2));
             if (kinds == NULL) {
                 ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-                status = -1;
+                status = ERROR_VALUE;
                 break;
             }
             for (i = 0; i < roots->count; i++) {
@@ -403,24 +422,24 @@ static int roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int
                 kinds[i] = chain_forward_fraction(chain, cases[c].w * x, cases[c].s * x + cases[c].o) >= 0.5;
                 kinds[roots->count + i] = !kinds[i];
             }
-            status = take(roots, kinds, n, &forward[c], error, size) ||
-                     take(roots, kinds + roots->count, n, &backward[c], error, size);
+            status = take(roots, kinds, n, &forward[c], error, size);
+            status = status != ERROR_NONE ? status : take(roots, kinds + roots->count, n, &backward[c], error, size);
             free(kinds);
             kinds = NULL;
         }
     }
     rotor_roots_free(found_roots, count);
     free_all(lines, first, found_roots);
-    if (status) {
+    if (status != ERROR_NONE) {
         rotor_roots_free(forward, m);
         rotor_roots_free(backward, m);
-        return -1;
+        return status;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
-int rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
-                         RotorRoots *forward, RotorRoots *backward, char *error, size_t size)
+ErrorKind rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
+                               RotorRoots *forward, RotorRoots *backward, char *error, size_t size)
 {
     return roots_by_whirl(chain, cases, m, n == 0 ? N_NONE : n, x_max, limit, forward, backward, error, size);
 }
@@ -443,14 +462,17 @@ static int compare_ranked(const void *a, const void *b)
     return (x->index > y->index) - (x->index < y->index);
 }
 
-/* Driveline.order_resonances with n = N_NONE for None and spin_max = 0 for None */
-static int order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n, double spin_max,
-                            double limit, OrderResonance **out, int *count, char *error, size_t size)
+/* Driveline.order_resonances with n = N_NONE for None and spin_max = 0 for None; returns as
+ * rotor_order_resonances */
+static ErrorKind order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n,
+                                  double spin_max, double limit, OrderResonance **out, int *count, char *error,
+                                  size_t size)
 {
     RotorLine *cases;
     RotorRoots *forward, *backward;
     Ranked *ranked;
     int k, i, total = 0, at = 0;
+    ErrorKind failed;
     *out = NULL;
     *count = 0;
     if (spin_max != 0.0 && (!(spin_max > 0.0) || isinf(spin_max))) {
@@ -461,11 +483,11 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
             if (error != NULL && size > 0) {
                 snprintf(error, size, "order must be a positive integer, got %d", orders[k]);
             }
-            return -1;
+            return ERROR_VALUE;
         }
     }
     if (n_orders < 1) {
-        return 0;
+        return ERROR_NONE;
     }
     cases = malloc((size_t)n_orders * sizeof *cases);
     forward = malloc((size_t)n_orders * sizeof *forward);
@@ -473,16 +495,17 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
     if (cases == NULL || forward == NULL || backward == NULL) {
         free_all(cases, forward, backward);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-        return -1;
+        return ERROR_VALUE;
     }
     for (k = 0; k < n_orders; k++) {
         cases[k].w = orders[k];
         cases[k].s = 1.0;
         cases[k].o = 0.0;
     }
-    if (roots_by_whirl(chain, cases, n_orders, n, spin_max, limit, forward, backward, error, size)) {
+    if ((failed = roots_by_whirl(chain, cases, n_orders, n, spin_max, limit, forward, backward, error, size)) !=
+        ERROR_NONE) {
         free_all(cases, forward, backward);
-        return -1;
+        return failed;
     }
     for (k = 0; k < n_orders; k++) {
         total += (whirls & WHIRL_FORWARD ? forward[k].count : 0) + (whirls & WHIRL_BACKWARD ? backward[k].count : 0);
@@ -515,8 +538,8 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
     rotor_roots_free(forward, n_orders);
     rotor_roots_free(backward, n_orders);
     free_all(cases, forward, backward);
-    if (total < 0) {
-        return -1;
+    if (total < 0) { /* out of memory */
+        return ERROR_VALUE;
     }
     qsort(ranked, (size_t)total, sizeof *ranked, compare_ranked);
     for (i = 0; i < total; i++) {
@@ -524,11 +547,12 @@ static int order_resonances(const Chain *chain, const int *orders, int n_orders,
     }
     free(ranked);
     *count = total;
-    return 0;
+    return ERROR_NONE;
 }
 
-int rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n, double spin_max,
-                           double limit, OrderResonance **found_out, int *count, char *error, size_t size)
+ErrorKind rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n,
+                                 double spin_max, double limit, OrderResonance **found_out, int *count, char *error,
+                                 size_t size)
 {
     return order_resonances(chain, orders, n_orders, whirls, n == 0 ? N_NONE : n, spin_max, limit, found_out, count,
                             error, size);
@@ -550,32 +574,33 @@ static int compare_shares(const void *a, const void *b)
 /* Driveline.critical_speeds(n) = unbalance_critical_speeds(n): isotropic, the forward synchronous roots;
  * anisotropic, those of the 2 (n + 1) lowest synchronous roots whose forward share is at least
  * EXCITED_SHARE. */
-int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size)
+ErrorKind rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size)
 {
     static const int first_order[1] = {1};
     OrderResonance *found_list = NULL;
     int found_count = 0, i;
+    ErrorKind failed;
     *count = 0;
     if (chain_isotropic(chain)) {
-        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD, n, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT, &found_list,
-                             &found_count, error, size)) {
-            return -1;
+        if ((failed = order_resonances(chain, first_order, 1, WHIRL_FORWARD, n, 0.0, ROTOR_DRIVELINE_SEARCH_LIMIT,
+                                       &found_list, &found_count, error, size)) != ERROR_NONE) {
+            return failed;
         }
         for (i = 0; i < found_count && i < n; i++) {
             spins[(*count)++] = found_list[i].spin;
         }
     } else {
         Share *shares;
-        if (order_resonances(chain, first_order, 1, WHIRL_FORWARD | WHIRL_BACKWARD, n + 1, 0.0,
-                             ROTOR_DRIVELINE_SEARCH_LIMIT,
-                             &found_list, &found_count, error, size)) {
-            return -1;
+        if ((failed = order_resonances(chain, first_order, 1, WHIRL_FORWARD | WHIRL_BACKWARD, n + 1, 0.0,
+                                       ROTOR_DRIVELINE_SEARCH_LIMIT, &found_list, &found_count, error, size)) !=
+            ERROR_NONE) {
+            return failed;
         }
         shares = malloc((size_t)(found_count > 0 ? found_count : 1) * sizeof *shares);
         if (shares == NULL) {
             free(found_list);
             ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
-            return -1;
+            return ERROR_VALUE;
         }
         for (i = 0; i < found_count; i++) {
             shares[i].spin = found_list[i].spin;
@@ -590,5 +615,5 @@ int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, 
         free(shares);
     }
     free(found_list);
-    return 0;
+    return ERROR_NONE;
 }

@@ -13,9 +13,12 @@
  *   campbell.c   whirl branches over the speed and the Campbell table
  *   fem.c        finite-element model: the plausibility check's natural frequencies
  *   damped.c     damped finite-element model: damped modes, unbalance response, bearing forces
- * Every function that can fail returns 0 (ERROR_NONE) on success, or the kind of the failure (a
- * negative ErrorKind of driveline_constants.h; -1 is ERROR_VALUE) with a message in ``error``
- * (``size`` bytes, always terminated) worded as the Python core's exception text. No global state.
+ * Every function that fails with a message returns ErrorKind (driveline_constants.h): ERROR_NONE on
+ * success, else the kind of the failure, the exception the Python core raises there (ERROR_VALUE for
+ * its ValueErrors, and for out of memory), with the message in ``error`` (``size`` bytes, always
+ * terminated) worded as the Python core's exception text; a constructor (``*_new``) puts the object
+ * in its last argument before ``error`` (NULL on failure). A function whose int result means
+ * something else (an index, a pivot test) says so. No global state.
  */
 #ifndef ROTOR_H
 #define ROTOR_H
@@ -92,15 +95,17 @@ typedef struct {
 
 /* ---- layout.c ------------------------------------------------------------------------------ */
 void driveline_free(Driveline *driveline);
-/* loader.one_piece_shaft */
-int driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error, size_t size);
+/* loader.one_piece_shaft; ERROR_NONE, or ERROR_VALUE with the message */
+ErrorKind driveline_one_piece(const OnePieceShaft *shaft, Driveline *out, char *error, size_t size);
 /* model.build_driveline for a non-empty ``layout``: a file path ending in ".toml" (any case; relative
  * to the working directory; messages name it by its absolute path, as pathlib's absolute()) or the
- * name of a description shipped in ``resources`` (the FMU's resources folder: loader.example_path). */
-int driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size);
-/* loader.loads_driveline: TOML text (``length`` bytes, not necessarily terminated) from ``source``. */
-int driveline_from_text(const char *text, size_t length, const char *source, Driveline *out, char *error,
-                        size_t size);
+ * name of a description shipped in ``resources`` (the FMU's resources folder: loader.example_path).
+ * ERROR_NONE, or the failure's kind (ERROR_VALUE; the length's math.fsum its own) with the message. */
+ErrorKind driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size);
+/* loader.loads_driveline: TOML text (``length`` bytes, not necessarily terminated) from ``source``;
+ * returns as driveline_from_layout. */
+ErrorKind driveline_from_text(const char *text, size_t length, const char *source, Driveline *out, char *error,
+                              size_t size);
 /* Driveline.length (math.fsum of the segment lengths) */
 double driveline_length(const Driveline *driveline);
 /* Driveline.is_isotropic: every bearing has kxx == kyy */
@@ -117,8 +122,9 @@ void text_append(char *out, size_t size, size_t *used, const char *bytes, size_t
 
 /* ---- transfer.c: the scaled frequency determinant (transfer.py) ---------------------------- */
 typedef struct Chain Chain; /* transfer.Chain of a driveline (it keeps no pointer to it) */
-/* transfer.Chain.build; fails with elements.Bearing._undamped_stiffness's message on cross-coupling */
-Chain *chain_new(const Driveline *driveline, char *error, size_t size);
+/* transfer.Chain.build into *out; ERROR_NONE, or ERROR_VALUE with the message (Driveline's checks,
+ * elements.Bearing._undamped_stiffness's on cross-coupling, out of memory) */
+ErrorKind chain_new(const Driveline *driveline, Chain **out, char *error, size_t size);
 void chain_free(Chain *chain);
 int chain_isotropic(const Chain *chain);
 /* Driveline._kappa: sum of L (m'/EI)^(1/4) */
@@ -145,13 +151,14 @@ typedef struct {
 
 void rotor_roots_free(RotorRoots *roots, int m);
 /* Driveline._line_roots: ``x_max`` > 0: every root up to x_max (``coarse`` per line, NULL: none
- * coarse); x_max = 0: the first ``n`` below ``limit``. ``roots`` has ``m`` entries. */
-int rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
-                     const unsigned char *coarse, RotorRoots *roots, char *error, size_t size);
+ * coarse); x_max = 0: the first ``n`` below ``limit``. ``roots`` has ``m`` entries. ERROR_NONE, or
+ * ERROR_VALUE with the message (a bad n, x_max or limit; the refinement not converging; out of memory). */
+ErrorKind rotor_line_roots(const Chain *chain, const RotorLine *lines, int m, int n, double x_max, double limit,
+                           const unsigned char *coarse, RotorRoots *roots, char *error, size_t size);
 /* Driveline._roots_by_whirl for both senses: ``forward`` and ``backward`` have ``m`` entries;
- * n = 0 means all up to x_max. */
-int rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
-                         RotorRoots *forward, RotorRoots *backward, char *error, size_t size);
+ * n = 0 means all up to x_max. Returns as rotor_line_roots. */
+ErrorKind rotor_roots_by_whirl(const Chain *chain, const RotorLine *cases, int m, int n, double x_max, double limit,
+                               RotorRoots *forward, RotorRoots *backward, char *error, size_t size);
 
 /* driveline.OrderResonance; whirl 1 forward, -1 backward */
 typedef struct {
@@ -162,11 +169,14 @@ typedef struct {
 #define WHIRL_FORWARD 1
 #define WHIRL_BACKWARD 2
 /* Driveline.order_resonances(orders, whirls (WHIRL_* bits, forward first), n (0: all up to
- * spin_max), spin_max (0: none), limit), sorted by (spin, order); *found is owned (free()). */
-int rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n, double spin_max,
-                           double limit, OrderResonance **found, int *count, char *error, size_t size);
-/* Driveline.critical_speeds(n) (forward: unbalance_critical_speeds); ``spins`` holds n. */
-int rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size);
+ * spin_max), spin_max (0: none), limit), sorted by (spin, order); *found is owned (free()).
+ * Returns as rotor_line_roots (an order < 1 is a ValueError too). */
+ErrorKind rotor_order_resonances(const Chain *chain, const int *orders, int n_orders, int whirls, int n,
+                                 double spin_max, double limit, OrderResonance **found, int *count, char *error,
+                                 size_t size);
+/* Driveline.critical_speeds(n) (forward: unbalance_critical_speeds); ``spins`` holds n. Returns as
+ * rotor_line_roots. */
+ErrorKind rotor_critical_speeds(const Chain *chain, int n, double *spins, int *count, char *error, size_t size);
 
 /* ---- spline.c: scipy.interpolate.CubicSpline(x, y) (not-a-knot), y of shape (n, m) -------- */
 typedef struct {
@@ -175,6 +185,7 @@ typedef struct {
     double *c; /* (n - 1) intervals x 4 powers x m columns */
 } CubicSpline;
 
+/* 0, or -1 (no message) for fewer than two knots, knots not finite and increasing, or out of memory */
 int cubic_spline_build(CubicSpline *spline, int n, const double *x, int m, const double *y);
 /* All m columns at ``x`` (extrapolated beyond the ends, as scipy's). */
 void cubic_spline_evaluate(const CubicSpline *spline, double x, double *out);
@@ -185,8 +196,10 @@ void cubic_spline_free(CubicSpline *spline);
 /* ---- campbell.c: model.whirl_table (campbell.whirl_branches + WhirlTable) ------------------ */
 typedef struct WhirlTable WhirlTable;
 /* The first ``n_modes`` forward and backward whirl frequencies over ``points`` equal speeds on
- * [0, omega_max], refined where a branch bends; missing values read as SEARCH_LIMIT. */
-WhirlTable *whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, char *error, size_t size);
+ * [0, omega_max], refined where a branch bends, into *out; missing values read as SEARCH_LIMIT.
+ * ERROR_NONE, or the failure's kind with the message (ERROR_VALUE for bad speeds or n_modes). */
+ErrorKind whirl_table_new(const Chain *chain, double omega_max, int points, int n_modes, WhirlTable **out,
+                          char *error, size_t size);
 /* WhirlTable.__call__: forward_1..n, backward_1..n at ``speed`` */
 void whirl_table_evaluate(const WhirlTable *table, double speed, double *out);
 /* The speeds the splines pass through (whirl_branches' knots: ``points`` and those added). */
@@ -207,24 +220,28 @@ typedef struct {
 
 /* fem.elements_by_length: ``counts`` has n_segments entries */
 void fe_elements_by_length(const Driveline *driveline, int most, int *counts);
-/* fem.mesh(driveline, counts, undamped = with_bearings) and its kept K, M, G (fem.assemble) */
-int fe_model_build(const Driveline *driveline, const int *counts, int with_bearings, FeModel *model, char *error,
-                   size_t size);
+/* fem.mesh(driveline, counts, undamped = with_bearings) and its kept K, M, G (fem.assemble); ERROR_NONE,
+ * or ERROR_VALUE with the message (anisotropic bearings with ``with_bearings``, out of memory) */
+ErrorKind fe_model_build(const Driveline *driveline, const int *counts, int with_bearings, FeModel *model, char *error,
+                         size_t size);
 void fe_model_free(FeModel *model);
 
 /* model.natural_frequencies: sqrt|eigenvalues| of the undamped FE model with ``elements``
  * elements per segment (both planes for anisotropic bearings: the kxx plane first, each plane
- * ascending); *frequencies is owned (free()). */
-int fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count, char *error,
-                           size_t size);
+ * ascending); *frequencies is owned (free()). ERROR_NONE; ERROR_ZERO_DIVISION for no elements; else
+ * ERROR_VALUE with the message (scipy.linalg.eigh's LinAlgError and its checks, out of memory). */
+ErrorKind fe_natural_frequencies(const Driveline *driveline, int elements, double **frequencies, int *count,
+                                 char *error, size_t size);
 
 typedef struct UnbalanceOutputs UnbalanceOutputs;
 /* unbalance_outputs.UnbalanceOutputs.build; the mode table from the dense eigensolver up to DENSE_SIZE
  * first-order unknowns, above from shift-invert Arnoldi (as Python) on one banded factorisation per
  * speed: O(unknowns (band^2 + vectors^2)) with at most 400 Krylov vectors, an error if the wanted
- * eigenvalues have not converged by then */
-UnbalanceOutputs *unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
-                                        double response_fraction, double omega_max, char *error, size_t size);
+ * eigenvalues have not converged by then. Into *out; ERROR_NONE, or the failure's kind with the message
+ * (ERROR_VALUE: a position off the shaft, numpy's and scipy's refusals, no convergence). */
+ErrorKind unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance *unbalances, int n_unbalances,
+                                double response_fraction, double omega_max, UnbalanceOutputs **out, char *error,
+                                size_t size);
 /* UnbalanceOutputs.evaluate: out = response, largest bearing force, damping ratio (an exactly singular
  * dynamic stiffness: infinite response and force). It allocates nothing: the object holds the
  * solve's work arrays, so one object is evaluated by one caller at a time. */

@@ -13,7 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- the reader (tomllib.loads) ----------------------------------------------------------- */
+/* ---- the reader (tomllib.loads) -----------------------------------------------------------
+ * A function of the reader that returns ErrorKind gives ERROR_NONE, or ERROR_VALUE with the message
+ * in reader->error (one that returns a Value gives NULL with it): the loader raises tomllib's
+ * TOMLDecodeError as a ValueError (and out of memory as one too, as the FMU reports it). */
 
 typedef struct Pending {
     Value *table;
@@ -39,7 +42,7 @@ typedef struct {
 } Key;
 
 /* suffixed_err: the reason and where the reader stands (line, column in characters). */
-static int malformed(Reader *reader, const char *reason)
+static ErrorKind malformed(Reader *reader, const char *reason)
 {
     size_t line = 1, column = 1, i;
     if (reader->pos >= reader->length) {
@@ -61,7 +64,7 @@ static int malformed(Reader *reader, const char *reason)
     }
 }
 
-static int out_of_memory(Reader *reader)
+static ErrorKind out_of_memory(Reader *reader)
 {
     return layout_error(reader->error, reader->size, "out of memory");
 }
@@ -90,33 +93,34 @@ static void skip_blanks(Reader *reader)
 }
 
 /* skip_comment */
-static int skip_comment(Reader *reader)
+static ErrorKind skip_comment(Reader *reader)
 {
     if (peek(reader, 0) != '#') {
-        return 0;
+        return ERROR_NONE;
     }
     for (reader->pos++; reader->pos < reader->length && reader->src[reader->pos] != '\n'; reader->pos++) {
         if (control(peek(reader, 0)) && peek(reader, 0) != '\t') {
             return malformed(reader, "invalid character in a comment");
         }
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* skip_comments_and_array_ws */
-static int skip_array_space(Reader *reader)
+static ErrorKind skip_array_space(Reader *reader)
 {
     size_t before;
+    ErrorKind failed;
     do {
         before = reader->pos;
         while (peek(reader, 0) == ' ' || peek(reader, 0) == '\t' || peek(reader, 0) == '\n') {
             reader->pos++;
         }
-        if (skip_comment(reader) != 0) {
-            return -1;
+        if ((failed = skip_comment(reader)) != ERROR_NONE) {
+            return failed;
         }
     } while (reader->pos != before);
-    return 0;
+    return ERROR_NONE;
 }
 
 static Value *new_value(Reader *reader, Kind kind, int depth)
@@ -130,7 +134,7 @@ static Value *new_value(Reader *reader, Kind kind, int depth)
     return value;
 }
 
-static int append(Reader *reader, Value *container, const char *key, size_t key_length, Value *value)
+static ErrorKind append(Reader *reader, Value *container, const char *key, size_t key_length, Value *value)
 {
     Item *item = arena_alloc(&reader->arena, sizeof *item);
     if (item == NULL) {
@@ -147,7 +151,7 @@ static int append(Reader *reader, Value *container, const char *key, size_t key_
     }
     container->last = item;
     container->count++;
-    return 0;
+    return ERROR_NONE;
 }
 
 Value *toml_find(const Value *table, const char *key, size_t key_length)
@@ -220,7 +224,7 @@ static size_t put_utf8(char *out, unsigned long code)
 
 /* parse_basic_str_escape: one escape at pos (a backslash); its characters go to ``out`` (NULL: only
  * counted in ``*count``). */
-static int basic_escape(Reader *reader, int multiline, char *out, size_t *count)
+static ErrorKind basic_escape(Reader *reader, int multiline, char *out, size_t *count)
 {
     int c = peek(reader, 1);
     static const char from[] = "btnfr\"\\", to[] = "\b\t\n\f\r\"\\";
@@ -230,7 +234,7 @@ static int basic_escape(Reader *reader, int multiline, char *out, size_t *count)
         if (c != '\n') {
             skip_blanks(reader);
             if (reader->pos >= reader->length) {
-                return 0;
+                return ERROR_NONE;
             }
             if (peek(reader, 0) != '\n') {
                 return malformed(reader, "unescaped '\\' in a string");
@@ -240,7 +244,7 @@ static int basic_escape(Reader *reader, int multiline, char *out, size_t *count)
         while (peek(reader, 0) == ' ' || peek(reader, 0) == '\t' || peek(reader, 0) == '\n') {
             reader->pos++;
         }
-        return 0;
+        return ERROR_NONE;
     }
     if (c == 'u' || c == 'U') {
         size_t digits = c == 'u' ? 4 : 8, i;
@@ -258,7 +262,7 @@ static int basic_escape(Reader *reader, int multiline, char *out, size_t *count)
             return malformed(reader, "escaped character is not a Unicode scalar value");
         }
         *count += put_utf8(out != NULL ? out + *count : NULL, code);
-        return 0;
+        return ERROR_NONE;
     }
     known = c > 0 ? strchr(from, c) : NULL;
     if (known == NULL) {
@@ -270,12 +274,12 @@ static int basic_escape(Reader *reader, int multiline, char *out, size_t *count)
     }
     (*count)++;
     reader->pos += 2;
-    return 0;
+    return ERROR_NONE;
 }
 
 /* The body of a string opened at pos (parse_one_line_basic_str, parse_literal_str,
  * parse_multiline_str): its characters to ``out`` (NULL: counted only), pos after the closing quotes. */
-static int string_body(Reader *reader, char *out, size_t *count)
+static ErrorKind string_body(Reader *reader, char *out, size_t *count)
 {
     char quote = reader->src[reader->pos];
     int multiline = starts(reader, quote == '"' ? "\"\"\"" : "'''");
@@ -293,7 +297,7 @@ static int string_body(Reader *reader, char *out, size_t *count)
             int extra;
             if (!multiline) {
                 reader->pos++;
-                return 0;
+                return ERROR_NONE;
             }
             if (peek(reader, 1) == quote && peek(reader, 2) == quote) {
                 reader->pos += 3;
@@ -304,11 +308,12 @@ static int string_body(Reader *reader, char *out, size_t *count)
                     (*count)++;
                     reader->pos++;
                 }
-                return 0;
+                return ERROR_NONE;
             }
         } else if (c == '\\' && quote == '"') {
-            if (basic_escape(reader, multiline, out, count) != 0) {
-                return -1;
+            ErrorKind failed = basic_escape(reader, multiline, out, count);
+            if (failed != ERROR_NONE) {
+                return failed;
             }
             continue;
         } else if (control(c) && c != '\t' && !(multiline && c == '\n')) {
@@ -323,12 +328,13 @@ static int string_body(Reader *reader, char *out, size_t *count)
 }
 
 /* A string at pos into the arena. */
-static int read_string(Reader *reader, const char **text, size_t *length)
+static ErrorKind read_string(Reader *reader, const char **text, size_t *length)
 {
     size_t start = reader->pos, count;
     char *out;
-    if (string_body(reader, NULL, &count) != 0) {
-        return -1;
+    ErrorKind failed = string_body(reader, NULL, &count);
+    if (failed != ERROR_NONE) {
+        return failed;
     }
     out = arena_alloc(&reader->arena, count + 1);
     if (out == NULL) {
@@ -339,7 +345,7 @@ static int read_string(Reader *reader, const char **text, size_t *length)
     out[count] = '\0';
     *text = out;
     *length = count;
-    return 0;
+    return ERROR_NONE;
 }
 
 int toml_bare_key_char(int c)
@@ -348,7 +354,7 @@ int toml_bare_key_char(int c)
 }
 
 /* parse_key: dotted parts, quoted or bare (one-line strings only). */
-static int read_key(Reader *reader, Key *key)
+static ErrorKind read_key(Reader *reader, Key *key)
 {
     key->count = 0;
     for (;;) {
@@ -369,8 +375,9 @@ static int read_key(Reader *reader, Key *key)
             if (starts(reader, c == '"' ? "\"\"\"" : "\'\'\'")) { /* an empty key, then a quote */
                 return malformed(reader, "invalid key");
             }
-            if (read_string(reader, &part, &length) != 0) {
-                return -1;
+            ErrorKind failed = read_string(reader, &part, &length);
+            if (failed != ERROR_NONE) {
+                return failed;
             }
         } else {
             return malformed(reader, "invalid initial character for a key part");
@@ -380,7 +387,7 @@ static int read_key(Reader *reader, Key *key)
         key->count++;
         skip_blanks(reader);
         if (peek(reader, 0) != '.') {
-            return 0;
+            return ERROR_NONE;
         }
         reader->pos++;
         skip_blanks(reader);
@@ -417,7 +424,7 @@ static size_t digit_run(const Reader *reader, size_t at, int base)
 }
 
 /* The integer of [start, end) in ``base`` (underscores skipped), negative if ``minus``. */
-static int integer_value(Reader *reader, size_t start, size_t end, int base, int minus, long long *out)
+static ErrorKind integer_value(Reader *reader, size_t start, size_t end, int base, int minus, long long *out)
 {
     unsigned long long magnitude = 0, limit = minus ? (unsigned long long)LLONG_MAX + 1u : LLONG_MAX;
     size_t i;
@@ -437,11 +444,11 @@ static int integer_value(Reader *reader, size_t start, size_t end, int base, int
     } else {
         *out = (long long)magnitude;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* float() of the TOML float text [start, end): underscores dropped, the locale's decimal point. */
-static int float_value(Reader *reader, size_t start, size_t end, double *out)
+static ErrorKind float_value(Reader *reader, size_t start, size_t end, double *out)
 {
     char *copy = arena_alloc(&reader->arena, end - start + 8), point = *localeconv()->decimal_point;
     size_t i, n = 0;
@@ -456,7 +463,7 @@ static int float_value(Reader *reader, size_t start, size_t end, double *out)
     }
     copy[n] = '\0';
     *out = strtod(copy, NULL);
-    return 0;
+    return ERROR_NONE;
 }
 
 /* Whether ``count`` decimal digits and ``c`` follow (the start of a date or a time). */
@@ -472,7 +479,7 @@ static int digits_then(const Reader *reader, size_t count, int c)
 }
 
 /* A number, inf or nan at pos (RE_NUMBER, match_to_number); datetimes are refused. */
-static int read_number(Reader *reader, Value *value)
+static ErrorKind read_number(Reader *reader, Value *value)
 {
     size_t start = reader->pos, at = start, run;
     int c = peek(reader, 0), base = 0, minus = c == '-';
@@ -504,7 +511,7 @@ static int read_number(Reader *reader, Value *value)
             value->kind = V_FLOAT;
             value->number = word[0] == 'n' ? NAN : minus ? -INFINITY : INFINITY;
             reader->pos = at + 3;
-            return 0;
+            return ERROR_NONE;
         }
         return malformed(reader, "invalid value");
     }
@@ -533,9 +540,9 @@ static int read_number(Reader *reader, Value *value)
     }
 }
 
-static int read_value(Reader *reader, int depth, Value **out);
+static ErrorKind read_value(Reader *reader, int depth, Value **out);
 
-static int descend_error(Reader *reader)
+static ErrorKind descend_error(Reader *reader)
 {
     return malformed(reader, "cannot overwrite a value");
 }
@@ -551,42 +558,45 @@ static int closes(Reader *reader, int c)
 }
 
 /* parse_array: [ values, ... ] over lines, with comments and a trailing comma. */
-static int read_array(Reader *reader, Value *array)
+static ErrorKind read_array(Reader *reader, Value *array)
 {
+    ErrorKind failed;
     reader->pos++;
-    if (skip_array_space(reader) != 0) {
-        return -1;
+    if ((failed = skip_array_space(reader)) != ERROR_NONE) {
+        return failed;
     }
     if (closes(reader, ']')) {
-        return 0;
+        return ERROR_NONE;
     }
     for (;;) {
         Value *item;
-        if (read_value(reader, array->depth + 1, &item) != 0 || append(reader, array, NULL, 0, item) != 0 ||
-            skip_array_space(reader) != 0) {
-            return -1;
+        if ((failed = read_value(reader, array->depth + 1, &item)) != ERROR_NONE ||
+            (failed = append(reader, array, NULL, 0, item)) != ERROR_NONE ||
+            (failed = skip_array_space(reader)) != ERROR_NONE) {
+            return failed;
         }
         if (closes(reader, ']')) {
-            return 0;
+            return ERROR_NONE;
         }
         if (peek(reader, 0) != ',') {
             return malformed(reader, "unclosed array");
         }
         reader->pos++;
-        if (skip_array_space(reader) != 0) {
-            return -1;
+        if ((failed = skip_array_space(reader)) != ERROR_NONE) {
+            return failed;
         }
         if (closes(reader, ']')) {
-            return 0;
+            return ERROR_NONE;
         }
     }
 }
 
 /* parse_key_value_pair: key = value, the value at the depth of its place below ``parent``. */
-static int read_pair(Reader *reader, const Value *parent, Key *key, Value **value)
+static ErrorKind read_pair(Reader *reader, const Value *parent, Key *key, Value **value)
 {
-    if (read_key(reader, key) != 0) {
-        return -1;
+    ErrorKind failed = read_key(reader, key);
+    if (failed != ERROR_NONE) {
+        return failed;
     }
     if (peek(reader, 0) != '=') {
         return malformed(reader, "expected '=' after a key in a key/value pair");
@@ -603,7 +613,7 @@ static int read_pair(Reader *reader, const Value *parent, Key *key, Value **valu
  * value under its last part. ``section``: a statement of a section (key_value_rule: a table declared
  * before is closed to dotted keys; the ones passed count as declared from the next header on); else
  * a pair of an inline table (parse_inline_table). Literal arrays and inline tables stay closed. */
-static int place_pair(Reader *reader, Value *table, const Key *key, Value *value, int section)
+static ErrorKind place_pair(Reader *reader, Value *table, const Key *key, Value *value, int section)
 {
     Value *nest = table;
     int i;
@@ -611,8 +621,8 @@ static int place_pair(Reader *reader, Value *table, const Key *key, Value *value
         Value *next = toml_find(nest, key->part[i], key->length[i]);
         if (next == NULL) {
             next = add_child(reader, nest, V_TABLE, key->part[i], key->length[i]);
-            if (next == NULL) {
-                return -1;
+            if (next == NULL) { /* malformed or out of memory, its message written */
+                return ERROR_VALUE;
             }
         } else if (section && next->declared) {
             return malformed(reader, "cannot redefine a namespace");
@@ -637,22 +647,24 @@ static int place_pair(Reader *reader, Value *table, const Key *key, Value *value
 }
 
 /* parse_inline_table: { key = value, ... } on one line; dotted keys make tables inside. */
-static int read_inline_table(Reader *reader, Value *table)
+static ErrorKind read_inline_table(Reader *reader, Value *table)
 {
     reader->pos++;
     skip_blanks(reader);
     if (closes(reader, '}')) {
-        return 0;
+        return ERROR_NONE;
     }
     for (;;) {
         Key key;
         Value *value;
-        if (read_pair(reader, table, &key, &value) != 0 || place_pair(reader, table, &key, value, 0) != 0) {
-            return -1;
+        ErrorKind failed;
+        if ((failed = read_pair(reader, table, &key, &value)) != ERROR_NONE ||
+            (failed = place_pair(reader, table, &key, value, 0)) != ERROR_NONE) {
+            return failed;
         }
         skip_blanks(reader);
         if (closes(reader, '}')) {
-            return 0;
+            return ERROR_NONE;
         }
         if (peek(reader, 0) != ',') {
             return malformed(reader, "unclosed inline table");
@@ -663,7 +675,7 @@ static int read_inline_table(Reader *reader, Value *table)
 }
 
 /* parse_value */
-static int read_value(Reader *reader, int depth, Value **out)
+static ErrorKind read_value(Reader *reader, int depth, Value **out)
 {
     int c = peek(reader, 0);
     Value *value = new_value(reader, V_BOOL, depth);
@@ -678,7 +690,7 @@ static int read_value(Reader *reader, int depth, Value **out)
     if (starts(reader, "true") || starts(reader, "false")) {
         value->integer = c == 't';
         reader->pos += c == 't' ? 4 : 5;
-        return 0;
+        return ERROR_NONE;
     }
     if (c == '[' || c == '{') {
         if (depth > TREE_DEPTH) {
@@ -787,11 +799,12 @@ static Value *read_header(Reader *reader, Value *root)
 }
 
 /* key_value_rule: a pair in the section's table ``header``. */
-static int read_statement_pair(Reader *reader, Value *header)
+static ErrorKind read_statement_pair(Reader *reader, Value *header)
 {
     Key key;
     Value *value;
-    return read_pair(reader, header, &key, &value) != 0 ? -1 : place_pair(reader, header, &key, value, 1);
+    ErrorKind failed = read_pair(reader, header, &key, &value);
+    return failed != ERROR_NONE ? failed : place_pair(reader, header, &key, value, 1);
 }
 
 /* tomllib.loads: the document's table (in the reader's arena), NULL with the message. */
@@ -861,17 +874,17 @@ static Value *read_document(Reader *reader, const char *text, size_t length)
     return root;
 }
 
-Value *toml_read(const char *text, size_t length, const char *source, Arena *arena, char *error, size_t size)
+ErrorKind toml_read(const char *text, size_t length, const char *source, Arena *arena, Value **root, char *error,
+                    size_t size)
 {
     Reader reader;
-    Value *root;
     memset(&reader, 0, sizeof reader);
     reader.source = source;
     reader.error = error;
     reader.size = size;
-    root = read_document(&reader, text, length);
+    *root = read_document(&reader, text, length);
     *arena = reader.arena;
-    return root;
+    return *root != NULL ? ERROR_NONE : ERROR_VALUE;
 }
 
 /* The first invalid UTF-8 sequence (CPython's decoder: its reason and start), -1 if none. */

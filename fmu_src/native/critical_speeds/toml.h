@@ -67,12 +67,15 @@ void text_put_str_repr(Text *text, const char *bytes, size_t count);
 void text_put_float(Text *text, double value);
 void text_put_repr(Text *text, const Value *value);
 /* The message into ``error``: ``format`` with %s (C string), %d (int), %v (a Value's repr), %g (a
- * double's repr), %r (a C string's repr). Returns -1. */
-int layout_error(char *error, size_t size, const char *format, ...);
+ * double's repr), %r (a C string's repr). Returns ERROR_VALUE: the loader raises ValueError only. */
+ErrorKind layout_error(char *error, size_t size, const char *format, ...);
 
-/* tomllib.loads of ``text`` (``length`` bytes of UTF-8): the document's table, built in ``arena``
- * (which the caller frees, also on failure), or NULL with the message ``source``: malformed TOML: ... */
-Value *toml_read(const char *text, size_t length, const char *source, Arena *arena, char *error, size_t size);
+/* tomllib.loads of ``text`` (``length`` bytes of UTF-8): the document's table into *root, built in
+ * ``arena`` (which the caller frees, also on failure); ERROR_NONE, or ERROR_VALUE (*root NULL) with the
+ * message ``source``: malformed TOML: ... (tomllib's TOMLDecodeError, which the loader raises as a
+ * ValueError) or out of memory */
+ErrorKind toml_read(const char *text, size_t length, const char *source, Arena *arena, Value **root, char *error,
+                    size_t size);
 /* the value of ``key`` in ``table``, NULL if absent */
 Value *toml_find(const Value *table, const char *key, size_t key_length);
 /* The first invalid UTF-8 sequence (CPython's decoder: its reason and start), -1 if none. */

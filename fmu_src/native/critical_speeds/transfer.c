@@ -57,13 +57,6 @@ typedef struct {
     double forward[4][4], backward[4][4];
 } Gram;
 
-static void set_error(char *error, size_t size, const char *text)
-{
-    if (error != NULL && size > 0) {
-        snprintf(error, size, "%s", text);
-    }
-}
-
 /* ---- elements.ShaftSegment ------------------------------------------------------------------- */
 
 /* ShaftSegment._couple: c = rho I w^2 - rho Ip Omega w, Ip = 2 I */
@@ -717,22 +710,24 @@ void chain_free(Chain *chain)
     }
 }
 
-static int check_node(const char *kind, int i, int node, int n_nodes, int inner, char *error, size_t size)
+/* Driveline.__post_init__'s check of a point element's node (``inner``: a hinge's); ERROR_NONE, or
+ * ERROR_VALUE with the message */
+static ErrorKind check_node(const char *kind, int i, int node, int n_nodes, int inner, char *error, size_t size)
 {
     if (node < 0 || node >= n_nodes) {
         if (error != NULL && size > 0) {
             snprintf(error, size, "%s[%d].node = %d is out of range: nodes are 0..%d", kind, i, node, n_nodes - 1);
         }
-        return -1;
+        return ERROR_VALUE;
     }
     if (inner && (node == 0 || node == n_nodes - 1)) {
         if (error != NULL && size > 0) {
             snprintf(error, size, "%s[%d].node = %d: a hinge must sit at an inner node (1..%d), not at an end", kind,
                      i, node, n_nodes - 2);
         }
-        return -1;
+        return ERROR_VALUE;
     }
-    return 0;
+    return ERROR_NONE;
 }
 
 /* ShaftSegment's derived constants the transfer matrices use */
@@ -750,55 +745,57 @@ static void segment_constants(const RotorSegment *s, ChainSegment *out)
 }
 
 /* transfer.Chain.build (with Driveline's node checks and the freedoms _grid counts) */
-Chain *chain_new(const Driveline *driveline, char *error, size_t size)
+ErrorKind chain_new(const Driveline *driveline, Chain **out, char *error, size_t size)
 {
     Chain *chain;
     int n_nodes, n_points, i, k, at;
     double L0 = 0.0, EI0;
+    ErrorKind failed;
+    *out = NULL;
     if (driveline->n_segments < 1 || driveline->segments == NULL) {
-        set_error(error, size, "segments: a driveline needs at least one shaft segment");
-        return NULL;
+        ROTOR_ERROR(error, size, "segments: a driveline needs at least one shaft segment");
+        return ERROR_VALUE;
     }
     if ((unsigned)driveline->left > END_CLAMPED || (unsigned)driveline->right > END_CLAMPED) {
-        set_error(error, size, "end condition is not one of: free, pinned, clamped");
-        return NULL;
+        ROTOR_ERROR(error, size, "end condition is not one of: free, pinned, clamped");
+        return ERROR_VALUE;
     }
     n_nodes = driveline->n_segments + 1;
     for (i = 0; i < driveline->n_masses; i++) {
-        if (check_node("masses", i, driveline->masses[i].node, n_nodes, 0, error, size)) {
-            return NULL;
+        if ((failed = check_node("masses", i, driveline->masses[i].node, n_nodes, 0, error, size)) != ERROR_NONE) {
+            return failed;
         }
     }
     for (i = 0; i < driveline->n_bearings; i++) {
         const RotorBearing *b = &driveline->bearings[i];
-        if (check_node("bearings", i, b->node, n_nodes, 0, error, size)) {
-            return NULL;
+        if ((failed = check_node("bearings", i, b->node, n_nodes, 0, error, size)) != ERROR_NONE) {
+            return failed;
         }
         if (b->kxy != 0.0 || b->kyx != 0.0) { /* Bearing._undamped_stiffness */
-            set_error(error, size,
-                      "cross-coupled bearing stiffness (kxy, kyx) enters the damped analyses only, not the undamped "
-                      "transfer matrices");
-            return NULL;
+            ROTOR_ERROR(error, size,
+                        "cross-coupled bearing stiffness (kxy, kyx) enters the damped analyses only, not the undamped "
+                        "transfer matrices");
+            return ERROR_VALUE;
         }
     }
     for (i = 0; i < driveline->n_hinges; i++) {
-        if (check_node("joints", i, driveline->hinges[i].node, n_nodes, 1, error, size)) {
-            return NULL;
+        if ((failed = check_node("joints", i, driveline->hinges[i].node, n_nodes, 1, error, size)) != ERROR_NONE) {
+            return failed;
         }
     }
     n_points = driveline->n_masses + driveline->n_bearings + driveline->n_hinges;
     chain = malloc(sizeof *chain);
     if (chain == NULL) {
-        set_error(error, size, "out of memory");
-        return NULL;
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
+        return ERROR_VALUE;
     }
     chain->segments = malloc((size_t)driveline->n_segments * sizeof *chain->segments);
     chain->first = malloc((size_t)(n_nodes + 1) * sizeof *chain->first);
     chain->points = malloc((size_t)(n_points > 0 ? n_points : 1) * sizeof *chain->points);
     if (chain->segments == NULL || chain->first == NULL || chain->points == NULL) {
         chain_free(chain);
-        set_error(error, size, "out of memory");
-        return NULL;
+        ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
+        return ERROR_VALUE;
     }
     chain->n_segments = driveline->n_segments;
     chain->left = driveline->left;
@@ -866,7 +863,8 @@ Chain *chain_new(const Driveline *driveline, char *error, size_t size)
         chain->freedoms += translation + tilt + hinge; /* Driveline._grid: distinct freedoms per node */
     }
     chain->first[n_nodes] = at;
-    return chain;
+    *out = chain;
+    return ERROR_NONE;
 }
 
 int chain_isotropic(const Chain *chain)
