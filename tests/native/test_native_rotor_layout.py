@@ -4,10 +4,14 @@ the same drivelines, field for field and bit for bit, and the same messages."""
 from __future__ import annotations
 
 import ctypes
+import json
 import math
 import os
 import random
 import struct
+import subprocess
+import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -603,6 +607,53 @@ def test_file_checks(lib, tmp_path, monkeypatch):
                      str(tmp_path / "sub" / ".." / "sub" / "malformed.toml") + ": malformed TOML",
                      "/" + str(tmp_path / "sub" / "bad.toml") + ": masses[0]"):
         assert expected in text, expected
+
+
+SWAPPED_LOADS = """
+import ctypes, json, sys
+sys.path[:0] = sys.argv[4:]
+from support.native_rotor import CDriveline
+lib = ctypes.CDLL(sys.argv[1])
+outcomes = set()
+for _ in range(int(sys.argv[3])):
+    d, error = CDriveline(), ctypes.create_string_buffer(512)
+    kind = lib.driveline_from_layout(sys.argv[2].encode(), b"", ctypes.byref(d), error, ctypes.c_size_t(512))
+    outcomes.add(error.value.decode().rsplit("' ", 1)[-1] if kind else "loaded")
+    if not kind:
+        lib.driveline_free(ctypes.byref(d))
+print(json.dumps(sorted(outcomes)))
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs are POSIX's")
+def test_a_fifo_swapped_in_while_loading_is_refused_without_blocking(lib, tmp_path):
+    """The file is opened without blocking and its type asked of the open file, as the Python
+    loader does: a FIFO renamed over the layout between a look at the path and its opening would
+    block the host's thread forever in the open (20,000 loads with the names swapping hung within
+    2,000 when the type was asked of the path first; they take about 0.2 s)."""
+    path, fifo, regular, link = (tmp_path / name for name in ("swapped.toml", "fifo", "regular", "link"))
+    regular.write_text(ONE)
+    os.mkfifo(fifo)
+    os.link(regular, path)
+    loading = True
+
+    def swap() -> None:
+        while loading:
+            for source in (fifo, regular):
+                link.unlink(missing_ok=True)
+                os.link(source, link)
+                os.replace(link, path)
+
+    swapper = threading.Thread(target=swap, daemon=True)
+    swapper.start()
+    try:
+        done = subprocess.run([sys.executable, "-c", SWAPPED_LOADS, lib._name, str(path), "20000",
+                               str(Path(__file__).parents[1])], capture_output=True, text=True, timeout=30)
+    finally:
+        loading = False
+        swapper.join()
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout) == ["is not a regular file", "loaded"]
 
 
 def test_shipped_names(lib, tmp_path):

@@ -334,6 +334,35 @@ def test_cross_coupled_bearing_is_refused(lib):
     assert "cross-coupled" in str(native.value)
 
 
+def _three_segments(masses, bearings, hinges, **cross) -> Driveline:
+    return Driveline([ShaftSegment(0.5, 0.05)] * 3, masses=[_joint(node) for node in masses],
+                     bearings=[Bearing(node, 1e7, **cross) for node in bearings],
+                     joints=[Hinge(node) for node in hinges])
+
+
+@pytest.mark.parametrize("masses, bearings, hinges", [
+    ((4,), (0, 3), (1,)),  # nodes are 0..3
+    ((1,), (0, 7), (2,)),
+    ((1, 2), (0, 3), (0,)),  # a hinge at an end
+    ((1,), (0, 3), (2, 3)),
+    ((1,), (0, 3), (9,)),
+])
+def test_nodes_are_checked_as_the_driveline_checks_them(lib, masses, bearings, hinges):
+    """``chain_new`` refuses a point element off the nodes, or a hinge at an end, with the message
+    of ``Driveline.__post_init__`` (where no Python driveline with such nodes gets made), before
+    a bearing's cross-coupling, as the Python core refuses a driveline before building its chain."""
+    with pytest.raises(ValueError) as python:
+        _three_segments(masses, bearings, hinges)
+    struct = c_driveline(_three_segments([1] * len(masses), [0] * len(bearings), [1] * len(hinges), kyx=-2e5))
+    for array, nodes in ((struct.masses, masses), (struct.bearings, bearings), (struct.hinges, hinges)):
+        for i, node in enumerate(nodes):
+            array[i].node = node
+    error, chain = ctypes.create_string_buffer(ERROR_SIZE), ctypes.c_void_p()
+    kind = lib.chain_new(ctypes.byref(struct), ctypes.byref(chain), error, ERROR_SIZE)
+    assert not chain
+    assert (kind, error.value.decode()) == (ERROR_KIND["ERROR_VALUE"], str(python.value))
+
+
 @pytest.mark.parametrize(
     "call",
     [

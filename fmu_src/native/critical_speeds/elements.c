@@ -277,3 +277,38 @@ ErrorKind unbalance_check(const RotorUnbalance *u, char *error, size_t size)
     }
     return failed;
 }
+
+/* Driveline.__post_init__'s check of a point element's node (``inner``: a hinge's) */
+static ErrorKind check_node(const char *kind, int i, int node, int n_nodes, int inner, char *error, size_t size)
+{
+    if (node < 0 || node >= n_nodes) {
+        if (error != NULL && size > 0) {
+            snprintf(error, size, "%s[%d].node = %d is out of range: nodes are 0..%d", kind, i, node, n_nodes - 1);
+        }
+        return ERROR_VALUE;
+    }
+    if (inner && (node == 0 || node == n_nodes - 1)) {
+        if (error != NULL && size > 0) {
+            snprintf(error, size, "%s[%d].node = %d: a hinge must sit at an inner node (1..%d), not at an end", kind,
+                     i, node, n_nodes - 2);
+        }
+        return ERROR_VALUE;
+    }
+    return ERROR_NONE;
+}
+
+ErrorKind driveline_check_nodes(const Driveline *d, char *error, size_t size)
+{
+    int n_nodes = d->n_segments + 1, i;
+    ErrorKind failed = ERROR_NONE;
+    for (i = 0; i < d->n_masses && failed == ERROR_NONE; i++) {
+        failed = check_node("masses", i, d->masses[i].node, n_nodes, 0, error, size);
+    }
+    for (i = 0; i < d->n_bearings && failed == ERROR_NONE; i++) {
+        failed = check_node("bearings", i, d->bearings[i].node, n_nodes, 0, error, size);
+    }
+    for (i = 0; i < d->n_hinges && failed == ERROR_NONE; i++) {
+        failed = check_node("joints", i, d->hinges[i].node, n_nodes, 1, error, size);
+    }
+    return failed;
+}

@@ -36,5 +36,8 @@ ErrorKind mass_check(const RotorMass *m, char *error, size_t size);
 ErrorKind bearing_check(const RotorBearing *b, char *error, size_t size);
 /* Unbalance.__post_init__ */
 ErrorKind unbalance_check(const RotorUnbalance *u, char *error, size_t size);
+/* Driveline.__post_init__'s node checks: every point element at a node 0..n_segments, a hinge at
+ * an inner one */
+ErrorKind driveline_check_nodes(const Driveline *d, char *error, size_t size);
 
 #endif

@@ -167,35 +167,14 @@ static ErrorKind segments_length(const Driveline *d, double *sum, const char **m
 /* Driveline.__post_init__'s checks on the nodes and the unbalances. */
 static ErrorKind check_driveline(const Loader *loader, const Driveline *d)
 {
-    int n_nodes = d->n_segments + 1, i;
+    int i;
     double length;
-    for (i = 0; i < d->n_masses; i++) {
-        if (d->masses[i].node >= n_nodes) {
-            return layout_error(loader->error, loader->size, "masses[%d].node = %d is out of range: nodes are 0..%d", i,
-                        d->masses[i].node, n_nodes - 1);
-        }
-    }
-    for (i = 0; i < d->n_bearings; i++) {
-        if (d->bearings[i].node >= n_nodes) {
-            return layout_error(loader->error, loader->size,
-                                "bearings[%d].node = %d is out of range: nodes are 0..%d", i,
-                        d->bearings[i].node, n_nodes - 1);
-        }
-    }
-    for (i = 0; i < d->n_hinges; i++) {
-        int node = d->hinges[i].node;
-        if (node >= n_nodes) {
-            return layout_error(loader->error, loader->size, "joints[%d].node = %d is out of range: nodes are 0..%d", i,
-                        node, n_nodes - 1);
-        }
-        if (node == 0 || node == n_nodes - 1) {
-            return layout_error(loader->error, loader->size,
-                        "joints[%d].node = %d: a hinge must sit at an inner node (1..%d), not at an end", i, node,
-                        n_nodes - 2);
-        }
-    }
     const char *failure;
-    ErrorKind kind = segments_length(d, &length, &failure);
+    ErrorKind kind = driveline_check_nodes(d, loader->error, loader->size);
+    if (kind != ERROR_NONE) {
+        return kind;
+    }
+    kind = segments_length(d, &length, &failure);
     if (kind != ERROR_NONE) { /* math.fsum's OverflowError or ValueError */
         layout_error(loader->error, loader->size, "%s", failure);
         return kind;

@@ -1,8 +1,12 @@
 /* A layout by file or shipped name (loader.load_driveline, loader.example_path): the path made
  * absolute as pathlib does, the file read with stdio, at most MAX_FILE_BYTES, only a regular file. */
+#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 200809L /* fdopen and O_CLOEXEC besides ISO C */
+#endif
 #include "toml.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,14 +14,34 @@
 #include <sys/stat.h>
 #ifdef _WIN32
 #include <direct.h> /* _getcwd */
+#include <io.h>     /* _open, _close */
 #else
-#include <unistd.h> /* getcwd */
+#include <unistd.h> /* getcwd, close */
 #endif
 
 /* ---- what ISO C cannot ask the operating system ------------------------------------------ */
 /* Standard C has neither the working directory nor a file's type, and opening a FIFO with fopen
- * blocks until a writer comes: these two calls, with the C library each platform has, are all the
- * loader asks of the system beyond stdio. */
+ * blocks until a writer comes: the working directory, a path's type, and a file opened without
+ * blocking whose type is then asked of the open file (so that nothing can swap a FIFO in between),
+ * with the C library each platform has, are all the loader asks of the system beyond stdio. */
+#ifdef _WIN32
+typedef struct _stat64 FileInfo;
+#define open_without_blocking(path) _open((path), _O_RDONLY | _O_BINARY) /* no FIFOs among Windows' files */
+#define info_of_open_file _fstat64
+#define close_file _close
+#define stream_of_open_file _fdopen
+#define IS_REGULAR(mode) (((mode) & _S_IFMT) == _S_IFREG)
+#else
+typedef struct stat FileInfo;
+#ifndef O_CLOEXEC
+#define O_CLOEXEC 0
+#endif
+#define open_without_blocking(path) open((path), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)
+#define info_of_open_file fstat
+#define close_file close
+#define stream_of_open_file fdopen
+#define IS_REGULAR(mode) S_ISREG(mode)
+#endif
 
 /* The working directory into ``out`` (``room`` bytes); NULL with errno (ERANGE: too small). */
 static char *working_directory(char *out, size_t room)
@@ -38,14 +62,43 @@ static int regular_file(const char *path)
     if (_stat64(path, &info) != 0) {
         return -1;
     }
-    return (info.st_mode & _S_IFMT) == _S_IFREG;
 #else
     struct stat info;
     if (stat(path, &info) != 0) {
         return -1;
     }
-    return S_ISREG(info.st_mode) != 0;
 #endif
+    return IS_REGULAR(info.st_mode) != 0;
+}
+
+/* loader._read_regular_file's opening: ``path`` opened for reading without blocking (a FIFO opens at
+ * once), its type asked of the open file. 1 with ``*file`` open for a regular file, 0 for something
+ * else (closed again), -1 with errno when it cannot be opened or looked at. */
+static int open_regular_file(const char *path, FILE **file)
+{
+    FileInfo info;
+    int descriptor = open_without_blocking(path), err;
+    *file = NULL;
+    if (descriptor < 0) {
+        return -1;
+    }
+    if (info_of_open_file(descriptor, &info) != 0) {
+        err = errno;
+        close_file(descriptor);
+        errno = err;
+        return -1;
+    }
+    if (!IS_REGULAR(info.st_mode)) {
+        close_file(descriptor);
+        return 0;
+    }
+    if ((*file = stream_of_open_file(descriptor, "rb")) == NULL) {
+        err = errno;
+        close_file(descriptor);
+        errno = err;
+        return -1;
+    }
+    return 1;
 }
 
 /* os.strerror */
@@ -139,9 +192,9 @@ static char *absolute_path(const char *path)
     return out;
 }
 
-/* loader._read_regular_file: refuse what is not a regular file before opening it (a FIFO would block
- * fopen), read at most MAX_FILE_BYTES + 1 bytes. ``*data`` owned (free()). ERROR_NONE, or ERROR_VALUE
- * with the message (the loader raises the OSError as a ValueError). */
+/* loader._read_regular_file: refuse what is not a regular file (opened without blocking), read at
+ * most MAX_FILE_BYTES + 1 bytes. ``*data`` owned (free()). ERROR_NONE, or ERROR_VALUE with the
+ * message (the loader raises the OSError as a ValueError). */
 static ErrorKind read_regular_file(const char *path, char **data, size_t *length, char *error, size_t size)
 {
     char reason[128];
@@ -150,11 +203,11 @@ static ErrorKind read_regular_file(const char *path, char **data, size_t *length
     FILE *file = NULL;
     *data = NULL;
     errno = 0;
-    regular = regular_file(path);
+    regular = open_regular_file(path, &file);
     if (regular == 0) {
         return layout_error(error, size, "driveline file %r is not a regular file", path);
     }
-    if (regular < 0 || (file = fopen(path, "rb")) == NULL) {
+    if (regular < 0) {
         err = errno != 0 ? errno : EINVAL;
     } else if ((*data = malloc(ROTOR_LOADER_MAX_FILE_BYTES + 1)) == NULL) {
         fclose(file);

@@ -121,7 +121,7 @@ static ErrorKind refine(Search *st, double a, double b, double fa, double fb)
         t = t < 1.0 - tlim ? t : 1.0 - tlim;
     }
     ROTOR_ERROR(st->error, st->size, "root refinement did not converge");
-    return ERROR_VALUE; /* Python's is an ArithmeticError; the FMU has reported a ValueError's message */
+    return ERROR_ARITHMETIC;
 }
 
 /* roots._scan for one sampled sequence: its zeros and sign changes, then its dips re-scanned on

@@ -710,26 +710,6 @@ void chain_free(Chain *chain)
     }
 }
 
-/* Driveline.__post_init__'s check of a point element's node (``inner``: a hinge's); ERROR_NONE, or
- * ERROR_VALUE with the message */
-static ErrorKind check_node(const char *kind, int i, int node, int n_nodes, int inner, char *error, size_t size)
-{
-    if (node < 0 || node >= n_nodes) {
-        if (error != NULL && size > 0) {
-            snprintf(error, size, "%s[%d].node = %d is out of range: nodes are 0..%d", kind, i, node, n_nodes - 1);
-        }
-        return ERROR_VALUE;
-    }
-    if (inner && (node == 0 || node == n_nodes - 1)) {
-        if (error != NULL && size > 0) {
-            snprintf(error, size, "%s[%d].node = %d: a hinge must sit at an inner node (1..%d), not at an end", kind,
-                     i, node, n_nodes - 2);
-        }
-        return ERROR_VALUE;
-    }
-    return ERROR_NONE;
-}
-
 /* ShaftSegment's derived constants the transfer matrices use */
 static void segment_constants(const RotorSegment *s, ChainSegment *out)
 {
@@ -761,26 +741,16 @@ ErrorKind chain_new(const Driveline *driveline, Chain **out, char *error, size_t
         return ERROR_VALUE;
     }
     n_nodes = driveline->n_segments + 1;
-    for (i = 0; i < driveline->n_masses; i++) {
-        if ((failed = check_node("masses", i, driveline->masses[i].node, n_nodes, 0, error, size)) != ERROR_NONE) {
-            return failed;
-        }
+    if ((failed = driveline_check_nodes(driveline, error, size)) != ERROR_NONE) {
+        return failed;
     }
     for (i = 0; i < driveline->n_bearings; i++) {
         const RotorBearing *b = &driveline->bearings[i];
-        if ((failed = check_node("bearings", i, b->node, n_nodes, 0, error, size)) != ERROR_NONE) {
-            return failed;
-        }
         if (b->kxy != 0.0 || b->kyx != 0.0) { /* Bearing._undamped_stiffness */
             ROTOR_ERROR(error, size,
                         "cross-coupled bearing stiffness (kxy, kyx) enters the damped analyses only, not the undamped "
                         "transfer matrices");
             return ERROR_VALUE;
-        }
-    }
-    for (i = 0; i < driveline->n_hinges; i++) {
-        if ((failed = check_node("joints", i, driveline->hinges[i].node, n_nodes, 1, error, size)) != ERROR_NONE) {
-            return failed;
         }
     }
     n_points = driveline->n_masses + driveline->n_bearings + driveline->n_hinges;
