@@ -259,6 +259,7 @@ def test_speed_zero_gives_no_response_and_the_tabulated_damping(library):
 
 
 @pytest.mark.parametrize("omega_max", [0.0, -5.0, float("nan"), float("inf")])
+@pytest.mark.filterwarnings("ignore:invalid value encountered in multiply:RuntimeWarning")  # numpy's linspace to inf
 def test_refusals_are_worded_as_pythons(library, omega_max):
     """Equal or falling knots, which CubicSpline refuses; knots that are not finite, which numpy's eig
     refuses."""

@@ -26,6 +26,7 @@
  * with the C library each platform has, are all the loader asks of the system beyond stdio. */
 #ifdef _WIN32
 typedef struct _stat64 FileInfo;
+#define info_of_path _stat64
 #define open_without_blocking(path) _open((path), _O_RDONLY | _O_BINARY) /* no FIFOs among Windows' files */
 #define info_of_open_file _fstat64
 #define close_file _close
@@ -33,6 +34,7 @@ typedef struct _stat64 FileInfo;
 #define IS_REGULAR(mode) (((mode) & _S_IFMT) == _S_IFREG)
 #else
 typedef struct stat FileInfo;
+#define info_of_path stat
 #ifndef O_CLOEXEC
 #define O_CLOEXEC 0
 #endif
@@ -57,17 +59,10 @@ static char *working_directory(char *out, size_t room)
  * device), -1 with errno when it names nothing that can be looked at. */
 static int regular_file(const char *path)
 {
-#ifdef _WIN32
-    struct _stat64 info;
-    if (_stat64(path, &info) != 0) {
+    FileInfo info;
+    if (info_of_path(path, &info) != 0) {
         return -1;
     }
-#else
-    struct stat info;
-    if (stat(path, &info) != 0) {
-        return -1;
-    }
-#endif
     return IS_REGULAR(info.st_mode) != 0;
 }
 
