@@ -364,8 +364,8 @@ static ErrorKind build_one_piece(const ModelData *data, Driveline *out, char *er
 
 /* searched_modes: bare-shaft bending modes below the frequencies the order-resonance searches scan,
  * times the stations a determinant evaluation passes. */
-static ErrorKind searched_modes(const Driveline *driveline, const int *orders, int n_orders, double omega_max, double *work,
-                          char *error)
+static ErrorKind searched_modes(const Driveline *driveline, const int *orders, int n_orders, double omega_max,
+                                double *work, char *error)
 {
     double *terms, kappa, scanned, squared_outer, squared_inner, fourth_outer, fourth_inner, ratio, root;
     int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, i, n = 0;
@@ -429,11 +429,13 @@ static double work_grid(double per_pi, double phase)
 
 /* work.estimate, then Work.refusal: ERROR_NONE, or the refusal (ERROR_VALUE) or a failure's kind
  * with its message in ``error``. */
-static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int n_orders, double omega_max, char *error)
+static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int n_orders, double omega_max,
+                              char *error)
 {
     static const char *const names[WORK_STAGE_COUNT] = {WORK_STAGE_0, WORK_STAGE_1, WORK_STAGE_2,
                                                    WORK_STAGE_3, WORK_STAGE_4, WORK_STAGE_5};
-    double seconds[WORK_STAGE_COUNT], terms[ROTOR_MODEL_MAX_ORDERS + 1], per_pi, kappa, to_limit, resonances, check, total, search;
+    double seconds[WORK_STAGE_COUNT], terms[ROTOR_MODEL_MAX_ORDERS + 1], per_pi, kappa, to_limit, resonances, check,
+        total, search;
     int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, *counts, i, n = 0, stations, planes = 1, isotropic, freedoms, table = 0,
         response = 0;
     char shown[40], stage[80];

@@ -164,8 +164,9 @@ typedef struct {
 #define NO_FAILURE FAILURE(ERROR_NONE, NULL)
 
 /* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
- * The physics returns NO_FAILURE, or the arithmetic failure Python raises. A model whose outputs are functions of time alone gives ``at_time``
- * (start: at the start time, step: at its end); the others give ``start`` and ``advance``.
+ * The physics returns NO_FAILURE, or the arithmetic failure Python raises. A model whose outputs
+ * are functions of time alone gives ``at_time`` (start: at the start time, step: at its end); the
+ * others give ``start`` and ``advance``.
  * A NULL ``reset_internal`` or ``extra_*_errors`` means none. A model with derived data builds it
  * in ``extra_parameter_errors`` (run before every initialisation and step, once the declared
  * checks pass) into ``data->cache->derived``, keyed by the parameters it was built for, and gives

@@ -100,8 +100,8 @@ Status instance_set_input_derivatives(Instance *instance, const char *function, 
         return instance_fail(instance, instance->fmi_prefix, function, ": a NULL array", (const char *)NULL);
     }
     if (n > MODEL_INPUT_DERIVATIVE_COUNT) {
-        return instance_fail(instance, instance->fmi_prefix, function, ": more derivatives than the model's inputs hold",
-                             (const char *)NULL);
+        return instance_fail(instance, instance->fmi_prefix, function,
+                             ": more derivatives than the model's inputs hold", (const char *)NULL);
     }
     for (i = 0; i < n; i++) {
         for (k = 0; k < MODEL_INPUT_DERIVATIVE_COUNT; k++) {

@@ -202,7 +202,8 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
         signs[j][0] = slip_sign(guard, a->zdot, load->slip_speed);
         signs[j][1] = slip_sign(guard, a->sigma * root(guard, a->exy2 + a->ez * a->ez), load->slip_speed);
     }
-    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE; iteration++) {
+    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE;
+         iteration++) {
         double Mx = load_moment[0], My = load_moment[1], Mz = load_moment[2], change = 0.0, scale = 0.0;
         for (j = 0; j < 3; j++) {
             const Arm *a = &arm[j];
@@ -262,7 +263,8 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     double Sx = -l * sb, Sz = l * cb, Px = Sx - l * Ux, Py = -l * Uy, Pz = Sz - l * Uz;
     /* the moving bearing: Sdot = l betadot (-cos, 0, -sin), Sddot = l betaddot (-cos, 0, -sin) - l betadot^2 e_out */
     double bd = load->beta_dot, bdd = load->beta_ddot;
-    double Svx = -l * cb * bd, Svz = -l * sb * bd, Sax = l * (sb * bd * bd - cb * bdd), Saz = -l * (cb * bd * bd + sb * bdd);
+    double Svx = -l * cb * bd, Svz = -l * sb * bd;
+    double Sax = l * (sb * bd * bd - cb * bdd), Saz = -l * (cb * bd * bd + sb * bdd);
     double p_dot_u = Px * Ux + Py * Uy + Pz * Uz, omega2 = omega * omega;
     double c[3], s[3], adj[3][3], inv_det, rhs[3], Wx, Wy, Wz, W2, Ax, Ay, Az, Mx, My, Mz;
     double lams[3], mus[3], slips[3] = {0.0, 0.0, 0.0}, grooves[3] = {0.0, 0.0, 0.0}, moment[3];
@@ -396,7 +398,8 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
     double cb = load->cb, tb = divide(guard, load->sb, cb), half = divide(guard, load->sb, 1.0 + cb);
     double A = divide(guard, 1.5 * m * r * r * tb, cb * cb), omega2 = load->omega * load->omega;
     double ry_in = divide(guard, -(T * half + A * omega_dot * cb), l);
-    double bend = divide(guard, m * r, cb * cb), bend_rates = load->beta_ddot + 2.0 * tb * load->beta_dot * load->beta_dot;
+    double bend = divide(guard, m * r, cb * cb);
+    double bend_rates = load->beta_ddot + 2.0 * tb * load->beta_dot * load->beta_dot;
     int j;
     for (j = 0; j < 3; j++) {
         double angle = load->phi_in + TRIPOD_GEOMETRY_THIRD_TURN * j, c = cosine(guard, angle), s = sine(guard, angle);

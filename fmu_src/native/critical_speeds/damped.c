@@ -583,7 +583,8 @@ static ErrorKind rotor_modes(const Rotor *rotor, Dense *dense, double spin, int 
     int order = dense->order, count, *index = dense->index;
     ErrorKind failed;
     if (dense->krylov.cap) { /* above DENSE_SIZE: the 2 n + EXTRA_EIGENVALUES nearest SHIFT by Arnoldi */
-        count = 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES < dense->krylov.cap ? 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES : dense->krylov.cap;
+        count = 2 * n + ROTOR_DAMPED_EXTRA_EIGENVALUES;
+        count = count < dense->krylov.cap ? count : dense->krylov.cap;
         if ((failed = krylov_modes(rotor, &dense->krylov, spin, count, dense->lambda, error, size)) != ERROR_NONE) {
             return failed;
         }
@@ -741,7 +742,8 @@ static ErrorKind mode_table(const Driveline *d, const int *counts, const double 
                 excited++;
             }
         }
-        for (; excited < ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES; excited++) { /* a short model: beyond the search limit, undamped */
+        /* a short model: beyond the search limit, undamped */
+        for (; excited < ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES; excited++) {
             out[excited] = ROTOR_DRIVELINE_SEARCH_LIMIT;
             out[ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES + excited] = 0.0;
         }
@@ -766,7 +768,8 @@ ErrorKind unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbala
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return ERROR_VALUE;
     }
-    double spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS], table[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
+    double spins[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS],
+        table[ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS * 2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
     double step = omega_max / (ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS - 1); /* numpy.linspace */
     for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS; i++) {
         spins[i] = i * step + 0.0;
@@ -827,7 +830,8 @@ ErrorKind unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbala
         refused = isfinite(table[i]) ? refused : "`y` must contain only finite values.";
     }
     for (int i = 0; i < ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS; i++) {
-        refused = i > 0 && !(spins[i] > spins[i - 1]) && !refused ? "`x` must be strictly increasing sequence." : refused;
+        refused = i > 0 && !(spins[i] > spins[i - 1]) && !refused ? "`x` must be strictly increasing sequence."
+                                                                   : refused;
     }
     refused = isfinite(omega_max) ? refused : "`x` must contain only finite values.";
     if (refused || cubic_spline_build(&outputs->modes, ROTOR_UNBALANCE_OUTPUTS_DAMPING_POINTS, spins,

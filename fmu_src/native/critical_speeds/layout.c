@@ -514,7 +514,8 @@ static ErrorKind cut(const Loader *loader, const RotorSegment *old, int n_old, S
             for (k = 0; k < n_old && !(ends[k] <= value && value <= ends[k + 1]); k++) {
             }
             k = k == n_old ? 0 : k;
-            if ((value - ends[k] < ends[k + 1] - value ? value - ends[k] : ends[k + 1] - value) > ROTOR_LOADER_NODE_SNAP) {
+            double left = value - ends[k], right = ends[k + 1] - value;
+            if ((left < right ? left : right) > ROTOR_LOADER_NODE_SNAP) {
                 segment_of[n_cuts] = k;
                 cuts[n_cuts++] = value;
             }

@@ -164,8 +164,8 @@ int hessenberg_eigenvalues(cplx *h, int n, cplx *lambda)
             cplx a = H(hi - 1, hi - 1), b = H(hi - 1, hi), c = H(hi, hi - 1), d = H(hi, hi);
             cplx p = cplx_scale(0.5, cplx_sub(a, d)), bc = cplx_mul(b, c), root = cplx_sqrt(cplx_add(cplx_mul(p, p),
                                                                                                      bc));
-            cplx plus = cplx_add(p, root), minus = cplx_sub(p,
-                                                            root), den = cplx_abs(plus) >= cplx_abs(minus) ? plus : minus;
+            cplx plus = cplx_add(p, root), minus = cplx_sub(p, root);
+            cplx den = cplx_abs(plus) >= cplx_abs(minus) ? plus : minus;
             mu = cplx_is_zero(den) ? d : cplx_sub(d, cplx_div(bc, den));
         }
         cplx x = cplx_sub(H(lo, lo), mu), y = H(lo + 1, lo);

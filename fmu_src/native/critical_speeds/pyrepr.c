@@ -1,5 +1,6 @@
 /* Python's repr() of the strings the rotor library's messages show (unicode_repr; a float's is
- * python_float_repr of the shared python_numbers.c). Every function writes at most ``size`` bytes, always terminated. */
+ * python_float_repr of the shared python_numbers.c). Every function writes at most ``size`` bytes,
+ * always terminated. */
 #include "rotor.h"
 
 #include <math.h>
