@@ -45,7 +45,7 @@ def bits(value: float) -> bytes:
     return struct.pack("<d", value)
 
 
-def native_fields(lib: ctypes.CDLL, d: CDriveline) -> dict:
+def native_fields(d: CDriveline) -> dict:
     """The driveline's fields, the numbers as their bits."""
     def rows(pointer, count, names):
         return [tuple(bits(v) if isinstance(v, float) else v for v in (getattr(pointer[i], n) for n in names))
@@ -57,7 +57,6 @@ def native_fields(lib: ctypes.CDLL, d: CDriveline) -> dict:
         "hinges": rows(d.hinges, d.n_hinges, [f[0] for f in RotorHinge._fields_]),
         "unbalances": rows(d.unbalances, d.n_unbalances, [f[0] for f in RotorUnbalance._fields_]),
         "ends": (d.left, d.right),
-        "isotropic": bool(lib.driveline_isotropic(ctypes.byref(d))),
     }
 
 
@@ -73,7 +72,6 @@ def python_fields(drv) -> dict:
         "hinges": [(h.node, bits(h.bending_stiffness)) for h in drv.joints],
         "unbalances": [(bits(u.position), bits(u.amount), bits(u.phase)) for u in drv.unbalances],
         "ends": (ends.index(drv.left.value), ends.index(drv.right.value)),
-        "isotropic": drv.is_isotropic,
     }
 
 
@@ -85,7 +83,7 @@ def native_result(lib: ctypes.CDLL, call, *args):
         assert status == ERROR_KIND["ERROR_VALUE"] and not d.segments and d.n_segments == 0
         return error.value.decode("utf-8", "surrogateescape")
     try:
-        return native_fields(lib, d), lib.driveline_length(ctypes.byref(d))
+        return native_fields(d), lib.driveline_length(ctypes.byref(d))
     finally:
         lib.driveline_free(ctypes.byref(d))
 

@@ -926,15 +926,3 @@ double driveline_length(const Driveline *driveline)
     const char *failure;
     return segments_length(driveline, &sum, &failure) == ERROR_NONE ? sum : HUGE_VAL;
 }
-
-/* Driveline.is_isotropic (the chain's: every bearing with kxx == kyy) */
-int driveline_isotropic(const Driveline *driveline)
-{
-    int i;
-    for (i = 0; i < driveline->n_bearings; i++) {
-        if (driveline->bearings[i].kxx != driveline->bearings[i].kyy) {
-            return 0;
-        }
-    }
-    return 1;
-}

@@ -108,8 +108,6 @@ ErrorKind driveline_from_text(const char *text, size_t length, const char *sourc
                               size_t size);
 /* Driveline.length (math.fsum of the segment lengths) */
 double driveline_length(const Driveline *driveline);
-/* Driveline.is_isotropic: every bearing has kxx == kyy */
-int driveline_isotropic(const Driveline *driveline);
 
 /* ---- pyrepr.c -------------------------------------------------------------------------------- */
 /* repr() of a Python str holding the UTF-8 ``text`` cut to its first ``max_chars`` code points (0: all). */
