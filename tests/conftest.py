@@ -100,6 +100,12 @@ def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool 
 
 
 @pytest.fixture(scope="session")
+def fmi_versions(pytestconfig: pytest.Config) -> list[str]:
+    """The FMI versions the run builds and tests (``--fmi``; all by default, "2" with ``--quick``)."""
+    return selected_versions(pytestconfig)
+
+
+@pytest.fixture(scope="session")
 def fmu_store(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The session's folder of built FMUs (built by :func:`fmu_path` when first asked for)."""
     return tmp_path_factory.mktemp("models")
@@ -169,6 +175,14 @@ def fmu_dir(fmu_store: Path, fmu_path: FmuPath, pytestconfig: pytest.Config) -> 
 
 
 @pytest.fixture(scope="session")
+def fmi2_dir(fmu_dir: Path, fmi_versions: list[str]) -> Path:
+    """:func:`fmu_dir` for a test that runs the FMI 2.0 FMUs in it (``<model>.fmu``, a system of
+    them); skipped when FMI 2.0 is not selected."""
+    skip_unless_selected("2", fmi_versions)
+    return fmu_dir
+
+
+@pytest.fixture(scope="session")
 def tripod_fmu(fmu_path: FmuPath) -> Path:
     return fmu_path("TripodCoupling")
 
@@ -185,10 +199,11 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
 @pytest.hookimpl(tryfirst=True)  # before ``-m`` selects by these markers
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark every test (see the module docstring); with ``--fmi``, deselect the other versions'
-    variants of tests parametrized by ``fmi`` or ``version``; a whole-suite collection warns of
-    a durations file that names tests no longer collected."""
+    variants of tests parametrized by ``fmi`` or ``version``; a whole-suite collection of every
+    FMI version warns of a durations file that names tests no longer collected."""
     durations = measured()
-    if config.args_source == pytest.Config.ArgsSource.TESTPATHS and not config.getoption("quick"):
+    whole_suite = config.args_source == pytest.Config.ArgsSource.TESTPATHS and not config.getoption("quick")
+    if whole_suite and not config.getoption("fmi"):  # --fmi leaves the other version's variants uncollected
         stale = sorted(set(durations) - {item.nodeid for item in items})
         if stale and config.getoption("update_durations") and not hasattr(config, "workerinput"):
             _write_durations({n: s for n, s in durations.items() if n not in stale})

@@ -245,12 +245,13 @@ def _start_time(fmu_path: FmuPath, fmi: str) -> list[Case]:
                  (str(fmu_path("SpeedSource", fmi)), 1.0), fmi, (NO_START_TIME,) if fmi == "3" else ())]
 
 
-def _engines(fmu_path: FmuPath) -> list[Case]:
+def _engines(fmu_path: FmuPath, versions: Iterable[str]) -> list[Case]:
+    """Refused steps in the co-simulation engines installed, in the ``versions`` each of them imports."""
     found = []
-    for engine, package, versions in (("libcosim", "libcosimpy", ("2",)), ("Ecos", "ecospy", ("2", "3"))):
+    for engine, package, imports in (("libcosim", "libcosimpy", ("2",)), ("Ecos", "ecospy", ("2", "3"))):
         if importlib.util.find_spec(package) is None:
             continue
-        for fmi in versions:
+        for fmi in (fmi for fmi in versions if fmi in imports):
             for model, name in (("CardanJoint", "omega_in"), ("TripodCoupling", "beta")):
                 found.append(Case(f"refused steps in {engine}", f"{model}.{name} = nan", "engine_refusal",
                                   (str(fmu_path(model, fmi)), engine, name, math.nan), fmi,
@@ -296,7 +297,7 @@ def cases(fmu_path: FmuPath, slow: bool = False, versions: Iterable[str] = ("2",
                   + (_model_failures(fmu_path, fmi) if family == "python" else []))
         if slow:
             found += _soak(fmu_path, fmi)
-    found += _engines(fmu_path)
+    found += _engines(fmu_path, versions)
     if family == "python":
         return found
     return [replace(case, family=family, departures=tuple(d for d in case.departures if d not in WRAPPER_DEPARTURES))

@@ -14,10 +14,10 @@ from fmu_harness.runs.runner import StepRefused, simulate
 
 @pytest.mark.parametrize("beta_deg", [0.0, 10.0, 30.0, 44.0])
 @pytest.mark.parametrize("omega", [300.0, -120.0])
-def test_cardan_follows_the_seed_over_many_turns(fmu_dir, beta_deg, omega):
+def test_cardan_follows_the_seed_over_many_turns(fmu_path, beta_deg, omega):
     beta, phase = math.radians(beta_deg), 0.4
     result = simulate(
-        fmu_dir / "CardanJoint.fmu", 1.0, 1e-3,
+        fmu_path("CardanJoint"), 1.0, 1e-3,
         inputs={"omega_in": omega, "beta": beta, "T_load": 50.0}, start_values={"phase": phase},
     )  # 48 turns at 300 rad/s
     np.testing.assert_allclose(result["phi_in"], omega * result["time"], rtol=1e-12)
@@ -36,15 +36,15 @@ def test_cardan_follows_the_seed_over_many_turns(fmu_dir, beta_deg, omega):
     np.testing.assert_allclose(result["speed_fluctuation"], kinematics.speed_fluctuation(beta), rtol=1e-12)
 
 
-def test_cardan_acceleration_includes_the_input_acceleration(fmu_dir):
+def test_cardan_acceleration_includes_the_input_acceleration(fmu_path):
     ramp = 400.0  # rad/s^2
-    result = simulate(fmu_dir / "CardanJoint.fmu", 0.2, 1e-4, inputs={"omega_in": lambda t: 50.0 + ramp * t, "beta": 0.5})
+    result = simulate(fmu_path("CardanJoint"), 0.2, 1e-4, inputs={"omega_in": lambda t: 50.0 + ramp * t, "beta": 0.5})
     np.testing.assert_allclose(result["alpha_in"][2:], ramp, rtol=1e-6)
 
 
 @pytest.mark.parametrize("alpha_deg", [95.0, 135.0, 160.0, 170.0])
-def test_reducer_ratio_is_exact_at_any_angle(fmu_dir, alpha_deg):
-    result = simulate(fmu_dir / "UniversalReducer.fmu", 0.5, 1e-3, inputs={"alpha": math.radians(alpha_deg), "T_load": 68.0})
+def test_reducer_ratio_is_exact_at_any_angle(fmu_path, alpha_deg):
+    result = simulate(fmu_path("UniversalReducer"), 0.5, 1e-3, inputs={"alpha": math.radians(alpha_deg), "T_load": 68.0})
     i = transmission_ratio(34, 29)
     assert i == pytest.approx(6.8)
     np.testing.assert_allclose(result["omega_out"], result["omega_out"][0], rtol=1e-15)
@@ -52,9 +52,9 @@ def test_reducer_ratio_is_exact_at_any_angle(fmu_dir, alpha_deg):
     np.testing.assert_allclose(result["T_in"] * (1000 * math.pi / 30), 68.0 * result["omega_out"], rtol=1e-14)
 
 
-def test_reducer_ratio_holds_while_the_angle_and_speed_change(fmu_dir):
+def test_reducer_ratio_holds_while_the_angle_and_speed_change(fmu_path):
     result = simulate(
-        fmu_dir / "UniversalReducer.fmu", 1.0, 1e-3,
+        fmu_path("UniversalReducer"), 1.0, 1e-3,
         inputs={"alpha": lambda t: math.radians(130 + 35 * math.sin(7 * t)), "omega_in": lambda t: 100 + 50 * math.sin(3 * t)},
     )
     np.testing.assert_allclose(result["phi_out"] * 6.8, result["phi_in"], rtol=1e-14)

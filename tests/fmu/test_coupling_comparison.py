@@ -11,8 +11,8 @@ from driveline.cardan.kinematics import speed_fluctuation
 from fmu_harness.studies import coupling_comparison as comparison
 
 
-def test_fluctuation_and_dominant_order_of_each_coupling(fmu_dir):
-    rows = {(r["coupling"], r["beta_deg"]): r for r in comparison.speed_fluctuation_table(fmu_dir, [10.0, 30.0])}
+def test_fluctuation_and_dominant_order_of_each_coupling(fmi2_dir):
+    rows = {(r["coupling"], r["beta_deg"]): r for r in comparison.speed_fluctuation_table(fmi2_dir, [10.0, 30.0])}
     for beta in (10.0, 30.0):
         cardan = rows[("CardanJoint", beta)]
         assert cardan["order"] == 2
@@ -28,12 +28,12 @@ def fluctuation(speed: np.ndarray) -> float:
     return float(np.ptp(settled) / np.mean(settled))
 
 
-def test_two_cardan_joints_cancel_when_phased_and_double_when_not(fmu_dir):
+def test_two_cardan_joints_cancel_when_phased_and_double_when_not(fmi2_dir):
     beta = math.radians(20.0)
     single = float(speed_fluctuation(beta))
     steps = (1e-4, 1e-5)
-    phased = [fluctuation(comparison.cardan_shaft(fmu_dir, beta, math.pi / 2, h)["omega_out"]) for h in steps]
-    wrong = fluctuation(comparison.cardan_shaft(fmu_dir, beta, 0.0, 1e-5)["omega_out"])
+    phased = [fluctuation(comparison.cardan_shaft(fmi2_dir, beta, math.pi / 2, h)["omega_out"]) for h in steps]
+    wrong = fluctuation(comparison.cardan_shaft(fmi2_dir, beta, 0.0, 1e-5)["omega_out"])
     # The second joint integrates the first one's speed held over each communication step, so the
     # cancellation leaves a residue of first order in the step: measured 4.0e-3 and 4.0e-4.
     assert phased[0] < 0.05 * single and phased[1] < 0.005 * single

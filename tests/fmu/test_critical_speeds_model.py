@@ -112,8 +112,8 @@ def test_malformed_description_file_is_refused(tmp_path):
     assert errors and "length" in errors[0]
 
 
-def test_fmu_follows_a_speed_ramp_and_refuses_overspeed(fmu_dir, rotor_b):
-    path = fmu_dir / "CriticalSpeeds.fmu"
+def test_fmu_follows_a_speed_ramp_and_refuses_overspeed(fmu_path, rotor_b):
+    path = fmu_path("CriticalSpeeds")
     result = simulate(path, 1.0, 0.05, inputs={"omega": lambda t: 1400.0 * t})
     np.testing.assert_allclose(result["omega_crit_1"], rotor_b.critical_speeds(1)[0], rtol=1e-12)
     np.testing.assert_allclose(result["speed_ratio"][1:], 1400.0 * (result["time"][1:] - 0.05) / result["omega_crit_1"][1:], rtol=1e-12)

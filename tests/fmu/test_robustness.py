@@ -47,17 +47,17 @@ def _report(results: list[robustness.Result]) -> str:
 
 
 @pytest.fixture(scope="module")
-def results(paths: robustness.FmuPath, family: str) -> list[robustness.Result]:
-    return robustness.run_all(robustness.cases(paths, family=family))
+def results(paths: robustness.FmuPath, family: str, fmi_versions: list[str]) -> list[robustness.Result]:
+    return robustness.run_all(robustness.cases(paths, versions=fmi_versions, family=family))
 
 
 def test_no_case_crashes_hangs_or_gets_a_wrong_status_or_output(results):
     assert not robustness.failures(results), _report(results)
 
 
-def test_the_suite_covers_every_class_in_both_fmi_versions(results, family):
+def test_the_suite_covers_every_class_in_each_fmi_version(results, family, fmi_versions):
     expected = CLASSES - NOT_NATIVE if family == "native" else CLASSES
-    for fmi in ("2", "3"):
+    for fmi in fmi_versions:
         assert {r.case.kind for r in results if r.case.fmi == fmi and r.verdict != "skipped"} >= expected
 
 
@@ -68,10 +68,12 @@ def test_only_cases_of_models_without_an_fmu_of_the_family_are_skipped(results, 
 
 
 @pytest.mark.slow
-def test_every_variable_value_and_model_and_a_long_soak(paths: robustness.FmuPath, family: str, results):
+def test_every_variable_value_and_model_and_a_long_soak(paths: robustness.FmuPath, family: str, results,
+                                                       fmi_versions: list[str]):
     """The cases the default run samples, and 100,000 bad/good alternations per FMI version with
     resident memory bounded."""
     sampled = {(r.case.fmi, r.case.kind, r.case.name) for r in results}
-    rest = [c for c in robustness.cases(paths, slow=True, family=family) if (c.fmi, c.kind, c.name) not in sampled]
+    rest = [c for c in robustness.cases(paths, slow=True, versions=fmi_versions, family=family)
+            if (c.fmi, c.kind, c.name) not in sampled]
     slow_results = robustness.run_all(rest)
     assert not robustness.failures(slow_results), _report(slow_results)

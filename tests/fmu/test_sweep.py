@@ -89,11 +89,11 @@ def test_grid_axes():
         parse_axis("beta")
 
 
-def test_cli_with_points_file_on_a_running_scheduler(client, fmu_dir, tmp_path):
+def test_cli_with_points_file_on_a_running_scheduler(client, fmi2_dir, tmp_path):
     points = tmp_path / "points.json"
     points.write_text(json.dumps([{"beta": 0.2, "omega_in": 300.0}, {"beta": 0.4, "omega_in": 300.0}]))
     out = tmp_path / "sweep.csv"
-    main(["--points", str(points), "--models", str(fmu_dir), "--scheduler", client.scheduler.address,
+    main(["--points", str(points), "--models", str(fmi2_dir), "--scheduler", client.scheduler.address,
           "--steps-per-turn", str(STEPS), "--out", str(out)])
     table = pyarrow.csv.read_csv(out)
     assert table.column("status").to_pylist() == ["ok", "ok"]

@@ -24,18 +24,18 @@ PACKAGES = ("driveline_ssp", "native_ssp")
 
 
 @pytest.fixture(scope="module")
-def driveline_ssp(fmu_dir: Path) -> Path:
-    return system.write_ssp(system.driveline(), fmu_dir)
+def driveline_ssp(fmi2_dir: Path) -> Path:
+    return system.write_ssp(system.driveline(), fmi2_dir)
 
 
 @pytest.fixture(scope="module")
-def native_ssp(fmu_dir: Path, native_dir: Path) -> Path:
-    return system.write_ssp(system.driveline(), fmu_dir, native_dir)
+def native_ssp(fmi2_dir: Path, native_dir: Path) -> Path:
+    return system.write_ssp(system.driveline(), fmi2_dir, native_dir)
 
 
 @pytest.fixture(scope="module")
-def master_result(fmu_dir: Path) -> np.ndarray:
-    return system.simulate(system.driveline(), fmu_dir)
+def master_result(fmi2_dir: Path) -> np.ndarray:
+    return system.simulate(system.driveline(), fmi2_dir)
 
 
 def _deviation(result: np.ndarray, master_result: np.ndarray) -> dict[str, float]:
@@ -89,23 +89,23 @@ def test_package_wires_existing_variables_and_binds_parameters(package, request,
         assert variables[connection.get("endElement")][connection.get("endConnector")] == "input"
 
 
-def test_native_package_holds_the_native_fmu_of_each_model_that_has_one(native_ssp, fmu_dir, native_dir):
+def test_native_package_holds_the_native_fmu_of_each_model_that_has_one(native_ssp, fmi2_dir, native_dir):
     ported = set(native.native_models())
     assert "SpeedSource" in ported
     with zipfile.ZipFile(native_ssp) as archive:
         root = ET.fromstring(archive.read("SystemStructure.ssd"))
         for component in root.iterfind("ssd:System/ssd:Elements/ssd:Component", SSD):
             model = system.driveline().component(component.get("name")).model
-            family, fmu = ("native", native.fmu_path(native_dir, model)) if model in ported else ("Python", fmu_path(fmu_dir, model))
+            family, fmu = ("native", native.fmu_path(native_dir, model)) if model in ported else ("Python", fmu_path(fmi2_dir, model))
             assert archive.read(component.get("source")) == fmu.read_bytes(), model
             assert component.get("description") == f"{family} FMU of {model}"
 
 
-def test_the_master_runs_the_native_variant_like_the_python_system(fmu_dir, native_dir, master_result):
+def test_the_master_runs_the_native_variant_like_the_python_system(fmi2_dir, native_dir, master_result):
     """Within the native FMUs' own promise of each output's largest magnitude (tests/support/native_agreement.py:
     1e-12, the watcher's eigenvalue-conditioned outputs 1e-9 and 1e-8; measured: bit for bit but the
     tripod's theta, 1.4e-16, and the watcher's damping ratio, 6.9e-11)."""
-    result = system.simulate(system.driveline(), fmu_dir, natives=native_dir)
+    result = system.simulate(system.driveline(), fmi2_dir, natives=native_dir)
     deviation = _deviation(result, master_result)
     beyond = {name: d for name, d in deviation.items()
               if not d <= SIGNAL_TOLERANCE.get(name.rpartition(".")[2], TOLERANCE)}
