@@ -166,9 +166,9 @@ def family(request: pytest.FixtureRequest, fmu_path: FmuPath, tmp_path_factory: 
 
 
 @pytest.fixture(scope="session")
-def fmu_dir(fmu_store: Path, fmu_path: FmuPath, pytestconfig: pytest.Config) -> Path:
+def fmu_dir(fmu_store: Path, fmu_path: FmuPath, fmi_versions: list[str]) -> Path:
     """The folder holding the FMUs of all models in the selected FMI versions (FMI 3.0 ones in ``fmi3/``)."""
-    for version in selected_versions(pytestconfig):
+    for version in fmi_versions:
         for name in MODELS:
             fmu_path(name, version)
     return fmu_store

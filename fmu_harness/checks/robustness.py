@@ -251,7 +251,7 @@ def _engines(fmu_path: FmuPath, versions: Iterable[str]) -> list[Case]:
     for engine, package, imports in (("libcosim", "libcosimpy", ("2",)), ("Ecos", "ecospy", ("2", "3"))):
         if importlib.util.find_spec(package) is None:
             continue
-        for fmi in (fmi for fmi in versions if fmi in imports):
+        for fmi in [version for version in versions if version in imports]:
             for model, name in (("CardanJoint", "omega_in"), ("TripodCoupling", "beta")):
                 found.append(Case(f"refused steps in {engine}", f"{model}.{name} = nan", "engine_refusal",
                                   (str(fmu_path(model, fmi)), engine, name, math.nan), fmi,
