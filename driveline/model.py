@@ -122,6 +122,13 @@ class SteppedModel(ABC):
     #: table into the model's variable header (``PART_<NAME>``, ``model_part_values``).
     derived_parts: ClassVar[dict[str, tuple[str, ...]]] = {}
 
+    #: Parameter and input values, besides the start values, at which the dependency test perturbs
+    #: every parameter and input (``tests/fmu/test_dependencies.py``): where an output's declared
+    #: dependency (``depends_on`` in the spec) shows only at other values (friction only with the
+    #: exact kinematics, a phase only away from the bend plane). A variable is perturbed by a small
+    #: step and to the value it has at each other point.
+    dependency_points: ClassVar[tuple[dict[str, Any], ...]] = ()
+
     #: Files a native FMU of the model ships in its ``resources/`` folder, by their path here (the
     #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.
     resource_files: ClassVar[tuple[Path, ...]] = ()

@@ -6,7 +6,9 @@ ranges and descriptions from them into the model description. What makes a value
 is declared here once, as data: each variable's bounds (inclusive or exclusive) and the
 :class:`Relation` s between variables; :class:`driveline.model.SteppedModel` enforces them.
 The model description carries the bounds as FMI's inclusive ``min``/``max``; an exclusive
-bound is refused by the model alone.
+bound is refused by the model alone. What each output is computed from is declared here too
+(``depends_on``, :class:`State`): the build writes it as the ``dependencies`` of the model
+structure, and a test perturbs every parameter and input of the FMUs against it.
 """
 
 from __future__ import annotations
@@ -90,6 +92,13 @@ class Variable:
     #: An input that is the time derivative of the input named here (FMI 3.0's ``derivative``
     #: attribute; the native FMI 2.0 FMUs take it from ``fmi2SetRealInputDerivatives``).
     derivative: str | None = None
+    #: An output's direct dependencies: the inputs, parameters and states (:class:`State`) its value
+    #: is computed from at one instant, whatever their values (a friction coefficient that acts with
+    #: the exact kinematics only is named). Every output that is no state declares them.
+    depends_on: tuple[str, ...] | None = None
+    #: What the output's value at initialisation depends on, where that differs from ``depends_on``
+    #: (a difference of two samples is zero until the second sample).
+    initial_depends_on: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.unit is not None and self.unit not in UNITS:
@@ -156,6 +165,22 @@ class Relation:
 
 
 @dataclass(frozen=True)
+class State:
+    """An output the model integrates over time (an input shaft's angle): its value at one instant
+    is its own, ``initial`` names the parameters its value at initialisation is computed from and
+    ``derivative`` the input or output that is its time derivative (a Model Exchange FMU's
+    continuous state, whose derivative is the variable ``der(<name>)``)."""
+
+    name: str
+    initial: tuple[str, ...]
+    derivative: str
+
+    @property
+    def derivative_name(self) -> str:
+        return f"der({self.name})"
+
+
+@dataclass(frozen=True)
 class DefaultExperiment:
     start_time: float
     stop_time: float
@@ -165,14 +190,15 @@ class DefaultExperiment:
 
 @dataclass(frozen=True)
 class ModelSpec:
-    """The interface of one model: its FMU name, description, variables, default experiment and
-    the relations its parameters and inputs must satisfy."""
+    """The interface of one model: its FMU name, description, variables, default experiment, the
+    relations its parameters and inputs must satisfy and the outputs that are states."""
 
     name: str
     description: str
     variables: tuple[Variable, ...]
     default_experiment: DefaultExperiment
     relations: tuple[Relation, ...] = ()
+    states: tuple[State, ...] = ()
 
     def __post_init__(self) -> None:
         names = [v.name for v in self.variables]
@@ -188,6 +214,57 @@ class ModelSpec:
                 raise ValueError(f"{self.name}: relation {relation} must relate numeric parameters or inputs")
             if len({v.unit for v in variables}) > 1:
                 raise ValueError(f"{self.name}: relation {relation} relates different units")
+        self._check_dependencies()
+
+    def _check_dependencies(self) -> None:
+        """Every output is a state or declares ``depends_on``, naming inputs, parameters and states."""
+        states = {state.name for state in self.states}
+        knowns = {v.name for v in self.of("input", "parameter")}
+        outputs = {v.name for v in self.of("output")}
+        for state in self.states:
+            if state.name not in outputs or not set(state.initial) <= {v.name for v in self.of("parameter")}:
+                raise ValueError(f"{self.name}: state {state.name} must be an output and its initial values "
+                                 f"must name parameters, got {state.initial}")
+            if state.derivative not in outputs | {v.name for v in self.of("input")}:
+                raise ValueError(f"{self.name}: the derivative of state {state.name} must be an input or output, "
+                                 f"got {state.derivative!r}")
+        for v in self.of("output"):
+            if v.depends_on is None and v.name not in states:
+                raise ValueError(
+                    f"{self.name}: output {v.name} declares no dependencies: give its Variable "
+                    f"depends_on=(...), the inputs, parameters and states (ModelSpec.states) it is computed "
+                    f"from, or () for none (docs/development.md, Add a model)")
+            for names in (v.depends_on or (), v.initial_depends_on or ()):
+                unknown = [name for name in names if name not in knowns | states]
+                if unknown:
+                    raise ValueError(f"{self.name}: output {v.name} depends on {unknown}, which are no "
+                                     f"input, parameter or state of the model")
+
+    def output_dependencies(self, name: str, states: bool = False) -> tuple[str, ...]:
+        """The inputs output ``name`` depends on directly (FMI ``<Outputs>``), and with ``states`` the
+        states (Model Exchange: a state depends on itself), in the spec's order."""
+        declared = set(self[name].depends_on or ()) | {name}
+        known = [v.name for v in self.of("input")] + [s.name for s in self.states if states]
+        return tuple(v.name for v in self.variables if v.name in known and v.name in declared)
+
+    def derivative_dependencies(self, state: State, initial: bool = False) -> tuple[str, ...]:
+        """What ``der(state)`` depends on: its derivative's dependencies, an input depending on itself."""
+        if self[state.derivative].causality == "input":
+            return (state.derivative,)
+        if initial:
+            return self.initial_dependencies(state.derivative)
+        return self.output_dependencies(state.derivative, states=True)
+
+    def initial_dependencies(self, name: str) -> tuple[str, ...]:
+        """The parameters and inputs output ``name`` depends on at initialisation (FMI
+        ``<InitialUnknowns>``), a state's through its initial values, in the spec's order."""
+        variable = self[name]
+        declared = variable.initial_depends_on if variable.initial_depends_on is not None else variable.depends_on
+        names = set(declared or ())
+        for state in self.states:
+            if state.name in names or state.name == name:
+                names |= set(state.initial)
+        return tuple(v.name for v in self.of("parameter", "input") if v.name in names)
 
     def involves_input(self, relation: Relation) -> bool:
         """Whether ``relation`` is checked with the inputs (it involves one) rather than the parameters."""

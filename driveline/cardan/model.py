@@ -20,6 +20,7 @@ class CardanJointModel(DrivenShaftModel):
     """The ``CardanJoint`` co-simulation model (inputs held constant over a step)."""
 
     spec = SPEC
+    dependency_points = ({"phase": 0.3, "phi_in_start": 0.2},)
 
     def reset_internal_state(self) -> None:
         self._omega_sample = 0.0  # omega_in of the last evaluation [rad/s]

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
+from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
+
+JOINT = ("phi_in", "beta", "phase")  # the joint's position
 
 SPEC = ModelSpec(
     name="CardanJoint",
@@ -30,21 +32,25 @@ SPEC = ModelSpec(
         Variable("phi_in", "output", 0.0, "Input shaft angle, integrated from omega_in", "rad", "deg"),
         Variable("phi_out", "output", 0.0,
                  "Output shaft angle: phase + gamma_2 with tan gamma_1 = cos beta tan gamma_2 (C2), unwrapped",
-                 "rad", "deg"),
+                 "rad", "deg", depends_on=JOINT),
         Variable("omega_out", "output", 0.0,
                  "Output shaft speed omega_2 = omega_1 cos beta / (1 - sin^2 beta cos^2 gamma_1) (C3)",
-                 "rad/s", "rpm"),
+                 "rad/s", "rpm", depends_on=(*JOINT, "omega_in")),
         Variable("alpha_in", "output", 0.0,
                  "Input acceleration a_1 used in alpha_out: backward difference of the last two "
-                 "omega_in samples", "rad/s2"),
+                 "omega_in samples", "rad/s2", depends_on=("omega_in",), initial_depends_on=()),
         Variable("alpha_out", "output", 0.0,
-                 "Output shaft acceleration a_2 (C4) with a_1 = alpha_in", "rad/s2"),
+                 "Output shaft acceleration a_2 (C4) with a_1 = alpha_in", "rad/s2",
+                 depends_on=(*JOINT, "omega_in")),
         Variable("T_in", "output", 0.0,
-                 "Input torque from the power balance T_in omega_1 = T_load omega_2", "N.m"),
-        Variable("speed_ratio", "output", 1.0, "Kinematic ratio omega_2 / omega_1 (C3)", "1"),
+                 "Input torque from the power balance T_in omega_1 = T_load omega_2", "N.m",
+                 depends_on=(*JOINT, "T_load")),
+        Variable("speed_ratio", "output", 1.0, "Kinematic ratio omega_2 / omega_1 (C3)", "1", depends_on=JOINT),
         Variable("speed_fluctuation", "output", 0.0,
-                 "Output-speed fluctuation (max - min) / mean = tan beta sin beta at the current beta (C5)", "1"),
+                 "Output-speed fluctuation (max - min) / mean = tan beta sin beta at the current beta (C5)", "1",
+                 depends_on=("beta",)),
     ),
     default_experiment=DefaultExperiment(0.0, 0.12, 1e-4),
     relations=(Relation("beta", "<=", "beta_max"),),
+    states=(State("phi_in", ("phi_in_start",), derivative="omega_in"),),
 )

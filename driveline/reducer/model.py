@@ -17,6 +17,7 @@ class UniversalReducerModel(DrivenShaftModel):
     """The ``UniversalReducer`` co-simulation model (inputs held constant over a step)."""
 
     spec = SPEC
+    dependency_points = ({"phi_in_start": 0.3},)  # the slide s_b is zero at phi_in = 0
 
     def evaluate(self, input_time: float) -> None:
         """Outputs at the current phi_in and inputs."""

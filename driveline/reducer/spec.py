@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
+from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
 
 SINGULAR = "eq 21 is singular at 0 and 180 deg"
 #: Largest stress [Pa] of the connecting shaft an output may report: ten times the tensile strength of
 #: the strongest shaft steels (about 1 GPa). Beyond it no shaft carries the load and the rigid-body
 #: statics of eqs 18-21 describe nothing; near alpha = 180 deg eq 21 gave 3.2e19 Pa with status OK.
 MAX_STRESS = 1e10
+RATIO = ("z1", "z2")
+#: The connecting shaft's bending at C and E (eqs 19, 21): load, intersection angle and geometry
+BENDING = ("T_load", "alpha", *RATIO, "e", "L1")
 
 SPEC = ModelSpec(
     name="UniversalReducer",
@@ -53,27 +56,35 @@ SPEC = ModelSpec(
                  "Load torque M_out acting on the output shaft (eq 18); the start value, input torque 10 N.m, "
                  "passes the strength check (utilisation 0.83)", "N.m"),
         Variable("phi_in", "output", 0.0, "Input shaft angle, integrated from omega_in", "rad", "deg"),
-        Variable("phi_out", "output", 0.0, "Output (centre gear) angle phi_in / i (eq 17)", "rad", "deg"),
-        Variable("omega_out", "output", 0.0, "Output speed omega_1 = omega_H / i (eq 17)", "rad/s", "rpm"),
-        Variable("speed_ratio", "output", 0.0, "Speed ratio omega_1 / omega_H = 1 / i = (z1 - z2) / z1", "1"),
-        Variable("T_in", "output", 0.0, "Input torque M_in = M_out / i (eq 18, lossless)", "N.m"),
+        Variable("phi_out", "output", 0.0, "Output (centre gear) angle phi_in / i (eq 17)", "rad", "deg",
+                 depends_on=("phi_in", *RATIO)),
+        Variable("omega_out", "output", 0.0, "Output speed omega_1 = omega_H / i (eq 17)", "rad/s", "rpm",
+                 depends_on=("omega_in", *RATIO)),
+        Variable("speed_ratio", "output", 0.0, "Speed ratio omega_1 / omega_H = 1 / i = (z1 - z2) / z1", "1",
+                 depends_on=RATIO),
+        Variable("T_in", "output", 0.0, "Input torque M_in = M_out / i (eq 18, lossless)", "N.m",
+                 depends_on=("T_load", *RATIO)),
         Variable("s_b", "output", 0.0,
                  "Slide of the connecting shaft in the cylindrical pair b, e cot(alpha/2) sin phi_in (eq 15)",
-                 "m", "mm"),
-        Variable("M_E", "output", 0.0, "Moment M_E = 2 F_B L1 sin(alpha/2) at E (eq 19)", "N.m"),
-        Variable("M_C1", "output", 0.0, "Torque M_C1 = F_t r2 on the connecting shaft at C (eq 20)", "N.m"),
-        Variable("M_B", "output", 0.0, "Moment M_B at B from the balance eq 21", "N.m"),
-        Variable("M_C", "output", 0.0, "Bending moment M_C at C from the balance eq 21", "N.m"),
+                 "m", "mm", depends_on=("phi_in", "alpha", "e")),
+        Variable("M_E", "output", 0.0, "Moment M_E = 2 F_B L1 sin(alpha/2) at E (eq 19)", "N.m", depends_on=BENDING),
+        Variable("M_C1", "output", 0.0, "Torque M_C1 = F_t r2 on the connecting shaft at C (eq 20)", "N.m",
+                 depends_on=("T_load", *RATIO, "module")),
+        Variable("M_B", "output", 0.0, "Moment M_B at B from the balance eq 21", "N.m",
+                 depends_on=(*BENDING, "module")),
+        Variable("M_C", "output", 0.0, "Bending moment M_C at C from the balance eq 21", "N.m", depends_on=BENDING),
         Variable("sigma_bend", "output", 0.0, "Bending stress of the connecting shaft at C, M_C / W", "Pa", "MPa",
-                 min=-MAX_STRESS, max=MAX_STRESS),
+                 min=-MAX_STRESS, max=MAX_STRESS, depends_on=(*BENDING, "r_shaft")),
         Variable("tau_torsion", "output", 0.0, "Torsional stress of the connecting shaft at C, M_C1 / W_t",
-                 "Pa", "MPa", min=-MAX_STRESS, max=MAX_STRESS),
+                 "Pa", "MPa", min=-MAX_STRESS, max=MAX_STRESS, depends_on=("T_load", *RATIO, "r_shaft")),
         Variable("sigma_eq", "output", 0.0,
                  "Equivalent stress at C, third strength theory sqrt(sigma^2 + 4 tau^2)", "Pa", "MPa",
-                 max=MAX_STRESS),
-        Variable("utilisation", "output", 0.0, "sigma_eq / sigma_allow (at most 1 to pass the seed's check)", "1"),
+                 max=MAX_STRESS, depends_on=(*BENDING, "r_shaft")),
+        Variable("utilisation", "output", 0.0, "sigma_eq / sigma_allow (at most 1 to pass the seed's check)", "1",
+                 depends_on=(*BENDING, "r_shaft", "sigma_allow")),
         Variable("T_in_allow", "output", 0.0,
-                 "Input torque at which sigma_eq reaches sigma_allow at the current alpha", "N.m"),
+                 "Input torque at which sigma_eq reaches sigma_allow at the current alpha", "N.m",
+                 depends_on=(*BENDING[1:], "module", "r_shaft", "sigma_allow")),
     ),
     default_experiment=DefaultExperiment(0.0, 0.5, 1e-3),
     relations=(
@@ -82,4 +93,5 @@ SPEC = ModelSpec(
         Relation("alpha", ">=", "alpha_min", reason=SINGULAR),
         Relation("alpha", "<=", "alpha_max", reason=SINGULAR),
     ),
+    states=(State("phi_in", ("phi_in_start",), derivative="omega_in"),),
 )

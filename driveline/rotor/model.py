@@ -203,6 +203,9 @@ class CriticalSpeedsModel(SteppedModel):
     """The ``CriticalSpeeds`` co-simulation model."""
 
     spec = SPEC
+    # the first forward whirl moves with the table's range (omega_max) by 1e-11 rad/s at 800 rad/s
+    dependency_points = ({"omega": 800.0, "omega_max": 3000.0, "orders": "3", "band": 0.3},
+                         {"layout": "two_piece_propshaft"})
     derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts", "_unbalance")
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))

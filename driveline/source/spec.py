@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Variable
+from ..variables import DefaultExperiment, ModelSpec, State, Variable
 
 RPM = math.pi / 30.0
+SPEED = ("omega_start", "ramp_rate", "sine_amplitude", "sine_frequency")
 
 SPEC = ModelSpec(
     name="SpeedSource",
@@ -21,9 +22,10 @@ SPEC = ModelSpec(
                  "rad/s", "rpm", min=0.0),
         Variable("sine_frequency", "parameter", 5.0, "Frequency of the superposed speed oscillation", "Hz", min=0.0),
         Variable("phi_start", "parameter", 0.0, "Shaft angle at t = 0", "rad", "deg"),
-        Variable("omega", "output", 0.0, "Shaft speed omega(t)", "rad/s", "rpm"),
+        Variable("omega", "output", 0.0, "Shaft speed omega(t)", "rad/s", "rpm", depends_on=SPEED),
         Variable("phi", "output", 0.0, "Shaft angle, the exact integral of omega from t = 0", "rad", "deg"),
-        Variable("alpha", "output", 0.0, "Shaft acceleration d(omega)/dt", "rad/s2"),
+        Variable("alpha", "output", 0.0, "Shaft acceleration d(omega)/dt", "rad/s2", depends_on=SPEED[1:]),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-3),
+    states=(State("phi", ("phi_start", *SPEED), derivative="omega"),),
 )

@@ -30,6 +30,11 @@ class TripodCouplingModel(DrivenShaftModel):
     bend following their rates over the step, outputs at the step's end."""
 
     spec = SPEC
+    dependency_points = (
+        {"kinematics": EXACT, "mu": 0.05, "seed_reactions": 1, "alpha_in": 30.0, "beta_dot": 0.5, "beta_ddot": 3.0,
+         "phi_in_start": 0.4},
+        {"beta_rate": RATES_FROM_SAMPLES, "beta_dot": 0.5, "phi_in_start": 0.4},
+    )
 
     def reset_internal_state(self) -> None:
         self._solution: Solution | None = None  # warm start of the exact solver

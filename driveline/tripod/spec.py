@@ -4,15 +4,23 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
+from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
 
 CLOSED_FORM, EXACT = 0, 1
 RATES_FROM_INPUTS, RATES_FROM_SAMPLES = 0, 1
+# What the outputs are computed from (``depends_on``): the joint's position, the plungers' inertia,
+# the rates of speed and bend, the plungers' forces and the forces with friction
+POSITION = ("phi_in", "beta", "r", "l", "kinematics")
+INERTIA = (*POSITION, "omega_in", "m_plunger", "seed_reactions")
+PLUNGERS = (*POSITION, "omega_in", "m_plunger", "alpha_in", "beta_dot", "beta_ddot", "beta_rate")
+FORCES = (*PLUNGERS, "T_load", "mu", "v_slip")
+FRICTION = tuple(name for name in FORCES if name != "kinematics")  # zero without friction, which needs the exact
 ARM_OUTPUTS = tuple(
-    Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N")
-    for name, text in (
-        ("F_arm", "Force of the ball on tripod arm, in the tripod plane normal to the arm (the seed's F)"),
-        ("F_plunger", "Axial force of the ball joint on its plunger along Z', m times its acceleration"),
+    Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N",
+             depends_on=depends_on)
+    for name, text, depends_on in (
+        ("F_arm", "Force of the ball on tripod arm, in the tripod plane normal to the arm (the seed's F)", FORCES),
+        ("F_plunger", "Axial force of the ball joint on its plunger along Z', m times its acceleration", PLUNGERS),
     )
     for j in (1, 2, 3)
 )
@@ -59,40 +67,50 @@ SPEC = ModelSpec(
         Variable("T_load", "input", 100.0,
                  "Load torque T0 on the output shaft, about its own axis, resisting its rotation (eq 22)", "N.m"),
         Variable("phi_in", "output", 0.0, "Input shaft angle phi_1, integrated from omega_in", "rad", "deg"),
-        Variable("phi_out", "output", 0.0, "Output shaft angle phi_0 (eq 18 or exact kinematics)", "rad", "deg"),
-        Variable("delta_phi", "output", 0.0, "Angular deviation phi_out - phi_in (eq 18)", "rad", "deg"),
+        Variable("phi_out", "output", 0.0, "Output shaft angle phi_0 (eq 18 or exact kinematics)", "rad", "deg",
+                 depends_on=POSITION),
+        Variable("delta_phi", "output", 0.0, "Angular deviation phi_out - phi_in (eq 18)", "rad", "deg",
+                 depends_on=POSITION),
         Variable("omega_out", "output", 0.0, "Output shaft speed, d(phi_out)/dt (consistent derivative of eq 18)",
-                 "rad/s", "rpm"),
+                 "rad/s", "rpm", depends_on=(*POSITION, "omega_in")),
         Variable("omega_spin", "output", 0.0,
                  "Angular velocity of the output shaft about its own axis (T_in omega_in = T0 omega_spin "
-                 "+ dKE/dt); differs from omega_out by the cone's geometric phase", "rad/s", "rpm"),
+                 "+ dKE/dt); differs from omega_out by the cone's geometric phase", "rad/s", "rpm",
+                 depends_on=(*POSITION, "omega_in", "beta_dot", "beta_rate")),
         Variable("T_in", "output", 0.0, "Driving torque on the input shaft about Z', plunger inertia included",
-                 "N.m"),
-        Variable("F_pin", "output", 0.0, "Force F on each tripod arm, eq 24 with corrected eq 21: T0/(3r + 3rho)", "N"),
+                 "N.m", depends_on=FORCES),
+        Variable("F_pin", "output", 0.0, "Force F on each tripod arm, eq 24 with corrected eq 21: T0/(3r + 3rho)", "N",
+                 depends_on=("T_load", "beta", "r")),
         Variable("rho", "output", 0.0, "Orbit radius rho of the tripod centre, r(1 - cos beta)/(2 cos beta)",
-                 "m", "mm"),
-        Variable("theta", "output", 0.0, "Cone angle theta of the output shaft about the bearing centre", "rad", "deg"),
+                 "m", "mm", depends_on=("beta", "r")),
+        Variable("theta", "output", 0.0, "Cone angle theta of the output shaft about the bearing centre", "rad", "deg",
+                 depends_on=POSITION),
         Variable("a_plunger_sum", "output", 0.0, "Sum a1 + a2 + a3 of the plungers' axial accelerations (eq 20)",
-                 "m/s2"),
+                 "m/s2", depends_on=("phi_in", "beta", "r", "kinematics", "omega_in", "seed_reactions")),
         Variable("Rz_out", "output", 0.0,
-                 "Output self-aligning bearing on the output shaft: axial force R_z'' along the shaft (eq 30)", "N"),
+                 "Output self-aligning bearing on the output shaft: axial force R_z'' along the shaft (eq 30)", "N",
+                 depends_on=INERTIA),
         Variable("Rx_out", "output", 0.0,
                  "Output bearing on the output shaft: radial force along E1 (bend-plane side, normal to the shaft)",
-                 "N"),
-        Variable("Ry_out", "output", 0.0, "Output bearing on the output shaft: radial force along E2 = Y' swung", "N"),
-        Variable("Rx_in", "output", 0.0, "Input bearing on the input shaft: force R_x' along X' (eq 33)", "N"),
-        Variable("Ry_in", "output", 0.0, "Input bearing on the input shaft: force R_y' along Y' (eq 34)", "N"),
+                 "N", depends_on=FORCES),
+        Variable("Ry_out", "output", 0.0, "Output bearing on the output shaft: radial force along E2 = Y' swung", "N",
+                 depends_on=FORCES),
+        Variable("Rx_in", "output", 0.0, "Input bearing on the input shaft: force R_x' along X' (eq 33)", "N",
+                 depends_on=INERTIA),
+        Variable("Ry_in", "output", 0.0, "Input bearing on the input shaft: force R_y' along Y' (eq 34)", "N",
+                 depends_on=(*INERTIA, "T_load", "alpha_in")),
         Variable("Mx_in", "output", 0.0, "Input bearing on the input shaft: moment about X' through the joint centre O",
-                 "N.m"),
+                 "N.m", depends_on=FORCES),
         Variable("My_in", "output", 0.0, "Input bearing on the input shaft: moment about Y' through the joint centre O",
-                 "N.m"),
+                 "N.m", depends_on=FORCES),
         Variable("Rz_in", "output", 0.0,
                  "Input bearing on the input shaft: axial force along Z'; the joint's generated axial force "
-                 "on its housing is -Rz_in (friction only)", "N"),
-        Variable("P_friction", "output", 0.0, "Power dissipated by friction in the six sliding pairs", "W"),
+                 "on its housing is -Rz_in (friction only)", "N", depends_on=FRICTION),
+        Variable("P_friction", "output", 0.0, "Power dissipated by friction in the six sliding pairs", "W",
+                 depends_on=FRICTION),
         Variable("efficiency", "output", 1.0,
                  "Instantaneous efficiency T_load omega_spin / (T_load omega_spin + P_friction); 1 without power flow",
-                 "1"),
+                 "1", depends_on=FRICTION),
         *ARM_OUTPUTS,
         # appended after every other variable: value references are positions, so those of
         # the variables above stay what hosts, SSP files and reference results know
@@ -112,4 +130,5 @@ SPEC = ModelSpec(
         Relation("l", ">", "r", reason="the bearing centre lies beyond the grooves"),
         Relation("beta", "<=", "beta_max"),
     ),
+    states=(State("phi_in", ("phi_in_start",), derivative="omega_in"),),
 )

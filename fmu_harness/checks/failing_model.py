@@ -29,7 +29,7 @@ class FailingModel(SteppedModel):
             Variable("failure", "parameter", 0, "0 none, 1 MemoryError, 2 RecursionError, 3 OverflowError, "
                      "4 KeyError", type="Integer", min=0, max=4, variability="tunable"),
             Variable("u", "input", 1.0, "Input copied to y"),
-            Variable("y", "output", 0.0, "Output"),
+            Variable("y", "output", 0.0, "Output", depends_on=("u",)),
         ),
         default_experiment=DefaultExperiment(0.0, 1.0, 1e-3),
     )

@@ -1,14 +1,16 @@
 """Completes the model description that pythonfmu or pythonfmu3 writes, from the model's spec.
 
-The one place where units, display units, ranges, descriptions and the initial
-unknowns are added; the FMI 2.0 build calls :func:`complete_fmi2`, the FMI 3.0 build
-:func:`complete_fmi3`.
+The one place where units, display units, ranges, descriptions and the model structure
+(outputs and initial unknowns with the ``dependencies`` the spec declares) are added; the FMI 2.0
+build calls :func:`complete_fmi2`, the FMI 3.0 build :func:`complete_fmi3`, for the Python and
+the native FMUs alike.
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from driveline.variables import ModelSpec, Unit, Variable
 
@@ -46,51 +48,92 @@ def _complete(
     root: ET.Element,
     spec: ModelSpec,
     variables: list[tuple[ET.Element, ET.Element]],
-    structure: Callable[[ET.Element, list[tuple[int, ET.Element]]], None],
+    structure: Callable[[ET.Element, list[Unknown], list[Unknown]], None],
 ) -> bytes:
     """Add units, descriptions and attributes to ``variables`` (pairs of the variable's element
     and the element that carries unit, min and max, in document order) and rebuild the model
-    structure with ``structure`` from the outputs' 1-based indices and elements."""
+    structure with ``structure`` from the outputs' and state derivatives' 1-based indices,
+    elements and dependencies. A description with a ``<ModelExchange>`` element has the states'
+    derivatives ``der(<state>)`` among its variables (written complete), and its outputs depend
+    on the states too."""
     if spec.units:
         unit_definitions = ET.Element("UnitDefinitions")
         unit_definitions.extend(_unit_element("Unit", unit) for unit in spec.units)
         root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions)
     outputs = []
     references = {element.get("name"): element.get("valueReference") for element, _ in variables}
+    indices = {element.get("name"): index for index, (element, _) in enumerate(variables, start=1)}
     fmi3 = root.get("fmiVersion", "").startswith("3")
+    states = root.find("ModelExchange") is not None
+
+    def known(names: tuple[str, ...]) -> list[tuple[int, str]]:
+        return [(indices[name], references[name]) for name in names]
+
+    derivatives = [Unknown(indices[state.derivative_name], variables[indices[state.derivative_name] - 1][0],
+                           known(spec.derivative_dependencies(state)),
+                           known(spec.derivative_dependencies(state, initial=True)))
+                   for state in spec.states if states]
     for index, (element, typed) in enumerate(variables, start=1):
+        if element.get("name") not in {v.name for v in spec.variables}:
+            continue
         variable = spec[element.get("name")]
         element.set("description", variable.description)
         typed.attrib.update(_type_attributes(variable))
         if fmi3 and variable.derivative is not None:  # FMI 3.0: an input's derivative is an input too
             element.set("derivative", references[variable.derivative])
         if variable.causality == "output":
-            outputs.append((index, element))
+            outputs.append(Unknown(index, element, known(spec.output_dependencies(variable.name, states)),
+                                   known(spec.initial_dependencies(variable.name))))
     model_structure = root.find("ModelStructure")
     for child in list(model_structure):
         model_structure.remove(child)
-    structure(model_structure, outputs)
+    structure(model_structure, outputs, derivatives)
     ET.indent(root)
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def _fmi2_structure(model_structure: ET.Element, outputs: list[tuple[int, ET.Element]]) -> None:
-    if outputs:
-        for tag in ("Outputs", "InitialUnknowns"):
-            unknowns = ET.SubElement(model_structure, tag)
-            unknowns.extend(ET.Element("Unknown", index=str(index)) for index, _ in outputs)
+@dataclass(frozen=True)
+class Unknown:
+    """An output or a state derivative: its 1-based index, its element, and the (index, value
+    reference) of each variable it depends on in step or continuous-time mode (inputs, states) and
+    at initialisation (parameters and inputs)."""
+
+    index: int
+    element: ET.Element
+    step: list[tuple[int, str]]
+    initial: list[tuple[int, str]]
 
 
-def _fmi3_structure(model_structure: ET.Element, outputs: list[tuple[int, ET.Element]]) -> None:
-    for tag in ("Output", "InitialUnknown"):
-        model_structure.extend(ET.Element(tag, valueReference=output.get("valueReference")) for _, output in outputs)
+def _dependencies(known: list[str]) -> dict[str, str]:
+    """``dependencies`` and ``dependenciesKind``: nonlinear ("dependent") on every known listed."""
+    return {"dependencies": " ".join(known), "dependenciesKind": " ".join(["dependent"] * len(known))}
+
+
+def _fmi2_structure(model_structure: ET.Element, outputs: list[Unknown], derivatives: list[Unknown]) -> None:
+    for tag, unknowns, initial in (("Outputs", outputs, False), ("Derivatives", derivatives, False),
+                                   ("InitialUnknowns", outputs + derivatives, True)):
+        if unknowns:
+            ET.SubElement(model_structure, tag).extend(
+                ET.Element("Unknown", index=str(unknown.index),
+                           **_dependencies([str(index) for index, _ in (unknown.initial if initial else unknown.step)]))
+                for unknown in unknowns)
+
+
+def _fmi3_structure(model_structure: ET.Element, outputs: list[Unknown], derivatives: list[Unknown]) -> None:
+    for tag, unknowns, initial in (("Output", outputs, False), ("ContinuousStateDerivative", derivatives, False),
+                                   ("InitialUnknown", outputs + derivatives, True)):
+        model_structure.extend(
+            ET.Element(tag, valueReference=unknown.element.get("valueReference"),
+                       **_dependencies([reference for _, reference in (unknown.initial if initial else unknown.step)]))
+            for unknown in unknowns)
 
 
 def complete_fmi2(xml: bytes, spec: ModelSpec) -> bytes:
     """Return pythonfmu's FMI 2.0 model description with the spec's details added."""
     root = ET.fromstring(xml)
     scalars = root.find("ModelVariables").findall("ScalarVariable")
-    variables = [(scalar, scalar.find(spec[scalar.get("name")].type)) for scalar in scalars]
+    variables = [(scalar, scalar.find("Real") if scalar.get("name").startswith("der(") else
+                  scalar.find(spec[scalar.get("name")].type)) for scalar in scalars]
     return _complete(root, spec, variables, _fmi2_structure)
 
 

@@ -11,7 +11,7 @@ from driveline.catalog import MODELS
 from driveline.model import SteppedModel
 from driveline.rotor.model import CriticalSpeedsModel
 from driveline.tripod.model import TripodCouplingModel
-from driveline.variables import DefaultExperiment, ModelSpec, Relation, Variable
+from driveline.variables import DefaultExperiment, ModelSpec, Relation, State, Variable
 from fmu_harness.doc_pages.variable_table import markdown
 
 
@@ -24,7 +24,7 @@ def spec_with(*relations: Relation) -> ModelSpec:
             Variable("limit", "parameter", 2.0, "an inclusive bound", "m", min=0.0),
             Variable("count", "parameter", 3, "an integer", type="Integer"),
             Variable("x", "input", 1.0, "an input", "m"),
-            Variable("y", "output", 0.0, "an output", "m"),
+            Variable("y", "output", 0.0, "an output", "m", depends_on=("x",)),
         ),
         DefaultExperiment(0.0, 1.0, 0.1),
         relations,
@@ -105,6 +105,36 @@ def test_relations_wait_for_the_bounds():
 def test_a_spec_refuses_relations_it_cannot_enforce(relation, fragment):
     with pytest.raises(ValueError, match=fragment):
         spec_with(relation)
+
+
+@pytest.mark.parametrize(
+    ("output", "states", "fragment"),
+    [
+        (Variable("y", "output", 0.0, "undeclared"), (), r"output y declares no dependencies: give its Variable "
+                                                        r"depends_on=\(...\).*docs/development.md, Add a model"),
+        (Variable("y", "output", 0.0, "declared", depends_on=("nowhere",)), (), "no input, parameter or state"),
+        (Variable("y", "output", 0.0, "a state"), (State("y", ("x",), "x"),), "initial values must name parameters"),
+        (Variable("y", "output", 0.0, "at start", depends_on=(), initial_depends_on=("y",)), (), "no input"),
+    ],
+)
+def test_a_spec_refuses_outputs_without_a_correct_dependency_declaration(output, states, fragment):
+    variables = (Variable("x", "input", 1.0, "an input"), Variable("p", "parameter", 1.0, "a parameter"), output)
+    with pytest.raises(ValueError, match=fragment):
+        ModelSpec("Probe", "an output and what it depends on", variables, DefaultExperiment(0.0, 1.0, 0.1),
+                  states=states)
+
+
+def test_the_dependencies_at_initialisation_follow_a_state_to_its_initial_values():
+    variables = (Variable("x", "input", 1.0, "an input"), Variable("p", "parameter", 1.0, "a parameter"),
+                 Variable("x0", "parameter", 0.0, "the state's initial value"),
+                 Variable("s", "output", 0.0, "a state"),
+                 Variable("y", "output", 0.0, "from the state and the input", depends_on=("s", "x")),
+                 Variable("z", "output", 0.0, "from p alone, zero at the start", depends_on=("p",),
+                          initial_depends_on=()))
+    spec = ModelSpec("Probe", "a state and two outputs", variables, DefaultExperiment(0.0, 1.0, 0.1),
+                     states=(State("s", ("x0",), "x"),))
+    assert [spec.output_dependencies(name) for name in ("s", "y", "z")] == [(), ("x",), ()]
+    assert [spec.initial_dependencies(name) for name in ("s", "y", "z")] == [("x0",), ("x", "x0"), ()]
 
 
 def test_an_exclusive_bound_needs_its_value():
