@@ -6,7 +6,8 @@ that page's ``interop`` section (:mod:`fmu_harness.doc_pages.sections`). The nat
 under ``models/native/`` (:mod:`fmu_harness.packaging.native`).
 
 Importers: ``fmpy validate``, ``fmutool -input X.fmu -check`` (FMU Manipulation Toolbox),
-and two co-simulation engines, libcosimpy and ecospy, that run the model's standard scenario
+fmpy's Model Exchange (:func:`_fmpy_model_exchange`), and two co-simulation engines, libcosimpy
+and ecospy, that run the model's standard scenario
 (:mod:`fmu_harness.runs.scenario`): a run passes if every compared output stays within
 :data:`TOLERANCE` times the output's largest magnitude of the fmpy run of the model's Python FMU
 (same FMI version) at t_1 ... t_N, for a native FMU too: the equivalence a host relies on when
@@ -29,7 +30,7 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from fmpy import read_model_description
+from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
@@ -41,6 +42,11 @@ from ..runs.scenario import scenario, standard_run
 from . import importers
 
 TOLERANCE = 1e-9
+#: Model Exchange against co-simulation: CVODE's relative tolerance, and the largest relative deviation
+#: passed (its global error: the source's phase, the one state that is no straight line, stays below 1e-7)
+MODEL_EXCHANGE_TOLERANCE, MODEL_EXCHANGE_PASS = 1e-8, 1e-6
+PYTHON_CO_SIMULATION_ONLY = ("co-simulation only: pythonfmu 0.7 (FMI 2.0) has no Model Exchange; the FMI 3.0 "
+                             "adapter does not use pythonfmu3's")
 RESULT = "interop result: "
 Status = Literal["pass", "fail", "unsupported", "unavailable"]
 Family = Literal["Python", "native"]
@@ -90,6 +96,25 @@ def _fmutool_check(fmu: Path) -> Outcome:
     return Outcome("pass")
 
 
+def _fmpy_model_exchange(fmu: Path) -> Outcome:
+    """The default experiment through fmpy in Model Exchange (CVODE) against its co-simulation run of
+    the same FMU, at the co-simulation's output points."""
+    description = read_model_description(str(fmu))
+    if description.modelExchange is None:
+        return Outcome("unsupported", PYTHON_CO_SIMULATION_ONLY)
+    step = MODELS[description.modelName].spec.default_experiment.step_size
+    runs = [simulate_fmu(str(fmu), fmi_type=interface, step_size=step, output_interval=10 * step,
+                         relative_tolerance=MODEL_EXCHANGE_TOLERANCE)
+            for interface in ("CoSimulation", "ModelExchange")]
+    outputs = [v.name for v in MODELS[description.modelName].spec.of("output") if v.type == "Real"]
+    deviation = max(float(np.abs(runs[1][n] - runs[0][n]).max() / (np.abs(runs[0][n]).max() or 1.0))
+                    for n in outputs)
+    if deviation <= MODEL_EXCHANGE_PASS:
+        return Outcome("pass", deviation=deviation)
+    return Outcome("fail", f"largest relative deviation from co-simulation {deviation:.3g} > {MODEL_EXCHANGE_PASS:g}",
+                   deviation)
+
+
 def _engine(name: str) -> Callable[[Path, Path], Outcome]:
     """Run the scenario in engine ``name`` in a subprocess (see :func:`simulate_in`)."""
 
@@ -111,6 +136,7 @@ def _engine(name: str) -> Callable[[Path, Path], Outcome]:
 IMPORTERS = (
     Importer("fmpy validate", "fmpy", ("2.0", "3.0"), lambda fmu, reference: _fmpy_validate(fmu)),
     Importer("fmutool -check", "fmu_manipulation_toolbox", ("2.0", "3.0"), lambda fmu, reference: _fmutool_check(fmu)),
+    Importer("fmpy Model Exchange", "fmpy", ("2.0", "3.0"), lambda fmu, reference: _fmpy_model_exchange(fmu)),
     Importer("libcosimpy", "libcosimpy", ("2.0",), _engine("libcosimpy"),
              "libcosim loads FMI 1.0 and 2.0 only: it logs 'Unsupported FMI version' and libcosimpy "
              "0.0.6 then crashes the host (segmentation fault)"),

@@ -50,7 +50,7 @@ from .native_constants import constants_header
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
 MODEL_SOURCES = NATIVE_SRC
 SHARED_SOURCES = ("fmu_instance.h", "fmu_layer.h", "fmu_instance.c", "fmu_checks.c", "fmu_values.c", "fmu_state.c",
-                  "python_numbers.h", "python_numbers.c")
+                  "fmu_model_exchange.c", "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
@@ -288,6 +288,8 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 /* driveline.model.TIME_TOLERANCE: how far, relative to the time reached, a step may start before it */
 #define MODEL_TIME_TOLERANCE {_c_double(TIME_TOLERANCE)}
 #define MODEL_INPUT_DERIVATIVE_COUNT {len(derivatives)}
+/* Model Exchange: continuous states (ModelSpec.states) */
+#define MODEL_STATE_COUNT {len(spec.states)}
 {constants}
 /* the FMU's token (FMI 2.0 GUID, FMI 3.0 instantiation token): the FMI version's, in model_variables.c */
 extern const char model_token[];
@@ -332,6 +334,14 @@ const ExtraMessage model_extra_messages[MODEL_EXTRA_MESSAGE_COUNT] = {{
 const int model_part_values[PARTS][PART_MOST_VALUES + 1] = {{
 {lists}
 }};
+"""
+    if spec.states:
+        states = ", ".join(f"V_{state.name}" for state in spec.states)
+        sources = ", ".join(f"V_{state.derivative}" for state in spec.states)
+        source += f"""
+/* the continuous states and the variables that are their time derivatives */
+const int model_states[MODEL_STATE_COUNT] = {{{states}}};
+const int model_state_derivatives[MODEL_STATE_COUNT] = {{{sources}}};
 """
     if derivatives:
         table = "\n".join(f"    {{V_{of}, {order}, V_{target}}}," for of, order, target in derivatives)
@@ -378,6 +388,12 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
         "generationTool": "driveline-fmus native build", "variableNamingConvention": "structured",
     })
     state = "State" if fmi3 else "state"
+    ET.SubElement(root, "ModelExchange", {  # the same binary: one model identifier for both interfaces
+        "modelIdentifier": spec.name, "needsExecutionTool": "false", "canBeInstantiatedOnlyOncePerProcess": "false",
+        f"canGetAndSetFMU{state}": "true", f"canSerializeFMU{state}": "true",
+        **({"needsCompletedIntegratorStep": "false"} if fmi3 else
+           {"completedIntegratorStepNotNeeded": "true", "canNotUseMemoryManagementFunctions": "true"}),
+    })
     cosimulation = ET.SubElement(root, "CoSimulation", {
         "modelIdentifier": spec.name, "needsExecutionTool": "false", "canHandleVariableCommunicationStepSize": "true",
         "canBeInstantiatedOnlyOncePerProcess": "false", f"canGetAndSetFMU{state}": "true",
@@ -386,8 +402,9 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
                              "canNotUseMemoryManagementFunctions": "true"}),
     })
     if not fmi3:
-        files = ET.SubElement(cosimulation, "SourceFiles")
-        files.extend(ET.Element("File", name=name) for name in sources)
+        for interface in root.iter():
+            if interface.tag in ("ModelExchange", "CoSimulation"):
+                ET.SubElement(interface, "SourceFiles").extend(ET.Element("File", name=name) for name in sources)
     categories = ET.SubElement(root, "LogCategories")
     for status in LOG_CATEGORIES:
         ET.SubElement(categories, "Category", name=f"logStatus{status}",
@@ -414,8 +431,23 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
     if fmi3:
         ET.SubElement(variables, "Float64", name="time", valueReference=str(len(spec.variables)),
                       causality="independent", variability="continuous", description="Simulation time")
+    for k, state in enumerate(spec.states):
+        source = spec[state.derivative]
+        attributes = {"name": state.derivative_name, "valueReference": str(derivative_reference(spec, fmi, k)),
+                      "causality": "local", "variability": "continuous",
+                      "description": f"Time derivative of the continuous state {state.name}: {state.derivative}"}
+        typed = {"unit": source.unit, "derivative": str(spec.variables.index(spec[state.name]) + (0 if fmi3 else 1))}
+        if fmi3:
+            ET.SubElement(variables, "Float64", {**attributes, **typed})
+        else:
+            ET.SubElement(ET.SubElement(variables, "ScalarVariable", attributes), "Real", typed)
     ET.SubElement(root, "ModelStructure")
     return root
+
+
+def derivative_reference(spec: ModelSpec, fmi: str, k: int) -> int:
+    """Value reference of ``der(<state k>)``: after the spec's variables (FMI 3.0: and ``time``)."""
+    return len(spec.variables) + (1 if fmi == "3" else 0) + k
 
 
 def model_description(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> bytes:

@@ -47,4 +47,5 @@ static Failure evaluate(ModelData *data, double input_time)
 
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance};
+const ModelHooks model_hooks = {
+    .reset_internal = reset_internal, .start = start, .advance = advance, .evaluate = evaluate};

@@ -788,5 +788,11 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
     return evaluate(data);
 }
 
-const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors,
-                                .free_derived = free_analysis};
+/* The outputs at any time: the analysis looked up at |omega| (Model Exchange; no state). */
+static Failure evaluate_now(ModelData *data, double time UNUSED)
+{
+    return evaluate(data);
+}
+
+const ModelHooks model_hooks = {.start = start, .advance = advance, .evaluate = evaluate_now,
+                                .extra_parameter_errors = extra_parameter_errors, .free_derived = free_analysis};

@@ -1,4 +1,5 @@
-/* FMI 2.0 co-simulation entry points over the shared core (fmu_instance.c).
+/* FMI 2.0 co-simulation and Model Exchange entry points over the shared core (fmu_instance.c,
+ * fmu_model_exchange.c).
  *
  * Calls out of sequence, unknown value references, wrong types and bad FMU states return
  * fmi2Error with a logged reason (the instance then accepts only get, reset, free and set FMU
@@ -48,10 +49,11 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     void *environment = functions != NULL ? functions->componentEnvironment : NULL;
     char *resources;
     Instance *instance;
-    if (fmuType != fmi2CoSimulation) {
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
         if (logger != NULL) {
             ((fmi2CallbackLogger)logger)(environment, instanceName ? instanceName : "", fmi2Error, "logStatusError",
-                                         "%s", "fmi2Instantiate: this FMU offers co-simulation only");
+                                         "%s", "fmi2Instantiate: fmuType is neither fmi2ModelExchange nor "
+                                         "fmi2CoSimulation");
         }
         return NULL;
     }
@@ -59,6 +61,9 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     resources = resource_folder_of_uri(fmuResourceLocation);
     instance = instance_new(instanceName, fmuGUID, "fmi2", emit, logger, environment, resources);
     free(resources);
+    if (instance != NULL) {
+        instance->model_exchange = fmuType == fmi2ModelExchange;
+    }
     return instance;
 }
 
@@ -144,11 +149,66 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint UNUSED)
 {
     INSTANCE(c, fmi2Error)
-    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "DoStep")) {
+    if (!instance_is(instance, 0, "DoStep") || !instance_allows(instance, MODE_BIT(MODE_STEP), "DoStep")) {
         return fmi2Error;
     }
     return (fmi2Status)instance_do_step(instance, currentCommunicationPoint, communicationStepSize);
 }
+
+/* ---- Model Exchange --------------------------------------------------------------------- */
+
+fmi2Status fmi2EnterEventMode(fmi2Component c)
+ON_INSTANCE(fmi2, model_exchange_enter_mode(instance, "EnterEventMode", 1))
+
+/* No events: nothing to update, no next event. */
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo)
+{
+    INSTANCE(c, fmi2Error)
+    if (!model_exchange_call(instance, "NewDiscreteStates", eventInfo != NULL)) {
+        return fmi2Error;
+    }
+    eventInfo->newDiscreteStatesNeeded = fmi2False;
+    eventInfo->terminateSimulation = fmi2False;
+    eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
+    eventInfo->valuesOfContinuousStatesChanged = fmi2False;
+    eventInfo->nextEventTimeDefined = fmi2False;
+    eventInfo->nextEventTime = 0.0;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c)
+ON_INSTANCE(fmi2, model_exchange_enter_mode(instance, "EnterContinuousTimeMode", 0))
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint UNUSED,
+                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation)
+{
+    INSTANCE(c, fmi2Error)
+    if (!model_exchange_call(instance, "CompletedIntegratorStep",
+                             enterEventMode != NULL && terminateSimulation != NULL)) {
+        return fmi2Error;
+    }
+    *enterEventMode = fmi2False;
+    *terminateSimulation = fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time)
+ON_INSTANCE(fmi2, model_exchange_set_time(instance, "SetTime", time))
+
+fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx)
+ON_INSTANCE(fmi2, model_exchange_set_states(instance, "SetContinuousStates", x, nx))
+
+fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx)
+ON_INSTANCE(fmi2, model_exchange_get_derivatives(instance, "GetDerivatives", derivatives, nx))
+
+fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[] UNUSED, size_t ni)
+ON_INSTANCE(fmi2, model_exchange_get_event_indicators(instance, "GetEventIndicators", ni))
+
+fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx)
+ON_INSTANCE(fmi2, model_exchange_get_states(instance, "GetContinuousStates", x, nx))
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx)
+ON_INSTANCE(fmi2, model_exchange_get_nominals(instance, "GetNominalsOfContinuousStates", x_nominal, nx))
 
 fmi2Status fmi2CancelStep(fmi2Component c)
 ON_INSTANCE(fmi2, instance_unsupported(instance, "CancelStep"))

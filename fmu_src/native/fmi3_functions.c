@@ -1,13 +1,13 @@
-/* FMI 3.0 co-simulation entry points over the shared core (fmu_instance.c).
+/* FMI 3.0 co-simulation and Model Exchange entry points over the shared core (fmu_instance.c).
  *
  * The model is initialised at the startTime given to fmi3EnterInitializationMode. Misuse returns
  * fmi3Error with a logged reason (the instance then accepts only get, reset, free and set FMU
  * state); a refused step returns fmi3Discard with the model unchanged, lastSuccessfulTime =
  * currentCommunicationPoint and terminateSimulation true (the same step would be refused again, so
  * the importer stops; one that corrects its inputs may step again). The independent variable ``time``
- * has the value reference after the spec's variables. Functions of the model exchange and
- * scheduled execution interfaces, clocks, event mode and derivatives are exported, as the
- * standard requires, and return fmi3Error (instantiation: NULL).
+ * has the value reference after the spec's variables. Model Exchange: fmu_model_exchange.c. Functions of
+ * the scheduled execution interface, clocks and derivatives are exported, as the standard requires, and
+ * return fmi3Error (instantiation: NULL).
  */
 #include <stddef.h>
 
@@ -42,17 +42,18 @@ fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean loggingOn UNUSED, siz
                                const fmi3String categories[])
 ON_INSTANCE(fmi3, instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories))
 
-fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName UNUSED, fmi3String instantiationToken UNUSED,
-                                          fmi3String resourcePath UNUSED, fmi3Boolean visible UNUSED,
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
+                                          fmi3String resourcePath, fmi3Boolean visible UNUSED,
                                           fmi3Boolean loggingOn UNUSED,
                                           fmi3InstanceEnvironment instanceEnvironment,
                                           fmi3LogMessageCallback logMessage)
 {
-    if (logMessage != NULL) {
-        logMessage(instanceEnvironment, fmi3Error, "logStatusError",
-                   "fmi3InstantiateModelExchange: this FMU offers co-simulation only");
+    Instance *instance = instance_new(instanceName, instantiationToken, "fmi3", emit, (void (*)(void))logMessage,
+                                      instanceEnvironment, resourcePath);
+    if (instance != NULL) {
+        instance->model_exchange = 1;
     }
-    return NULL;
+    return instance;
 }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
@@ -110,7 +111,7 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance c)
 ON_INSTANCE(fmi3, instance_exit_initialization(instance))
 
 fmi3Status fmi3EnterEventMode(fmi3Instance c)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterEventMode"))
+ON_INSTANCE(fmi3, model_exchange_enter_mode(instance, "EnterEventMode", 1))
 
 fmi3Status fmi3Terminate(fmi3Instance c)
 ON_INSTANCE(fmi3, instance_terminate(instance))
@@ -205,7 +206,7 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
 {
     Status status;
     INSTANCE(c, fmi3Error)
-    if (!instance_allows(instance, MODE_BIT(MODE_STEP), "DoStep")) {
+    if (!instance_is(instance, 0, "DoStep") || !instance_allows(instance, MODE_BIT(MODE_STEP), "DoStep")) {
         return fmi3Error;
     }
     if (eventHandlingNeeded == NULL || terminateSimulation == NULL || earlyReturn == NULL ||
@@ -293,49 +294,80 @@ ON_INSTANCE(fmi3, instance_unsupported(instance, "SetShiftFraction"))
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance c)
 ON_INSTANCE(fmi3, instance_unsupported(instance, "EvaluateDiscreteStates"))
 
-fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesNeedUpdate UNUSED,
-                                    fmi3Boolean *terminateSimulation UNUSED,
-                                    fmi3Boolean *nominalsOfContinuousStatesChanged UNUSED,
-                                    fmi3Boolean *valuesOfContinuousStatesChanged UNUSED,
-                                    fmi3Boolean *nextEventTimeDefined UNUSED,
-                                    fmi3Float64 *nextEventTime UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "UpdateDiscreteStates"))
+/* No events: nothing to update, no next event. */
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesNeedUpdate,
+                                    fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
+                                    fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
+                                    fmi3Float64 *nextEventTime)
+{
+    INSTANCE(c, fmi3Error)
+    if (!model_exchange_call(instance, "UpdateDiscreteStates",
+                             discreteStatesNeedUpdate != NULL && terminateSimulation != NULL &&
+                                 nominalsOfContinuousStatesChanged != NULL && valuesOfContinuousStatesChanged != NULL &&
+                                 nextEventTimeDefined != NULL && nextEventTime != NULL)) {
+        return fmi3Error;
+    }
+    *discreteStatesNeedUpdate = fmi3False;
+    *terminateSimulation = fmi3False;
+    *nominalsOfContinuousStatesChanged = fmi3False;
+    *valuesOfContinuousStatesChanged = fmi3False;
+    *nextEventTimeDefined = fmi3False;
+    *nextEventTime = 0.0;
+    return fmi3OK;
+}
 
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterContinuousTimeMode"))
+ON_INSTANCE(fmi3, model_exchange_enter_mode(instance, "EnterContinuousTimeMode", 0))
 
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUStatePriorToCurrentPoint UNUSED,
-                                       fmi3Boolean *enterEventMode UNUSED, fmi3Boolean *terminateSimulation UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "CompletedIntegratorStep"))
+                                       fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation)
+{
+    INSTANCE(c, fmi3Error)
+    if (!model_exchange_call(instance, "CompletedIntegratorStep",
+                             enterEventMode != NULL && terminateSimulation != NULL)) {
+        return fmi3Error;
+    }
+    *enterEventMode = fmi3False;
+    *terminateSimulation = fmi3False;
+    return fmi3OK;
+}
 
-fmi3Status fmi3SetTime(fmi3Instance c, fmi3Float64 time UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "SetTime"))
+fmi3Status fmi3SetTime(fmi3Instance c, fmi3Float64 time)
+ON_INSTANCE(fmi3, model_exchange_set_time(instance, "SetTime", time))
 
-fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 continuousStates[] UNUSED,
-                                   size_t nContinuousStates UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "SetContinuousStates"))
+fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 continuousStates[], size_t nContinuousStates)
+ON_INSTANCE(fmi3, model_exchange_set_states(instance, "SetContinuousStates", continuousStates, nContinuousStates))
 
-fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance c, fmi3Float64 derivatives[] UNUSED,
-                                             size_t nContinuousStates UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetContinuousStateDerivatives"))
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance c, fmi3Float64 derivatives[], size_t nContinuousStates)
+ON_INSTANCE(fmi3, model_exchange_get_derivatives(instance, "GetContinuousStateDerivatives", derivatives,
+                                                 nContinuousStates))
 
-fmi3Status fmi3GetEventIndicators(fmi3Instance c, fmi3Float64 eventIndicators[] UNUSED,
-                                  size_t nEventIndicators UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetEventIndicators"))
+fmi3Status fmi3GetEventIndicators(fmi3Instance c, fmi3Float64 eventIndicators[] UNUSED, size_t nEventIndicators)
+ON_INSTANCE(fmi3, model_exchange_get_event_indicators(instance, "GetEventIndicators", nEventIndicators))
 
-fmi3Status fmi3GetContinuousStates(fmi3Instance c, fmi3Float64 continuousStates[] UNUSED,
-                                   size_t nContinuousStates UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetContinuousStates"))
+fmi3Status fmi3GetContinuousStates(fmi3Instance c, fmi3Float64 continuousStates[], size_t nContinuousStates)
+ON_INSTANCE(fmi3, model_exchange_get_states(instance, "GetContinuousStates", continuousStates, nContinuousStates))
 
-fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance c, fmi3Float64 nominals[] UNUSED,
-                                             size_t nContinuousStates UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetNominalsOfContinuousStates"))
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance c, fmi3Float64 nominals[], size_t nContinuousStates)
+ON_INSTANCE(fmi3, model_exchange_get_nominals(instance, "GetNominalsOfContinuousStates", nominals, nContinuousStates))
 
-fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance c, size_t *nEventIndicators UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetNumberOfEventIndicators"))
+static fmi3Status count(Instance *instance, const char *function, size_t *number, size_t value)
+{
+    if (!instance_is(instance, 1, function)) {
+        return fmi3Error;
+    }
+    if (number == NULL) {
+        return (fmi3Status)instance_fail(instance, "fmi3", function, ": null output argument", (const char *)NULL);
+    }
+    *number = value;
+    return fmi3OK;
+}
 
-fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance c, size_t *nContinuousStates UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetNumberOfContinuousStates"))
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance c, size_t *nEventIndicators)
+ON_INSTANCE(fmi3, count(instance, "GetNumberOfEventIndicators", nEventIndicators, 0))
+
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance c, size_t *nContinuousStates)
+ON_INSTANCE(fmi3, count(instance, "GetNumberOfContinuousStates", nContinuousStates, MODEL_STATE_COUNT))
 
 fmi3Status fmi3EnterStepMode(fmi3Instance c)
 ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterStepMode"))

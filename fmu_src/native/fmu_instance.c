@@ -252,6 +252,8 @@ Status instance_exit_initialization(Instance *instance)
     initialize(instance, instance->start_time);
     instance_log_messages(instance, STATUS_ERROR); /* inputs the host may still correct: logged, and OK */
     instance->mode = MODE_STEP;
+    instance->event_mode = instance->model_exchange;
+    instance->stale = instance->messages.count > 0;
     return STATUS_OK;
 }
 
@@ -282,7 +284,12 @@ Status instance_do_step(Instance *instance, double current_time, double step_siz
     instance->messages.count = 0;
     step(instance, current_time, step_size);
     instance->terminated = instance->messages.count > 0;
-    if (instance->terminated) { /* the same call would be refused again: its reasons are logged once */
+    return instance_refusal(instance);
+}
+
+Status instance_refusal(Instance *instance)
+{
+    if (instance->messages.count) { /* the same call would be refused again: its reasons are logged once */
         if (strcmp(instance->refusal, instance->messages.text[0]) != 0) {
             instance_log_messages(instance, STATUS_ERROR);
             strcpy(instance->refusal, instance->messages.text[0]);

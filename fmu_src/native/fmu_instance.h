@@ -88,6 +88,11 @@ typedef struct {
 } InputDerivative;
 
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
+#if MODEL_STATE_COUNT > 0
+/* Model Exchange: the continuous states and the variables their time derivatives are */
+extern const int model_states[MODEL_STATE_COUNT];
+extern const int model_state_derivatives[MODEL_STATE_COUNT];
+#endif
 #if MODEL_INPUT_DERIVATIVE_COUNT > 0
 extern const InputDerivative model_input_derivatives[MODEL_INPUT_DERIVATIVE_COUNT];
 #endif
@@ -150,6 +155,9 @@ struct Instance {
     ModelCache cache;
     char *resources; /* owned; cache.resources points at it */
     char refusal[FMU_MESSAGE_SIZE]; /* the first reason of the last refusal or misuse: a repeat is not logged */
+    int model_exchange; /* instantiated for Model Exchange (fmu_model_exchange.c) */
+    int event_mode;     /* Model Exchange after initialisation: event mode, else continuous-time mode */
+    int stale;          /* Model Exchange: a time, state or input was set since the outputs were evaluated */
 };
 
 /* A failure of a model's physics: its kind (ERROR_NONE: none) and Python's message of it
@@ -166,7 +174,9 @@ typedef struct {
 /* ---- what a model file defines (see driveline/<model>/model.py) -------------------------
  * The physics returns NO_FAILURE, or the arithmetic failure Python raises. A model whose outputs
  * are functions of time alone gives ``at_time`` (start: at the start time, step: at its end); the
- * others give ``start`` and ``advance``.
+ * others give ``start`` and ``advance``. ``evaluate`` gives the outputs at ``time`` from the current
+ * states, inputs and parameters, for Model Exchange (the states are the solver's: what it writes into
+ * them is replaced; the internal state was reset before).
  * A NULL ``reset_internal`` or ``extra_*_errors`` means none. A model with derived data builds it
  * in ``extra_parameter_errors`` (run before every initialisation and step, once the declared
  * checks pass) into ``data->cache->derived``, keyed by the parameters it was built for, and gives
@@ -176,6 +186,7 @@ typedef struct {
     Failure (*at_time)(ModelData *data, double time);
     Failure (*start)(ModelData *data, double start_time);
     Failure (*advance)(ModelData *data, double current_time, double step_size);
+    Failure (*evaluate)(ModelData *data, double time);
     void (*extra_parameter_errors)(const ModelData *data, Messages *out);
     void (*extra_input_errors)(const ModelData *data, Messages *out);
     void (*free_derived)(void *derived);
@@ -220,6 +231,9 @@ int instance_allows(Instance *instance, unsigned allowed, const char *function);
 Status instance_exit_initialization(Instance *instance);
 Status instance_terminate(Instance *instance);
 Status instance_do_step(Instance *instance, double current_time, double step_size);
+/* Discard with the instance's messages logged (once while they stay the same) if there are any;
+ * else OK, the last refusal forgotten. */
+Status instance_refusal(Instance *instance);
 Status instance_set_real(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                          const double value[]);
 Status instance_set_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n,
@@ -269,6 +283,24 @@ Status instance_unsupported(Instance *instance, const char *function);
         INSTANCE(c, version##Error)                                                                             \
         return (version##Status)(expression);                                                                  \
     }
+
+/* ---- Model Exchange (fmu_model_exchange.c) -------------------------------------------- */
+/* The outputs at the current time, states and inputs if one of them changed (OK otherwise, and for a
+ * co-simulation instance); Discard with the reasons logged if the values are refused. */
+Status model_exchange_update(Instance *instance);
+Status model_exchange_set_time(Instance *instance, const char *function, double time);
+Status model_exchange_set_states(Instance *instance, const char *function, const double x[], size_t n);
+Status model_exchange_get_states(Instance *instance, const char *function, double x[], size_t n);
+Status model_exchange_get_derivatives(Instance *instance, const char *function, double dx[], size_t n);
+Status model_exchange_get_nominals(Instance *instance, const char *function, double nominals[], size_t n);
+Status model_exchange_get_event_indicators(Instance *instance, const char *function, size_t n);
+/* Enters event mode (``event`` 1) or continuous-time mode (0). */
+Status model_exchange_enter_mode(Instance *instance, const char *function, int event);
+/* 1 when ``function``, of Model Exchange after initialisation, may run now with its output
+ * arguments (``outputs_given``: none is NULL); else Error with the reason logged. */
+int model_exchange_call(Instance *instance, const char *function, int outputs_given);
+/* Error unless the instance is one of the interface's (``model_exchange`` 1: Model Exchange). */
+int instance_is(Instance *instance, int model_exchange, const char *function);
 
 /* ---- FMU state ------------------------------------------------------------------------ */
 typedef struct StoredState StoredState;

@@ -109,6 +109,7 @@ Status state_set(Instance *instance, const char *function, const void *state)
     instance->data.cache = &instance->cache;
     instance->terminated = 0;
     instance->refusal[0] = '\0';
+    instance->stale = 1;
     return STATUS_OK;
 }
 

@@ -23,8 +23,23 @@ static int is_time(const Instance *instance, uint32_t reference)
     return reference == MODEL_VARIABLE_COUNT && instance->fmi_prefix[3] == '3';
 }
 
+#if MODEL_STATE_COUNT > 0
+#define DERIVATIVE_VALUE(k) (instance->data.real_value[model_state_derivatives[k]])
+#else
+#define DERIVATIVE_VALUE(k) 0.0 /* no state: never used */
+#endif
+
+/* The state k whose derivative der(<state>) has value reference ``reference`` (after the spec's
+ * variables and FMI 3.0's time), or -1. */
+static int derivative_of(const Instance *instance, uint32_t reference)
+{
+    uint32_t first = MODEL_VARIABLE_COUNT + (instance->fmi_prefix[3] == '3' ? 1u : 0u);
+    return reference >= first && reference - first < (uint32_t)MODEL_STATE_COUNT ? (int)(reference - first) : -1;
+}
+
 /* 1 when ``reference`` names a variable of ``type`` that may be got (``setting`` 0) or set now;
- * else Error, with the reason logged. FMI 3.0's independent variable time is a Real to get only. */
+ * else Error, with the reason logged. FMI 3.0's independent variable time and the states'
+ * derivatives are Reals to get only. */
 static int accessible(Instance *instance, const char *function, uint32_t reference, VariableType type, int setting)
 {
     const VariableInfo *v = reference < MODEL_VARIABLE_COUNT ? &model_variables[reference] : NULL;
@@ -32,6 +47,8 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
     char number[24];
     if (is_time(instance, reference)) {
         problem = type == VAR_REAL && !setting ? NULL : " is the independent variable time, a Real that cannot be set";
+    } else if (derivative_of(instance, reference) >= 0) {
+        problem = type == VAR_REAL && !setting ? NULL : " is a state derivative, a Real that cannot be set";
     } else if (v == NULL) {
         problem = " is unknown";
     } else if (v->type != type) {
@@ -73,6 +90,7 @@ static int all_accessible(Instance *instance, const char *function, const uint32
             return 0;
         }
     }
+    instance->stale = instance->stale || setting; /* Model Exchange: the outputs follow at the next get */
     return 1;
 }
 
@@ -143,25 +161,33 @@ Status instance_set_integer(Instance *instance, const char *function, const uint
 Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[])
 {
     size_t i;
+    Status status;
+    int k;
     if (!all_accessible(instance, function, vr, n, value, VAR_REAL, 0)) {
         return STATUS_ERROR;
     }
+    status = model_exchange_update(instance);
     for (i = 0; i < n; i++) {
-        value[i] = is_time(instance, vr[i]) ? instance->data.time : instance->data.real_value[vr[i]];
+        k = derivative_of(instance, vr[i]);
+        value[i] = is_time(instance, vr[i]) ? instance->data.time
+                   : k >= 0                ? DERIVATIVE_VALUE(k)
+                                           : instance->data.real_value[vr[i]];
     }
-    return STATUS_OK;
+    return status;
 }
 
 Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[])
 {
     size_t i;
+    Status status;
     if (!all_accessible(instance, function, vr, n, value, VAR_INTEGER, 0)) {
         return STATUS_ERROR;
     }
+    status = model_exchange_update(instance);
     for (i = 0; i < n; i++) {
         value[i] = instance->data.int_value[vr[i]];
     }
-    return STATUS_OK;
+    return status;
 }
 
 static int boolean_at(const void *values, size_t size, size_t i)
@@ -193,9 +219,11 @@ Status instance_get_boolean(Instance *instance, const char *function, const uint
                             size_t size)
 {
     size_t i;
+    Status status;
     if (!all_accessible(instance, function, vr, n, value, VAR_BOOLEAN, 0)) {
         return STATUS_ERROR;
     }
+    status = model_exchange_update(instance);
     for (i = 0; i < n; i++) {
         unsigned char *at = (unsigned char *)value + i * size;
         int truth = instance->data.int_value[vr[i]] != 0;
@@ -206,7 +234,7 @@ Status instance_get_boolean(Instance *instance, const char *function, const uint
             at[0] = (unsigned char)truth;
         }
     }
-    return STATUS_OK;
+    return status;
 }
 
 /* Characters (code points, as Python's len()) of the UTF-8 ``text`` of ``length`` bytes. */

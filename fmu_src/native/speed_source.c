@@ -18,4 +18,4 @@ static Failure evaluate(ModelData *data, double t)
     return NO_FAILURE;
 }
 
-const ModelHooks model_hooks = {.at_time = evaluate};
+const ModelHooks model_hooks = {.at_time = evaluate, .evaluate = evaluate};

@@ -577,6 +577,19 @@ static Failure advance(ModelData *data, double current_time, double step_size)
     return evaluate(data, current_time, step_size);
 }
 
+/* No warm start and no bend samples (Model Exchange evaluates afresh each time). */
+static void reset_internal(ModelData *data)
+{
+    HAS_SOLUTION = 0.0;
+    SAMPLE_COUNT = 0.0;
+}
+
+/* The outputs at the current phi_in and inputs (TripodCouplingModel.evaluate). */
+static Failure evaluate_now(ModelData *data, double time)
+{
+    return evaluate(data, time, 0.0);
+}
+
 /* TripodCouplingModel.extra_parameter_errors: friction needs the exact kinematics. */
 static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
@@ -585,4 +598,5 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     }
 }
 
-const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors};
+const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance,
+                                 .evaluate = evaluate_now, .extra_parameter_errors = extra_parameter_errors};

@@ -62,4 +62,4 @@ static Failure evaluate(ModelData *data, double input_time UNUSED)
 
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {.start = start, .advance = advance};
+const ModelHooks model_hooks = {.start = start, .advance = advance, .evaluate = evaluate};

@@ -91,8 +91,12 @@ def _value(text: str | None) -> float | str | None:
 
 
 def _described(path: Path) -> dict:
-    """Everything a host reads from a model description, except token and generator."""
+    """Everything a host reads from a model description, except token, generator and Model Exchange
+    (the native FMUs': the states' derivatives, tests/native/test_native_model_exchange.py)."""
     d = read_model_description(str(path))
+    derivatives = {u.variable.name for u in d.derivatives}
+    d.modelVariables = [v for v in d.modelVariables if v.name not in derivatives]
+    d.initialUnknowns = [u for u in d.initialUnknowns if u.variable.name not in derivatives]
     fields = ("name", "valueReference", "causality", "variability", "description", "type", "unit", "displayUnit",
               "min", "max", "start", "initial")
     return {
