@@ -69,6 +69,8 @@ class Importer:
     versions: tuple[str, ...]
     check: Callable[[Path, Path], Outcome]
     unsupported: str = ""
+    #: Why an FMU without Model Exchange is unsupported, for an importer that runs that interface ("": any FMU)
+    model_exchange_only: str = ""
 
 
 @dataclass(frozen=True)
@@ -100,8 +102,6 @@ def _fmpy_model_exchange(fmu: Path) -> Outcome:
     """The default experiment through fmpy in Model Exchange (CVODE) against its co-simulation run of
     the same FMU, at the co-simulation's output points."""
     description = read_model_description(str(fmu))
-    if description.modelExchange is None:
-        return Outcome("unsupported", PYTHON_CO_SIMULATION_ONLY)
     step = MODELS[description.modelName].spec.default_experiment.step_size
     runs = [simulate_fmu(str(fmu), fmi_type=interface, step_size=step, output_interval=10 * step,
                          relative_tolerance=MODEL_EXCHANGE_TOLERANCE)
@@ -136,7 +136,8 @@ def _engine(name: str) -> Callable[[Path, Path], Outcome]:
 IMPORTERS = (
     Importer("fmpy validate", "fmpy", ("2.0", "3.0"), lambda fmu, reference: _fmpy_validate(fmu)),
     Importer("fmutool -check", "fmu_manipulation_toolbox", ("2.0", "3.0"), lambda fmu, reference: _fmutool_check(fmu)),
-    Importer("fmpy Model Exchange", "fmpy", ("2.0", "3.0"), lambda fmu, reference: _fmpy_model_exchange(fmu)),
+    Importer("fmpy Model Exchange", "fmpy", ("2.0", "3.0"), lambda fmu, reference: _fmpy_model_exchange(fmu),
+             model_exchange_only=PYTHON_CO_SIMULATION_ONLY),
     Importer("libcosimpy", "libcosimpy", ("2.0",), _engine("libcosimpy"),
              "libcosim loads FMI 1.0 and 2.0 only: it logs 'Unsupported FMI version' and libcosimpy "
              "0.0.6 then crashes the host (segmentation fault)"),
@@ -172,9 +173,11 @@ def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcom
 
 def outcome(importer: Importer, fmu: Path, reference: Path | None = None) -> Outcome:
     """``fmu`` in ``importer``, engine runs compared with fmpy's run of ``reference`` (default: ``fmu``)."""
-    version = read_model_description(str(fmu)).fmiVersion
-    if version not in importer.versions:
+    description = read_model_description(str(fmu))
+    if description.fmiVersion not in importer.versions:
         return Outcome("unsupported", importer.unsupported)
+    if importer.model_exchange_only and description.modelExchange is None:
+        return Outcome("unsupported", importer.model_exchange_only)
     if importlib.util.find_spec(importer.package) is None:
         return Outcome("unavailable", f"{importer.package} is not installed (pip install '.[interop]')")
     try:
