@@ -11,18 +11,16 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from driveline.rotor.campbell import whirl_branches
+from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline
+from driveline.rotor.spec import SPEC
 
-from driveline.rotor.campbell import whirl_branches  # noqa: E402
-from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline  # noqa: E402
-from driveline.rotor.spec import SPEC  # noqa: E402
-
-from ..runs.runner import FmuInstance  # noqa: E402
-from .result_table import column, write_csv  # noqa: E402
+from ..runs.runner import FmuInstance
+from .figures import figure, save
+from .result_table import column, write_csv
 
 RPM = 30.0 / math.pi
 ORDERS = (1, 2, 3)  # unbalance; Cardan joints; the tripod coupling (docs/tripod_coupling.md)
@@ -31,7 +29,12 @@ MODES = 2  # whirl pairs the FMU outputs
 BEYOND = 1.1  # the ramp ends this far beyond the highest critical speed
 STEPS = 300
 SENSES = {"forward": ("tab:blue", "-", "o"), "backward": ("tab:orange", "--", "s")}  # colour, line, marker
-MARKER_SIZE = {"forward": 8, "backward": 5}  # where they meet, the forward ring holds the backward square
+#: Crossing marks, nested where they meet: a backward crossing's filled square on top, inside a
+#: forward crossing's ring or a critical speed's larger red ring (the backward 1x crossings lie
+#: within 3 % of the critical speeds).
+MARKS = {"critical": {"marker": "o", "ms": 12, "mfc": "none", "mec": "red", "mew": 2.0, "zorder": 5},
+         "forward": {"marker": "o", "ms": 8, "mfc": "none", "mec": "tab:blue", "mew": 1.4, "zorder": 6},
+         "backward": {"marker": "s", "ms": 5, "mfc": "tab:orange", "mec": "tab:orange", "zorder": 7}}
 
 
 def critical_speeds(fmu: Path) -> tuple[float, ...]:
@@ -91,39 +94,38 @@ def write(fmu: Path, out: Path) -> list[Path]:
     names = result.dtype.names
     ramp_csv = write_csv(out / "critical_speeds_ramp.csv", ("time [s]", *(column(SPEC, n) for n in names[1:])),
                          result.tolist())
-    figure = campbell_figure(result, branches(result), criticals, out / "campbell_diagram.png")
-    return [table, ramp_csv, figure]
+    diagram = save(campbell_figure(result, branches(result), criticals), out / "campbell_diagram.png")
+    return [table, ramp_csv, diagram]
 
 
-def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray], criticals: tuple[float, ...],
-                    path: Path) -> Path:
+def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray],
+                    criticals: tuple[float, ...]) -> Figure:
     """Whirl branches against shaft speed, the order lines labelled inside the axes, every crossing
     marked with its speed; the 1x forward crossings (the critical speeds) in red."""
     spins = result["omega"]
     x_top = spins[-1] * RPM
     y_top = 1.08 * max(np.nanmax(values) for values in whirl.values()) * RPM
-    fig, ax = plt.subplots(figsize=(9, 7))
+    fig, ax = figure(figsize=(9, 7))
     for (sense, mode), values in whirl.items():
         color, style, _ = SENSES[sense]
         from_fmu = mode <= MODES
         label = {1: f"{sense} whirl, modes 1-{MODES} (FMU)", MODES + 1: f"{sense} whirl, mode {mode} (rotor core)"}
         ax.plot(spins * RPM, values * RPM, style, color=color, lw=1.6 if from_fmu else 1.1,
-                alpha=1.0 if from_fmu else 0.75, label=label.get(mode))
+                alpha=1.0 if from_fmu else 0.75, label=label.get(mode, f"_{sense} whirl, mode {mode}"))
     for (sense, mode), values in whirl.items():
-        color, _, marker = SENSES[sense]
+        color = SENSES[sense][0]
         for order in ORDERS:
             for speed in crossings(spins, values, order):
                 critical = order == 1 and sense == "forward"
-                ax.plot(speed * RPM, order * speed * RPM, marker, ms=MARKER_SIZE[sense],
-                        mfc="red" if critical else "none", mec="red" if critical else color, mew=1.4,
-                        zorder=5 if critical else 7 if sense == "forward" else 6)
+                ax.plot(speed * RPM, order * speed * RPM, ls="none", **MARKS["critical" if critical else sense],
+                        label=f"_{'critical speed' if critical else sense} {order}x, mode {mode}")  # not in the legend
                 ax.annotate(f"{speed * RPM:.0f}", (speed * RPM, order * speed * RPM),
                             xytext=(5, -11) if sense == "forward" else (-5, 4), textcoords="offset points",
                             ha="left" if sense == "forward" else "right", fontsize=7.5,
                             color="red" if critical else color, fontweight="bold" if critical else "normal")
-    ax.plot([], [], "o", mfc="red", mec="red", label="critical speed (1x, forward) [rpm]")
-    ax.plot([], [], "o", ms=8, mfc="none", mec="tab:blue", label="order resonance, forward [rpm]")
-    ax.plot([], [], "s", ms=5, mfc="none", mec="tab:orange", label="order resonance, backward [rpm]")
+    for mark, label in (("critical", "critical speed (1x, forward) [rpm]"), ("forward", "order resonance, forward [rpm]"),
+                        ("backward", "order resonance, backward [rpm]")):
+        ax.plot([], [], ls="none", **MARKS[mark], label=label)
     ax.set_xlim(0, x_top)
     ax.set_ylim(0, y_top)
     ax.set_xlabel("shaft speed [rpm]")
@@ -140,6 +142,4 @@ def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray]
         angle = ax.transData.transform_angles(np.array([math.degrees(math.atan(order))]), at[None, :])[0]
         ax.annotate(f"{order}x", at, xytext=(-4, 4), textcoords="offset points", fontsize=10, color="0.2",
                     ha="right", va="bottom", rotation=angle, rotation_mode="anchor")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig
