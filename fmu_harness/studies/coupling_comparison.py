@@ -78,7 +78,7 @@ def write(models: Path, out: Path, betas_deg: list[float] | None = None) -> list
     betas_deg = betas_deg or [5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0]
     rows = speed_fluctuation_table(models, betas_deg)
     out.mkdir(parents=True, exist_ok=True)
-    table = write_csv(out / "coupling_comparison.csv", ("beta [deg]", "coupling", "fluctuation [1]", "order [1]"),
+    table = write_csv(out / "coupling_comparison.csv", ("beta [deg]", "coupling [name]", "fluctuation [1]", "order [1]"),
                       ((r["beta_deg"], r["coupling"], r["fluctuation"], r["order"] or "") for r in rows))
     markdown = out / "coupling_comparison.md"
     lines = ["| beta [deg] | " + " | ".join(c.name for c in COUPLINGS) + " |", "|---" * (len(COUPLINGS) + 1) + "|"]

@@ -6,8 +6,6 @@ defects they were written for, on figures drawn here."""
 
 from __future__ import annotations
 
-import math
-
 import matplotlib
 
 matplotlib.use("Agg")
@@ -98,7 +96,8 @@ def test_coupling_comparison_names_a_zero_fluctuation_instead_of_plotting_it(fmi
 def test_campbell_diagram_nests_the_backward_crossings_inside_the_critical_speeds(native_dir):
     fmu = native.fmu_path(native_dir, "CriticalSpeeds")
     criticals = critical_speed_study.critical_speeds(fmu)
-    result = critical_speed_study.ramp(fmu, math.ceil(critical_speed_study.BEYOND * max(criticals) / 100) * 100)
+    result = critical_speed_study.ramp(
+        fmu, critical_speed_study.ramp_speeds(critical_speed_study.BEYOND * max(criticals), criticals))
     fig = critical_speed_study.campbell_figure(result, critical_speed_study.branches(result), criticals)
     assert_clean(fig)
     (ax,) = fig.axes
