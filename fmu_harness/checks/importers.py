@@ -9,9 +9,9 @@
 
 A :class:`Session` addresses variables as ``"instance.variable"``. Both sessions first check the
 start values (the SSP's parameter bindings included) with the models' own validation
-(:func:`fmu_harness.runs.start_values.check`) and raise ``StartValuesRefused`` with the FMU's
-reason before the engine starts: libcosim aborts the process on a parameter the FMU refuses at
-initialisation (docs/hosting.md).
+(:func:`fmu_harness.runs.start_values.check_start_values`) and raise ``StartValuesRefused`` with
+the FMU's reason before the engine starts: libcosim aborts the process on a parameter the FMU
+refuses at initialisation (docs/hosting.md).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..runs.start_values import check, engine_instances
+from ..runs.start_values import check_start_values, engine_instances
 
 NANOSECONDS = 1_000_000_000
 
@@ -77,7 +77,7 @@ def ecos_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp: 
     with ``start_values`` and the SSP's ``parameter_set`` (Ecos applies none unless named);
     ``checked=False`` skips the check of the start values (to observe the engine itself)."""
     if checked:
-        check(engine_instances(fmus, ssp, start_values))
+        check_start_values(engine_instances(fmus, ssp, start_values))
     _load_tbb()
     from ecospy import EcosSimulation, EcosSimulationStructure
 
@@ -109,7 +109,7 @@ def cosim_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp:
     """libcosim running the FMUs ``{instance: path}`` (unconnected) or an SSP archive, with
     ``start_values`` as initial values; ``checked=False`` as for :func:`ecos_session`."""
     if checked:
-        check(engine_instances(fmus, ssp, start_values))
+        check_start_values(engine_instances(fmus, ssp, start_values))
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level

@@ -66,7 +66,7 @@ def refusals(model: str, values: Mapping[str, Any], declared_only: bool = False)
     return core.declared_parameter_errors() if declared_only else core.parameter_errors()
 
 
-def check(instances: list[Instance]) -> None:
+def check_start_values(instances: list[Instance]) -> None:
     """Raise :class:`StartValuesRefused` for the first instance whose FMU would refuse its start
     values (one line: the instance, the FMU's first reason, how many more there are)."""
     for instance in instances:
@@ -105,7 +105,7 @@ def main(argv: list[str] | None = None) -> None:
             instances = engine_instances(ssp=args.target)
         else:
             instances = engine_instances({args.target.stem: args.target}, start_values=values)
-        check(instances)
+        check_start_values(instances)
     except StartValuesRefused as refused:
         parser.exit(1, f"refused: {refused}\n")
     except (OSError, KeyError, ValueError, zipfile.BadZipFile, ET.ParseError) as error:

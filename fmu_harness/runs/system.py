@@ -37,7 +37,7 @@ from driveline.variables import UNITS, ModelSpec, Variable
 from ..packaging import fmu_path, native
 from .runner import FmuInstance
 from .ssp import SSC, SSD, SSV
-from .start_values import Instance, StartValuesRefused, check
+from .start_values import Instance, StartValuesRefused, check_start_values
 
 for prefix, uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
     ET.register_namespace(prefix, uri)
@@ -187,7 +187,7 @@ def simulate(system: System, models: Path, outputs: list[str] | None = None, nat
     """Run ``system`` with the FMUs of :func:`component_fmus`; rows of t_k and ``outputs``
     (default: all Real outputs) for t_1 ... t_N. Parameters an FMU would refuse raise
     ``StartValuesRefused`` before any FMU is loaded."""
-    check([Instance(c.name, c.model, c.parameters) for c in system.components])
+    check_start_values([Instance(c.name, c.model, c.parameters) for c in system.components])
     names = outputs or system.outputs()
     fmus = component_fmus(system, models, natives)
     instances = {c.name: FmuInstance(fmus[c.model], c.name) for c in system.components}
