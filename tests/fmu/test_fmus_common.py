@@ -3,7 +3,9 @@ a default experiment that runs, and refusals."""
 
 from __future__ import annotations
 
+import ctypes
 import math
+import sys
 
 import pytest
 from fmpy.validation import validate_fmu
@@ -11,6 +13,7 @@ from fmpy.validation import validate_fmu
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
+from fmu_src.fmi3_slave import host_start_time
 from support.native_agreement import rows_beyond_tolerance
 
 INPUTS = [(name, v.name) for name, model in MODELS.items() for v in model.spec.of("input") if v.type == "Real"]
@@ -86,3 +89,15 @@ def test_initial_outputs_are_those_at_the_start_time(family, name, fmi, native_d
         native_initial = reference.get(outputs)
     family.assert_outputs_agree(outputs, [initial], [[getattr(core, output) for output in outputs]])
     assert not rows_beyond_tolerance(outputs, [native_initial], [initial]).any()
+
+
+def test_the_fmi3_start_time_is_read_from_a_python_hosts_call_only():
+    """pythonfmu3 withholds startTime: the adapter reads it from the calling frame named after the
+    standard's function (a float or a ctypes fmi3Float64), and finds none where no such frame is."""
+    def fmi3EnterInitializationMode(instance, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime):
+        return host_start_time(sys._getframe())
+
+    assert fmi3EnterInitializationMode(None, False, 0.0, ctypes.c_double(2.5), False, 0.0) == 2.5
+    assert fmi3EnterInitializationMode(None, False, 0.0, 7, False, 0.0) == 7.0
+    assert math.isnan(fmi3EnterInitializationMode(None, False, 0.0, math.nan, False, 0.0))
+    assert host_start_time(sys._getframe()) is None  # a host written in C leaves no such frame
