@@ -17,6 +17,7 @@ import pytest
 from scipy.linalg import eigh
 
 from driveline.mounts.layout import loads_layout
+from driveline.mounts.model import PowertrainMountsModel
 from driveline.mounts.rigid_body import COORDINATES, RigidBody, modes, torque_roll_axis, unrestrained_error
 from support.mount_layouts import random_layout, reference_matrices
 
@@ -87,3 +88,21 @@ def test_torque_roll_axis_is_the_free_rotation_under_the_torque(seed):
     assert np.linalg.norm(axis) == pytest.approx(1.0, abs=1e-15)
     assert np.linalg.norm(np.cross(inertia @ axis, torque)) < 1e-13 * np.linalg.norm(inertia @ axis) * np.linalg.norm(torque)
     assert axis @ torque > 0.0
+
+
+def test_static_sag_of_a_symmetric_layout_is_the_springs_own(tmp_path):
+    """Four equal mounts in the centre of gravity's plane: the weight sags them by m g / (4 k_z),
+    the mean torque T about y (motor_axis) turns the body by -T / (4 k_z a^2) about y."""
+    path_text = ("mass = 200.0\ncentre_of_gravity = [0.0, 0.0, 0.4]\ninertia = [11.0, 8.0, 10.0, 0, 0, 0]\n"
+                 + "".join(f"[[mounts]]\nposition = [{x}, {y}, 0.4]\nstiffness = [1.1e5, 0.7e5, 2.3e5]\n"
+                           for x in (0.2, -0.2) for y in (0.3, -0.3)))
+    (tmp_path / "layout.toml").write_text(path_text)
+    model = PowertrainMountsModel()
+    model.layout, model.T_mean = str(tmp_path / "layout.toml"), 250.0
+    assert model.initialize(0.0) == []
+    assert model.z_static == pytest.approx(-200.0 * 9.81 / (4 * 2.3e5), rel=1e-13)
+    assert model.pitch_static == pytest.approx(-250.0 / (4 * 2.3e5 * 0.2**2), rel=1e-13)
+    assert abs(model.x_static) + abs(model.y_static) + abs(model.roll_static) + abs(model.yaw_static) < 1e-15
+    assert model.F_z_mount1 + model.F_z_mount2 + model.F_z_mount3 + model.F_z_mount4 == pytest.approx(200.0 * 9.81,
+                                                                                                     rel=1e-13)
+
