@@ -1,7 +1,8 @@
 """The main job: simulate the project's FMUs through fmpy and write results and figures.
 
 Usage: ``python -m fmu_harness.main [--models models] [--out results]`` after
-``python build_fmu.py``. The studies run the native FMUs (``models/native/``); the Python FMUs
+``python build_fmu.py``. The studies run the native FMUs (``models/native/``; PowertrainMounts its
+FMI 2.0 Python FMU until its C port); the Python FMUs
 are compared with them in a process of their own (:mod:`fmu_harness.checks.python_fmu_check`), so that
 the pythonfmu wrapper's exit-time defect cannot end the main job.
 """
