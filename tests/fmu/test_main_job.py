@@ -15,6 +15,8 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 from driveline.catalog import MODELS
+from driveline.mounts.layout import load_layout, shipped_layout
+from driveline.mounts.rigid_body import RigidBody, modes
 from fmu_harness.checks import python_fmu_check
 from fmu_harness.runs.runner import FmuInstance
 from fmu_harness.studies import critical_speed_study
@@ -48,7 +50,7 @@ def results(models, tmp_path_factory) -> Path:
 def test_every_csv_starts_with_time_or_the_swept_variable_with_units_and_no_repeated_row(results):
     tables = sorted(results.glob("*.csv"))
     assert [t.name for t in tables] == ["coupling_comparison.csv", "critical_speeds.csv", "critical_speeds_ramp.csv",
-                                        "tripod_coupling.csv"]
+                                        "powertrain_modes.csv", "tripod_coupling.csv"]
     for table in tables:
         header, *rows = list(csv.reader(table.open()))
         assert header[0] in FIRST_COLUMNS, table.name
@@ -101,9 +103,9 @@ def test_ramp_records_the_unbalance_response_peak(results, models):
     assert found.x == pytest.approx(ramp["omega_crit_1_rads"][0], rel=1e-3)
 
 
-def test_python_fmu_check_lists_every_model(results):
+def test_python_fmu_check_lists_every_model_with_a_c_port(results):
     report = (results / python_fmu_check.REPORT).read_text()
-    for name in MODELS:
+    for name in native.native_models():
         assert f"| {name} |" in report
 
 
@@ -113,3 +115,13 @@ def test_the_python_fmus_process_exits_0_every_time(models, tmp_path):
     codes = [subprocess.run(python_fmu_check.command(models, models, tmp_path), capture_output=True,
                             timeout=300).returncode for _ in range(RUNS)]
     assert codes == [0] * RUNS
+
+
+def test_the_modal_table_is_the_cores_for_the_default_layout(results):
+    """powertrain_modes.csv: the FMU's frequencies and shares of the default layout, those of the
+    core (driveline.mounts) within 1e-9 (the native FMU computes them with its own eigensolver)."""
+    table = np.genfromtxt(results / "powertrain_modes.csv", delimiter=",", skip_header=1, usecols=(1, 4, 5, 6, 7, 8, 9))
+    found = modes(RigidBody.of(load_layout(shipped_layout("transverse_fwd_powertrain"))))
+    np.testing.assert_allclose(table[:, 0], found.frequencies, rtol=1e-9)
+    np.testing.assert_allclose(table[:, 1:], found.shares, rtol=0.0, atol=1e-9)
+    assert (results / "powertrain_decoupling.png").stat().st_size > 30_000
