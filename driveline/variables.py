@@ -58,6 +58,8 @@ UNITS: dict[str, Unit] = {
         Unit("N.m", {"kg": 1, "m": 2, "s": -2}),
         Unit("N/m", {"kg": 1, "s": -2}),
         Unit("N.s/m", {"kg": 1, "s": -1}),
+        Unit("N/s", {"kg": 1, "m": 1, "s": -3}),
+        Unit("N.m/s", {"kg": 1, "m": 2, "s": -3}),
         Unit("kg.m", {"kg": 1, "m": 1}, (DisplayUnit("g.mm", 1e6),)),
         Unit("Pa", {"kg": 1, "m": -1, "s": -2}, (DisplayUnit("MPa", 1e-6),)),
         Unit("kg/m3", {"kg": 1, "m": -3}),
@@ -167,9 +169,10 @@ class Relation:
 @dataclass(frozen=True)
 class State:
     """An output the model integrates over time (an input shaft's angle): its value at one instant
-    is its own, ``initial`` names the parameters its value at initialisation is computed from and
-    ``derivative`` the input or output that is its time derivative (a Model Exchange FMU's
-    continuous state, whose derivative is the variable ``der(<name>)``)."""
+    is its own, ``initial`` names the parameters and inputs its value at initialisation is computed
+    from (inputs: a start in the equilibrium under the start inputs) and ``derivative`` the input
+    or output that is its time derivative (a Model Exchange FMU's continuous state, whose
+    derivative is the variable ``der(<name>)``)."""
 
     name: str
     initial: tuple[str, ...]
@@ -222,9 +225,9 @@ class ModelSpec:
         knowns = {v.name for v in self.of("input", "parameter")}
         outputs = {v.name for v in self.of("output")}
         for state in self.states:
-            if state.name not in outputs or not set(state.initial) <= {v.name for v in self.of("parameter")}:
+            if state.name not in outputs or not set(state.initial) <= knowns:
                 raise ValueError(f"{self.name}: state {state.name} must be an output and its initial values "
-                                 f"must name parameters, got {state.initial}")
+                                 f"must name parameters or inputs, got {state.initial}")
             if state.derivative not in outputs | {v.name for v in self.of("input")}:
                 raise ValueError(f"{self.name}: the derivative of state {state.name} must be an input or output, "
                                  f"got {state.derivative!r}")

@@ -113,7 +113,8 @@ def test_a_spec_refuses_relations_it_cannot_enforce(relation, fragment):
         (Variable("y", "output", 0.0, "undeclared"), (), r"output y declares no dependencies: give its Variable "
                                                         r"depends_on=\(...\).*docs/development.md, Add a model"),
         (Variable("y", "output", 0.0, "declared", depends_on=("nowhere",)), (), "no input, parameter or state"),
-        (Variable("y", "output", 0.0, "a state"), (State("y", ("x",), "x"),), "initial values must name parameters"),
+        (Variable("y", "output", 0.0, "a state"), (State("y", ("y",), "x"),),
+         "initial values must name parameters or inputs"),
         (Variable("y", "output", 0.0, "at start", depends_on=(), initial_depends_on=("y",)), (), "no input"),
     ],
 )
@@ -135,6 +136,18 @@ def test_the_dependencies_at_initialisation_follow_a_state_to_its_initial_values
                      states=(State("s", ("x0",), "x"),))
     assert [spec.output_dependencies(name) for name in ("s", "y", "z")] == [(), ("x",), ()]
     assert [spec.initial_dependencies(name) for name in ("s", "y", "z")] == [("x0",), ("x", "x0"), ()]
+
+
+def test_a_state_starting_in_an_equilibrium_depends_at_initialisation_on_the_inputs():
+    variables = (Variable("F", "input", 1.0, "a force"), Variable("k", "parameter", 1.0, "a stiffness"),
+                 Variable("q", "output", 0.0, "the displacement, F / k at the start"),
+                 Variable("v", "output", 0.0, "the velocity, 0 at the start"),
+                 Variable("a", "output", 0.0, "the acceleration, 0 at the start",
+                          depends_on=("F", "k", "q"), initial_depends_on=()))
+    spec = ModelSpec("Probe", "a spring starting at rest", variables, DefaultExperiment(0.0, 1.0, 0.1),
+                     states=(State("q", ("F", "k"), "v"), State("v", (), "a")))
+    assert [spec.initial_dependencies(name) for name in ("q", "v", "a")] == [("F", "k"), (), ()]
+    assert [spec.output_dependencies(name) for name in ("q", "v", "a")] == [(), (), ("F",)]
 
 
 def test_an_exclusive_bound_needs_its_value():
