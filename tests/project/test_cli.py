@@ -5,11 +5,14 @@ every run failed says why and fails, long work shows its progress."""
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+
+from fmu_harness.checks import interop
 
 SCRIPT = Path(sys.executable).with_name("driveline-fmus.exe" if sys.platform == "win32" else "driveline-fmus")
 OPTIONAL = ("pyarrow", "distributed", "dask", "libcosimpy", "ecospy", "fmu_manipulation_toolbox")
@@ -91,3 +94,16 @@ def test_a_sweep_without_its_extra_names_it_in_one_line(tripod_fmu, tmp_path):
     run = driveline_fmus("sweep", "--grid", "beta=0.1", "--models", str(tripod_fmu.parent), cwd=tmp_path,
                          env=_without_optional_packages(tmp_path / "stubs"))
     assert_one_line_mistake(run, "needs pyarrow", "pip install 'driveline-fmus[sweep]'")
+
+
+def test_the_importer_matrix_shows_its_progress(fmu_path, tmp_path):
+    models = tmp_path / "models"
+    models.mkdir()
+    shutil.copy(fmu_path("SpeedSource"), models)
+    run = driveline_fmus("interop", "--models", str(models), cwd=tmp_path)
+    assert run.returncode == 0, run.stderr[-2000:]
+    shown = [line for line in run.stderr.splitlines() if line.startswith("importer matrix [")]
+    total = len(interop.IMPORTERS)
+    assert shown[0] == f"importer matrix [1/{total}] SpeedSource Python FMI 2.0 in {interop.IMPORTERS[0].name}"
+    assert shown[-1] == f"importer matrix [{total}/{total}] SpeedSource Python FMI 2.0 in {interop.IMPORTERS[-1].name}"
+    assert "| `SpeedSource` | Python | 2.0 |" in run.stdout
