@@ -30,6 +30,7 @@ def assert_one_line_mistake(run: subprocess.CompletedProcess, *words: str) -> No
 
 
 @pytest.mark.parametrize("arguments, words", [
+    (["biuld"], ["invalid choice: 'biuld'"]),
     (["build", "Tripod"], ["no model 'Tripod'", "did you mean TripodCoupling"]),
     (["sweep", "--grid", "beta=0.1", "--workers", "-2"], ["--workers", "at least 1"]),
     (["sweep", "--grid", "beta=0.1", "--turns", "-1"], ["turns must be a whole number of at least 1, got -1"]),
