@@ -15,9 +15,12 @@ input (held constant) of the FMU. A run lasts ``--turns`` input turns at the poi
 Every point is one :func:`fmu_harness.runs.runner.simulate` call on a worker. The FMU's bytes are
 scattered to the workers once, extracted and their model description parsed once per worker
 process, so workers need no shared file system. A refused or crashed run becomes a ``failed``
-row with its reason; the command ends non-zero when every run failed and names the distinct
-reasons. Its arguments, the FMU and the layout are checked before the cluster starts; Dask and
-pyarrow (the ``sweep`` extra) are imported when a sweep runs, so ``--help`` needs neither.
+row with its reason; a point whose parameters break the spec's bounds or relations, which the
+FMU would refuse at initialisation, is not run (:mod:`fmu_harness.runs.start_values`). The command
+ends non-zero when every run failed and names the distinct reasons, before any worker starts when
+every point is refused so. Its arguments, the FMU and the layout are checked before the cluster
+starts; Dask and pyarrow (the ``sweep`` extra) are imported when a sweep runs, so ``--help``
+needs neither.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ import os
 import sys
 import threading
 import zipfile
+from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -47,6 +51,7 @@ from driveline.catalog import MODELS
 
 from ..console import CommandParser, Progress, optional
 from .runner import StepRefused, simulate
+from .start_values import refusals
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -344,11 +349,13 @@ def critical_speed_margins(speeds: Sequence[float], critical: Sequence[float]) -
 @dataclass(frozen=True)
 class Plan:
     """A sweep checked before anything runs: the FMU read, every point's names known to it, the
-    timing valid and the critical speeds of the margin (None when there is no margin)."""
+    timing valid, the points the FMU would refuse (:func:`refused_points`, not run) and the
+    critical speeds of the margin (None when there is no margin)."""
 
     fmu: ShippedFmu
     points: Sequence[Point]
     timing: Timing
+    refused: dict[int, str]
     critical: list[float] | None
 
     @classmethod
@@ -360,12 +367,13 @@ class Plan:
         shipped = ShippedFmu.read(fmu)
         for point in points:
             shipped.interface.split(point)
+        refused = refused_points(shipped.interface.model, points)
         if shipped.interface.speed_start is None:
             if layout:
                 raise ValueError(f"the layout sets the critical-speed margin, which needs an {SPEED} input: "
                                  f"{shipped.interface.model} has none")
-            return cls(shipped, points, timing, None)
-        return cls(shipped, points, timing, critical_speeds(layout))
+            return cls(shipped, points, timing, refused, None)
+        return cls(shipped, points, timing, refused, critical_speeds(layout))
 
 
 def run(client: Client, plan: Plan, show_progress: bool = False) -> pa.Table:
@@ -379,15 +387,14 @@ def run(client: Client, plan: Plan, show_progress: bool = False) -> pa.Table:
     distributed = optional("distributed", EXTRA, COMMAND)
     interface, points = plan.fmu.interface, plan.points
     payload = client.scatter(plan.fmu, broadcast=True, hash=False)
-    futures = [client.submit(run_point, payload, point, plan.timing, pure=False) for point in points]
-    if show_progress:
-        at = {future.key: point for future, point in zip(futures, points)}
-        with Progress("sweep", len(futures)) as shown:
-            for future in distributed.as_completed(futures):
-                shown.advance(" ".join(f"{k}={v}" for k, v in at[future.key].items())
-                              + f": {_outcome(future)['status']}")
-    distributed.wait(futures)
-    rows = [{**point, **_outcome(future)} for point, future in zip(points, futures)]
+    futures = {i: client.submit(run_point, payload, point, plan.timing, pure=False)
+               for i, point in enumerate(points) if i not in plan.refused}
+    at = {future.key: points[i] for i, future in futures.items()}
+    with Progress("sweep", len(futures), enabled=show_progress) as shown:
+        for future in distributed.as_completed(futures.values()):
+            shown.advance(" ".join(f"{k}={v}" for k, v in at[future.key].items()) + f": {_outcome(future)['status']}")
+    rows = [{**point, **({"status": "failed", "reason": plan.refused[i]} if i in plan.refused
+                         else _outcome(futures[i]))} for i, point in enumerate(points)]
     metrics = interface.metric_columns()
     names = list(dict.fromkeys(name for point in points for name in point))
     types = {"status": pa.string(), "reason": pa.string(), **{m: pa.float64() for m in metrics}}
@@ -411,6 +418,14 @@ def sweep(
     return run(client, Plan.of(fmu, points, timing, layout), show_progress)
 
 
+def refused_points(model: str, points: Sequence[Point]) -> dict[int, str]:
+    """``{index: reason}`` of the points whose values the FMU of ``model`` would refuse at
+    initialisation by the spec's bounds and relations (its first reason); such a point is not
+    run. The model's own checks (a structural analysis) are left to the run on a worker."""
+    found = {i: refusals(model, point, declared_only=True) for i, point in enumerate(points)}
+    return {i: reasons[0] for i, reasons in found.items() if reasons}
+
+
 def write_table(table: pa.Table, path: Path) -> None:
     """Parquet, or CSV when ``path`` ends in ``.csv``."""
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -420,11 +435,16 @@ def write_table(table: pa.Table, path: Path) -> None:
         optional("pyarrow.parquet", EXTRA, COMMAND).write_table(table, path)
 
 
-def failure_reasons(table: pa.Table) -> dict[str, int]:
-    """How many runs failed for each distinct reason, most frequent first."""
-    reasons = [r for s, r in zip(table.column("status").to_pylist(), table.column("reason").to_pylist())
-               if s == "failed"]
-    return {reason: reasons.count(reason) for reason in sorted(set(reasons), key=lambda r: -reasons.count(r))}
+def failure_reasons(table: pa.Table) -> Counter[str]:
+    """How many runs failed for each distinct reason."""
+    return Counter(r for s, r in zip(table.column("status").to_pylist(), table.column("reason").to_pylist())
+                   if s == "failed")
+
+
+def print_reasons(reasons: Counter[str]) -> None:
+    """Each distinct reason of failed runs with their number, most frequent first, on standard error."""
+    for reason, count in reasons.most_common():
+        print(f"  {count} failed: {reason}", file=sys.stderr)
 
 
 @contextmanager
@@ -489,16 +509,18 @@ def main(argv: list[str] | None = None) -> None:
         plan = Plan.of(_fmu_file(args.models, args.model), points, timing, args.layout)
     except (ValueError, OSError, zipfile.BadZipFile) as error:
         parser.error(str(error))
+    if len(plan.refused) == len(points):
+        print_reasons(Counter(plan.refused.values()))
+        sys.exit(f"{COMMAND}: every point refused, none run")
     optional("pyarrow", EXTRA, COMMAND)  # before the cluster starts
     with open_client(args.scheduler, args.workers) as client:
         print(f"{len(points)} runs of {args.model} on {client.scheduler.address}")
         table = run(client, plan, show_progress=True)
     write_table(table, args.out)
     reasons = failure_reasons(table)
-    print(f"{table.num_rows} runs, {sum(reasons.values())} failed -> {args.out}")
-    for reason, count in reasons.items():
-        print(f"  {count} failed: {reason}", file=sys.stderr)
-    if reasons and sum(reasons.values()) == table.num_rows:
+    print(f"{table.num_rows} runs, {reasons.total()} failed -> {args.out}")
+    print_reasons(reasons)
+    if reasons.total() == table.num_rows:
         sys.exit(f"{COMMAND}: every run failed")
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from fmu_harness import cli
 from fmu_harness.checks import interop
 
 SCRIPT = Path(sys.executable).with_name("driveline-fmus.exe" if sys.platform == "win32" else "driveline-fmus")
@@ -64,12 +65,15 @@ def test_run_outside_a_built_folder_tells_a_wheel_user_what_to_do(tmp_path):
 
 
 def test_a_sweep_whose_every_run_failed_names_the_reasons_and_fails(tripod_fmu, tmp_path):
-    run = driveline_fmus("sweep", "--grid", "r=-0.01,-0.02", "--models", str(tripod_fmu.parent), "--workers", "1",
-                         "--steps-per-turn", "4", "--out", "sweep.csv", cwd=tmp_path)
+    """One point refused before it runs (r < 0 breaks a declared bound), two that fail on the
+    workers (no whole turn at omega_in = 0)."""
+    run = driveline_fmus("sweep", "--grid", "r=-0.01,0.02,0.026", "omega_in=0", "--models", str(tripod_fmu.parent),
+                         "--workers", "1", "--steps-per-turn", "4", "--out", "sweep.csv", cwd=tmp_path)
     assert run.returncode == 1 and "Traceback" not in run.stderr
-    assert "2 runs, 2 failed" in run.stdout and (tmp_path / "sweep.csv").is_file()
-    reasons = [line for line in run.stderr.splitlines() if line.startswith("  1 failed: ")]
-    assert len(reasons) == 2 and "r = -10 mm must be positive" in reasons[1] + reasons[0]
+    assert "3 runs, 3 failed" in run.stdout and (tmp_path / "sweep.csv").is_file()
+    reasons = [line for line in run.stderr.splitlines() if " failed: " in line]
+    assert reasons[0].startswith("  2 failed: ValueError: a run of whole input turns needs a finite non-zero omega_in")
+    assert reasons[1] == "  1 failed: parameter r = -10 mm must be positive" and len(reasons) == 2
     assert "sweep [1/2]" in run.stderr and "sweep [2/2]" in run.stderr
     assert run.stderr.splitlines()[-1] == "driveline-fmus sweep: every run failed"
 
@@ -83,7 +87,7 @@ def _without_optional_packages(folder: Path) -> dict[str, str]:
     return {"PYTHONPATH": os.pathsep.join([str(folder), os.environ.get("PYTHONPATH", "")])}
 
 
-@pytest.mark.parametrize("command", ["build", "run", "sweep", "interop", None])
+@pytest.mark.parametrize("command", [*cli.COMMANDS, None])
 def test_help_needs_no_optional_package(command, tmp_path):
     run = driveline_fmus(*[command] * bool(command), "--help", cwd=tmp_path,
                          env=_without_optional_packages(tmp_path / "stubs"))
