@@ -1,7 +1,8 @@
 """The main job: simulate the project's FMUs through fmpy and write results and figures.
 
 Usage: ``driveline-fmus run [--models models] [--out results]`` (or ``python -m fmu_harness.main``)
-after ``driveline-fmus build``. The studies run the native FMUs (``models/native/``); the Python FMUs
+after ``driveline-fmus build``. The studies run the native FMUs (``models/native/``; PowertrainMounts its
+FMI 2.0 Python FMU until its C port); the Python FMUs
 are compared with them in a process of their own (:mod:`fmu_harness.checks.python_fmu_check`), so that
 the pythonfmu wrapper's exit-time defect cannot end the main job.
 """
@@ -13,7 +14,7 @@ from pathlib import Path
 from .checks import python_fmu_check
 from .console import CommandParser, Progress
 from .packaging import native
-from .studies import coupling_comparison, critical_speed_study, tripod_study
+from .studies import coupling_comparison, critical_speed_study, mounts_study, tripod_study
 
 
 def simulate(models: Path, out: Path) -> list[Path]:
@@ -29,6 +30,7 @@ def simulate(models: Path, out: Path) -> list[Path]:
         "tripod coupling": lambda: tripod_study.write(fmus["TripodCoupling"], out),
         "coupling comparison": lambda: coupling_comparison.write(fmus["CardanJoint"].parent, out),
         "critical speeds": lambda: critical_speed_study.write(fmus["CriticalSpeeds"], out),
+        "powertrain mounts": lambda: mounts_study.write(_mounts_fmu(models), out),
         "Python FMUs against native": lambda: python_fmu_check.run(models, models, out),
     }
     written = []
@@ -37,6 +39,13 @@ def simulate(models: Path, out: Path) -> list[Path]:
             written += study()
             shown.advance(name)
     return written
+
+
+def _mounts_fmu(models: Path) -> Path:
+    """The native PowertrainMounts FMU once the model has its C port, else its FMI 2.0 Python FMU."""
+    if "PowertrainMounts" in native.native_models():
+        return native.fmu_path(models, "PowertrainMounts")
+    return models / "PowertrainMounts.fmu"
 
 
 def main(argv: list[str] | None = None) -> None:
