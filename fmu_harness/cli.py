@@ -16,6 +16,7 @@ COMMANDS = {
     "run": ("fmu_harness.main", "the main job: simulate the FMUs, write CSV files and figures"),
     "sweep": ("fmu_harness.runs.sweep", "a parameter sweep of one FMU on Dask"),
     "interop": ("fmu_harness.checks.interop", "every FMU in every importer: the interoperability matrix"),
+    "system": ("fmu_harness.system_command", "run an SSP package, every output of every component to CSV"),
 }
 
 
