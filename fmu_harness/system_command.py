@@ -25,6 +25,7 @@ from .checks import importers
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
+from .runs.start_values import StartValuesRefused, check_start_values, engine_instances
 from .runs.system import run_jacobi
 from .studies.result_table import write_csv
 
@@ -181,6 +182,7 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
     if changes:
         package = ssp_package.with_parameters(args.package, changes, scratch / args.package.name)
         system = ssp_package.read(package)
+    check_start_values(engine_instances(ssp=package))
     outputs, headers = output_columns(system, descriptions)
     out = args.out or Path(args.package.name).with_suffix(".csv")
     if not out.parent.is_dir():
@@ -194,7 +196,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         with tempfile.TemporaryDirectory(prefix="driveline-system-") as scratch:
             out = run(args, Path(scratch))
-    except (UsageError, PackageError) as error:
+    except (UsageError, PackageError, StartValuesRefused) as error:
         print(f"{sys.argv[0]}: error: {error}", file=sys.stderr)
         sys.exit(2)
     except StepRefused as error:

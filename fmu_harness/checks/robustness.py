@@ -35,7 +35,7 @@ from driveline.catalog import MODELS
 
 from .failing_model import FAILURES, FailingModel, build_failing_fmus
 from .robustness_probe import (DISTINCT_TEXTS_LEAK, ECOS_IGNORES_DISCARD, FMI2_DISCARD, NO_GUID_CHECK,
-                                NO_START_TIME, STATUS_OK_LOGGED, VERDICT, WRAPPER_DEPARTURES)
+                                STATUS_OK_LOGGED, VERDICT, WRAPPER_DEPARTURES)
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Seconds a case may take; every case needs a few seconds at most (a host process start included).
@@ -147,8 +147,6 @@ def _misuse(fmu_path: FmuPath, fmi: str) -> list[Case]:
         model = "TripodCoupling" if kind == "fixed parameter after initialisation" else "CardanJoint"
         if kind == "wrong guid":
             departures = (NO_GUID_CHECK,)
-        elif kind == "nan start time" and fmi == "3":
-            departures = (NO_START_TIME,)
         else:
             departures = _refusing(fmi, STATUS_OK_LOGGED) if kind in LOGGED_WITH_OK else _refusing(fmi)
         found.append(Case("call sequence misuse", kind, "misuse", (str(fmu_path(model, fmi)), kind), fmi, departures))
@@ -242,7 +240,7 @@ def _persistent(fmu_path: FmuPath, fmi: str) -> list[Case]:
 
 def _start_time(fmu_path: FmuPath, fmi: str) -> list[Case]:
     return [Case("outputs at a start time other than 0", "SpeedSource at t0 = 1 s", "start_time",
-                 (str(fmu_path("SpeedSource", fmi)), 1.0), fmi, (NO_START_TIME,) if fmi == "3" else ())]
+                 (str(fmu_path("SpeedSource", fmi)), 1.0), fmi)]
 
 
 def _engines(fmu_path: FmuPath, versions: Iterable[str]) -> list[Case]:

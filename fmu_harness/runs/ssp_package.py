@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from .system import SSD, SSV
+from .ssp import SSD, SSV
 
 STRUCTURE = "SystemStructure.ssd"
 TYPES = ("Real", "Integer", "Boolean", "String")

@@ -85,6 +85,7 @@ def test_the_engines_give_the_masters_results(engine, native_ssp, tmp_path, fmi2
     (["--set", "coupling.omega_in=1"], "it is a connected input"),
     (["--set", "coupling.T_load=abc"], "'abc' is no Real value"),
     (["--set", "coupling.kinematics=0.5"], "'0.5' is no Integer value"),
+    (["--set", "coupling.r=-0.01"], "coupling (TripodCoupling): parameter r = -10 mm must be positive"),
     (["--step", "0"], "need 0 < step <= stop time"),
     (["--step", "0.003"], "no whole number of steps"),
     (["--engine", "dymola"], "invalid choice: 'dymola'"),

@@ -38,7 +38,7 @@ def test_a_stale_table_is_found_and_regenerated(tmp_path):
 
 
 def test_readme_holds_the_ci_test_command():
-    assert 'python -m pip install -e ".[test,interop]" && python -m pytest -q' in README.read_text()
+    assert 'python -m pip install -e ".[test,interop]" && python -m pytest -q -n 2' in README.read_text()
 
 
 def test_readme_connects_the_models_as_the_ssp_system_does():
