@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from .cardan.model import CardanJointModel
 from .model import SteppedModel
+from .mounts.model import PowertrainMountsModel
 from .reducer.model import UniversalReducerModel
 from .rotor.model import CriticalSpeedsModel
 from .source.model import SpeedSourceModel
@@ -13,6 +14,8 @@ from .vehicle.model import VehicleDrivelineModel
 
 MODELS: dict[str, type[SteppedModel]] = {
     model.spec.name: model
-    for model in (TripodCouplingModel, CardanJointModel, UniversalReducerModel, CriticalSpeedsModel, SpeedSourceModel,
-                  TorqueSourceModel, VehicleDrivelineModel)
+    for model in (
+        TripodCouplingModel, CardanJointModel, UniversalReducerModel, CriticalSpeedsModel, SpeedSourceModel,
+        PowertrainMountsModel, TorqueSourceModel, VehicleDrivelineModel,
+    )
 }

@@ -59,6 +59,8 @@ UNITS: dict[str, Unit] = {
         Unit("N.m/rad", {"kg": 1, "m": 2, "s": -2, "rad": -1}),
         Unit("N.m.s/rad", {"kg": 1, "m": 2, "s": -1, "rad": -1}),
         Unit("m2", {"m": 2}),
+        Unit("N/s", {"kg": 1, "m": 1, "s": -3}),
+        Unit("N.m/s", {"kg": 1, "m": 2, "s": -3}),
         Unit("kg.m", {"kg": 1, "m": 1}, (DisplayUnit("g.mm", 1e6),)),
         Unit("Pa", {"kg": 1, "m": -1, "s": -2}, (DisplayUnit("MPa", 1e-6),)),
         Unit("kg/m3", {"kg": 1, "m": -3}),

@@ -186,10 +186,28 @@ LAYOUTS = (
 )
 
 
+#: The same for PowertrainMounts' layouts, read by the same rules (driveline/layout_files.py).
+MOUNT_LAYOUTS = (
+    ("fifo.toml", "fifo", "not a regular file"),
+    ("zero.toml", "dev zero", "not a regular file"),
+    ("folder.toml", "directory", "not a regular file"),
+    ("mounts.toml", "many mounts", "9 [[mounts]] tables are more than the 8 accepted"),
+    ("line.toml", "mounts on a line", "leave a rigid-body motion unrestrained"),
+    ("nested.toml", "deep nesting", "brackets nest deeper than 16 levels"),
+    ("large.toml", "large file", "is larger than 65536 bytes"),
+    ("missing.toml", "", "No such file or directory"),
+    ("../../../etc/passwd", "", "no shipped layout named"),
+)
+
+
 def _layouts(fmu_path: FmuPath, fmi: str) -> list[Case]:
     path = str(fmu_path("CriticalSpeeds", fmi))
     found = [Case("hostile layout values", f"layout {value[:24]!r}", "layout", (path, value, fragment, prepare), fmi,
                   _departures("bad_parameter", fmi)) for value, prepare, fragment in LAYOUTS]
+    mounts = str(fmu_path("PowertrainMounts", fmi))
+    found += [Case("hostile layout values", f"PowertrainMounts layout {value[:24]!r}", "layout",
+                   (mounts, value, fragment, prepare), fmi, _departures("bad_parameter", fmi))
+              for value, prepare, fragment in MOUNT_LAYOUTS]
     found.append(Case("hostile layout values", "layout of 10^5 characters", "long_string",
                       (path, "layout", 100000), fmi, _refusing(fmi, STATUS_OK_LOGGED)))
     return found

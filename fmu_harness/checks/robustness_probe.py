@@ -377,6 +377,7 @@ def state(path: str, kind: str, other_path: str = "") -> None:
     probe.close()
 
 
+MOUNTS_HEADER = "mass = 200.0\ncentre_of_gravity = [0.0, 0.0, 0.0]\ninertia = [10.0, 8.0, 9.0, 0.0, 0.0, 0.0]\n"
 SEGMENT_TABLE = "[[segments]]\nlength = 0.1\nouter_diameter = 0.05\nyoungs_modulus = 2.1e11\ndensity = 7850.0\n"
 
 
@@ -392,6 +393,10 @@ def hostile_file(target: Path, kind: str) -> None:
         from .analysis_work import layout_text
 
         target.write_text(layout_text(100, 1.4, 202, 202, 200))
+    elif kind in ("many mounts", "mounts on a line"):
+        count = 9 if kind == "many mounts" else 3
+        target.write_text(MOUNTS_HEADER + "".join(f"[[mounts]]\nposition = [{0.1 * i}, 0.0, 0.0]\n"
+                                                  "stiffness = [1e5, 1e5, 1e5]\n" for i in range(count)))
     elif kind == "deep nesting":
         target.write_text("x = " + "[" * 1000 + "]" * 1000)
     else:

@@ -10,6 +10,7 @@ import pytest
 
 from driveline.catalog import MODELS
 from fmu_harness.runs import system
+from fmu_harness.packaging import documentation
 from fmu_harness.doc_pages.sections import model_page, replace_section, section
 from fmu_harness.doc_pages.variable_table import markdown
 
@@ -70,5 +71,4 @@ def test_relative_links_lead_to_files_and_headings(page):
 
 def _anchors(markdown_text: str) -> set[str]:
     """GitHub's heading anchors: lower case, punctuation dropped, spaces as hyphens."""
-    headings = re.findall(r"^#+ (.+)$", markdown_text, flags=re.MULTILINE)
-    return {re.sub(r"[^\w\- ]", "", h).strip().lower().replace(" ", "-") for h in headings}
+    return {documentation.anchor(h) for h in re.findall(r"^#+ (.+)$", markdown_text, flags=re.MULTILINE)}
