@@ -10,7 +10,9 @@ from .spec import SPEC
 
 class VehicleDrivelineModel(SteppedModel):
     """The ``VehicleDriveline`` co-simulation model: inputs held from a communication point (the joints'
-    output angles moving at their output speeds), the state moved by :func:`dynamics.advance`."""
+    output angles moving at their output speeds), the state moved by :func:`dynamics.advance`. Each
+    joint's quantities are in its own frame, Z' from the differential towards its wheel: forward, the
+    left joint turns positively and the right one negatively (ISO 8855, y to the left)."""
 
     spec = SPEC
 
@@ -30,7 +32,10 @@ class VehicleDrivelineModel(SteppedModel):
         return Drive(*(getattr(self, name) for name in Drive._fields))
 
     def _joints(self) -> Joints:
-        return Joints(*(getattr(self, name) for name in Joints._fields))
+        """The joints' inputs in the drive's sense (each joint's own frame has Z' towards its wheel:
+        the right joint's quantities change sign)."""
+        return Joints(self.T_in_left, -self.T_in_right, self.phi_out_left, -self.phi_out_right,
+                      self.omega_out_left, -self.omega_out_right)
 
     def start(self, start_time: float) -> None:
         drive, joints = self._drive(), self._joints()
@@ -47,10 +52,11 @@ class VehicleDrivelineModel(SteppedModel):
         state = self._state
         rate = dynamics.rates(drive, state, self.T_motor, joints, elapsed)
         case, diff = state[dynamics.CASE], state[dynamics.DIFF]
-        self.omega_in_left, self.omega_in_right = case + diff, case - diff
+        self.omega_in_left, self.omega_in_right = case + diff, -(case - diff)
         self.alpha_in_left = rate[dynamics.CASE] + rate[dynamics.DIFF]
-        self.alpha_in_right = rate[dynamics.CASE] - rate[dynamics.DIFF]
-        self.T_load_left, self.T_load_right = dynamics.halfshaft_torques(drive, state, joints, elapsed)
+        self.alpha_in_right = -(rate[dynamics.CASE] - rate[dynamics.DIFF])
+        T_left, T_right = dynamics.halfshaft_torques(drive, state, joints, elapsed)
+        self.T_load_left, self.T_load_right = T_left, -T_right
         self.T_reaction = dynamics.reaction_torque(drive, joints, rate[dynamics.CASE])
         self.omega_motor = drive.ratio * case
         self.omega_wheel_left, self.omega_wheel_right = state[dynamics.WHEEL_LEFT], state[dynamics.WHEEL_RIGHT]

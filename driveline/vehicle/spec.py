@@ -24,7 +24,8 @@ SPEC = ModelSpec(
         "Front-wheel drive between the motor and the road without the joints: motor, reduction gear and "
         "open differential inertia, halfshafts (torsional stiffness and damping from each joint's output "
         "angle to its wheel), wheels, tyres with transient slip saturating at the road's friction, the car's "
-        "mass, rolling resistance, drag and grade. Defaults: a 2011 Nissan Leaf."
+        "mass, rolling resistance, drag and grade. Each joint's quantities in its own frame (Z' towards its "
+        "wheel: forward, the right joint turns negatively). Defaults: a 2011 Nissan Leaf."
     ),
     variables=(
         Variable("ratio", "parameter", car.RATIO, "Overall ratio i: motor speed / differential case speed", "1",

@@ -35,10 +35,11 @@ static double divide(Failure *failure, double a, double b)
     return 0.0;
 }
 
+/* VehicleDrivelineModel._joints: in the drive's sense (the right joint's frame turns the other way) */
 static Joints joints_of(const ModelData *data)
 {
-    Joints joints = {VALUE(T_in_left), VALUE(T_in_right), VALUE(phi_out_left), VALUE(phi_out_right),
-                     VALUE(omega_out_left), VALUE(omega_out_right)};
+    Joints joints = {VALUE(T_in_left), -VALUE(T_in_right), VALUE(phi_out_left), -VALUE(phi_out_right),
+                     VALUE(omega_out_left), -VALUE(omega_out_right)};
     return joints;
 }
 
@@ -197,12 +198,12 @@ static Failure evaluate(ModelData *data, const Joints *joints, double elapsed)
     Failure failure = NO_FAILURE;
     rates(data, &failure, STATE, joints, elapsed, rate);
     VALUE(omega_in_left) = STATE[CASE] + STATE[DIFF];
-    VALUE(omega_in_right) = STATE[CASE] - STATE[DIFF];
+    VALUE(omega_in_right) = -(STATE[CASE] - STATE[DIFF]);
     VALUE(alpha_in_left) = rate[CASE] + rate[DIFF];
-    VALUE(alpha_in_right) = rate[CASE] - rate[DIFF];
+    VALUE(alpha_in_right) = -(rate[CASE] - rate[DIFF]);
     halfshaft_torques(data, STATE, joints, elapsed, &left, &right);
     VALUE(T_load_left) = left;
-    VALUE(T_load_right) = right;
+    VALUE(T_load_right) = -right;
     VALUE(T_reaction) = reaction_torque(data, joints, rate[CASE]);
     VALUE(omega_motor) = VALUE(ratio) * STATE[CASE];
     VALUE(omega_wheel_left) = STATE[WHEEL_LEFT];

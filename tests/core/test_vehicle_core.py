@@ -211,8 +211,8 @@ def test_stepping_against_solve_ivp_of_the_equations_written_again(step):
         u = {"T_motor": rng.uniform(-100, 250), "T_in_left": rng.uniform(0, 900), "T_in_right": rng.uniform(0, 900),
              "phi_out_left": wheel[0] + rng.uniform(-0.1, 0.1), "phi_out_right": wheel[1] + rng.uniform(-0.1, 0.1),
              "omega_out_left": rng.uniform(10, 20), "omega_out_right": rng.uniform(10, 20)}
-        for name, value in u.items():
-            setattr(model, name, value)
+        for name, value in u.items():  # the right joint's quantities in its own frame, turning the other way
+            setattr(model, name, -value if name.endswith("_right") else value)
         assert model.step(t, step) == []
         y = solve_ivp(lambda tau, s: _independent_rates(p, u, tau, s), (0.0, step), y, method="DOP853",
                       rtol=1e-12, atol=1e-12).y[:, -1]
@@ -225,15 +225,17 @@ def test_stepping_against_solve_ivp_of_the_equations_written_again(step):
 
 
 def test_reaction_torque_is_the_momentum_balance():
-    """T_reaction + T_in_left + T_in_right = -(ratio J_motor + J_diff + 2 J_side) d(omega_case)/dt, with
-    d(omega_case)/dt from V1: checked on the model's outputs after a step with torques in."""
-    model = model_checks.started(VehicleDrivelineModel, T_motor=200.0, T_in_left=500.0, T_in_right=700.0)
+    """T_reaction + T_L + T_R = -(ratio J_motor + J_diff + 2 J_side) d(omega_case)/dt, with
+    d(omega_case)/dt from V1 (T_R = -T_in_right: the right joint's frame turns the other way): checked
+    on the model's outputs after a step with torques in."""
+    model = model_checks.started(VehicleDrivelineModel, T_motor=200.0, T_in_left=500.0, T_in_right=-700.0)
     assert model.step(0.0, 1e-3) == []
     d = model._drive()
     case_rate = (d.ratio * 200.0 - 1200.0) / dynamics.case_inertia(d)
     momentum = d.ratio * d.J_motor + d.J_diff + 2 * d.J_side
     assert model.T_reaction == pytest.approx(-1200.0 - momentum * case_rate, rel=1e-14)
-    assert model.alpha_in_left - model.alpha_in_right == pytest.approx((700.0 - 500.0) / d.J_side, rel=1e-12)
+    # the right joint's frame turns the other way: its acceleration and torque change sign
+    assert model.alpha_in_left + model.alpha_in_right == pytest.approx((700.0 - 500.0) / d.J_side, rel=1e-12)
 
 
 def test_a_step_needing_unbounded_work_is_refused():
