@@ -52,7 +52,8 @@ def _value(element: ET.Element) -> float | int | bool | str:
     kind = element.tag.rpartition("}")[2]
     text = element.get("value", "")
     try:
-        return {"Real": float, "Integer": int, "Boolean": lambda s: s.strip() in ("true", "1"), "String": str}[kind](text)
+        read = {"Real": float, "Integer": int, "Boolean": lambda s: s.strip() in ("true", "1"), "String": str}
+        return read[kind](text)
     except (KeyError, ValueError):
         raise PackageError(f"parameter value {text!r} of type {kind} cannot be read") from None
 

@@ -88,7 +88,8 @@ def test_coast_down_against_the_closed_form():
     v0, t_end = 30.0, 40.0
     solution, _ = closed_loop(d, 0.0, v0, t_end, points=5)
     r = d.r_wheel
-    m_total = d.m_vehicle + (2.0 * d.J_wheel + d.ratio**2 * d.J_motor + d.J_diff + 2.0 * d.J_side + 2.0 * d.J_wheel) / r**2
+    rotating = 2.0 * d.J_wheel + d.ratio**2 * d.J_motor + d.J_diff + 2.0 * d.J_side + 2.0 * d.J_wheel
+    m_total = d.m_vehicle + rotating / r**2
     F_r, c = d.f_roll * d.m_vehicle * G, 0.5 * d.rho_air * d.c_drag * d.A_front
     t = solution.t
     expected = math.sqrt(F_r / c) * np.tan(math.atan(v0 * math.sqrt(c / F_r)) - math.sqrt(F_r * c) * t / m_total)
@@ -176,9 +177,10 @@ def _independent_rates(p: dict[str, float], u: dict[str, float], tau: float, y: 
     Jc = p["ratio"] ** 2 * p["J_motor"] + p["J_diff"] + 2 * p["J_side"]
     wheel = np.array([wL, wR])
     angle = np.array([pL, pR])
-    out_angle = np.array([u["phi_out_left"], u["phi_out_right"]]) + np.array([u["omega_out_left"], u["omega_out_right"]]) * tau
     out_speed = np.array([u["omega_out_left"], u["omega_out_right"]])
-    torque = np.array([p["k_left"], p["k_right"]]) * (out_angle - angle) + np.array([p["c_left"], p["c_right"]]) * (out_speed - wheel)
+    out_angle = np.array([u["phi_out_left"], u["phi_out_right"]]) + out_speed * tau
+    stiffness, damping = np.array([p["k_left"], p["k_right"]]), np.array([p["c_left"], p["c_right"]])
+    torque = stiffness * (out_angle - angle) + damping * (out_speed - wheel)
     load = p["m_vehicle"] * G * np.cos(p["grade"]) * p["front_share"] / 2
     mu = np.array([p["mu_road_left"], p["mu_road_right"]])
     slip = np.array([sL, sR])

@@ -49,7 +49,8 @@ def test_every_output_of_every_component_is_a_column_headed_with_its_unit(native
         path = native.fmu_path(native_dir, component.model)
         for v in read_model_description(str(path)).modelVariables:
             if v.causality == "output" and v.type == "Real":
-                expected.append(f"{component.name}.{v.name} [{v.unit or (v.declaredType and v.declaredType.unit) or '1'}]")
+                unit = v.unit or (v.declaredType and v.declaredType.unit) or "1"
+                expected.append(f"{component.name}.{v.name} [{unit}]")
     assert header == expected
     np.testing.assert_array_equal(values, _master(fmi2_dir, native_dir))
 
