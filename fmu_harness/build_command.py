@@ -9,9 +9,9 @@ Python FMU per FMI version (:mod:`.fmu`). The native (C) FMUs of the models with
 the first time, while zig builds each target's C library into its cache). Without a C compiler
 the build says what to install in one line and builds the rest; it fails only with ``--native``.
 Then the FMI Cross-Check reference results are written next to each FMU, Python and native
-(:mod:`fmu_harness.checks.crosscheck`), and, once its FMI 2.0 FMUs are there, the driveline system's SSP
-packages, ``Driveline.ssp`` with the Python FMUs and ``native/Driveline.ssp`` with the native ones
-(:mod:`fmu_harness.runs.system`). Each stage shows its progress on standard error.
+(:mod:`fmu_harness.checks.crosscheck`), and, once their FMI 2.0 FMUs are there, the systems' SSP
+packages (``Driveline.ssp``, ``VehicleLaunch.ssp``) with the Python FMUs and under ``native/`` with the
+native ones (:mod:`fmu_harness.runs.system`). Each stage shows its progress on standard error.
 """
 
 from __future__ import annotations
@@ -71,13 +71,13 @@ def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Pa
             for fmu in fmus:
                 paths += crosscheck.write(fmu)
                 shown.advance(fmu.name)
-    driveline = system.driveline()
-    for variant in (None, args.dest) if natives else (None,):  # the Python system, then its native variant
-        if all(fmu.exists() for fmu in system.component_fmus(driveline, args.dest, variant).values()):
-            paths.append(system.write_ssp(driveline, args.dest, variant))
-        else:
-            print(f"{system.ssp_path(driveline, args.dest, variant)} not written: not all its FMUs were built",
-                  file=sys.stderr)
+    for packaged in system.systems():
+        for variant in (None, args.dest) if natives else (None,):  # the Python system, then its native variant
+            if all(fmu.exists() for fmu in system.component_fmus(packaged, args.dest, variant).values()):
+                paths.append(system.write_ssp(packaged, args.dest, variant))
+            else:
+                print(f"{system.ssp_path(packaged, args.dest, variant)} not written: not all its FMUs were built",
+                      file=sys.stderr)
     here = Path.cwd()
     for path in paths:
         print(path.relative_to(here) if path.is_relative_to(here) else path)

@@ -20,6 +20,7 @@ COMMANDS = {
     "sweep": ("fmu_harness.runs.sweep", "a parameter sweep of one FMU on Dask"),
     "interop": ("fmu_harness.checks.interop", "every FMU in every importer: the interoperability matrix"),
     "check": ("fmu_harness.runs.start_values", "the start values of an SSP package or an FMU, as the FMUs check them"),
+    "system": ("fmu_harness.system_command", "run an SSP package, every output of every component to CSV"),
 }
 
 
