@@ -61,8 +61,10 @@ SPEC = ModelSpec(
         Variable("phi_in", "output", 0.0, "Input shaft angle phi_1, integrated from omega_in", "rad", "deg"),
         Variable("phi_out", "output", 0.0, "Output shaft angle phi_0 (eq 18 or exact kinematics)", "rad", "deg"),
         Variable("delta_phi", "output", 0.0, "Angular deviation phi_out - phi_in (eq 18)", "rad", "deg"),
-        Variable("omega_out", "output", 0.0, "Output shaft speed, d(phi_out)/dt (consistent derivative of eq 18)",
-                 "rad/s", "rpm"),
+        Variable("omega_out", "output", 0.0,
+                 "Output shaft speed at the current bend, omega_in d(phi_out)/d(phi_in) (derivative of eq 18 or "
+                 "of the exact kinematics); d(phi_out)/dt only while beta is constant: a moving bend adds "
+                 "d(phi_out)/d(beta) beta_dot", "rad/s", "rpm"),
         Variable("omega_spin", "output", 0.0,
                  "Angular velocity of the output shaft about its own axis (T_in omega_in = T0 omega_spin "
                  "+ dKE/dt); differs from omega_out by the cone's geometric phase", "rad/s", "rpm"),
@@ -91,7 +93,9 @@ SPEC = ModelSpec(
                  "on its housing is -Rz_in (friction only)", "N"),
         Variable("P_friction", "output", 0.0, "Power dissipated by friction in the six sliding pairs", "W"),
         Variable("efficiency", "output", 1.0,
-                 "Instantaneous efficiency T_load omega_spin / (T_load omega_spin + P_friction); 1 without power flow",
+                 "Instantaneous efficiency, delivered over supplied power, with P_load = T_load omega_spin: drive "
+                 "(P_load >= 0) P_load / (P_load + P_friction), 1 without power flow; coast (the load drives, "
+                 "P_load + P_friction <= 0) (P_load + P_friction) / P_load; 0 in between (friction takes all)",
                  "1"),
         *ARM_OUTPUTS,
         # appended after every other variable: value references are positions, so those of
