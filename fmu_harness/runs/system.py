@@ -90,7 +90,8 @@ def driveline() -> System:
                                             "sine_amplitude": 50.0 * RPM, "sine_frequency": 5.0}),
         Component("coupling", "TripodCoupling", {"kinematics": 1, "beta": math.radians(20.0), "T_load": 150.0}),
     ]
-    connections = [Connection(("source", "omega"), ("coupling", "omega_in"))]
+    connections = [Connection(("source", "omega"), ("coupling", "omega_in")),
+                   Connection(("source", "alpha"), ("coupling", "alpha_in"))]
     if WATCHER in MODELS:
         components.append(Component("critical", WATCHER, {}))
         connections += [
