@@ -39,6 +39,7 @@ _PLACEHOLDER = {"Real": float("nan"), "Integer": 0, "Boolean": False, "String": 
 _LOG_TEXTS_KEPT = 1024
 #: One category object for every message (the wrappers would build, and leak, a new one each time).
 _ERROR_CATEGORY = "logStatusError"
+_WARNING_CATEGORY = "logStatusWarning"
 
 
 class Phase(Enum):
@@ -83,6 +84,7 @@ class ModelAdapter:
     causalities: ClassVar[type[Enum]]
     variabilities: ClassVar[type[Enum]]
     error_status: ClassVar[Enum]
+    warning_status: ClassVar[Enum]
     author = "driveline-fmus contributors"
     license = "MIT"
     version = __version__
@@ -191,7 +193,10 @@ class ModelAdapter:
                 self.initialize_model()
 
     def initialize_model(self) -> None:
-        self._guarded("exitInitializationMode", lambda: self._report(self.model.initialize(self.start_time)))
+        if self._guarded("exitInitializationMode", lambda: self._report(self.model.initialize(self.start_time))):
+            notice = self.model.start_notice()
+            if notice is not None:
+                self.log(self.log_text(notice), self.warning_status, _WARNING_CATEGORY)
 
     def terminate(self) -> None:
         if self._in_phase("terminate", Phase.STEPPING):

@@ -7,7 +7,7 @@ import math
 from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 CLOSED_FORM, EXACT = 0, 1
-RATES_FROM_INPUTS, RATES_FROM_SAMPLES = 0, 1
+RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 ARM_OUTPUTS = tuple(
     Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N")
     for name, text in (
@@ -101,15 +101,18 @@ SPEC = ModelSpec(
         # appended after every other variable: value references are positions, so those of
         # the variables above stay what hosts, SSP files and reference results know
         Variable("beta_dot", "input", 0.0,
-                 "Bend angle rate d(beta)/dt over the step (beta_rate = 0): the moving output bearing's "
+                 "Bend angle rate d(beta)/dt over the step (read as beta_rate says): the moving output bearing's "
                  "terms in the force balance; beta at the step's end is beta + beta_dot h + beta_ddot h^2/2",
                  "rad/s", derivative="beta"),
-        Variable("beta_ddot", "input", 0.0, "Bend angle acceleration d(beta_dot)/dt over the step (beta_rate = 0)",
+        Variable("beta_ddot", "input", 0.0,
+                 "Bend angle acceleration d(beta_dot)/dt over the step (read as beta_rate says)",
                  "rad/s2", derivative="beta_dot"),
-        Variable("beta_rate", "parameter", RATES_FROM_INPUTS,
+        Variable("beta_rate", "parameter", RATES_AUTOMATIC,
                  "Source of the bend angle's rates: 0 = the inputs beta_dot and beta_ddot, 1 = estimated "
-                 "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored)",
-                 type="Integer", min=RATES_FROM_INPUTS, max=RATES_FROM_SAMPLES),
+                 "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored), "
+                 "2 = automatic: the samples until the host sets beta_dot or beta_ddot non-zero (or their input "
+                 "derivatives), the inputs from then on; a warning at the start while both are 0",
+                 type="Integer", min=RATES_FROM_INPUTS, max=RATES_AUTOMATIC),
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
     relations=(
