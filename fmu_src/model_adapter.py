@@ -181,9 +181,10 @@ class ModelAdapter:
             self.phase = Phase.INITIALIZATION
 
     def exit_initialization_mode(self) -> None:
-        """Initialise the model at the start time. Parameters that no input can make valid enter
-        the error state here (the wrappers can only return OK: the reasons are logged and every
-        step is refused); bad inputs are logged and refuse every step until corrected."""
+        """Initialise the model at the start time. Parameters that no input can make valid, and
+        start values the model refuses (an input beyond its bounds, outputs it cannot compute),
+        enter the error state here, each reason logged once (the wrappers can only return OK:
+        every step is then refused)."""
         if self._in_phase("exitInitializationMode", Phase.INITIALIZATION):
             self.phase = Phase.STEPPING
             errors = self._guarded("exitInitializationMode", self.model.parameter_errors, [])
@@ -193,7 +194,10 @@ class ModelAdapter:
                 self.initialize_model()
 
     def initialize_model(self) -> None:
-        if self._guarded("exitInitializationMode", lambda: self._report(self.model.initialize(self.start_time))):
+        errors = self._guarded("exitInitializationMode", lambda: self.model.initialize(self.start_time))
+        for reason in errors or ():
+            self._fail("exitInitializationMode", reason)
+        if errors == []:
             notice = self.model.start_notice()
             if notice is not None:
                 self.log(self.log_text(notice), self.warning_status, _WARNING_CATEGORY)

@@ -7,6 +7,8 @@ import math
 from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 CLOSED_FORM, EXACT = 0, 1
+#: The largest bend angle the model accepts with any beta_max: the declared max of beta and of beta_max.
+BETA_LIMIT = math.radians(60.0)
 RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 ARM_OUTPUTS = tuple(
     Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N")
@@ -32,7 +34,7 @@ SPEC = ModelSpec(
         Variable("m_plunger", "parameter", 0.2, "Plunger (sliding pin) mass m, eqs 28-34", "kg", min=0.0),
         Variable("beta_max", "parameter", math.radians(45.0),
                  "Largest accepted bend angle beta (guard; the exact solver is verified up to 60 deg)",
-                 "rad", "deg", min=0.0, max=math.radians(60.0)),
+                 "rad", "deg", min=0.0, max=BETA_LIMIT),
         Variable("kinematics", "parameter", CLOSED_FORM,
                  "Kinematics of phi_out: 0 = closed form (eq 18, small r/l), 1 = exact closed-loop solution",
                  type="Integer", min=CLOSED_FORM, max=EXACT),
@@ -50,8 +52,10 @@ SPEC = ModelSpec(
         Variable("omega_in", "input", 2000.0 * math.pi / 30.0,
                  "Input shaft speed omega_1 at the step's start (rising at alpha_in over the step)",
                  "rad/s", "rpm"),
-        Variable("beta", "input", math.radians(30.0), "Bend angle beta between input and output axes",
-                 "rad", "deg", min=0.0, max=math.radians(60.0)),
+        Variable("beta", "input", math.radians(30.0),
+                 "Bend angle beta between input and output axes, at most beta_max (start value 45 deg; the "
+                 "declared max is beta_max's own); a start value beyond it is refused at initialisation",
+                 "rad", "deg", min=0.0, max=BETA_LIMIT),
         Variable("alpha_in", "input", 0.0,
                  "Input shaft angular acceleration d(omega_in)/dt over the step: phi_in advances by "
                  "omega_in h + alpha_in h^2/2 and the outputs at the step's end use omega_in + alpha_in h",

@@ -253,8 +253,12 @@ Status instance_exit_initialization(Instance *instance)
         return STATUS_ERROR;
     }
     initialize(instance, instance->start_time);
-    instance_log_messages(instance, STATUS_ERROR); /* inputs the host may still correct: logged, and OK */
-    if (instance->data.initialized && model_hooks.start_notice != NULL) {
+    if (instance->messages.count) { /* start values the model refuses (an input beyond its bounds): Error */
+        instance_log_messages(instance, STATUS_ERROR);
+        instance->mode = MODE_ERROR;
+        return STATUS_ERROR;
+    }
+    if (model_hooks.start_notice != NULL) {
         const char *notice = model_hooks.start_notice(&instance->data);
         if (notice != NULL) {
             instance_log(instance, STATUS_WARNING, notice, (const char *)NULL);
