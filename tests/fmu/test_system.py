@@ -122,11 +122,11 @@ def test_the_master_feeds_the_coupling_with_the_source_speed_and_acceleration(ma
     column = {name: master_result[:, i + 1] for i, name in enumerate(outputs)}
     h = driveline.step_size
     source = driveline.component("source").parameters
-    speed = np.concatenate([[source["omega_start"]], column["source.omega"][:-1]])
+    speed = np.concatenate([[source["omega_out_start"]], column["source.omega_out"][:-1]])
     start_acceleration = source["ramp_rate"] + 2 * np.pi * source["sine_frequency"] * source["sine_amplitude"]
-    acceleration = np.concatenate([[start_acceleration], column["source.alpha"][:-1]])
+    acceleration = np.concatenate([[start_acceleration], column["source.alpha_out"][:-1]])
     np.testing.assert_allclose(column["coupling.phi_in"], np.cumsum((speed + 0.5 * acceleration * h) * h), rtol=1e-12)
-    assert np.abs(column["coupling.phi_in"] - column["source.phi"]).max() < 1e-4
+    assert np.abs(column["coupling.phi_in"] - column["source.phi_out"]).max() < 1e-4
 
 
 @pytest.mark.parametrize("package", PACKAGES)
