@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from .cardan.model import CardanJointModel
 from .model import SteppedModel
+from .mounts.model import PowertrainMountsModel
 from .reducer.model import UniversalReducerModel
 from .rotor.model import CriticalSpeedsModel
 from .source.model import SpeedSourceModel
@@ -11,5 +12,8 @@ from .tripod.model import TripodCouplingModel
 
 MODELS: dict[str, type[SteppedModel]] = {
     model.spec.name: model
-    for model in (TripodCouplingModel, CardanJointModel, UniversalReducerModel, CriticalSpeedsModel, SpeedSourceModel)
+    for model in (
+        TripodCouplingModel, CardanJointModel, UniversalReducerModel, CriticalSpeedsModel, SpeedSourceModel,
+        PowertrainMountsModel,
+    )
 }

@@ -147,11 +147,15 @@ class SteppedModel(ABC):
             cls._parameter_relations = tuple(r for r in spec.relations if not spec.involves_input(r))
 
     def parameter_errors(self) -> list[str]:
-        """Each parameter against its bounds, then the relations between parameters, then the
-        model's own checks: each stage only once the one before it passed."""
+        """The declared checks (:meth:`declared_parameter_errors`), then the model's own: each stage
+        only once the one before it passed."""
+        return self.declared_parameter_errors() or self._guarded(self.extra_parameter_errors, "the parameters")
+
+    def declared_parameter_errors(self) -> list[str]:
+        """Each parameter against its bounds, then the relations between parameters (the spec's
+        rules alone, without the model's own checks, which may analyse the structure)."""
         errors = [e for v in self.spec.of("parameter") if (e := self._range_error(v))]
-        errors = errors or [e for r in self._parameter_relations if (e := self._relation_error(r))]
-        return errors or self._guarded(self.extra_parameter_errors, "the parameters")
+        return errors or [e for r in self._parameter_relations if (e := self._relation_error(r))]
 
     def input_errors(self) -> list[str]:
         """As :meth:`parameter_errors`, for the inputs and the relations involving them."""

@@ -56,6 +56,8 @@ UNITS: dict[str, Unit] = {
         Unit("N.m", {"kg": 1, "m": 2, "s": -2}),
         Unit("N/m", {"kg": 1, "s": -2}),
         Unit("N.s/m", {"kg": 1, "s": -1}),
+        Unit("N/s", {"kg": 1, "m": 1, "s": -3}),
+        Unit("N.m/s", {"kg": 1, "m": 2, "s": -3}),
         Unit("kg.m", {"kg": 1, "m": 1}, (DisplayUnit("g.mm", 1e6),)),
         Unit("Pa", {"kg": 1, "m": -1, "s": -2}, (DisplayUnit("MPa", 1e-6),)),
         Unit("kg/m3", {"kg": 1, "m": -3}),

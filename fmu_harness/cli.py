@@ -1,7 +1,8 @@
 """``driveline-fmus COMMAND [ARGS]``: the everyday commands in one console script.
 
 ``driveline-fmus build`` builds the FMUs, ``run`` runs the main job, ``sweep`` a parameter sweep
-on Dask, ``interop`` the importer matrix; ``driveline-fmus COMMAND --help`` lists a command's
+on Dask, ``interop`` the importer matrix, ``check`` the start values of an SSP package or FMU
+before another engine runs it; ``driveline-fmus COMMAND --help`` lists a command's
 options. Each command is the ``main`` of the module named in :data:`COMMANDS`.
 """
 
@@ -16,6 +17,7 @@ COMMANDS = {
     "run": ("fmu_harness.main", "the main job: simulate the FMUs, write CSV files and figures"),
     "sweep": ("fmu_harness.runs.sweep", "a parameter sweep of one FMU on Dask"),
     "interop": ("fmu_harness.checks.interop", "every FMU in every importer: the interoperability matrix"),
+    "check": ("fmu_harness.runs.start_values", "the start values of an SSP package or an FMU, as the FMUs check them"),
 }
 
 

@@ -1,7 +1,8 @@
 """The main job: simulate the project's FMUs through fmpy and write results and figures.
 
 Usage: ``python -m fmu_harness.main [--models models] [--out results]`` after
-``python build_fmu.py``. The studies run the native FMUs (``models/native/``); the Python FMUs
+``python build_fmu.py``. The studies run the native FMUs (``models/native/``; PowertrainMounts its
+FMI 2.0 Python FMU until its C port); the Python FMUs
 are compared with them in a process of their own (:mod:`fmu_harness.checks.python_fmu_check`), so that
 the pythonfmu wrapper's exit-time defect cannot end the main job.
 """
@@ -13,7 +14,7 @@ from pathlib import Path
 
 from .checks import python_fmu_check
 from .packaging import native
-from .studies import coupling_comparison, critical_speed_study, tripod_study
+from .studies import coupling_comparison, critical_speed_study, mounts_study, tripod_study
 
 
 def simulate(models: Path, out: Path) -> list[Path]:
@@ -27,7 +28,15 @@ def simulate(models: Path, out: Path) -> list[Path]:
     written = tripod_study.write(fmus["TripodCoupling"], out)
     written += coupling_comparison.write(fmus["CardanJoint"].parent, out)
     written += critical_speed_study.write(fmus["CriticalSpeeds"], out)
+    written += mounts_study.write(_mounts_fmu(models), out)
     return written + python_fmu_check.run(models, models, out)
+
+
+def _mounts_fmu(models: Path) -> Path:
+    """The native PowertrainMounts FMU once the model has its C port, else its FMI 2.0 Python FMU."""
+    if "PowertrainMounts" in native.native_models():
+        return native.fmu_path(models, "PowertrainMounts")
+    return models / "PowertrainMounts.fmu"
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import json
-import os
 import shutil
 import subprocess
 import sys
@@ -38,7 +36,9 @@ from ..doc_pages.sections import replace_section
 from ..packaging import fmu_path, native
 from ..runs.runner import FmuInstance
 from ..runs.scenario import scenario, standard_run
+from ..runs.start_values import StartValuesRefused
 from . import importers
+from .worker import answer, answer_in
 
 TOLERANCE = 1e-9
 RESULT = "interop result: "
@@ -99,11 +99,10 @@ def _engine(name: str) -> Callable[[Path, Path], Outcome]:
         if done.returncode:
             last = (done.stderr.strip().splitlines() or [""])[-1]
             return Outcome("fail", f"{name} exited with {done.returncode}: {last}")
-        # the engines' own messages may reach the pipe after the result: find its line
-        result = next((line for line in done.stdout.splitlines() if line.startswith(RESULT)), None)
+        result = answer_in(done.stdout, RESULT)
         if result is None:
             return Outcome("fail", f"{name} gave no result: {done.stdout.strip()[-200:]}")
-        return Outcome(**json.loads(result.removeprefix(RESULT)))
+        return Outcome(**result)
 
     return check
 
@@ -130,7 +129,10 @@ def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcom
     def inputs(time: float) -> dict[str, float]:
         return {f"m.{k}": v for k, v in case.input_values(time).items()}
 
-    session = SESSIONS[engine](case.step_size, fmus={"m": fmu}, start_values=inputs(0.0))
+    try:
+        session = SESSIONS[engine](case.step_size, fmus={"m": fmu}, start_values=inputs(0.0))
+    except StartValuesRefused as refused:
+        return Outcome("fail", f"refused before {engine} started: {refused}")
     try:
         result = importers.record(session, case.steps, case.step_size, [f"m.{n}" for n in case.outputs], inputs)
     finally:
@@ -212,11 +214,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.worker:
         engine, fmu, reference = args.worker
-        print(RESULT + json.dumps(asdict(simulate_in(engine, Path(fmu), Path(reference)))), flush=True)
-        sys.stderr.flush()
-        # a Python FMU's wrapper uses freed memory at exit and may abort the process after its
-        # result (wrapper defect 10, docs/robustness.md): leave without exit handlers
-        os._exit(0)
+        answer(RESULT, asdict(simulate_in(engine, Path(fmu), Path(reference))))
     table = matrix(args.models)
     text = markdown(table)
     print(text)

@@ -15,7 +15,9 @@ input (held constant) of the FMU. A run lasts ``--turns`` input turns at the poi
 Every point is one :func:`fmu_harness.runs.runner.simulate` call on a worker. The FMU's bytes are
 scattered to the workers once, extracted and their model description parsed once per worker
 process, so workers need no shared file system. A refused or crashed run becomes a ``failed``
-row with its reason.
+row with its reason; a point whose parameters break the spec's bounds or relations, which the
+FMU would refuse at initialisation, is not run (:mod:`fmu_harness.runs.start_values`), and when
+every point is, the command exits with the first reason before any worker starts.
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ from fmpy.model_description import ModelDescription
 from driveline.catalog import MODELS
 
 from .runner import StepRefused, simulate
+from .start_values import refusals
 
 Value = float | int | str
 Point = dict[str, Value]
@@ -337,12 +340,15 @@ def sweep(
     interface = shipped.interface
     for point in points:  # unknown names raise before anything runs
         interface.split(point)
+    refused = refused_points(interface.model, points)
     payload = client.scatter(shipped, broadcast=True, hash=False)
-    futures = [client.submit(run_point, payload, point, timing, pure=False) for point in points]
+    futures = {i: client.submit(run_point, payload, point, timing, pure=False)
+               for i, point in enumerate(points) if i not in refused}
     if show_progress:
-        progress(futures)
-    wait(futures)
-    rows = [{**point, **_outcome(future)} for point, future in zip(points, futures)]
+        progress(list(futures.values()))
+    wait(list(futures.values()))
+    rows = [{**point, **({"status": "failed", "reason": refused[i]} if i in refused else _outcome(futures[i]))}
+            for i, point in enumerate(points)]
     metrics = interface.metric_columns()
     names = list(dict.fromkeys(name for point in points for name in point))
     types = {"status": pa.string(), "reason": pa.string(), **{m: pa.float64() for m in metrics}}
@@ -351,6 +357,14 @@ def sweep(
     speeds = [interface.speed(point) for point in points]
     margins = None if interface.speed_start is None else critical_speed_margins(speeds, layout)
     return table if margins is None else table.append_column(MARGIN, pa.array(margins, pa.float64()))
+
+
+def refused_points(model: str, points: Sequence[Point]) -> dict[int, str]:
+    """``{index: reason}`` of the points whose values the FMU of ``model`` would refuse at
+    initialisation by the spec's bounds and relations (its first reason); such a point is not
+    run. The model's own checks (a structural analysis) are left to the run on a worker."""
+    found = {i: refusals(model, point, declared_only=True) for i, point in enumerate(points)}
+    return {i: reasons[0] for i, reasons in found.items() if reasons}
 
 
 def write_table(table: pa.Table, path: Path) -> None:
@@ -399,10 +413,14 @@ def main(argv: list[str] | None = None) -> None:
     except ValueError as error:
         parser.error(str(error))
     timing = Timing(args.turns, args.steps_per_turn, args.duration, args.step)
+    fmu = args.models / f"{args.model}.fmu"
+    refused = refused_points(Interface.of(fmu).model, points) if fmu.is_file() else {}
+    if points and len(refused) == len(points):
+        parser.exit(1, f"refused: every point; the first: {refused[0]}\n")
     with open_client(args.scheduler, args.workers) as client:
         print(f"{len(points)} runs of {args.model} on {client.scheduler.address}")
         try:
-            table = sweep(client, args.models / f"{args.model}.fmu", points, timing, True, args.layout)
+            table = sweep(client, fmu, points, timing, True, args.layout)
         except ValueError as error:
             parser.error(str(error))
     write_table(table, args.out)

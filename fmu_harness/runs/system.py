@@ -36,10 +36,9 @@ from driveline.variables import UNITS, ModelSpec, Variable
 
 from ..packaging import fmu_path, native
 from .runner import FmuInstance
+from .ssp import SSC, SSD, SSV
+from .start_values import Instance, StartValuesRefused, check_start_values
 
-SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
-SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
-SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 for prefix, uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
     ET.register_namespace(prefix, uri)
 
@@ -187,7 +186,9 @@ def write_ssp(system: System, models: Path, natives: Path | None = None) -> Path
 # -- fmpy master ----------------------------------------------------------------------------
 def simulate(system: System, models: Path, outputs: list[str] | None = None, natives: Path | None = None) -> np.ndarray:
     """Run ``system`` with the FMUs of :func:`component_fmus`; rows of t_k and ``outputs``
-    (default: all Real outputs) for t_1 ... t_N."""
+    (default: all Real outputs) for t_1 ... t_N. Parameters an FMU would refuse raise
+    ``StartValuesRefused`` before any FMU is loaded."""
+    check_start_values([Instance(c.name, c.model, c.parameters) for c in system.components])
     names = outputs or system.outputs()
     fmus = component_fmus(system, models, natives)
     instances = {c.name: FmuInstance(fmus[c.model], c.name) for c in system.components}
@@ -229,7 +230,10 @@ def main(argv: list[str] | None = None) -> None:
     system = driveline()
     natives = args.models if args.native else None
     print(write_ssp(system, args.models, natives))
-    result = simulate(system, args.models, natives=natives)
+    try:
+        result = simulate(system, args.models, natives=natives)
+    except StartValuesRefused as refused:
+        parser.exit(1, f"refused: {refused}\n")
     for name, last in zip(system.outputs(), result[-1, 1:]):
         print(f"{name} = {last:.9g}")
 

@@ -27,6 +27,7 @@ from fmu_harness.runs.runner import FmuInstance, StepRefused
 from fmu_harness.runs.scenario import scenario
 from support.alongside_the_core import expect_refused_parameters
 from support.native_agreement import TOLERANCE, beyond_tolerance, deviation, up_to_the_toml_reason
+from support.fmu_documentation import assert_documentation
 
 NATIVE = native.native_models()
 VERSIONS = ("2", "3")
@@ -245,10 +246,7 @@ def test_carried_sources_rebuild_with_fmpy(native_dir, tmp_path, loader, name, f
 
 @pytest.mark.parametrize("name", NATIVE)
 def test_fmu_carries_its_documentation_and_licence(native_dir, name, fmi):
-    with zipfile.ZipFile(_native(native_dir, name, fmi)) as archive:
-        page = archive.read(f"documentation/{native.snake_case(name)}.md").decode()
-        assert page.startswith("# ") and "## Variables" in page
-        assert archive.read("documentation/licenses/LICENSE.txt").decode().startswith("MIT License")
+    assert_documentation(_native(native_dir, name, fmi), name)
 
 
 DECLARED_RULES = [  # every kind of declared bound and relation the native models have, broken once
