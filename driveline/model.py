@@ -129,6 +129,10 @@ class SteppedModel(ABC):
     #: step and to the value it has at each other point.
     dependency_points: ClassVar[tuple[dict[str, Any], ...]] = ()
 
+    #: Why the model's native FMU offers co-simulation only ("": Model Exchange beside it, its states
+    #: the spec's ``states``): a state the spec cannot name as an output.
+    co_simulation_only: ClassVar[str] = ""
+
     def rounding_scales(self) -> dict[str, float]:
         """After :meth:`initialize`, the outputs whose initial value is a sum of terms that cancel
         (an equilibrium's accelerations, declared ``initial_depends_on=()``), each with the sum of
@@ -139,6 +143,11 @@ class SteppedModel(ABC):
     #: Files a native FMU of the model ships in its ``resources/`` folder, by their path here (the
     #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.
     resource_files: ClassVar[tuple[Path, ...]] = ()
+
+    def start_notice(self) -> str | None:
+        """What the log says once, at initialisation, of how the model reads inputs the host left at
+        their start values (a default it may not expect), or None; a warning, not a refusal."""
+        return None
 
     def extra_input_errors(self) -> list[str]:
         """Input checks the spec cannot declare, run once the declared ones pass."""
@@ -295,3 +304,18 @@ class DrivenShaftModel(SteppedModel):
     def evaluate(self, input_time: float) -> None:
         """Outputs from the current ``phi_in``, inputs and parameters; ``input_time`` is the
         communication point at which the host set the inputs (the start of the step)."""
+
+
+class TimeSourceModel(SteppedModel):
+    """A model whose outputs are exact functions of time: :meth:`at_time` at the start time and at the
+    end of each step, so they do not depend on the communication step."""
+
+    def start(self, start_time: float) -> None:
+        self.at_time(start_time)
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        self.at_time(current_time + step_size)
+
+    @abstractmethod
+    def at_time(self, t: float) -> None:
+        """The outputs at time ``t`` from the parameters."""

@@ -210,7 +210,7 @@ class CriticalSpeedsModel(SteppedModel):
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
     derived_parts = ANALYSIS_PARTS
-    native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d"),
+    native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d", least="%s"),
                         "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT, **NATIVE_CONSTANTS}
 
     def reset_internal_state(self) -> None:

@@ -24,6 +24,7 @@ SHARED = {
     "driveline.rotor.elements": ("_SERIES_LIMIT",),
     "driveline.rotor.transfer": ("MAX_PIECE_PHASE", "LOG_SCALE_CLIP"),
     "driveline.rotor.fem": ("SHARE_SLACK",),
+    "driveline.rotor.mechanism": ("RESOLVED_HINGE_SHARE",),
     "driveline.rotor.roots": ("SUBGRID", "MAX_DEPTH", "DIP_RATIO", "MAX_ITERATIONS", "XTOL", "RTOL"),
     "driveline.rotor.campbell": ("SLOPE_STEP", "SPLINE_RTOL", "REFINEMENTS", "MAX_KNOTS", "NOISE"),
     "driveline.rotor.damped": ("EXTRA_EIGENVALUES", "DENSE_SIZE", "SHIFT", "WHIRL_SHARE"),
@@ -36,6 +37,7 @@ SHARED = {
     "driveline.tripod.closed_form": ("PAPER_PHASE",),
     "driveline.tripod.plane_solver": ("FD_STEP", "LAST_UPDATE", "MAX_ITERATIONS"),
     "driveline.tripod.reactions": ("FRICTION_TOLERANCE", "MAX_FRICTION_ITERATIONS"),
+    "driveline.vehicle.dynamics": ("GRAVITY", "RATE_STEP", "MAX_SUBSTEPS", "STATE_SIZE"),
 }
 
 #: The kinds of failure the C port tells apart: the exceptions the Python core raises. ``ErrorKind``

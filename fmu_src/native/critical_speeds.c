@@ -317,6 +317,7 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
 {
     const char *layout = data->string_value[V_layout];
     int hinge = 0, node = 0, i;
+    char least[40];
     ErrorKind failed;
     if (layout[0] != '\0') {
         failed = driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
@@ -333,7 +334,8 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
     case MECHANISM_NONE:
         return failed;
     case MECHANISM_HINGE_FOLDS:
-        snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node);
+        python_g(driveline_least_resolved_stiffness(out), 6, least, sizeof least);
+        snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node, least);
         return ERROR_VALUE;
     case MECHANISM_RIGID_BODY:
         snprintf(error, ERROR_SIZE, "%s", MECHANISM_RIGID);

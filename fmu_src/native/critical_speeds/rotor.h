@@ -86,6 +86,8 @@ typedef struct {
  * MECHANISM_RIGID_BODY when the whole shaft moves rigidly; -1: out of memory. */
 enum { MECHANISM_NONE = 0, MECHANISM_HINGE_FOLDS = 1, MECHANISM_RIGID_BODY = 2 };
 int driveline_mechanism(const Driveline *driveline, int *hinge_index, int *hinge_node);
+/* mechanism.least_resolved_stiffness: RESOLVED_HINGE_SHARE EI / L, below which a hinge folds as a free one */
+double driveline_least_resolved_stiffness(const Driveline *driveline);
 
 /* The parameters of loader.one_piece_shaft (the FMU's one-piece tube). */
 typedef struct {
