@@ -142,11 +142,15 @@ class SteppedModel(ABC):
             cls._parameter_relations = tuple(r for r in spec.relations if not spec.involves_input(r))
 
     def parameter_errors(self) -> list[str]:
-        """Each parameter against its bounds, then the relations between parameters, then the
-        model's own checks: each stage only once the one before it passed."""
+        """The declared checks (:meth:`declared_parameter_errors`), then the model's own: each stage
+        only once the one before it passed."""
+        return self.declared_parameter_errors() or self._guarded(self.extra_parameter_errors, "the parameters")
+
+    def declared_parameter_errors(self) -> list[str]:
+        """Each parameter against its bounds, then the relations between parameters (the spec's
+        rules alone, without the model's own checks, which may analyse the structure)."""
         errors = [e for v in self.spec.of("parameter") if (e := self._range_error(v))]
-        errors = errors or [e for r in self._parameter_relations if (e := self._relation_error(r))]
-        return errors or self._guarded(self.extra_parameter_errors, "the parameters")
+        return errors or [e for r in self._parameter_relations if (e := self._relation_error(r))]
 
     def input_errors(self) -> list[str]:
         """As :meth:`parameter_errors`, for the inputs and the relations involving them."""
@@ -277,3 +281,18 @@ class DrivenShaftModel(SteppedModel):
     def evaluate(self, input_time: float) -> None:
         """Outputs from the current ``phi_in``, inputs and parameters; ``input_time`` is the
         communication point at which the host set the inputs (the start of the step)."""
+
+
+class TimeSourceModel(SteppedModel):
+    """A model whose outputs are exact functions of time: :meth:`at_time` at the start time and at the
+    end of each step, so they do not depend on the communication step."""
+
+    def start(self, start_time: float) -> None:
+        self.at_time(start_time)
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        self.at_time(current_time + step_size)
+
+    @abstractmethod
+    def at_time(self, t: float) -> None:
+        """The outputs at time ``t`` from the parameters."""

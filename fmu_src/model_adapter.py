@@ -167,12 +167,15 @@ class ModelAdapter:
 
     # -- life cycle --------------------------------------------------------------
     def setup_experiment(self, start_time: float, stop_time: float | None = None, tolerance: float | None = None) -> None:
-        if not self._in_phase("setupExperiment", Phase.INSTANTIATED):
-            return
-        if not _finite(start_time):
-            self._fail("setupExperiment", f"start time {start_time!r} is not finite")
-            return
-        self.start_time = start_time
+        if self._in_phase("setupExperiment", Phase.INSTANTIATED):
+            self.take_start_time("setupExperiment", start_time)
+
+    def take_start_time(self, call: str, start_time: float) -> None:
+        """The host's start time, the time the model is initialised at; one not finite is misuse."""
+        if _finite(start_time):
+            self.start_time = start_time
+        else:
+            self._fail(call, f"start time {start_time!r} is not finite")
 
     def enter_initialization_mode(self) -> None:
         if self._in_phase("enterInitializationMode", Phase.INSTANTIATED):

@@ -7,8 +7,8 @@ and on the native ones (:class:`support.families.Family`). Markers are assigned 
 test uses, so that test files carry none:
 
 * ``fmu``: the test uses a built FMU, Python or native (a fixture of this file);
-* ``importers``: its module drives the external importers (imports ``fmu_harness.checks.importers``
-  or ``fmu_harness.checks.interop``: libcosim, Ecos, fmutool);
+* ``importers``: its module drives the external importers (imports ``fmu_harness.checks.importers``,
+  ``fmu_harness.checks.interop`` or ``fmu_harness.checks.engine_refusals``: libcosim, Ecos, fmutool);
 * ``core``: neither, the FMI-free core and tools;
 * ``slow``: measured at :data:`SLOW_SECONDS` of CPU time or more in ``tests/durations.json``
   (:func:`pytest_runtest_call`: the test's call and fixtures, with the subprocesses they waited
@@ -47,7 +47,7 @@ from support.families import Family, NativeFamily, PythonFamily
 FmuPath = Callable[..., Path]
 
 FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir", "family"}
-IMPORTER_MODULES = ("fmu_harness.checks.importers", "fmu_harness.checks.interop")
+IMPORTER_MODULES = ("fmu_harness.checks.importers", "fmu_harness.checks.interop", "fmu_harness.checks.engine_refusals")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
 DURATIONS = Path(__file__).with_name("durations.json")

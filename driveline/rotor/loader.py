@@ -53,24 +53,16 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
-import os
-import re
-import stat
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
-import tomllib
-
+from ..layout_files import MAX_FILE_BYTES, MAX_NESTING, counted as _counted, number as _number, parse, read_layout
+from ..layout_files import shipped_path, unknown as _unknown
 from .driveline import Driveline
 from .elements import Bearing, ConcentratedMass, EndCondition, Hinge, ShaftSegment, Unbalance
 
 __all__ = ["example_path", "load_driveline", "loads_driveline", "one_piece_shaft"]
 
-#: A description of the largest driveline accepted is a few kilobytes.
-MAX_FILE_BYTES = 64 * 1024
-#: Brackets open at once (arrays, inline tables, table headers count one level each).
-MAX_NESTING = 16
 #: Segments of one description; the analysis cost grows with their number.
 MAX_SEGMENTS = 100
 #: Masses, bearings, hinges and unbalances of one description, each.
@@ -91,25 +83,6 @@ _UNBALANCE_KEYS = {"node", "position", "amount", "phase", "label"}
 _HINGE_KEYS = {"node", "position", "bending_stiffness", "label"}
 
 
-def _unknown(where: str, table: dict[str, Any], allowed: set[str]) -> None:
-    extra = sorted(set(table) - allowed)
-    if extra:
-        raise ValueError(f"{where}: unknown key {extra[0]!r} (allowed: {', '.join(sorted(allowed))})")
-
-
-def _number(where: str, key: str, value: Any, *, positive: bool = False, signed: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{where}.{key} must be a number, got {value!r}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{where}.{key} must be finite, got {value!r}")
-    if positive and v <= 0.0:
-        raise ValueError(f"{where}.{key} must be > 0, got {value!r}")
-    if v < 0.0 and not signed:
-        raise ValueError(f"{where}.{key} must be >= 0, got {value!r}")
-    return v
-
-
 def _node(where: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 0:
         raise ValueError(f"{where}.node must be an integer >= 0, got {value!r}")
@@ -120,31 +93,6 @@ def _flag(where: str, key: str, value: Any) -> bool:
     if not isinstance(value, bool):
         raise ValueError(f"{where}.{key} must be true or false, got {value!r}")
     return value
-
-
-def _table_list(data: dict[str, Any], key: str) -> list[dict[str, Any]]:
-    items = data.get(key, [])
-    if not isinstance(items, list) or not all(isinstance(t, dict) for t in items):
-        raise ValueError(f"{key} must be an array of tables ([[{key}]])")
-    return items
-
-
-def _counted(data: dict[str, Any], key: str, limit: int) -> list[dict[str, Any]]:
-    items = _table_list(data, key)
-    if len(items) > limit:
-        raise ValueError(f"{len(items)} [[{key}]] tables are more than the {limit} accepted")
-    return items
-
-
-def _nesting_errors(text: str, source: str) -> None:
-    """Refuse text whose brackets nest deeper than MAX_NESTING (brackets inside strings count
-    too: a conservative bound that keeps the TOML parser's recursion shallow)."""
-    depth = deepest = 0
-    for match in re.finditer(r"[\[{\]}]", text):
-        depth = depth + 1 if match.group() in "[{" else max(depth - 1, 0)
-        deepest = max(deepest, depth)
-        if deepest > MAX_NESTING:
-            raise ValueError(f"{source}: brackets nest deeper than {MAX_NESTING} levels")
 
 
 def _materials(data: dict[str, Any]) -> dict[str, tuple[float, float]]:
@@ -334,11 +282,7 @@ def _hinge(i: int, t: dict[str, Any], node: int, n_nodes: int) -> Hinge:
 
 def loads_driveline(text: str, source: str = "<string>") -> Driveline:
     """Build a :class:`Driveline` from TOML text (see the module docstring for the layout)."""
-    _nesting_errors(text, source)
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{source}: malformed TOML: {exc}") from None
+    data = parse(text, source)
     _unknown(source, data, _TOP_KEYS)
     name = data.get("name", "")
     if not isinstance(name, str):
@@ -373,46 +317,12 @@ def load_driveline(path: str | Path) -> Driveline:
     """Read a TOML driveline description from ``path`` (relative: to the working directory).
 
     Messages name the file by its absolute path."""
-    p = Path(path).absolute()
-    try:
-        raw = _read_regular_file(p)
-    except OSError as exc:
-        raise ValueError(f"cannot read driveline file {str(p)!r}: {exc.strerror}") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"driveline file {str(p)!r} is not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    try:
-        return loads_driveline(text, str(p))
-    except ValueError as exc:
-        message = str(exc)
-        raise ValueError(message if message.startswith(str(p)) else f"{p}: {message}") from None
-
-
-def _read_regular_file(path: Path) -> bytes:
-    """The bytes of ``path``, opened without blocking; only a regular file of at most MAX_FILE_BYTES."""
-    descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
-    try:
-        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
-            raise ValueError(f"driveline file {str(path)!r} is not a regular file")
-        data = b""
-        while len(data) <= MAX_FILE_BYTES and (chunk := os.read(descriptor, MAX_FILE_BYTES + 1 - len(data))):
-            data += chunk
-    finally:
-        os.close(descriptor)
-    if len(data) > MAX_FILE_BYTES:
-        raise ValueError(f"driveline file {str(path)!r} is larger than {MAX_FILE_BYTES} bytes")
-    return data
+    return read_layout(path, "driveline file", loads_driveline)
 
 
 def example_path(name: str = "two_piece_propshaft") -> Path:
     """Path of a shipped example description (``data/<name>.toml``)."""
-    if not re.fullmatch(r"\w{1,64}", name, re.ASCII):
-        raise ValueError(f"no shipped example named {name[:80]!r} (names are letters, digits and '_')")
-    p = Path(str(resources.files(__package__).joinpath("data", f"{name}.toml")))
-    if not p.is_file():
-        raise ValueError(f"no shipped example named {name!r}")
-    return p
+    return shipped_path(__package__, name, "example")
 
 
 def one_piece_shaft(

@@ -5,6 +5,9 @@ from __future__ import annotations
 from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 STRUCTURE = "Driveline structure (tunable: a change is re-analysed at the next step)"
+#: Smallest accepted omega_max [rad/s], far below any driveline speed and far above where the
+#: whirl and damping tables' splines over [0, omega_max] overflow (their knot spacing squared).
+OMEGA_MAX_MIN = 1e-3
 
 SPEC = ModelSpec(
     name="CriticalSpeeds",
@@ -61,8 +64,10 @@ SPEC = ModelSpec(
                  "Warning band: resonance_warning when |omega - resonance speed| < band * resonance speed",
                  "1", min=0.0, variability="tunable"),
         Variable("omega_max", "parameter", 1500.0,
-                 "Largest accepted |omega|; the whirl frequencies are tabulated up to it", "rad/s", "rpm",
-                 min=0.0, min_exclusive=True, variability="tunable"),
+                 "Largest accepted |omega|; the whirl frequencies are tabulated up to it (at least "
+                 f"{OMEGA_MAX_MIN:g} rad/s: the splines of the whirl and damping tables over [0, omega_max] "
+                 "overflow at tiny spans: 1e-140 rad/s measured)", "rad/s", "rpm",
+                 min=OMEGA_MAX_MIN, variability="tunable"),
         Variable("omega", "input", 300.0, "Current shaft speed (sign ignored)", "rad/s", "rpm"),
         Variable("omega_crit_1", "output", 0.0,
                  "First bending critical speed: synchronous whirl that unbalance excites (1e5 rad/s when none "

@@ -21,6 +21,7 @@ from pathlib import Path
 from driveline.rotor.loader import MAX_POINT_ELEMENTS, MAX_SEGMENTS, load_driveline
 from driveline.rotor.model import (CAMPBELL_POINTS, FE_ELEMENTS, MAX_ORDER, MAX_ORDERS, MAX_SEARCHED_MODES,
                                    CriticalSpeedsModel, parse_orders, searched_modes)
+from driveline.rotor.spec import OMEGA_MAX_MIN
 from driveline.rotor.work import MAX_ANALYSIS_SECONDS, STAGES, estimate
 
 #: The budgets of one analysis on the project's two-core machine: (seconds, bytes of memory).
@@ -175,7 +176,7 @@ def _most(make, top: int) -> int:
 def worst_cases() -> dict[str, tuple[str, dict]]:
     """Layout text and parameters of the worst inputs the limits allow, each kind at its edge, the
     propshaft engineer's shaft, and the issue's 566 s layout (refused)."""
-    slow = {"omega_max": 1e-3, "orders": "1", "omega": 0.0}
+    slow = {"omega_max": OMEGA_MAX_MIN, "orders": "1", "omega": 0.0}
 
     def stations(n: int) -> tuple[str, dict]:
         return layout_text(n, 1.4, 2 * (n + 1), 2 * (n + 1), min(MAX_POINT_ELEMENTS, 2 * n)), slow

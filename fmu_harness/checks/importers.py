@@ -7,7 +7,11 @@
 * ``libcosimpy`` (libcosim, FMI Library): FMI 1.0 and 2.0, single FMUs and SSP archives. It
   initialises the FMUs on the first step, so the outputs at the start time cannot be read.
 
-A :class:`Session` addresses variables as ``"instance.variable"``.
+A :class:`Session` addresses variables as ``"instance.variable"``. Both sessions first check the
+start values (the SSP's parameter bindings included) with the models' own validation
+(:func:`fmu_harness.runs.start_values.check_start_values`) and raise ``StartValuesRefused`` with
+the FMU's reason before the engine starts: libcosim aborts the process on a parameter the FMU
+refuses at initialisation (docs/hosting.md).
 """
 
 from __future__ import annotations
@@ -20,6 +24,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from ..runs.start_values import check_start_values, engine_instances
 
 NANOSECONDS = 1_000_000_000
 
@@ -65,9 +71,13 @@ def _load_tbb() -> None:
 
 
 def ecos_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp: Path | None = None,
-                 start_values: Mapping[str, float] | None = None, parameter_set: str | None = None) -> Session:
+                 start_values: Mapping[str, float] | None = None, parameter_set: str | None = None,
+                 checked: bool = True) -> Session:
     """Ecos running the FMUs ``{instance: path}`` (unconnected) or an SSP archive, initialised
-    with ``start_values`` and the SSP's ``parameter_set`` (Ecos applies none unless named)."""
+    with ``start_values`` and the SSP's ``parameter_set`` (Ecos applies none unless named);
+    ``checked=False`` skips the check of the start values (to observe the engine itself)."""
+    if checked:
+        check_start_values(engine_instances(fmus, ssp, start_values))
     _load_tbb()
     from ecospy import EcosSimulation, EcosSimulationStructure
 
@@ -95,9 +105,11 @@ def ecos_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp: 
 
 
 def cosim_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp: Path | None = None,
-                  start_values: Mapping[str, float] | None = None) -> Session:
+                  start_values: Mapping[str, float] | None = None, checked: bool = True) -> Session:
     """libcosim running the FMUs ``{instance: path}`` (unconnected) or an SSP archive, with
-    ``start_values`` as initial values."""
+    ``start_values`` as initial values; ``checked=False`` as for :func:`ecos_session`."""
+    if checked:
+        check_start_values(engine_instances(fmus, ssp, start_values))
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level

@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import json
-import os
 import shutil
 import subprocess
 import sys
@@ -34,11 +32,14 @@ from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
 
-from ..doc_pages.sections import replace_section
+from ..console import CommandParser, Progress
+from ..doc_pages.sections import replace_section, section
 from ..packaging import fmu_path, native
 from ..runs.runner import FmuInstance
 from ..runs.scenario import scenario, standard_run
+from ..runs.start_values import StartValuesRefused
 from . import importers
+from .worker import answer, answer_in
 
 TOLERANCE = 1e-9
 RESULT = "interop result: "
@@ -99,11 +100,10 @@ def _engine(name: str) -> Callable[[Path, Path], Outcome]:
         if done.returncode:
             last = (done.stderr.strip().splitlines() or [""])[-1]
             return Outcome("fail", f"{name} exited with {done.returncode}: {last}")
-        # the engines' own messages may reach the pipe after the result: find its line
-        result = next((line for line in done.stdout.splitlines() if line.startswith(RESULT)), None)
+        result = answer_in(done.stdout, RESULT)
         if result is None:
             return Outcome("fail", f"{name} gave no result: {done.stdout.strip()[-200:]}")
-        return Outcome(**json.loads(result.removeprefix(RESULT)))
+        return Outcome(**result)
 
     return check
 
@@ -130,7 +130,10 @@ def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcom
     def inputs(time: float) -> dict[str, float]:
         return {f"m.{k}": v for k, v in case.input_values(time).items()}
 
-    session = SESSIONS[engine](case.step_size, fmus={"m": fmu}, start_values=inputs(0.0))
+    try:
+        session = SESSIONS[engine](case.step_size, fmus={"m": fmu}, start_values=inputs(0.0))
+    except StartValuesRefused as refused:
+        return Outcome("fail", f"refused before {engine} started: {refused}")
     try:
         result = importers.record(session, case.steps, case.step_size, [f"m.{n}" for n in case.outputs], inputs)
     finally:
@@ -172,14 +175,18 @@ def fmus(models: Path, natives: Path | None = None) -> list[Fmu]:
 Table = dict[tuple[str, Family, str], dict[str, Outcome]]
 
 
-def matrix(models: Path, natives: Path | None = None) -> Table:
-    """``{(model, family, FMI version): {importer: outcome}}`` for every FMU of :func:`fmus`."""
+def matrix(models: Path, natives: Path | None = None, show_progress: bool = False) -> Table:
+    """``{(model, family, FMI version): {importer: outcome}}`` for every FMU of :func:`fmus`;
+    ``show_progress``: each FMU and importer on standard error."""
     table: Table = {}
-    for fmu in fmus(models, natives):
-        description = read_model_description(str(fmu.path))
-        table[description.modelName, fmu.family, description.fmiVersion] = {
-            i.name: outcome(i, fmu.path, fmu.reference) for i in IMPORTERS
-        }
+    found = fmus(models, natives)
+    with Progress("importer matrix", len(found) * len(IMPORTERS), enabled=show_progress) as shown:
+        for fmu in found:
+            description = read_model_description(str(fmu.path))
+            row = table[description.modelName, fmu.family, description.fmiVersion] = {}
+            for importer in IMPORTERS:
+                row[importer.name] = outcome(importer, fmu.path, fmu.reference)
+                shown.advance(f"{description.modelName} {fmu.family} FMI {description.fmiVersion} in {importer.name}")
     return table
 
 
@@ -205,19 +212,22 @@ def markdown(table: Table) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = CommandParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--update", type=Path, metavar="PAGE", help="markdown page whose matrix section to regenerate")
     parser.add_argument("--worker", nargs=3, metavar=("ENGINE", "FMU", "REFERENCE"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
         engine, fmu, reference = args.worker
-        print(RESULT + json.dumps(asdict(simulate_in(engine, Path(fmu), Path(reference)))), flush=True)
-        sys.stderr.flush()
-        # a Python FMU's wrapper uses freed memory at exit and may abort the process after its
-        # result (wrapper defect 10, docs/robustness.md): leave without exit handlers
-        os._exit(0)
-    table = matrix(args.models)
+        answer(RESULT, asdict(simulate_in(engine, Path(fmu), Path(reference))))
+    if not fmus(args.models):
+        parser.error(f"no built FMU in {args.models} (`driveline-fmus build` builds them; --models names another folder)")
+    if args.update:
+        try:
+            section(args.update, "interop")
+        except (OSError, ValueError) as error:
+            parser.error(f"--update {args.update}: {error}")
+    table = matrix(args.models, show_progress=True)
     text = markdown(table)
     print(text)
     for (name, family, version), row in table.items():

@@ -35,7 +35,7 @@ from driveline.catalog import MODELS
 
 from .failing_model import FAILURES, FailingModel, build_failing_fmus
 from .robustness_probe import (DISTINCT_TEXTS_LEAK, ECOS_IGNORES_DISCARD, FMI2_DISCARD, NO_GUID_CHECK,
-                                NO_START_TIME, STATUS_OK_LOGGED, VERDICT, WRAPPER_DEPARTURES)
+                                STATUS_OK_LOGGED, VERDICT, WRAPPER_DEPARTURES)
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Seconds a case may take; every case needs a few seconds at most (a host process start included).
@@ -147,8 +147,6 @@ def _misuse(fmu_path: FmuPath, fmi: str) -> list[Case]:
         model = "TripodCoupling" if kind == "fixed parameter after initialisation" else "CardanJoint"
         if kind == "wrong guid":
             departures = (NO_GUID_CHECK,)
-        elif kind == "nan start time" and fmi == "3":
-            departures = (NO_START_TIME,)
         else:
             departures = _refusing(fmi, STATUS_OK_LOGGED) if kind in LOGGED_WITH_OK else _refusing(fmi)
         found.append(Case("call sequence misuse", kind, "misuse", (str(fmu_path(model, fmi)), kind), fmi, departures))
@@ -188,10 +186,28 @@ LAYOUTS = (
 )
 
 
+#: The same for PowertrainMounts' layouts, read by the same rules (driveline/layout_files.py).
+MOUNT_LAYOUTS = (
+    ("fifo.toml", "fifo", "not a regular file"),
+    ("zero.toml", "dev zero", "not a regular file"),
+    ("folder.toml", "directory", "not a regular file"),
+    ("mounts.toml", "many mounts", "9 [[mounts]] tables are more than the 8 accepted"),
+    ("line.toml", "mounts on a line", "leave a rigid-body motion unrestrained"),
+    ("nested.toml", "deep nesting", "brackets nest deeper than 16 levels"),
+    ("large.toml", "large file", "is larger than 65536 bytes"),
+    ("missing.toml", "", "No such file or directory"),
+    ("../../../etc/passwd", "", "no shipped layout named"),
+)
+
+
 def _layouts(fmu_path: FmuPath, fmi: str) -> list[Case]:
     path = str(fmu_path("CriticalSpeeds", fmi))
     found = [Case("hostile layout values", f"layout {value[:24]!r}", "layout", (path, value, fragment, prepare), fmi,
                   _departures("bad_parameter", fmi)) for value, prepare, fragment in LAYOUTS]
+    mounts = str(fmu_path("PowertrainMounts", fmi))
+    found += [Case("hostile layout values", f"PowertrainMounts layout {value[:24]!r}", "layout",
+                   (mounts, value, fragment, prepare), fmi, _departures("bad_parameter", fmi))
+              for value, prepare, fragment in MOUNT_LAYOUTS]
     found.append(Case("hostile layout values", "layout of 10^5 characters", "long_string",
                       (path, "layout", 100000), fmi, _refusing(fmi, STATUS_OK_LOGGED)))
     return found
@@ -242,7 +258,7 @@ def _persistent(fmu_path: FmuPath, fmi: str) -> list[Case]:
 
 def _start_time(fmu_path: FmuPath, fmi: str) -> list[Case]:
     return [Case("outputs at a start time other than 0", "SpeedSource at t0 = 1 s", "start_time",
-                 (str(fmu_path("SpeedSource", fmi)), 1.0), fmi, (NO_START_TIME,) if fmi == "3" else ())]
+                 (str(fmu_path("SpeedSource", fmi)), 1.0), fmi)]
 
 
 def _engines(fmu_path: FmuPath, versions: Iterable[str]) -> list[Case]:

@@ -35,8 +35,10 @@ def package_root(name: str) -> Path:
 
 #: Sub-folders that hold no data of the Python FMUs: ``fmu_src/native/`` holds the native FMUs' C
 #: sources (85 kB more in every Python FMU, and with them a Python FMU of FMI 2.0 followed by one
-#: of FMI 3.0 in one process was seen to corrupt the heap of the wrappers' shared host).
-NOT_DATA = ("__pycache__", "native")
+#: of FMI 3.0 in one process was seen to corrupt the heap of the wrappers' shared host);
+#: ``fmu_src/docs`` the repository's doc pages (217 kB), of which ``documentation/`` carries the
+#: model's own (:mod:`.documentation`).
+NOT_DATA = ("__pycache__", "native", "docs")
 
 
 def data_files(package: Path) -> list[Path]:

@@ -13,14 +13,12 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..runs.runner import FmuInstance, simulate  # noqa: E402
-from .result_table import write_csv  # noqa: E402
+from ..runs.runner import FmuInstance, simulate
+from .figures import figure, save
+from .result_table import write_csv
 
 SPEED = 1500.0 * math.pi / 30.0  # rad/s
 SAMPLES_PER_TURN = 360
@@ -80,7 +78,7 @@ def write(models: Path, out: Path, betas_deg: list[float] | None = None) -> list
     betas_deg = betas_deg or [5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0]
     rows = speed_fluctuation_table(models, betas_deg)
     out.mkdir(parents=True, exist_ok=True)
-    table = write_csv(out / "coupling_comparison.csv", ("beta [deg]", "coupling", "fluctuation [1]", "order [1]"),
+    table = write_csv(out / "coupling_comparison.csv", ("beta [deg]", "coupling [name]", "fluctuation [1]", "order [1]"),
                       ((r["beta_deg"], r["coupling"], r["fluctuation"], r["order"] or "") for r in rows))
     markdown = out / "coupling_comparison.md"
     lines = ["| beta [deg] | " + " | ".join(c.name for c in COUPLINGS) + " |", "|---" * (len(COUPLINGS) + 1) + "|"]
@@ -91,20 +89,28 @@ def write(models: Path, out: Path, betas_deg: list[float] | None = None) -> list
         ]
         lines.append(f"| {beta_deg:g} | " + " | ".join(cells) + " |")
     markdown.write_text("Output-speed fluctuation (max - min) / mean over one input turn, dominant order:\n\n" + "\n".join(lines) + "\n")
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for coupling in COUPLINGS:
-        values = [max(row["fluctuation"], 1e-16) for row in rows if row["coupling"] == coupling.name]
-        ax.semilogy(betas_deg, values, "o-", label=coupling.name)
+    return [table, markdown, save(comparison_figure(rows, betas_deg), out / "coupling_comparison.png")]
+
+
+def comparison_figure(rows: list[dict[str, object]], betas_deg: list[float]) -> Figure:
+    """The fluctuation against beta on a log scale; a coupling whose fluctuation stays under
+    NO_ORDER_BELOW (the reducer's constant ratio gives 0) is named in the axes instead, at its
+    largest value: a log scale has no 0."""
+    fig, ax = figure(figsize=(7, 4))
+    for k, coupling in enumerate(COUPLINGS):
+        values = [row["fluctuation"] for row in rows if row["coupling"] == coupling.name]
+        if max(values) >= NO_ORDER_BELOW:
+            ax.semilogy(betas_deg, values, "o-", color=f"C{k}", label=coupling.name)
+        else:
+            ax.text(0.98, 0.04 + 0.07 * len(ax.texts), f"{coupling.name}: {max(values):.2g} at every bend angle (constant speed "
+                    "ratio), no point on a log scale", transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
     ax.set_xlabel("bend angle beta [deg]")
     ax.set_ylabel("output-speed fluctuation (max - min) / mean")
     ax.set_title(f"Coupling comparison at {SPEED * 30 / math.pi:.0f} rpm")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    figure = out / "coupling_comparison.png"
-    fig.savefig(figure, dpi=120)
-    plt.close(fig)
-    return [table, markdown, figure]
+    return fig
 
 
 def cardan_shaft(models: Path, beta: float, second_phase: float, step_size: float, turns: float = 1.0) -> np.ndarray:

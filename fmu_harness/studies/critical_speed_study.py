@@ -11,18 +11,16 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from driveline.rotor.campbell import whirl_branches
+from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline
+from driveline.rotor.spec import SPEC
 
-from driveline.rotor.campbell import whirl_branches  # noqa: E402
-from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline  # noqa: E402
-from driveline.rotor.spec import SPEC  # noqa: E402
-
-from ..runs.runner import FmuInstance  # noqa: E402
-from .result_table import column, write_csv  # noqa: E402
+from ..runs.runner import FmuInstance
+from .figures import figure, save
+from .result_table import column, write_csv
 
 RPM = 30.0 / math.pi
 ORDERS = (1, 2, 3)  # unbalance; Cardan joints; the tripod coupling (docs/tripod_coupling.md)
@@ -30,8 +28,16 @@ CRITICALS = ("omega_crit_1", "omega_crit_2", "omega_crit_3")
 MODES = 2  # whirl pairs the FMU outputs
 BEYOND = 1.1  # the ramp ends this far beyond the highest critical speed
 STEPS = 300
+#: Relative detunings sampled on both sides of each critical speed besides the ramp's equal steps:
+#: the unbalance response's peak at the first critical is 0.4 % wide at half its height.
+DETUNINGS = np.geomspace(1e-5, 0.03, 30)
 SENSES = {"forward": ("tab:blue", "-", "o"), "backward": ("tab:orange", "--", "s")}  # colour, line, marker
-MARKER_SIZE = {"forward": 8, "backward": 5}  # where they meet, the forward ring holds the backward square
+#: Crossing marks, nested where they meet: a backward crossing's filled square on top, inside a
+#: forward crossing's ring or a critical speed's larger red ring (the backward 1x crossings lie
+#: within 3 % of the critical speeds).
+MARKS = {"critical": {"marker": "o", "ms": 12, "mfc": "none", "mec": "red", "mew": 2.0, "zorder": 5},
+         "forward": {"marker": "o", "ms": 8, "mfc": "none", "mec": "tab:blue", "mew": 1.4, "zorder": 6},
+         "backward": {"marker": "s", "ms": 5, "mfc": "tab:orange", "mec": "tab:orange", "zorder": 7}}
 
 
 def critical_speeds(fmu: Path) -> tuple[float, ...]:
@@ -41,31 +47,39 @@ def critical_speeds(fmu: Path) -> tuple[float, ...]:
         return tuple(instance.get(CRITICALS))
 
 
-def ramp(fmu: Path, omega_max: float, steps: int = STEPS, seconds: float = 1.0) -> np.ndarray:
-    """The FMU on a speed ramp from 0 to ``omega_max`` over ``seconds``: each step's input is the
-    ramp's value at the step's end, so each row's outputs belong to its own time and speed."""
+def ramp_speeds(omega_max: float, criticals: tuple[float, ...], steps: int = STEPS) -> np.ndarray:
+    """The ramp's speeds: ``steps`` equal steps from 0 to ``omega_max``, and around each critical
+    speed the speeds ``omega_crit (1 +- DETUNINGS)`` and the critical speed itself, closer the
+    nearer they lie, so that a resonance peak is recorded at its height."""
+    near = np.concatenate([c * (1.0 + np.concatenate([-DETUNINGS, [0.0], DETUNINGS])) for c in criticals])
+    return np.unique(np.concatenate([np.linspace(0.0, omega_max, steps + 1), near[(near > 0) & (near < omega_max)]]))
+
+
+def ramp(fmu: Path, speeds: np.ndarray, seconds: float = 1.0) -> np.ndarray:
+    """The FMU on a speed ramp through ``speeds`` (rising from 0) at a constant rate, reaching the
+    last over ``seconds``: each step's input is the ramp's value at the step's end, so each row's
+    outputs belong to its own time and speed."""
     names = [v.name for v in SPEC.of("output")]
-    dt = seconds / steps
+    times = seconds * speeds / speeds[-1]
     with FmuInstance(fmu) as instance:
-        instance.initialize({"omega_max": omega_max, "omega": 0.0})
+        instance.initialize({"omega_max": float(speeds[-1]), "omega": float(speeds[0])})
         read, write = instance.reader(names), instance.writer(["omega"])
-        rows = [(0.0, 0.0, *read())]
-        for k in range(1, steps + 1):
-            speed = omega_max * k / steps
-            write([speed])
-            instance.step(dt)
-            rows.append((k * dt, speed, *read()))
+        rows = [(times[0], speeds[0], *read())]
+        for k in range(1, len(speeds)):
+            write([speeds[k]])
+            instance.step(times[k] - times[k - 1])
+            rows.append((times[k], speeds[k], *read()))
     return np.array(rows, dtype=[(n, float) for n in ("time", "omega", *names)])
 
 
 def crossings(spins: np.ndarray, whirl: np.ndarray, order: int) -> list[float]:
     """Speeds [rad/s] where ``order * spin`` meets the branch ``whirl(spins)`` (linear between samples)."""
     gap = order * spins - whirl
-    found = []
-    for i in np.flatnonzero(np.sign(gap[:-1]) * np.sign(gap[1:]) < 0):
+    found = [float(spins[i]) for i in np.flatnonzero(gap[1:] == 0.0) + 1]  # a sample on the branch (the ramp
+    for i in np.flatnonzero(np.sign(gap[:-1]) * np.sign(gap[1:]) < 0):  # samples each critical speed)
         fraction = gap[i] / (gap[i] - gap[i + 1])
         found.append(float(spins[i] + fraction * (spins[i + 1] - spins[i])))
-    return found
+    return sorted(found)
 
 
 def branches(result: np.ndarray) -> dict[tuple[str, int], np.ndarray]:
@@ -83,47 +97,45 @@ def write(fmu: Path, out: Path) -> list[Path]:
     """Run the study, write the two CSV files and the figure into ``out``; return the files written."""
     out.mkdir(parents=True, exist_ok=True)
     criticals = critical_speeds(fmu)
-    omega_max = math.ceil(BEYOND * max(criticals) / 100.0) * 100.0
-    result = ramp(fmu, omega_max)
+    result = ramp(fmu, ramp_speeds(BEYOND * max(criticals), criticals))
     table = write_csv(out / "critical_speeds.csv",
                       ("mode [1]", "critical speed [rad/s]", "critical speed [rpm]"),
                       ((k, f"{w:.6g}", f"{w * RPM:.6g}") for k, w in enumerate(criticals, start=1)))
     names = result.dtype.names
     ramp_csv = write_csv(out / "critical_speeds_ramp.csv", ("time [s]", *(column(SPEC, n) for n in names[1:])),
                          result.tolist())
-    figure = campbell_figure(result, branches(result), criticals, out / "campbell_diagram.png")
-    return [table, ramp_csv, figure]
+    diagram = save(campbell_figure(result, branches(result), criticals), out / "campbell_diagram.png")
+    return [table, ramp_csv, diagram]
 
 
-def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray], criticals: tuple[float, ...],
-                    path: Path) -> Path:
+def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray],
+                    criticals: tuple[float, ...]) -> Figure:
     """Whirl branches against shaft speed, the order lines labelled inside the axes, every crossing
     marked with its speed; the 1x forward crossings (the critical speeds) in red."""
     spins = result["omega"]
     x_top = spins[-1] * RPM
     y_top = 1.08 * max(np.nanmax(values) for values in whirl.values()) * RPM
-    fig, ax = plt.subplots(figsize=(9, 7))
+    fig, ax = figure(figsize=(9, 7))
     for (sense, mode), values in whirl.items():
         color, style, _ = SENSES[sense]
         from_fmu = mode <= MODES
         label = {1: f"{sense} whirl, modes 1-{MODES} (FMU)", MODES + 1: f"{sense} whirl, mode {mode} (rotor core)"}
         ax.plot(spins * RPM, values * RPM, style, color=color, lw=1.6 if from_fmu else 1.1,
-                alpha=1.0 if from_fmu else 0.75, label=label.get(mode))
+                alpha=1.0 if from_fmu else 0.75, label=label.get(mode, f"_{sense} whirl, mode {mode}"))
     for (sense, mode), values in whirl.items():
-        color, _, marker = SENSES[sense]
+        color = SENSES[sense][0]
         for order in ORDERS:
             for speed in crossings(spins, values, order):
                 critical = order == 1 and sense == "forward"
-                ax.plot(speed * RPM, order * speed * RPM, marker, ms=MARKER_SIZE[sense],
-                        mfc="red" if critical else "none", mec="red" if critical else color, mew=1.4,
-                        zorder=5 if critical else 7 if sense == "forward" else 6)
+                ax.plot(speed * RPM, order * speed * RPM, ls="none", **MARKS["critical" if critical else sense],
+                        label=f"_{'critical speed' if critical else sense} {order}x, mode {mode}")  # not in the legend
                 ax.annotate(f"{speed * RPM:.0f}", (speed * RPM, order * speed * RPM),
                             xytext=(5, -11) if sense == "forward" else (-5, 4), textcoords="offset points",
                             ha="left" if sense == "forward" else "right", fontsize=7.5,
                             color="red" if critical else color, fontweight="bold" if critical else "normal")
-    ax.plot([], [], "o", mfc="red", mec="red", label="critical speed (1x, forward) [rpm]")
-    ax.plot([], [], "o", ms=8, mfc="none", mec="tab:blue", label="order resonance, forward [rpm]")
-    ax.plot([], [], "s", ms=5, mfc="none", mec="tab:orange", label="order resonance, backward [rpm]")
+    for mark, label in (("critical", "critical speed (1x, forward) [rpm]"), ("forward", "order resonance, forward [rpm]"),
+                        ("backward", "order resonance, backward [rpm]")):
+        ax.plot([], [], ls="none", **MARKS[mark], label=label)
     ax.set_xlim(0, x_top)
     ax.set_ylim(0, y_top)
     ax.set_xlabel("shaft speed [rpm]")
@@ -140,6 +152,4 @@ def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray]
         angle = ax.transData.transform_angles(np.array([math.degrees(math.atan(order))]), at[None, :])[0]
         ax.annotate(f"{order}x", at, xytext=(-4, 4), textcoords="offset points", fontsize=10, color="0.2",
                     ha="right", va="bottom", rotation=angle, rotation_mode="anchor")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from driveline.rotor.damped import DampedRotor
 from driveline.rotor.driveline import EXCITED_SHARE
 from driveline.rotor.fem import elements_by_length
 from driveline.rotor.model import CriticalSpeedsModel
+from driveline.rotor.spec import OMEGA_MAX_MIN, SPEC
 from driveline.rotor.unbalance_outputs import DAMPED_MODES, DAMPING_POINTS, FE_ELEMENTS, TABLE_ELEMENTS
 from fmu_harness.runs.runner import FmuInstance, StepRefused, simulate
 
@@ -212,3 +214,35 @@ def test_a_layout_brings_its_own_unbalance_and_damping(tmp_path):
     assert model.bearing_force_max == pytest.approx(np.max(expected.bearing_forces), rel=1e-12)
     plain = model_checks.started(CriticalSpeedsModel, layout="two_piece_propshaft")
     assert plain.unbalance_response == 0.0 and plain.bearing_force_max == 0.0  # no [[unbalances]]
+
+
+#: The edges of every Real parameter that the property tests draw (``support.alongside_the_core``:
+#: +-1e300, one below the minimum, one above the maximum), and omega_max's declared minimum from
+#: both sides with the values of issue 34 (1e-300 and 1e-150 rad/s: the Python core's tables
+#: overflowed while the native ones ran).
+EDGES = [(v.name, value) for v in SPEC.of("parameter") if v.type == "Real"
+         for value in (1e300, -1e300, *([v.min - 1.0] if v.min is not None else []),
+                       *([v.max + 1.0] if v.max is not None else []))] + [
+    ("omega_max", OMEGA_MAX_MIN), ("omega_max", math.nextafter(OMEGA_MAX_MIN, 0.0)), ("omega_max", 1e-150),
+    ("omega_max", 1e-300)]
+
+
+@pytest.mark.parametrize("name, value", EDGES)
+def test_parameter_edges_get_the_cores_answer(family, name, value):
+    """At each edge both families give the core's answer: refused with its reason, or run with its
+    outputs (the family's tolerance)."""
+    start = {name: value, "omega": 0.0}
+    core = CriticalSpeedsModel()
+    for variable, start_value in start.items():
+        setattr(core, variable, start_value)
+    errors = core.initialize(0.0)
+    outputs = [v.name for v in SPEC.of("output") if v.type == "Real"]
+    with family.open("CriticalSpeeds") as fmu:
+        if errors:
+            with pytest.raises(StepRefused) as refused:  # native: at initialisation; Python: the first step
+                fmu.initialize(start)
+                fmu.step(1e-2)
+            assert any(family.reason(errors[0]) in family.reason(message) for message in refused.value.messages)
+        else:
+            fmu.initialize(start)
+            family.assert_outputs_agree(outputs, [fmu.get(outputs)], [[getattr(core, o) for o in outputs]])

@@ -3,16 +3,23 @@ a default experiment that runs, and refusals."""
 
 from __future__ import annotations
 
+import ctypes
 import math
+import sys
 
 import pytest
 from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
-from fmu_harness.runs.runner import StepRefused
+from fmu_harness.packaging import native
+from fmu_harness.runs.runner import FmuInstance, StepRefused
+from fmu_src.fmi3_slave import host_start_time
+from support.native_agreement import rows_beyond_tolerance
 
 INPUTS = [(name, v.name) for name, model in MODELS.items() for v in model.spec.of("input") if v.type == "Real"]
 PARAMETERS = [(name, v.name) for name, model in MODELS.items() for v in model.spec.of("parameter") if v.type == "Real"]
+#: A start time other than 0, at which SpeedSource's outputs differ from those at t = 0.
+START_TIME = 5.0
 
 
 @pytest.mark.parametrize("name", list(MODELS))
@@ -64,3 +71,33 @@ def test_bad_step_size_is_refused(family, name, step):
         with pytest.raises(StepRefused) as refused:
             fmu.step(step)
     assert "step size" in refused.value.messages[0]
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_initial_outputs_are_those_at_the_start_time(family, name, fmi, native_dir):
+    """Initialised at t0 = 5 s (FMI 2.0: fmi2SetupExperiment, FMI 3.0: fmi3EnterInitializationMode),
+    the outputs read before the first step are the core's at t0, and the native FMI 2.0 FMU's
+    within the native tolerances (docs/robustness.md, issue 33: pythonfmu3 withholds the start time)."""
+    outputs = [v.name for v in MODELS[name].spec.of("output") if v.type == "Real"]
+    core = MODELS[name]()
+    assert core.initialize(START_TIME) == []
+    with family.open(name, fmi) as fmu:
+        fmu.initialize(start_time=START_TIME)
+        initial = fmu.get(outputs)
+    with FmuInstance(native.fmu_path(native_dir, name, "2"), "reference") as reference:
+        reference.initialize(start_time=START_TIME)
+        native_initial = reference.get(outputs)
+    family.assert_outputs_agree(outputs, [initial], [[getattr(core, output) for output in outputs]])
+    assert not rows_beyond_tolerance(outputs, [native_initial], [initial]).any()
+
+
+def test_the_fmi3_start_time_is_read_from_a_python_hosts_call_only():
+    """pythonfmu3 withholds startTime: the adapter reads it from the calling frame named after the
+    standard's function (a float or a ctypes fmi3Float64), and finds none where no such frame is."""
+    def fmi3EnterInitializationMode(instance, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime):
+        return host_start_time(sys._getframe())
+
+    assert fmi3EnterInitializationMode(None, False, 0.0, ctypes.c_double(2.5), False, 0.0) == 2.5
+    assert fmi3EnterInitializationMode(None, False, 0.0, 7, False, 0.0) == 7.0
+    assert math.isnan(fmi3EnterInitializationMode(None, False, 0.0, math.nan, False, 0.0))
+    assert host_start_time(sys._getframe()) is None  # a host written in C leaves no such frame

@@ -67,9 +67,11 @@ def test_sweep_matches_direct_runs_and_writes_parquet(client, tripod_fmu, tmp_pa
 
 
 def test_failed_points_are_reported_with_their_reason(client, tripod_fmu):
-    points = [{"beta": 0.3}, {"beta": 0.9}, {"beta": 0.9, "beta_max": 1.0}, {"beta": 0.3, "omega_in": 0.0}]
+    points = [{"beta": 0.3}, {"beta": 0.9}, {"beta": 0.9, "beta_max": 1.0}, {"beta": 0.3, "omega_in": 0.0},
+              {"beta": 0.3, "r": -1.0}]
     rows = sweep(client, tripod_fmu, points, TIMING).to_pylist()
-    assert [row["status"] for row in rows] == ["ok", "failed", "ok", "failed"]
+    assert [row["status"] for row in rows] == ["ok", "failed", "ok", "failed", "failed"]
+    assert rows[4]["reason"] == "parameter r = -1000 mm must be positive"  # checked, not run
     assert "beta_max" in rows[1]["reason"] and "Discard" in rows[1]["reason"]
     assert rows[3]["reason"].startswith("ValueError: a run of whole input turns needs a finite non-zero omega_in")
     assert rows[1]["T_in_mean"] is None and rows[3]["T_in_mean"] is None

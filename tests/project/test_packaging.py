@@ -12,9 +12,10 @@ from pathlib import Path
 import pytest
 
 from fmu_harness import cli
-from fmu_harness.packaging import FMI_VERSIONS, fmu_path, native
+from fmu_harness.packaging import FMI_VERSIONS, documentation, fmu_path, native, toolchain
 
 from conftest import SLOW_SECONDS, measured
+from support.fmu_documentation import assert_documentation
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -39,11 +40,10 @@ def test_each_fmu_ships_the_modules_its_model_imports(fmu_path, version):
 
 
 @pytest.mark.parametrize("version", ["2", "3"])
-def test_each_fmu_carries_its_doc_page_and_the_licence(fmu_path, model_name, version):
-    with zipfile.ZipFile(fmu_path(model_name, version)) as archive:
-        page = archive.read(f"documentation/{native.snake_case(model_name)}.md").decode()
-        assert page == (ROOT / "docs" / f"{native.snake_case(model_name)}.md").read_text()
-        assert archive.read("documentation/licenses/LICENSE.txt") == (ROOT / "LICENSE").read_bytes()
+def test_each_fmu_carries_its_doc_page_as_index_html_and_the_licence(fmu_path, model_name, version):
+    """``documentation/index.html`` from the model's page, the page, the licence; no other page,
+    in ``documentation/`` or among the resources (the 14 pages were 217 kB of each Python FMU)."""
+    assert_documentation(fmu_path(model_name, version), model_name)
 
 
 @pytest.mark.parametrize("version", ["2", "3"])
@@ -108,11 +108,18 @@ def test_every_command_has_help(command, capsys):
 
 @pytest.mark.fmu
 def test_build_command_builds_one_model(tmp_path):
-    """The console script's build, in a process of its own as a user runs it."""
+    """The console script's build, in a process of its own as a user runs it: by default the native
+    FMU's binary for this machine alone, each stage's progress shown, n of N."""
     run = subprocess.run([sys.executable, "-m", "fmu_harness.cli", "build", "--dest", str(tmp_path), "--fmi", "2",
-                          "--no-references", "--host-only", "SpeedSource"], capture_output=True, text=True, timeout=300,
-                         cwd=ROOT)
+                          "--no-references", "SpeedSource"], capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert run.returncode == 0, run.stderr[-2000:]
+    progress = run.stderr.splitlines()
+    assert progress[0] == "Python FMUs [1/1] SpeedSource FMI 2.0"
+    host = toolchain.host_platform()
+    compiled = [line.split("[")[1].split("]")[0].split("/") for line in progress
+                if line.startswith(f"native FMUs: compiling for {host.tuple} [")]
+    assert compiled[0][0] == "1" and compiled[-1][0] == compiled[-1][1] == compiled[0][1]
+    assert f"native FMUs: linking [1/1] SpeedSource{host.suffix} for {host.tuple}" in progress
     built = fmu_path(tmp_path, "SpeedSource")
     native_built = native.fmu_path(tmp_path, "SpeedSource")  # the model has a C port too
     assert run.stdout.split() == [str(built), str(native_built)]
@@ -141,3 +148,28 @@ def test_markers_follow_what_the_tests_use():
     run = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "--fmi", "2",
                           "tests/project/test_packaging.py"], capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert "[2]" in run.stdout and "[3]" not in run.stdout
+
+
+def test_doc_page_rendering():
+    """Each construct the doc pages use, rendered; a link to another page of the repository is its
+    text and path, a link to a section of the page stays a link."""
+    page = "\n".join([
+        "# Model — a title", "", "Text with `a | b`, **bold**, *italic* and 2 * 3 * 4,", "joined lines.", "",
+        "* item one", "  continued", "* item [two](other_page.md#a-section)", "", "1. first", "2. [back](#model--a-title)",
+        "", "| name | rule |", "|---|---|", "| `x` | `|x| <= 1` |", "", "```bash", "a < b && c", "```", "",
+        "    indented code", "", "<!-- variables:start -->", "## Variables", "See [the web](https://fmi-standard.org).",
+    ])
+    rendered = documentation.to_html(page, "model.md")
+    body = rendered.split("<body>\n", 1)[1].split("\n</body>", 1)[0]
+    assert body.splitlines() == [
+        '<h1 id="model--a-title">Model — a title</h1>',
+        "<p>Text with <code>a | b</code>, <strong>bold</strong>, <em>italic</em> and 2 * 3 * 4, joined lines.</p>",
+        "<ul>", "<li>item one continued</li>",
+        "<li>item two (<code>docs/other_page.md</code> in the repository)</li>", "</ul>",
+        "<ol>", "<li>first</li>", '<li><a href="#model--a-title">back</a></li>', "</ol>",
+        "<table>", "<tr><th>name</th><th>rule</th></tr>", "<tr><td><code>x</code></td><td><code>|x| &lt;= 1</code></td></tr>",
+        "</table>",
+        "<pre><code>a &lt; b &amp;&amp; c</code></pre>", "<pre><code>indented code</code></pre>",
+        '<h2 id="variables">Variables</h2>', '<p>See <a href="https://fmi-standard.org">the web</a>.</p>',
+    ]
+    assert "<title>Model — a title</title>" in rendered

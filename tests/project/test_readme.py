@@ -10,6 +10,7 @@ import pytest
 
 from driveline.catalog import MODELS
 from fmu_harness.runs import system
+from fmu_harness.packaging import documentation
 from fmu_harness.doc_pages.sections import model_page, replace_section, section
 from fmu_harness.doc_pages.variable_table import markdown
 
@@ -38,7 +39,7 @@ def test_a_stale_table_is_found_and_regenerated(tmp_path):
 
 
 def test_readme_holds_the_ci_test_command():
-    assert 'python -m pip install -e ".[test,interop]" && python -m pytest -q' in README.read_text()
+    assert 'python -m pip install -e ".[test,interop]" && python -m pytest -q -n 2' in README.read_text()
 
 
 def test_readme_connects_the_models_as_the_ssp_system_does():
@@ -70,5 +71,4 @@ def test_relative_links_lead_to_files_and_headings(page):
 
 def _anchors(markdown_text: str) -> set[str]:
     """GitHub's heading anchors: lower case, punctuation dropped, spaces as hyphens."""
-    headings = re.findall(r"^#+ (.+)$", markdown_text, flags=re.MULTILINE)
-    return {re.sub(r"[^\w\- ]", "", h).strip().lower().replace(" ", "-") for h in headings}
+    return {documentation.anchor(h) for h in re.findall(r"^#+ (.+)$", markdown_text, flags=re.MULTILINE)}

@@ -1,0 +1,115 @@
+"""Time stepping of the powertrain on its mounts: exact over each step (:mod:`.exact_step`).
+
+The model starts at rest in the static equilibrium under the weight and the inputs at the
+start time. A step moves the state ``(q, q')`` by the propagator of its size (built again only
+when the size or a parameter changes) under the inputs at the step's start and their rates
+(first-order hold; rates 0: zero-order hold); the accelerations and mount forces are those at
+the step's end, under the inputs moved on by their rates.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..model import SteppedModel
+from .exact_step import Propagator, work_error
+from .layout import MAX_MOUNTS, Layout, load_layout, shipped_layout
+from .rigid_body import COORDINATES
+from .spec import AXES, INPUTS, SHARED_LAYOUT, SIDES, SPEC, derivative_name
+from .system import MountSystem, Placement
+
+RATES = tuple(derivative_name(name) for name in INPUTS)
+VELOCITIES = tuple(f"{name}_dot" for name in COORDINATES)
+ACCELERATIONS = tuple(f"{name}_ddot" for name in COORDINATES)
+
+
+def read_layout(layout: str) -> Layout:
+    """The layout: a file (a path ending in '.toml', any case) or a shipped name."""
+    return load_layout(Path(layout) if layout.lower().endswith(".toml") else shipped_layout(layout))
+
+
+class PowertrainMountsModel(SteppedModel):
+    """The ``PowertrainMounts`` co-simulation model."""
+
+    spec = SPEC
+    derived_state = ("_system", "_built_for", "_propagator")
+    resource_files = (Path(__file__).parent / "data" / f"{SHARED_LAYOUT}.toml",)
+
+    def reset_internal_state(self) -> None:
+        self._system: MountSystem | None = None
+        self._built_for: tuple | None = None
+        self._propagator: Propagator | None = None
+
+    def _vector(self, template: str, side: str = "") -> np.ndarray:
+        return np.array([float(getattr(self, template.format(axis=axis, side=side))) for axis in AXES])
+
+    def extra_parameter_errors(self) -> list[str]:
+        """Read the layout and build the system (refused: a layout that does not read, joint or
+        motor directions that give no frame, mounts that leave the body free to move)."""
+        key = tuple(getattr(self, name) for name in self._parameter_names)
+        if key == self._built_for:
+            return []
+        try:
+            placement = Placement.of(
+                {side: self._vector("{axis}_joint_{side}", side) for side in SIDES},
+                {side: self._vector("shaft_{axis}_{side}", side) for side in SIDES},
+                {side: self._vector("bend_{axis}_{side}", side) for side in SIDES},
+                self._vector("motor_axis_{axis}"))
+            system = MountSystem.build(read_layout(self.layout), placement, self.g)
+        except (ValueError, ArithmeticError) as error:
+            return [f"powertrain: {error}"]
+        self._system, self._built_for, self._propagator = system, key, None
+        return []
+
+    def _values(self, names: tuple[str, ...]) -> np.ndarray:
+        return np.array([float(getattr(self, name)) for name in names])
+
+    def start(self, start_time: float) -> None:
+        system = self._system
+        force = system.inputs @ self._values(INPUTS)
+        state = np.concatenate([system.body.static_displacement(force), np.zeros(6)])
+        self._show(state, force)
+        self._show_analysis()
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        system = self._system
+        propagator = self._propagator
+        if propagator is None or propagator.h != step_size:
+            reason = work_error(system.a, system.b, step_size)
+            if reason is not None:
+                raise ValueError(reason)
+            propagator = Propagator.build(system.a, system.b, step_size)
+        held, rates = system.inputs @ self._values(INPUTS), system.inputs @ self._values(RATES)
+        state = propagator.step(self._values(COORDINATES + VELOCITIES), held, rates)
+        self._propagator = propagator
+        self._show(state, held + rates * step_size)
+
+    def _show(self, state: np.ndarray, force: np.ndarray) -> None:
+        """Motion and mount-force outputs of ``state`` under the generalised ``force``."""
+        system = self._system
+        for name, value in zip(COORDINATES + VELOCITIES + ACCELERATIONS,
+                               np.concatenate([state, system.accelerations(state, force)])):
+            setattr(self, name, float(value))
+        forces = system.mount_forces(state)
+        for i in range(MAX_MOUNTS):
+            for k, axis in enumerate(AXES):
+                setattr(self, f"F_{axis}_mount{i + 1}", float(forces[i, k]) if i < len(forces) else 0.0)
+
+    def _show_analysis(self) -> None:
+        """Static sag, modal table and torque roll axis (fixed by the parameters)."""
+        system = self._system
+        for name, value in zip(COORDINATES, system.static_sag(self.g, self.T_mean)):
+            setattr(self, f"{name}_static", float(value))
+        found = system.modes
+        for j in range(6):
+            setattr(self, f"f_mode_{j + 1}", float(found.frequencies[j]))
+            dominant = int(found.dominant[j])
+            setattr(self, f"mode_{j + 1}_coordinate", dominant + 1)
+            setattr(self, f"mode_{j + 1}_share", float(found.shares[j, dominant]))
+            for k, name in enumerate(COORDINATES):
+                setattr(self, f"share_{j + 1}_{name}", float(found.shares[j, k]))
+        for axis, value in zip(AXES, system.torque_roll_axis()):
+            setattr(self, f"torque_roll_axis_{axis}", float(value))
+        self.mount_count = len(system.body.layout.mounts)

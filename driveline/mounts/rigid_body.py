@@ -1,0 +1,130 @@
+"""The powertrain as a rigid body on linear mounts: matrices, statics, modes, decoupling.
+
+Coordinates ``q = (x, y, z, roll, pitch, yaw)``: the displacement of the centre of gravity and
+the small rotations about the vehicle axes x, y, z (ISO 8855), from the static equilibrium.
+A point ``p`` of the body moves by ``u = t + theta x (p - c) = T(p) q`` with
+``T(p) = [I, -[p - c]x]`` (c the centre of gravity, ``[a]x`` the cross-product matrix), so
+
+* mass matrix ``M = diag(m I, J)`` (J the inertia tensor about the centre of gravity),
+* mount i with axes A_i (rows) adds ``T_i^T A_i^T diag(k_i) A_i T_i`` to the stiffness
+  matrix K and the same with ``c_i`` to the damping matrix C,
+* a force F at p and a moment N add ``T(p)^T F + (0, N)`` to the generalised force.
+
+Equations of motion ``M q'' + C q' + K q = f(t)``. The modes solve ``K phi = w^2 M phi``
+(:func:`scipy.linalg.eigh`); the kinetic-energy share of coordinate k in mode j is
+``phi_jk (M phi_j)_k / (phi_j^T M phi_j)``: each mode's shares sum to one (a product of
+inertia can make a rotational share slightly negative).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import eigh
+
+from .layout import Layout
+
+#: The coordinates in order, as the outputs name them.
+COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
+#: A mode whose frequency lies below this fraction of the highest is a rigid-body motion the
+#: mounts leave unrestrained (real layouts span a factor of 3 to 10).
+MIN_FREQUENCY_RATIO = 1e-4
+
+
+def cross_matrix(a: np.ndarray) -> np.ndarray:
+    """``[a]x``: ``cross_matrix(a) @ b == np.cross(a, b)``."""
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+def point_map(point: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """``T(p)`` (3 x 6): the displacement of the body point ``point`` from ``q``."""
+    return np.hstack([np.eye(3), -cross_matrix(np.asarray(point) - centre)])
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """Mass, stiffness and damping matrices of a layout (6 x 6, in the coordinates above)."""
+
+    mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    layout: Layout
+
+    @classmethod
+    def of(cls, layout: Layout) -> RigidBody:
+        mass = np.zeros((6, 6))
+        mass[:3, :3] = layout.mass * np.eye(3)
+        mass[3:, 3:] = layout.inertia
+        stiffness, damping = np.zeros((6, 6)), np.zeros((6, 6))
+        for mount in layout.mounts:
+            to_axes = mount.axes @ point_map(mount.position, layout.centre_of_gravity)
+            stiffness += to_axes.T @ (mount.stiffness[:, None] * to_axes)
+            damping += to_axes.T @ (mount.damping[:, None] * to_axes)
+        return cls(mass, stiffness, damping, layout)
+
+    def load(self, point: np.ndarray, force: np.ndarray, moment: np.ndarray) -> np.ndarray:
+        """Generalised force of ``force`` at ``point`` and the free ``moment`` (vehicle axes)."""
+        return np.concatenate([force, np.cross(np.asarray(point) - self.layout.centre_of_gravity, force) + moment])
+
+    def gravity(self, g: float) -> np.ndarray:
+        """Generalised force of the weight (along -z, at the centre of gravity)."""
+        return np.array([0.0, 0.0, -self.layout.mass * g, 0.0, 0.0, 0.0])
+
+    def static_displacement(self, load: np.ndarray) -> np.ndarray:
+        """``K^-1 load``: the static displacement under a constant generalised force."""
+        return np.linalg.solve(self.stiffness, load)
+
+    def mount_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """Force of each mount on the powertrain (vehicle axes, one row per mount) at
+        displacement ``q`` and velocity ``qdot`` measured from the unloaded mounts."""
+        forces = []
+        for mount in self.layout.mounts:
+            to_axes = mount.axes @ point_map(mount.position, self.layout.centre_of_gravity)
+            local = mount.stiffness * (to_axes @ q) + mount.damping * (to_axes @ qdot)
+            forces.append(-(mount.axes.T @ local))
+        return np.array(forces)
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Undamped modes: ``frequencies`` [Hz] ascending, ``shapes`` (columns, mass-normalised),
+    ``shares`` (row j: the kinetic-energy distribution of mode j over the coordinates)."""
+
+    frequencies: np.ndarray
+    shapes: np.ndarray
+    shares: np.ndarray
+
+    @property
+    def dominant(self) -> np.ndarray:
+        """Index of each mode's largest share."""
+        return np.argmax(self.shares, axis=1)
+
+
+def modes(body: RigidBody) -> Modes:
+    """The six undamped modes of ``body`` (eigenvalues below zero by rounding read as zero)."""
+    eigenvalues, shapes = eigh(body.stiffness, body.mass)
+    frequencies = np.sqrt(np.maximum(eigenvalues, 0.0)) / (2.0 * math.pi)
+    momenta = body.mass @ shapes
+    shares = (shapes * momenta).T / np.sum(shapes * momenta, axis=0)[:, None]
+    return Modes(frequencies, shapes, shares)
+
+
+def unrestrained_error(found: Modes) -> str | None:
+    """Why the mounts do not hold the body, or None: a mode below MIN_FREQUENCY_RATIO of the highest."""
+    lowest, highest = found.frequencies[0], found.frequencies[-1]
+    if lowest >= MIN_FREQUENCY_RATIO * highest:
+        return None
+    coordinate = COORDINATES[int(found.dominant[0])]
+    return (f"the mounts leave a rigid-body motion unrestrained (mode 1, mostly {coordinate}, at {lowest:.3g} Hz, "
+            f"below {MIN_FREQUENCY_RATIO:g} of the highest mode, {highest:.6g} Hz): add a mount or move "
+            "one off the line or plane of the others")
+
+
+def torque_roll_axis(inertia: np.ndarray, torque_axis: np.ndarray) -> np.ndarray:
+    """Unit direction of the torque roll axis: the free body's angular acceleration ``J^-1 e``
+    under a torque about ``torque_axis`` (e.g. the crankshaft), signed to lie along it."""
+    axis = np.linalg.solve(inertia, torque_axis)
+    axis = axis / np.linalg.norm(axis)
+    return axis if axis @ torque_axis >= 0.0 else -axis

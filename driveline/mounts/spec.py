@@ -1,0 +1,159 @@
+"""Interface of the ``PowertrainMounts`` FMU: the single source for the FMI 2.0 and 3.0 builds."""
+
+from __future__ import annotations
+
+from ..variables import DefaultExperiment, ModelSpec, Variable
+from .layout import MAX_MOUNTS
+from .rigid_body import COORDINATES
+
+SIDES = ("left", "right")
+AXES = ("x", "y", "z")
+#: TripodCoupling's housing reactions, in the order of :func:`driveline.mounts.joints.housing_load`.
+REACTIONS = ("Rx_in", "Ry_in", "Rz_in", "Mx_in", "My_in", "T_in")
+LOAD_INPUTS = ("F_x", "F_y", "F_z", "M_x", "M_y", "M_z")
+#: Every load input in the order of the input map: the load at the centre of gravity, the joints', the motor's.
+INPUTS = LOAD_INPUTS + tuple(f"{name}_{side}" for side in SIDES for name in REACTIONS) + ("T_motor",)
+SHARED_LAYOUT = "transverse_fwd_powertrain"
+COORDINATE_INDEX = ", ".join(f"{i} {name}" for i, name in enumerate(COORDINATES, 1))
+
+
+def derivative_name(name: str) -> str:
+    """``F_x`` -> ``F_x_dot``, ``Rz_in_left`` -> ``Rz_in_dot_left`` (the side stays last)."""
+    for side in SIDES:
+        if name.endswith(f"_{side}"):
+            return f"{name[:-len(side) - 1]}_dot_{side}"
+    return f"{name}_dot"
+
+
+def _unit(name: str, order: int) -> tuple[str, str | None]:
+    linear = name in AXES
+    base = "m" if linear else "rad"
+    if order == 0:
+        return (base, "mm" if linear else "deg")
+    return (f"{base}/s" if order == 1 else f"{base}/s2", None)
+
+
+def _load_unit(name: str) -> str:
+    return "N" if name.startswith(("F", "R")) else "N.m"
+
+
+def _inputs() -> tuple[Variable, ...]:
+    texts = {
+        "F_x": "Force on the powertrain at its centre of gravity along vehicle x (for any use)",
+        "F_y": "Force on the powertrain at its centre of gravity along vehicle y",
+        "F_z": "Force on the powertrain at its centre of gravity along vehicle z (the weight is applied already)",
+        "M_x": "Moment on the powertrain about vehicle x", "M_y": "Moment on the powertrain about vehicle y",
+        "M_z": "Moment on the powertrain about vehicle z",
+        "T_motor": "Motor torque on its shaft about motor_axis: the powertrain carries its reaction -T_motor "
+                   "(leave 0 when the joints' T_in already carry the drive torque)",
+    }
+    for side in SIDES:
+        for name in REACTIONS:
+            texts[f"{name}_{side}"] = (f"TripodCoupling.{name} of the {side} inboard joint, in its frame X'Y'Z' "
+                                       "(wire the output of the same name): the powertrain carries its opposite")
+    held = [Variable(name, "input", 0.0, texts[name], _load_unit(name)) for name in INPUTS]
+    rates = [Variable(derivative_name(name), "input", 0.0,
+                      f"Rate of {name} over the step (first-order hold; 0: held)",
+                      f"{_load_unit(name)}/s", derivative=name) for name in INPUTS]
+    return tuple(held + rates)
+
+
+def _geometry() -> tuple[Variable, ...]:
+    defaults = {
+        "left": ((0.0, 0.22, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+        "right": ((0.0, -0.28, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0)),
+    }
+    found = []
+    for side in SIDES:
+        centre, shaft, bend = defaults[side]
+        for axis, value in zip(AXES, centre):
+            found.append(Variable(f"{axis}_joint_{side}", "parameter", value,
+                                  f"Centre O of the {side} inboard joint, vehicle {axis}", "m", "mm"))
+        for axis, value in zip(AXES, shaft):
+            found.append(Variable(f"shaft_{axis}_{side}", "parameter", value,
+                                  f"Halfshaft direction of the {side} joint (its Z': the housing's axis, "
+                                  f"towards the wheel), vehicle {axis} component", "1"))
+        for axis, value in zip(AXES, bend):
+            found.append(Variable(f"bend_{axis}_{side}", "parameter", value,
+                                  f"Bend-plane direction of the {side} joint (its X': the output shaft "
+                                  f"leans towards -X'), vehicle {axis} component (its part along the shaft "
+                                  "is dropped)", "1"))
+    for axis, value in zip(AXES, (0.0, 1.0, 0.0)):
+        found.append(Variable(f"motor_axis_{axis}", "parameter", value,
+                              f"Axis of the motor's torque (crankshaft), vehicle {axis} component; also the "
+                              "torque of the torque roll axis", "1"))
+    return tuple(found)
+
+
+def _motion() -> tuple[Variable, ...]:
+    names = {0: "Displacement", 1: "Velocity", 2: "Acceleration"}
+    found = []
+    for order, suffix in ((0, ""), (1, "_dot"), (2, "_ddot")):
+        for name in COORDINATES:
+            unit, display = _unit(name, order)
+            what = f"of the centre of gravity along vehicle {name}" if name in AXES else \
+                f"{name} (small rotation about vehicle {AXES[COORDINATES.index(name) - 3]})"
+            found.append(Variable(f"{name}{suffix}", "output", 0.0,
+                                  f"{names[order]} {what}, from the static equilibrium under the weight",
+                                  unit, display))
+    return tuple(found)
+
+
+def _mounts() -> tuple[Variable, ...]:
+    return tuple(
+        Variable(f"F_{axis}_mount{i}", "output", 0.0,
+                 f"Force of mount {i} on the powertrain along vehicle {axis}, the weight's preload included "
+                 "(0 when the layout has fewer mounts)", "N")
+        for i in range(1, MAX_MOUNTS + 1) for axis in AXES)
+
+
+def _statics_and_modes() -> tuple[Variable, ...]:
+    found = []
+    for name in COORDINATES:
+        unit, display = _unit(name, 0)
+        found.append(Variable(f"{name}_static", "output", 0.0,
+                              f"Static sag {name} under the weight and T_mean, from the unloaded mounts",
+                              unit, display))
+    found += [Variable(f"f_mode_{j}", "output", 0.0, f"Undamped natural frequency of mode {j} (ascending)", "Hz")
+              for j in range(1, 7)]
+    for j in range(1, 7):
+        found.append(Variable(f"mode_{j}_coordinate", "output", 0,
+                              f"Coordinate with the largest kinetic-energy share of mode {j}: {COORDINATE_INDEX}",
+                              type="Integer"))
+        found.append(Variable(f"mode_{j}_share", "output", 0.0,
+                              f"Kinetic-energy share of mode {j} in its dominant coordinate", "1"))
+    found += [Variable(f"share_{j}_{name}", "output", 0.0,
+                       f"Kinetic-energy share of coordinate {name} in mode {j} (each mode's shares sum to 1)", "1")
+              for j in range(1, 7) for name in COORDINATES]
+    found += [Variable(f"torque_roll_axis_{axis}", "output", 0.0,
+                       f"Torque roll axis (unit vector, vehicle {axis} component): the free powertrain's "
+                       "rotation under a torque about motor_axis", "1") for axis in AXES]
+    found.append(Variable("mount_count", "output", 0, "Number of mounts in the layout", type="Integer"))
+    return tuple(found)
+
+
+SPEC = ModelSpec(
+    name="PowertrainMounts",
+    description=(
+        "Rigid powertrain (six degrees of freedom) on 1 to 8 linear rubber mounts, small motion about its "
+        "static equilibrium in vehicle axes (ISO 8855), loaded by two TripodCoupling housings, a motor's "
+        "reaction torque and a free force and moment; exact time stepping (matrix exponential, zero- or "
+        "first-order hold), modal table with the kinetic-energy decoupling and the torque roll axis."
+    ),
+    variables=(
+        Variable("layout", "parameter", SHARED_LAYOUT,
+                 "Powertrain and mounts (TOML): a file path ending in '.toml' (any case; a relative path is "
+                 "relative to the importing process's working directory), or the name of a layout shipped "
+                 f"in the FMU ('{SHARED_LAYOUT}')", type="String"),
+        Variable("g", "parameter", 9.81, "Gravitational acceleration (the weight along -z)", "m/s2", min=0.0),
+        Variable("T_mean", "parameter", 0.0,
+                 "Mean drive torque of the static sag outputs: the powertrain carries -T_mean about motor_axis",
+                 "N.m"),
+        *_geometry(),
+        *_inputs(),
+        *_motion(),
+        *_mounts(),
+        *_statics_and_modes(),
+    ),
+    default_experiment=DefaultExperiment(0.0, 1.0, 1e-3),
+)

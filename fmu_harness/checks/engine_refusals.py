@@ -1,0 +1,136 @@
+"""What each co-simulation engine does with a refusal, measured: the host table of docs/hosting.md.
+
+Usage: ``python -m fmu_harness.checks.engine_refusals [--models models] [--update docs/hosting.md]``
+after ``python build_fmu.py``. Runs ``TripodCoupling`` (FMI 2.0, the Python FMU and the native
+one) in each engine, each run a process of its own so that an engine aborting is a result:
+
+* **initialisation**: the parameter ``r = -1 m``, which the FMU refuses at
+  ``ExitInitializationMode`` (native: Error; Python: OK, every step refused);
+* **step**: the input ``beta = 1.2 rad`` (above its maximum), refused at every step (Discard).
+
+The engines: fmpy's ``simulate_fmu``, libcosim and Ecos (:mod:`.importers`, their start-value
+check switched off to observe the engine itself) and the project's master
+(:func:`fmu_harness.runs.runner.simulate`). Prints the table; ``--update`` rewrites the page's
+``engine-refusals`` section (``tests/fmu/test_engine_refusals.py`` measures it again and
+compares).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.metadata
+import importlib.util
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from ..doc_pages.sections import replace_section
+from ..packaging import fmu_path, native
+from .worker import answer, answer_in
+
+RESULT = "engine refusal: "
+MODEL = "TripodCoupling"
+#: The refusals: the start value that causes each.
+REFUSALS = {"initialisation": {"r": -1.0}, "step": {"beta": 1.2}}
+STEP_SIZE, STEPS = 1e-3, 3
+#: Engine name -> (package it needs, what the table calls it; ``{version}``: the package's version).
+ENGINES = {
+    "fmpy": ("fmpy", "fmpy {version} `simulate_fmu`"),
+    "libcosim": ("libcosimpy", "libcosim (libcosimpy {version})"),
+    "libcosim checked": ("libcosimpy", "libcosim through `importers.cosim_session` (start values checked)"),
+    "Ecos": ("ecospy", "Ecos (ecospy {version})"),
+    "Ecos checked": ("ecospy", "Ecos through `importers.ecos_session` (start values checked)"),
+    "master": ("fmpy", "the project's master (`runner.simulate`)"),
+}
+FAMILIES = ("native", "Python")
+
+
+def observe(engine: str, path: Path, values: dict[str, float]) -> str:
+    """Run ``STEPS`` steps of the FMU at ``path`` with start values ``values`` in ``engine`` and say
+    what the engine did (in the worker process)."""
+    if engine == "fmpy":
+        from fmpy import simulate_fmu
+        from fmpy.fmi1 import FMICallException
+
+        try:
+            rows = simulate_fmu(str(path), stop_time=STEPS * STEP_SIZE, output_interval=STEP_SIZE,
+                                start_values=values)
+        except FMICallException as error:
+            return f"raises FMICallException: {error}"
+        return f"stops at the refusal and returns {len(rows)} of {STEPS + 1} rows, no exception"
+    if engine == "master":
+        from ..runs.runner import StepRefused, simulate
+
+        try:
+            simulate(path, STEPS * STEP_SIZE, STEP_SIZE, start_values=values)
+        except StepRefused as refused:
+            return f"raises StepRefused at {refused.call} ({refused.status}) with the FMU's reason"
+        return "runs to the end"
+    from . import importers
+
+    from ..runs.start_values import StartValuesRefused
+
+    start = {f"m.{name}": value for name, value in values.items()}
+    session_of = importers.cosim_session if engine.startswith("libcosim") else importers.ecos_session
+    try:
+        session = session_of(STEP_SIZE, {"m": path}, start_values=start, checked=engine.endswith("checked"))
+        answers = [session.step() for _ in range(STEPS)]
+        session.close()
+    except StartValuesRefused as refused:
+        return f"raises StartValuesRefused before the engine starts: {refused}"
+    except Exception as error:  # noqa: BLE001 - what the engine raises is the result
+        return f"raises {type(error).__name__}"
+    if engine.startswith("libcosim"):
+        return f"`step()` returns {', '.join(map(str, answers))}; the process goes on"
+    return f"`step()` advances the time to {answers[-1]:g} s; the process goes on"
+
+
+def measure(engine: str, path: Path, refusal: str) -> str:
+    """:func:`observe` in a process of its own: its answer, or how the process ended."""
+    command = [sys.executable, "-m", "fmu_harness.checks.engine_refusals", "--worker", engine, str(path), refusal]
+    done = subprocess.run(command, capture_output=True, text=True, errors="replace", timeout=300,
+                          cwd=Path(__file__).parents[2])
+    result = answer_in(done.stdout, RESULT)
+    if result is not None:
+        return result
+    if done.returncode < 0:
+        said = next((line.strip() for line in done.stderr.splitlines() if "terminate called" in line), "")
+        return f"the process dies of {signal.Signals(-done.returncode).name}" + (f' ("{said}")' if said else "")
+    return f"the process exits with {done.returncode}: {(done.stderr.strip().splitlines() or [''])[-1]}"
+
+
+def table(models: Path, natives: Path | None = None) -> str:
+    """The markdown table: one row per engine, one column per refusal and family (the Python FMU
+    in ``models``, the native one below ``natives``, default ``models``)."""
+    paths = {"Python": fmu_path(models, MODEL, "2"), "native": native.fmu_path(natives or models, MODEL, "2")}
+    lines = ["| engine | " + " | ".join(f"refused at {refusal}, {family} FMU" for refusal in REFUSALS
+                                        for family in FAMILIES) + " |",
+             "|---|" + "---|" * len(REFUSALS) * len(FAMILIES)]
+    for engine, (package, name) in ENGINES.items():
+        if importlib.util.find_spec(package) is None:
+            cells = [f"{package} is not installed"] * (len(REFUSALS) * len(FAMILIES))
+        else:
+            cells = [measure(engine, paths[family], refusal) for refusal in REFUSALS for family in FAMILIES]
+        version = importlib.metadata.version(package) if "{version}" in name else ""
+        lines.append(f"| {name.format(version=version)} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
+    parser.add_argument("--update", type=Path, metavar="PAGE", help="markdown page whose section to regenerate")
+    parser.add_argument("--worker", nargs=3, metavar=("ENGINE", "FMU", "REFUSAL"), help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        engine, path, refusal = args.worker
+        answer(RESULT, observe(engine, Path(path), REFUSALS[refusal]))
+    text = table(args.models)
+    print(text)
+    if args.update:
+        replace_section(args.update, "engine-refusals", text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,117 @@
+"""Start values checked before an engine starts: the model's own validation, in the FMU's words.
+
+An FMU refuses a parameter that no input can make valid at ``ExitInitializationMode``: the native
+FMUs return Error there, and libcosim turns that Error into an uncaught C++ exception that aborts
+the host process (docs/hosting.md). Every place of the project that starts an engine (the
+importers' sessions, the system master, sweeps) therefore first gives the start values to the
+catalog model of each FMU, whose checks (the spec's bounds and relations, then the model's own,
+``SteppedModel.parameter_errors``) are the code the FMUs run, and stops with the first reason.
+
+Usage: ``driveline-fmus check TARGET [NAME=VALUE ...]``, TARGET an SSP package (its parameter
+bindings) or an FMU (the values given, ``beta=0.3``): prints what would be refused in one line
+and exits with 1, or prints that every start value is accepted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import zipfile
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+from xml.etree import ElementTree as ET
+
+from fmpy import read_model_description
+
+from driveline.catalog import MODELS
+
+from .ssp import bindings
+
+_KINDS = {"Real": float, "Integer": int, "Boolean": lambda text: str(text).lower() in ("true", "1"), "String": str}
+
+
+class StartValuesRefused(ValueError):
+    """Start values an FMU would refuse at initialisation; the message is one line, the
+    instance's name and the FMU's first reason."""
+
+
+@dataclass(frozen=True)
+class Instance:
+    """One FMU instance an engine is to start: its name, catalog model and start values."""
+
+    name: str
+    model: str
+    values: Mapping[str, Any]
+
+
+def refusals(model: str, values: Mapping[str, Any], declared_only: bool = False) -> list[str]:
+    """Why the FMU of catalog model ``model`` would refuse the start values ``values`` (parameters
+    and inputs by name) at initialisation, in its own words; [] when it takes them or when the
+    model is not in the catalog (nothing to check it with). ``declared_only``: the spec's bounds
+    and relations alone, not the model's own checks (``CriticalSpeeds`` analyses the structure
+    there, 0.04 to 0.5 s)."""
+    model_class = MODELS.get(model)
+    if model_class is None:
+        return []
+    core = model_class()
+    for name, value in values.items():
+        variable = next((v for v in core.spec.variables if v.name == name), None)
+        if variable is None or variable.causality not in ("parameter", "input"):
+            return [f"{name} is no parameter or input of {model}"]
+        try:
+            setattr(core, name, _KINDS[variable.type](value))
+        except (TypeError, ValueError):
+            return [f"{name} = {value!r} is not of type {variable.type}"]
+    return core.declared_parameter_errors() if declared_only else core.parameter_errors()
+
+
+def check_start_values(instances: list[Instance]) -> None:
+    """Raise :class:`StartValuesRefused` for the first instance whose FMU would refuse its start
+    values (one line: the instance, the FMU's first reason, how many more there are)."""
+    for instance in instances:
+        reasons = refusals(instance.model, instance.values)
+        if reasons:
+            more = f" (and {len(reasons) - 1} more)" if len(reasons) > 1 else ""
+            raise StartValuesRefused(f"{instance.name} ({instance.model}): {reasons[0]}{more}")
+
+
+def engine_instances(fmus: Mapping[str, Path] | None = None, ssp: Path | None = None,
+                     start_values: Mapping[str, Any] | None = None) -> list[Instance]:
+    """The instances an engine starts, as the importers' sessions take them: the FMUs ``{instance:
+    path}`` or the components of an SSP package (with its parameter bindings), each with its
+    share of ``start_values`` (``"instance.variable"``: value) on top."""
+    given: dict[str, dict[str, Any]] = {}
+    for key, value in (start_values or {}).items():
+        instance, _, name = key.partition(".")
+        given.setdefault(instance, {})[name] = value
+    found = [Instance(*component) for component in bindings(ssp)] if ssp is not None else [
+        Instance(name, read_model_description(str(path)).modelName, {}) for name, path in (fmus or {}).items()]
+    return [Instance(i.name, i.model, {**i.values, **given.get(i.name, {})}) for i in found]
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("target", type=Path, help="an SSP package or an FMU")
+    parser.add_argument("values", nargs="*", metavar="NAME=VALUE", help="start values of an FMU")
+    args = parser.parse_args(argv)
+    if any("=" not in value for value in args.values) or (args.values and args.target.suffix.lower() == ".ssp"):
+        parser.error("start values are NAME=VALUE, for an FMU (an SSP package brings its own)")
+    if not args.target.is_file():
+        parser.exit(1, f"{args.target}: no such file\n")
+    try:
+        values = {f"{args.target.stem}.{value.partition('=')[0]}": value.partition("=")[2] for value in args.values}
+        if args.target.suffix.lower() == ".ssp":
+            instances = engine_instances(ssp=args.target)
+        else:
+            instances = engine_instances({args.target.stem: args.target}, start_values=values)
+        check_start_values(instances)
+    except StartValuesRefused as refused:
+        parser.exit(1, f"refused: {refused}\n")
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile, ET.ParseError) as error:
+        parser.exit(1, f"{args.target}: cannot be read ({type(error).__name__}: {error})\n")
+    print(f"{args.target}: every start value accepted ({', '.join(i.name for i in instances)})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,148 @@
+"""The main job's figures show what their titles claim, measured on the matplotlib figures the
+studies return (``support.figure_checks``): no curve drawn under others, overlapping markers
+nested, every sample inside its axes, no log axis over a zero, no legend repeated; and, figure by
+figure, that each case the title names is drawn. The checks themselves are shown to catch the
+defects they were written for, on figures drawn here."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from fmu_harness.packaging import native  # noqa: E402
+from fmu_harness.studies import coupling_comparison, critical_speed_study, tripod_study  # noqa: E402
+from fmu_harness.studies.figures import by_scale  # noqa: E402
+from support import figure_checks  # noqa: E402
+
+
+def assert_clean(fig, name: str = "") -> None:
+    assert figure_checks.hidden_curves(fig) == [], name
+    assert figure_checks.stacked_markers(fig) == [], name
+    assert figure_checks.beyond_limits(fig) == [], name
+    assert figure_checks.log_over_zero(fig) == [], name
+    assert figure_checks.repeated_legends(fig) == [], name
+
+
+@pytest.fixture(scope="module")
+def tripod_figures(native_dir):
+    figures = tripod_study.figures(tripod_study.run(native.fmu_path(native_dir, "TripodCoupling")))
+    yield figures
+    for fig in figures.values():
+        plt.close(fig)
+
+
+def drawn_labels(fig) -> list[str]:
+    return [line.get_label() for ax in fig.axes if ax.get_visible() for line in ax.get_lines()]
+
+
+def test_every_tripod_figure_shows_each_curve(tripod_figures):
+    assert len(tripod_figures) == 9
+    for name, fig in tripod_figures.items():
+        assert_clean(fig, name)
+
+
+def test_every_bend_angle_is_drawn_in_the_seed_figures(tripod_figures):
+    """Figs 5, 10, 12, 13 draw each bend angle once per row of panels, under one legend."""
+    names = ["tripod_fig05_deviation.png", *(f"tripod_fig{n}_{c}.png" for n, c, _ in tripod_study.SEED_FIGURES)]
+    for name in names:
+        fig = tripod_figures[name]
+        rows = 1 if name.startswith("tripod_fig05") else 2
+        expected = sorted(f"beta = {beta} deg" for beta in tripod_study.BETAS_DEG) * rows
+        assert sorted(drawn_labels(fig)) == sorted(expected), name
+        assert figure_checks.legend_count(fig) == 1, name
+
+
+def test_turn_figure_draws_each_reaction_at_each_load_for_three_bend_angles(tripod_figures):
+    fig = tripod_figures["tripod_reactions_turn.png"]
+    titles = {ax.get_title(): ax for ax in fig.axes}
+    for column in tripod_study.REACTIONS:
+        for load in tripod_study.LOADS:
+            ax = titles[f"{column}, T_load = {load:.0f} N.m"]
+            assert sorted(line.get_label() for line in ax.get_lines()) == [
+                f"beta = {beta} deg" for beta in tripod_study.TURN_BETAS]
+
+
+def test_seed_means_are_drawn_around_the_force_balance_at_no_load(tripod_figures):
+    """The seed's mean Ry_in (0) coincides with the force balance's at 0 N.m: a larger ring."""
+    ax = next(ax for ax in tripod_figures["tripod_reactions_vs_beta.png"].axes if ax.get_title().startswith("Mean Ry_in"))
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    seed, unloaded = lines["seed's eq 34: mean 0 at every load"], lines["force balance, T = 0 N.m"]
+    np.testing.assert_allclose(seed.get_ydata(), unloaded.get_ydata(), atol=1e-9)
+    assert seed.get_markerfacecolor() == "none" and seed.get_markersize() > unloaded.get_markersize()
+
+
+def test_coupling_comparison_names_a_zero_fluctuation_instead_of_plotting_it(fmi2_dir):
+    betas = [5.0, 25.0, 45.0]
+    rows = coupling_comparison.speed_fluctuation_table(fmi2_dir, betas)
+    fig = coupling_comparison.comparison_figure(rows, betas)
+    assert_clean(fig)
+    (ax,) = fig.axes
+    plotted = {line.get_label(): list(line.get_ydata()) for line in ax.get_lines()}
+    for coupling in coupling_comparison.COUPLINGS:
+        values = [row["fluctuation"] for row in rows if row["coupling"] == coupling.name]
+        if max(values) == 0.0:
+            assert any(text.get_text().startswith(f"{coupling.name}: 0 at every") for text in ax.texts)
+            assert coupling.name not in plotted
+        else:
+            assert plotted[coupling.name] == values
+    assert set(plotted) == {"TripodCoupling", "CardanJoint"}
+    plt.close(fig)
+
+
+def test_campbell_diagram_nests_the_backward_crossings_inside_the_critical_speeds(native_dir):
+    fmu = native.fmu_path(native_dir, "CriticalSpeeds")
+    criticals = critical_speed_study.critical_speeds(fmu)
+    result = critical_speed_study.ramp(
+        fmu, critical_speed_study.ramp_speeds(critical_speed_study.BEYOND * max(criticals), criticals))
+    fig = critical_speed_study.campbell_figure(result, critical_speed_study.branches(result), criticals)
+    assert_clean(fig)
+    (ax,) = fig.axes
+    marks = [line for line in ax.get_lines() if len(line.get_xdata()) == 1]
+    critical = [line for line in marks if line.get_label().startswith("_critical speed 1x")]
+    backward_1x = [line for line in marks if line.get_label().startswith("_backward 1x")]
+    assert len(critical) == 3 and len(backward_1x) == 3
+    for ring, square in zip(critical, backward_1x):
+        # each backward 1x crossing lies within 3 % of a critical speed (2.1 % at the first), drawn over its ring
+        assert square.get_xdata()[0] == pytest.approx(ring.get_xdata()[0], rel=0.03)
+        assert square.get_zorder() > ring.get_zorder()
+    plt.close(fig)
+
+
+def deviations(*panels: tuple[float, ...]) -> plt.Figure:
+    """Sinusoids of the given amplitudes, one axes per tuple, drawn in that order (fig. 5's before)."""
+    fig, axes = plt.subplots(1, len(panels), squeeze=False)
+    phi = np.linspace(0.0, 2 * np.pi, 360)
+    for ax, amplitudes in zip(axes[0], panels):
+        for amplitude in amplitudes:
+            ax.plot(phi, amplitude * np.sin(3 * phi), label=f"{amplitude:g}")
+    return fig
+
+
+def test_the_checks_catch_what_the_old_figures_drew():
+    """The defects of the figures before: a 0.015 curve on an 11 scale under the larger one (fig
+    5), equal markers stacked (the seed's mean 0), a 0 plotted as 1e-16 on a log axis (the
+    reducer), a legend repeated (figs 10, 12, 13), data beyond the axes."""
+    hidden = deviations((0.015, 0.12, 0.4, 11.0))  # beta = 5, 10, 15, 45 deg in fig. 5 [arcmin]
+    assert figure_checks.hidden_curves(hidden) == [": 0.015"]
+    # spread over panels by the studies' rule: each seen
+    amplitudes = (0.015, 0.12, 0.4, 11.0)
+    split = deviations(*(tuple(group) for group in by_scale({a: a for a in amplitudes})))
+    assert len(split.axes) == 3 and figure_checks.hidden_curves(split) == []
+    fig, (left, right) = plt.subplots(1, 2)
+    left.plot([1, 2, 3], [0, 0, 0], "s", label="force balance")
+    left.plot([1, 2, 3], [0, 0, 0], "x", label="seed")
+    right.semilogy([1, 2, 3], [1e-2, 1e-1, 1.0], "o-", label="tripod")
+    right.semilogy([1, 2, 3], [1e-16] * 3, "o-", label="reducer")
+    left.legend()
+    right.legend(handles=left.get_lines())
+    right.set_xlim(1, 2)
+    assert len(figure_checks.stacked_markers(fig)) == 3
+    assert figure_checks.log_over_zero(fig) == [": reducer"]
+    assert figure_checks.repeated_legends(fig) == [["force balance", "seed"]]
+    assert figure_checks.beyond_limits(fig) == [": tripod", ": reducer"]
+    for figure in (hidden, split, fig):
+        plt.close(figure)
