@@ -99,3 +99,23 @@ def test_the_cosimulation_converges_to_the_monolithic_launch(fmi2_dir, native_di
     for name, bound in CONVERGED.items():
         assert found[1][name] <= bound
         assert 0.8 <= math.log2(found[0][name] / found[1][name]) <= 1.2
+
+
+def test_a_reversed_launch_is_the_mirror_image_of_the_forward_one(launch_ssp, master, tmp_path):
+    """Motor torque reversed (T_level = -140 N.m): the car launches backwards and each joint turns
+    through -phi_in(t), the mirror image about its bend plane of the forward launch. Sliding speeds
+    along the grooves are even under that mirror, so the friction forces and the generated axial force
+    Rz_in are the forward run's (to 1e-12 of its largest value); the out-of-plane Ry_in, the torques
+    and the speeds flip (docs/vehicle_launch.md, "Torque reversal")."""
+    system_command.main([str(launch_ssp), "--stop-time", str(STOP), "--step", str(STEP), "--out",
+                         str(tmp_path / "run.csv"), "--set", "motor.T_level=-140"])
+    with (tmp_path / "run.csv").open() as handle:
+        rows = list(csv.reader(handle))
+    header, values = rows[0], np.array(rows[1:], dtype=float)
+    forward_header, forward = master
+    for name, sign in (("drive.v_x", -1.0), ("drive.T_load_left", -1.0), ("joint_left.phi_in", -1.0),
+                       ("joint_left.Rz_in", 1.0), ("joint_right.Rz_in", 1.0), ("joint_left.Ry_in", -1.0)):
+        column = next(i for i, label in enumerate(header) if label.split(" [")[0] == name)
+        reference = forward[:, forward_header.index(header[column])]
+        assert np.abs(reference).max() > 0.0
+        assert np.abs(values[:, column] - sign * reference).max() <= 1e-12 * np.abs(reference).max(), name
