@@ -132,7 +132,9 @@ class LaunchEquations:
         self._alpha = alpha
         force = self.mounts.inputs @ self.mount_loads(joints)
         mount_state = np.asarray(y[MOUNTS_STATE], dtype=float)
+        placed = placed._replace(T_in_left=joints[0]["T_in"], T_in_right=-joints[1]["T_in"])
         return {"drive_rates": rates, "omega_in": omega, "joints": joints, "T_motor": T_motor, "loads": loads,
+                "placed": placed, "force": force,
                 "mount_rates": self.mounts.a @ mount_state + self.mounts.b @ force,
                 "mount_accelerations": self.mounts.accelerations(mount_state, force)}
 
