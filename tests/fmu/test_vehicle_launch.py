@@ -130,3 +130,19 @@ def test_the_cosimulation_balances_energy_to_first_order_in_the_step(fmi2_dir, n
     for name, bound in (("loop residual", 1.5e-3), ("mounting residual", 7.7e-4)):
         assert abs(found[1][name]) <= bound
         assert 0.8 <= math.log(found[0][name] / found[1][name]) / math.log(5.0) <= 1.2
+
+
+def test_a_step_too_long_for_the_differential_mode_is_refused_before_the_run(launch_ssp, tmp_path, capsys):
+    """5e-4 s, where the launch diverges (halfshaft torques of 1e7 N.m): one line naming the drive and its
+    limit, exit status 2, no file. The limit follows the drive's parameters: doubling J_side lowers the
+    mode to 477 rad/s and admits the step (the launch measured stable up to 5.97e-4 s there)."""
+    out = tmp_path / "run.csv"
+    with pytest.raises(SystemExit) as stopped:
+        system_command.main([str(launch_ssp), "--stop-time", "0.01", "--step", "5e-4", "--out", str(out)])
+    message = capsys.readouterr().err
+    assert stopped.value.code == 2 and not out.exists() and message.count("\n") == 1
+    assert "drive (VehicleDriveline): --step 0.0005 s is above 0.000415 s" in message
+    system_command.main([str(launch_ssp), "--stop-time", "0.01", "--step", "5e-4", "--out", str(out),
+                         "--set", "drive.J_side=0.03"])
+    with out.open() as handle:
+        assert len(list(csv.reader(handle))) == 21
