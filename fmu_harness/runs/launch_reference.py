@@ -12,7 +12,8 @@ about ``3 m r^2 / J_side`` = 0.03).
 
 Usage: ``python -m fmu_harness.runs.launch_reference [--models models] [--stop-time 0.5]`` after
 ``python build_fmu.py`` prints the co-simulation's error against the reference at each communication
-step of :data:`STEPS` (native package, the project's Jacobi master) as a Markdown table.
+step of :data:`STEPS` (native package, the project's Jacobi master) as a Markdown table; with
+``--gauss-seidel`` at each step of :data:`GAUSS_SEIDEL_STEPS` in the Gauss-Seidel master.
 """
 
 from __future__ import annotations
@@ -48,8 +49,9 @@ SIGNALS = {
     "joint_left.Rz_in": "left generated axial force `Rz_in`",
     "mounts.pitch_ddot": "powertrain pitch acceleration",
 }
-#: Communication steps of the convergence table [s] (Jacobi diverges at 5e-4 s).
+#: Communication steps of the convergence table [s] (Jacobi diverges at 5e-4 s, Gauss-Seidel at 1e-3 s).
 STEPS = (4e-4, 2e-4, 1e-4)
+GAUSS_SEIDEL_STEPS = (8e-4, 4e-4, 2e-4, 1e-4)
 #: solve_ivp's tolerances: relative, and absolute on states of order 1 (angles, speeds) down to 1e-3 m.
 RTOL, ATOL = 1e-10, 1e-12
 #: The algebraic loop is solved when the side gears' accelerations change by less than this share (the
@@ -202,21 +204,23 @@ def errors(cosimulation: Mapping[str, np.ndarray], times: np.ndarray, monolithic
             for name in SIGNALS}
 
 
-def cosimulate(models: Path, natives: Path | None, step: float, stop_time: float) -> dict[str, np.ndarray]:
-    """The launch in the project's Jacobi master at ``step`` (:func:`.system.component_fmus` of
-    ``models`` and ``natives``): ``"t"`` and :data:`SIGNALS`."""
+def cosimulate(models: Path, natives: Path | None, step: float, stop_time: float,
+               order: tuple[str, ...] | None = None) -> dict[str, np.ndarray]:
+    """The launch in the project's master at ``step`` (:func:`.system.component_fmus` of ``models`` and
+    ``natives``), Jacobi or Gauss-Seidel in ``order``: ``"t"`` and :data:`SIGNALS`."""
     launch = system.vehicle_launch()
     launch = system.System(launch.name, launch.components, launch.connections, stop_time, step)
-    rows = system.simulate(launch, models, list(SIGNALS), natives=natives)
+    rows = system.simulate(launch, models, list(SIGNALS), natives=natives, order=order)
     return {"t": rows[:, 0], **{name: rows[:, i + 1] for i, name in enumerate(SIGNALS)}}
 
 
-def convergence_table(models: Path, stop_time: float, steps: tuple[float, ...] = STEPS) -> str:
+def convergence_table(models: Path, stop_time: float, steps: tuple[float, ...] = STEPS,
+                      order: tuple[str, ...] | None = None) -> str:
     """Markdown table: each step's relative error of each signal against the reference, at the
-    coarsest step's instants, and the order between successive steps."""
+    coarsest step's instants, and the order between successive steps (Jacobi, or Gauss-Seidel in ``order``)."""
     times = np.arange(1, int(round(stop_time / max(steps))) + 1) * max(steps)
     monolithic = reference(times)
-    found = [errors(cosimulate(models, models, step, stop_time), times, monolithic) for step in steps]
+    found = [errors(cosimulate(models, models, step, stop_time, order), times, monolithic) for step in steps]
     lines = ["| step [s] | " + " | ".join(SIGNALS.values()) + " |", "|---" * (len(SIGNALS) + 1) + "|"]
     lines += [f"| {step:.0e} | " + " | ".join(f"{row[name]:.1e}" for name in SIGNALS) + " |"
               for step, row in zip(steps, found)]
@@ -230,8 +234,13 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs (native/ below)")
     parser.add_argument("--stop-time", type=float, default=0.5, help="length of the compared launch [s]")
+    parser.add_argument("--gauss-seidel", action="store_true",
+                        help=f"the Gauss-Seidel master in the order {', '.join(system.LAUNCH_ORDER)}")
     args = parser.parse_args(argv)
-    print(convergence_table(args.models, args.stop_time))
+    if args.gauss_seidel:
+        print(convergence_table(args.models, args.stop_time, GAUSS_SEIDEL_STEPS, system.LAUNCH_ORDER))
+    else:
+        print(convergence_table(args.models, args.stop_time))
 
 
 if __name__ == "__main__":
