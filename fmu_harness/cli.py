@@ -12,6 +12,8 @@ import argparse
 import importlib
 import sys
 
+from .console import CommandParser
+
 COMMANDS = {
     "build": ("fmu_harness.build_command", "build the FMUs (FMI 2.0 and 3.0), their reference results and the SSP system"),
     "run": ("fmu_harness.main", "the main job: simulate the FMUs, write CSV files and figures"),
@@ -23,7 +25,7 @@ COMMANDS = {
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="driveline-fmus",
         description="Build, run, sweep and check the driveline FMUs.",
         epilog="commands:\n" + "".join(f"  {name:<9} {text}\n" for name, (_, text) in COMMANDS.items())
