@@ -1,5 +1,5 @@
-/* The C library of the native PowertrainMounts FMU (port of driveline/mounts/; the model file
- * powertrain_mounts.c holds rigid_body.py, joints.py, system.py, exact_step.py and model.py):
+/* The C library of the native PowertrainMounts FMU (port of driveline/mounts/; rigid_body.py, joints.py,
+ * system.py, exact_step.py and model.py are in the model file next to this folder):
  *   layout.c     the layouts (layout.py), read by CriticalSpeeds' layout reader (critical_speeds/toml.h)
  *   dense.c      small dense linear algebra: products, solutions, symmetric eigenvalues, the matrix exponential
  */
