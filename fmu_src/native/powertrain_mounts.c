@@ -46,6 +46,7 @@ typedef struct {
     char *layout_name;                      /* owned */
     Layout layout;
     double mass[6][6], stiffness[6][6], damping[6][6], a[12][12], b[12][6], inputs[6][N_INPUTS];
+    double maps[MOUNTS_LAYOUT_MAX_MOUNTS][3][6]; /* each mount's A T(p) */
     double frequencies[6], shares[6][6], roll_axis[3], motor_axis[3], weight_sag[6];
     int dominant[6];
     int has_propagator;
@@ -122,7 +123,6 @@ static int joint_frame(const double shaft[3], const double bend[3], const char *
 static void matrices(System *s)
 {
     const Layout *l = &s->layout;
-    double map[3][6];
     int i, j, k, n;
     memset(s->mass, 0, sizeof s->mass);
     memset(s->stiffness, 0, sizeof s->stiffness);
@@ -134,6 +134,7 @@ static void matrices(System *s)
         }
     }
     for (n = 0; n < l->count; n++) {
+        double (*map)[6] = s->maps[n];
         mount_map(&l->mounts[n], l->centre, map);
         for (i = 0; i < 6; i++) {
             for (j = 0; j < 6; j++) {
@@ -527,7 +528,7 @@ static void generalised(const System *s, const ModelData *data, const int variab
 /* PowertrainMountsModel._show: motion and mount forces of ``state`` under ``force`` */
 static void show(const System *s, ModelData *data, const double state[12], const double force[6])
 {
-    double q[6], map[3][6];
+    double q[6];
     int i, k, n;
     for (i = 0; i < 12; i++) {
         data->real_value[STATE_VARIABLES[i]] = state[i];
@@ -548,7 +549,7 @@ static void show(const System *s, ModelData *data, const double state[12], const
         int first = V_F_x_mount1 + 3 * n;
         if (n < s->layout.count) {
             const Mount *m = &s->layout.mounts[n];
-            mount_map(m, s->layout.centre, map);
+            const double(*map)[6] = s->maps[n];
             for (k = 0; k < 3; k++) {
                 double moved = 0.0, speed = 0.0;
                 for (i = 0; i < 6; i++) {
