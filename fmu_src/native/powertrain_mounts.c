@@ -90,7 +90,7 @@ static int joint_frame(const double shaft[3], const double bend[3], const char *
     char text[40];
     int k;
     if (!(length >= MOUNTS_JOINTS_MIN_DIRECTION)) {
-        mounts_python_g(length, 3, text, sizeof text);
+        python_format_g(length, 3, text, sizeof text);
         snprintf(error, ERROR_SIZE, "the halfshaft direction of the %s joint has no length (%s)", side, text);
         return 0;
     }
@@ -324,9 +324,9 @@ static int restrained(const System *s, char *error)
     if (s->frequencies[0] >= MOUNTS_RIGID_BODY_MIN_FREQUENCY_RATIO * s->frequencies[5]) {
         return 1;
     }
-    mounts_python_g(s->frequencies[0], 3, lowest, sizeof lowest);
-    mounts_python_g(s->frequencies[5], 6, highest, sizeof highest);
-    mounts_python_g(MOUNTS_RIGID_BODY_MIN_FREQUENCY_RATIO, 6, ratio, sizeof ratio);
+    python_format_g(s->frequencies[0], 3, lowest, sizeof lowest);
+    python_format_g(s->frequencies[5], 6, highest, sizeof highest);
+    python_format_g(MOUNTS_RIGID_BODY_MIN_FREQUENCY_RATIO, 6, ratio, sizeof ratio);
     snprintf(error, ERROR_SIZE, "the mounts leave a rigid-body motion unrestrained (mode 1, mostly %s, at %s Hz, "
              "below %s of the highest mode, %s Hz): add a mount or move one off the line or plane of the others",
              COORDINATES[s->dominant[0]], lowest, ratio, highest);

@@ -25,7 +25,7 @@ from fmu_harness.packaging import native, toolchain
 from fmu_harness.runs.runner import FmuInstance, StepRefused
 from fmu_harness.runs.scenario import scenario
 from support.alongside_the_core import expect_refused_parameters
-from support.native_agreement import TOLERANCE, beyond_tolerance, deviation, up_to_the_toml_reason
+from support.native_agreement import TOLERANCE, beyond_tolerance, deviation, refusals, up_to_the_toml_reason
 from support.fmu_documentation import assert_documentation
 
 NATIVE = native.native_models()
@@ -480,18 +480,6 @@ def test_critical_speeds_layout_file_orders_change_and_ramp_match_the_python_fmu
         assert beyond_tolerance(reference, native_run) == {}, (parameters, changes, ramp)
 
 
-def _refusals(path: Path, parameters: dict) -> list[str]:
-    """The reasons ``parameters`` are refused for at initialisation: the native FMU's Error, the
-    Python FMU's messages (logged after the call's name, the wrappers returning OK)."""
-    with FmuInstance(path) as fmu:
-        first = len(fmu.log)
-        try:
-            fmu.initialize(parameters)
-        except StepRefused as refused:
-            return refused.messages
-        return [message.removeprefix("exitInitializationMode: ") for message in fmu.messages_since(first)]
-
-
 @pytest.mark.parametrize("name", CRITICAL)
 def test_critical_speeds_refuses_like_the_python_fmu(native_dir, fmu_path, tmp_path, name, fmi):
     """Bad orders, bad layout values and files, the work limit, the plausibility check: refused with
@@ -509,8 +497,8 @@ def test_critical_speeds_refuses_like_the_python_fmu(native_dir, fmu_path, tmp_p
         {"D_outer": 1e200, "D_inner": 0.0}, {"orders": "1,2", "D_outer": 1e-100, "D_inner": 0.0},
     ]
     for parameters in cases:
-        expected = [up_to_the_toml_reason(m) for m in _refusals(fmu_path(name, fmi), parameters)]
-        found = [up_to_the_toml_reason(m) for m in _refusals(_native(native_dir, name, fmi), parameters)]
+        expected = [up_to_the_toml_reason(m) for m in refusals(fmu_path(name, fmi), parameters)]
+        found = [up_to_the_toml_reason(m) for m in refusals(_native(native_dir, name, fmi), parameters)]
         assert found == expected, parameters
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
-from support.native_agreement import up_to_the_toml_reason
+from support.native_agreement import refusals, up_to_the_toml_reason
 
 NAME = "PowertrainMounts"
 BODY = 'mass = 200.0\ncentre_of_gravity = [0.1, 0.0, 0.2]\ninertia = [11.0, 8.0, 10.0, 0.3, 1.0, 0.4]\n'
@@ -50,17 +50,6 @@ LAYOUTS = {
 }
 
 
-def _refusals(path: Path, parameters: dict) -> list[str]:
-    """The reasons ``parameters`` are refused for at initialisation (see test_native_fmus._refusals)."""
-    with FmuInstance(path) as fmu:
-        first = len(fmu.log)
-        try:
-            fmu.initialize(parameters)
-        except StepRefused as refused:
-            return refused.messages
-        return [message.removeprefix("exitInitializationMode: ") for message in fmu.messages_since(first)]
-
-
 def _cases(folder: Path) -> list[dict]:
     (folder / "folder.toml").mkdir()
     (folder / "latin1.toml").write_bytes((BODY + THREE + "label = 'caf\xe9'\n").encode("latin-1"))
@@ -79,8 +68,8 @@ def _cases(folder: Path) -> list[dict]:
 def test_layout_and_placement_refusals_are_the_python_fmus(native_dir, fmu_path, tmp_path, fmi):
     """Every case is refused, by both FMUs alike (up to tomllib's own words for malformed TOML)."""
     for parameters in _cases(tmp_path):
-        expected = [up_to_the_toml_reason(m) for m in _refusals(fmu_path(NAME, fmi), parameters)]
-        found = [up_to_the_toml_reason(m) for m in _refusals(native.fmu_path(native_dir, NAME, fmi), parameters)]
+        expected = [up_to_the_toml_reason(m) for m in refusals(fmu_path(NAME, fmi), parameters)]
+        found = [up_to_the_toml_reason(m) for m in refusals(native.fmu_path(native_dir, NAME, fmi), parameters)]
         assert expected and found == expected, parameters
 
 

@@ -6,10 +6,13 @@ from __future__ import annotations
 
 import re
 
+from pathlib import Path
+
 import numpy as np
 
 from driveline.mounts.layout import MAX_MOUNTS
 from driveline.mounts.rigid_body import COORDINATES
+from fmu_harness.runs.runner import FmuInstance, StepRefused
 
 # Both sides evaluate the same formulas in float64, but numpy's and libm's sin, cos, atan2 may
 # differ in the last bit: outputs must agree within this fraction of each signal's largest magnitude.
@@ -82,3 +85,15 @@ def rows_beyond_tolerance(outputs: list[str], reference_rows: list[list[float]],
     tolerances = np.array([SIGNAL_TOLERANCE.get(n, TOLERANCE) for n in outputs])
     relative = (values - reference) / scales
     return np.where(np.abs(values - reference) <= tolerances * scales, 0.0, relative)
+
+
+def refusals(path: Path, parameters: dict) -> list[str]:
+    """The reasons ``parameters`` are refused for at initialisation: the native FMU's Error, the
+    Python FMU's messages (logged after the call's name, the wrappers returning OK)."""
+    with FmuInstance(path) as fmu:
+        first = len(fmu.log)
+        try:
+            fmu.initialize(parameters)
+        except StepRefused as refused:
+            return refused.messages
+        return [message.removeprefix("exitInitializationMode: ") for message in fmu.messages_since(first)]

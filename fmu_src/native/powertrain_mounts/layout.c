@@ -32,17 +32,6 @@ static ErrorKind vector3(const Loader *loader, const char *where, const char *ke
     return ERROR_NONE;
 }
 
-void mounts_python_g(double value, int digits, char *out, size_t size)
-{
-    if (isnan(value)) {
-        snprintf(out, size, "nan");
-    } else if (isinf(value)) {
-        snprintf(out, size, value > 0 ? "inf" : "-inf");
-    } else {
-        snprintf(out, size, "%.*g", digits, value);
-    }
-}
-
 static double det3(const double a[3][3])
 {
     return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
@@ -78,8 +67,8 @@ static ErrorKind orientation(const Loader *loader, const char *where, const Valu
     }
     det = det3(axes);
     if (!(deviation <= MOUNTS_LAYOUT_ROTATION_TOLERANCE && fabs(det - 1.0) <= MOUNTS_LAYOUT_ROTATION_TOLERANCE)) {
-        mounts_python_g(deviation, 3, deviation_text, sizeof deviation_text);
-        mounts_python_g(det, 6, det_text, sizeof det_text);
+        python_format_g(deviation, 3, deviation_text, sizeof deviation_text);
+        python_format_g(det, 6, det_text, sizeof det_text);
         return layout_error(loader->error, loader->size,
                             "%s.orientation is not a rotation: its rows must be orthonormal and right-handed "
                             "(|R R^T - I| = %s, det R = %s)", where, deviation_text, det_text);
@@ -180,7 +169,7 @@ static ErrorKind inertia(const Loader *loader, const Value *value, double tensor
     }
     used = 0;
     for (i = 0; i < 3; i++) {
-        mounts_python_g(a[4 * i], 6, piece, sizeof piece);
+        python_format_g(a[4 * i], 6, piece, sizeof piece);
         text_append(moments, sizeof moments, &used, piece, strlen(piece));
         text_append(moments, sizeof moments, &used, i < 2 ? ", " : "", i < 2 ? 2 : 0);
     }

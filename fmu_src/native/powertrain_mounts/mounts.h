@@ -27,8 +27,6 @@ typedef struct {
 
 /* layout.loads_layout into the Layout ``out`` (a LayoutLoads of layout_file_load) */
 ErrorKind loads_layout(const char *text, size_t length, const char *source, void *out, char *error, size_t size);
-/* Python's format(value, '.<digits>g') */
-void mounts_python_g(double value, int digits, char *out, size_t size);
 
 /* ---- dense.c ----------------------------------------------------------------------------------- */
 
