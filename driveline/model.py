@@ -281,3 +281,18 @@ class DrivenShaftModel(SteppedModel):
     def evaluate(self, input_time: float) -> None:
         """Outputs from the current ``phi_in``, inputs and parameters; ``input_time`` is the
         communication point at which the host set the inputs (the start of the step)."""
+
+
+class TimeSourceModel(SteppedModel):
+    """A model whose outputs are exact functions of time: :meth:`at_time` at the start time and at the
+    end of each step, so they do not depend on the communication step."""
+
+    def start(self, start_time: float) -> None:
+        self.at_time(start_time)
+
+    def advance(self, current_time: float, step_size: float) -> None:
+        self.at_time(current_time + step_size)
+
+    @abstractmethod
+    def at_time(self, t: float) -> None:
+        """The outputs at time ``t`` from the parameters."""

@@ -2,6 +2,7 @@
 
 One layer imports only the layers below it (``tests/project/test_package_layers.py`` holds them to it):
 
+* :mod:`.console`: what the commands show their user: one-line mistakes, progress, missing extras;
 * :mod:`.packaging`: the Python and native FMUs made from the catalog (model description, shipped
   files, C build for five platforms, generated C constants);
 * :mod:`.doc_pages`: the generated sections of the docs pages (variable tables);

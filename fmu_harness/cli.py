@@ -12,17 +12,20 @@ import argparse
 import importlib
 import sys
 
+from .console import CommandParser
+
 COMMANDS = {
     "build": ("fmu_harness.build_command", "build the FMUs (FMI 2.0 and 3.0), their reference results and the SSP system"),
     "run": ("fmu_harness.main", "the main job: simulate the FMUs, write CSV files and figures"),
     "sweep": ("fmu_harness.runs.sweep", "a parameter sweep of one FMU on Dask"),
     "interop": ("fmu_harness.checks.interop", "every FMU in every importer: the interoperability matrix"),
     "check": ("fmu_harness.runs.start_values", "the start values of an SSP package or an FMU, as the FMUs check them"),
+    "system": ("fmu_harness.system_command", "run an SSP package, every output of every component to CSV"),
 }
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="driveline-fmus",
         description="Build, run, sweep and check the driveline FMUs.",
         epilog="commands:\n" + "".join(f"  {name:<9} {text}\n" for name, (_, text) in COMMANDS.items())

@@ -1,17 +1,17 @@
 """The main job: simulate the project's FMUs through fmpy and write results and figures.
 
-Usage: ``python -m fmu_harness.main [--models models] [--out results]`` after
-``python build_fmu.py``. The studies run the native FMUs (``models/native/``); the Python FMUs
+Usage: ``driveline-fmus run [--models models] [--out results]`` (or ``python -m fmu_harness.main``)
+after ``driveline-fmus build``. The studies run the native FMUs (``models/native/``); the Python FMUs
 are compared with them in a process of their own (:mod:`fmu_harness.checks.python_fmu_check`), so that
 the pythonfmu wrapper's exit-time defect cannot end the main job.
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 from .checks import python_fmu_check
+from .console import CommandParser, Progress
 from .packaging import native
 from .studies import coupling_comparison, critical_speed_study, mounts_study, tripod_study
 
@@ -22,17 +22,26 @@ def simulate(models: Path, out: Path) -> list[Path]:
                                                              "CriticalSpeeds", "PowertrainMounts")}
     missing = [str(path) for path in fmus.values() if not path.exists()]
     if missing:
-        raise SystemExit(f"no native FMU {', '.join(missing)}: build them with `python build_fmu.py` "
-                         "(it needs a C compiler, docs/native_fmus.md)")
-    written = tripod_study.write(fmus["TripodCoupling"], out)
-    written += coupling_comparison.write(fmus["CardanJoint"].parent, out)
-    written += critical_speed_study.write(fmus["CriticalSpeeds"], out)
-    written += mounts_study.write(fmus["PowertrainMounts"], out)
-    return written + python_fmu_check.run(models, models, out)
+        raise SystemExit(f"driveline-fmus run: no native FMU {', '.join(missing)}: build the FMUs first with "
+                         f"`driveline-fmus build{'' if models == Path('models') else f' --dest {models}'}` "
+                         "(zig, which compiles the native ones, comes with the package)")
+    studies = {
+        "tripod coupling": lambda: tripod_study.write(fmus["TripodCoupling"], out),
+        "coupling comparison": lambda: coupling_comparison.write(fmus["CardanJoint"].parent, out),
+        "critical speeds": lambda: critical_speed_study.write(fmus["CriticalSpeeds"], out),
+        "powertrain mounts": lambda: mounts_study.write(fmus["PowertrainMounts"], out),
+        "Python FMUs against native": lambda: python_fmu_check.run(models, models, out),
+    }
+    written = []
+    with Progress("main job", len(studies)) as shown:
+        for name, study in studies.items():
+            written += study()
+            shown.advance(name)
+    return written
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = CommandParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--out", type=Path, default=Path("results"), help="folder for CSV files and figures")
     args = parser.parse_args(argv)

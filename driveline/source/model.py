@@ -4,22 +4,16 @@ from __future__ import annotations
 
 import math
 
-from ..model import SteppedModel
+from ..model import TimeSourceModel
 from .spec import SPEC
 
 
-class SpeedSourceModel(SteppedModel):
+class SpeedSourceModel(TimeSourceModel):
     """The ``SpeedSource`` co-simulation model: outputs are exact functions of time."""
 
     spec = SPEC
 
-    def start(self, start_time: float) -> None:
-        self._evaluate(start_time)
-
-    def advance(self, current_time: float, step_size: float) -> None:
-        self._evaluate(current_time + step_size)
-
-    def _evaluate(self, t: float) -> None:
+    def at_time(self, t: float) -> None:
         w = 2.0 * math.pi * self.sine_frequency
         a = self.sine_amplitude
         self.omega = self.omega_start + self.ramp_rate * t + a * math.sin(w * t)

@@ -32,7 +32,8 @@ from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
 
-from ..doc_pages.sections import replace_section
+from ..console import CommandParser, Progress
+from ..doc_pages.sections import replace_section, section
 from ..packaging import fmu_path, native
 from ..runs.runner import FmuInstance
 from ..runs.scenario import scenario, standard_run
@@ -174,14 +175,18 @@ def fmus(models: Path, natives: Path | None = None) -> list[Fmu]:
 Table = dict[tuple[str, Family, str], dict[str, Outcome]]
 
 
-def matrix(models: Path, natives: Path | None = None) -> Table:
-    """``{(model, family, FMI version): {importer: outcome}}`` for every FMU of :func:`fmus`."""
+def matrix(models: Path, natives: Path | None = None, show_progress: bool = False) -> Table:
+    """``{(model, family, FMI version): {importer: outcome}}`` for every FMU of :func:`fmus`;
+    ``show_progress``: each FMU and importer on standard error."""
     table: Table = {}
-    for fmu in fmus(models, natives):
-        description = read_model_description(str(fmu.path))
-        table[description.modelName, fmu.family, description.fmiVersion] = {
-            i.name: outcome(i, fmu.path, fmu.reference) for i in IMPORTERS
-        }
+    found = fmus(models, natives)
+    with Progress("importer matrix", len(found) * len(IMPORTERS), enabled=show_progress) as shown:
+        for fmu in found:
+            description = read_model_description(str(fmu.path))
+            row = table[description.modelName, fmu.family, description.fmiVersion] = {}
+            for importer in IMPORTERS:
+                row[importer.name] = outcome(importer, fmu.path, fmu.reference)
+                shown.advance(f"{description.modelName} {fmu.family} FMI {description.fmiVersion} in {importer.name}")
     return table
 
 
@@ -207,7 +212,7 @@ def markdown(table: Table) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = CommandParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--update", type=Path, metavar="PAGE", help="markdown page whose matrix section to regenerate")
     parser.add_argument("--worker", nargs=3, metavar=("ENGINE", "FMU", "REFERENCE"), help=argparse.SUPPRESS)
@@ -215,7 +220,14 @@ def main(argv: list[str] | None = None) -> None:
     if args.worker:
         engine, fmu, reference = args.worker
         answer(RESULT, asdict(simulate_in(engine, Path(fmu), Path(reference))))
-    table = matrix(args.models)
+    if not fmus(args.models):
+        parser.error(f"no built FMU in {args.models} (`driveline-fmus build` builds them; --models names another folder)")
+    if args.update:
+        try:
+            section(args.update, "interop")
+        except (OSError, ValueError) as error:
+            parser.error(f"--update {args.update}: {error}")
+    table = matrix(args.models, show_progress=True)
     text = markdown(table)
     print(text)
     for (name, family, version), row in table.items():

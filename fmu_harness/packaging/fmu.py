@@ -8,8 +8,11 @@ model's spec (:mod:`.model_description`).
 
 from __future__ import annotations
 
+import hashlib
 import shutil
 import tempfile
+import uuid
+import xml.etree.ElementTree as ET
 import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -23,6 +26,7 @@ from driveline.model import SteppedModel
 from driveline.variables import ModelSpec
 
 from . import documentation
+from .archive import TOKEN_NAMESPACE, write_zip
 from .model_description import complete_fmi2, complete_fmi3
 from .shipped_files import shipped_files
 
@@ -85,14 +89,17 @@ def script(name: str, version: FmiVersion, model: type[SteppedModel]) -> str:
                          adapters=ADAPTERS, adapter=version.adapter, model=f"{model.__module__}:{model.__qualname__}")
 
 
-def _rewrite_zip(path: Path, replace: dict[str, bytes]) -> None:
-    """Rewrite ``path`` with some members replaced or added."""
-    with zipfile.ZipFile(path) as source:
-        members = {info.filename: source.read(info) for info in source.infolist()}
-    members.update(replace)
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as target:
-        for name, data in members.items():
-            target.writestr(name, data)
+def _fixed_description(xml: bytes, others: dict[str, bytes]) -> bytes:
+    """The model description without the loader's build time and with a token computed from the
+    FMU's contents instead of its time-based one (``guid``, FMI 3.0 ``instantiationToken``): the
+    same sources give the same FMU, other sources another token."""
+    root = ET.fromstring(xml)
+    root.attrib.pop("generationDateAndTime", None)
+    attribute = "guid" if "guid" in root.attrib else "instantiationToken"
+    root.set(attribute, "")
+    digest = hashlib.sha256(repr((ET.tostring(root), sorted(others.items()))).encode())
+    root.set(attribute, str(uuid.uuid5(TOKEN_NAMESPACE, digest.hexdigest())))
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
 def build(name: str, dest: Path, fmi: str = "2", model: type[SteppedModel] | None = None) -> Path:
@@ -119,15 +126,11 @@ def build(name: str, dest: Path, fmi: str = "2", model: type[SteppedModel] | Non
             **version.options,
         ))
     with zipfile.ZipFile(fmu) as archive:
-        xml = archive.read("modelDescription.xml")
-    _rewrite_zip(
-        fmu,
-        {
-            "modelDescription.xml": version.complete(xml, model.spec),
-            "resources/requirements.txt": REQUIREMENTS.encode(),
-            **documentation.members(name),
-        },
-    )
+        members = {info.filename: archive.read(info) for info in archive.infolist()}
+    members.update({"resources/requirements.txt": REQUIREMENTS.encode(), **documentation.members(name)})
+    description = version.complete(members.pop("modelDescription.xml"), model.spec)
+    members["modelDescription.xml"] = _fixed_description(description, members)
+    write_zip(fmu, members)
     return fmu
 
 

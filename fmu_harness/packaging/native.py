@@ -29,7 +29,6 @@ import re
 import tempfile
 import uuid
 import xml.etree.ElementTree as ET
-import zipfile
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -41,7 +40,9 @@ from driveline.catalog import MODELS
 from driveline.model import TIME_TOLERANCE, SteppedModel
 from driveline.variables import UNITS, ModelSpec, Relation, Variable
 
+from ..console import Progress
 from . import documentation, toolchain
+from .archive import TOKEN_NAMESPACE, write_zip
 from .documentation import snake_case
 from .model_description import complete_fmi2, complete_fmi3
 from .native_constants import HEADER as CONSTANTS_HEADER
@@ -53,7 +54,6 @@ SHARED_SOURCES = ("fmu_instance.h", "fmu_layer.h", "fmu_instance.c", "fmu_checks
                   "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
-TOKEN_NAMESPACE = uuid.UUID("6f3b1d52-8a0e-4c59-9a57-1f0e2f4c7d10")
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
 
 
@@ -516,21 +516,18 @@ def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain
     }
     if fmi == "3":
         members["sources/buildDescription.xml"] = build_description(name, compiled)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
-        for member, data in members.items():
-            archive.writestr(member, data)
+    write_zip(target, members)
 
 
 def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] = ("2", "3"),
-              release: bool | None = None, model_file: Path | None = None) -> list[Path]:
+              release: bool | None = None, model_file: Path | None = None, show_progress: bool = False) -> list[Path]:
     """The native FMUs of ``names`` (default: every model with a C port) that have one, for each
     FMI version in ``fmi``, with binaries for every platform (``release``; the default when ziglang
     is installed, :func:`toolchain.chosen_platforms`) or for this machine's alone.
 
     Each source is compiled once per platform (the FMI layer and the generated table once per FMI
     version), all in parallel, then linked once per FMU and platform. ``model_file`` replaces the
-    models' C port (the benchmarks' no-physics twin)."""
+    models' C port (the benchmarks' no-physics twin); ``show_progress``: each step on standard error."""
     chosen = [name for name in (names or native_models()) if has_c_port(name)]
     platforms = toolchain.chosen_platforms(release)
     host_only = len(platforms) == 1 and not (release or (release is None and toolchain.release_available()))
@@ -560,8 +557,11 @@ def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] =
                     library = root / "binaries" / target.tuple / f"fmi{v}" / f"{name}{target.suffix}"
                     links.append(toolchain.link_step(target, [*model_objects, *own_objects], library, host_only))
                     libraries.setdefault((name, v), {})[target] = library
-        toolchain.run(compiles)
-        toolchain.run(links)
+        where = ", ".join(p.tuple for p in platforms)
+        with Progress(f"native FMUs: compiling for {where}", len(compiles), enabled=show_progress) as shown:
+            toolchain.run(compiles, progress=shown)
+        with Progress("native FMUs: linking", len(links), enabled=show_progress) as shown:
+            toolchain.run(links, progress=shown)
         for (name, v), binaries in libraries.items():
             _pack(name, v, files[name, v], binaries, fmu_path(dest, name, v))
     return [fmu_path(dest, name, v) for v in fmi for name in chosen]

@@ -22,6 +22,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..console import Progress
+
 # -ffp-contract=off: no fused multiply-add (clang fuses by default where the CPU has it, aarch64), so
 # every platform rounds as the Python core does, operation by operation
 CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", "-ffp-contract=off", "-fvisibility=hidden")
@@ -135,12 +137,15 @@ def compile_flags(target: Platform) -> list[str]:
     return [*CFLAGS, *(() if target.system == "windows" else ("-fPIC",))]
 
 
-def link_flags(target: Platform, library: Path) -> list[str]:
+def link_flags(target: Platform, library: Path, by_zig: bool = True) -> list[str]:
     """Shared library, stripped; libm where it is a library of its own (Linux); the name a macOS
-    loader records is the file's own."""
+    loader records is the file's own; linked by zig, a Windows DLL's header time is a hash of its
+    contents (``/Brepro``), not the time of the build, so that a rebuild gives the same bytes."""
     flags = ["-shared", "-s"]
     if target.system == "linux":
         flags.append("-lm")
+    elif target.system == "windows" and by_zig:
+        flags.append("-Wl,/Brepro")
     elif target.system == "darwin":
         flags.append(f"-Wl,-install_name,@rpath/{library.name}")
     return flags
@@ -181,19 +186,23 @@ def compile_step(target: Platform, source: Path, output: Path, include: Path, he
 
 
 def link_step(target: Platform, objects: Iterable[Path], library: Path, host_only: bool) -> Step:
-    command = [*compiler_for(target, host_only), *(() if target.system == "windows" else ("-fPIC",)),
-               *(str(o) for o in objects), "-o", str(library), *link_flags(target, library)]
+    compiler = compiler_for(target, host_only)
+    command = [*compiler, *(() if target.system == "windows" else ("-fPIC",)),
+               *(str(o) for o in objects), "-o", str(library), *link_flags(target, library, compiler[0] == str(zig()))]
     return Step(tuple(command), library, f"{library.name} for {target.tuple}")
 
 
-def run(steps: Sequence[Step], jobs: int | None = None) -> None:
-    """Run independent compiler steps, ``jobs`` at a time (default: one per core)."""
+def run(steps: Sequence[Step], jobs: int | None = None, progress: Progress | None = None) -> None:
+    """Run independent compiler steps, ``jobs`` at a time (default: one per core), each done
+    step shown on ``progress``."""
 
     def one(step: Step) -> None:
         step.output.parent.mkdir(parents=True, exist_ok=True)
         done = subprocess.run(step.command, capture_output=True, text=True)
         if done.returncode:
             raise RuntimeError(f"compiling {step.what} failed:\n{done.stderr}")
+        if progress is not None:
+            progress.advance(step.what)
 
     with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
         for future in [pool.submit(one, step) for step in steps]:

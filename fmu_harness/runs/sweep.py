@@ -16,8 +16,11 @@ Every point is one :func:`fmu_harness.runs.runner.simulate` call on a worker. Th
 scattered to the workers once, extracted and their model description parsed once per worker
 process, so workers need no shared file system. A refused or crashed run becomes a ``failed``
 row with its reason; a point whose parameters break the spec's bounds or relations, which the
-FMU would refuse at initialisation, is not run (:mod:`fmu_harness.runs.start_values`), and when
-every point is, the command exits with the first reason before any worker starts.
+FMU would refuse at initialisation, is not run (:mod:`fmu_harness.runs.start_values`). The command
+ends non-zero when every run failed and names the distinct reasons, before any worker starts when
+every point is refused so. Its arguments, the FMU and the layout are checked before the cluster
+starts; Dask and pyarrow (the ``sweep`` extra) are imported when a sweep runs, so ``--help``
+needs neither.
 """
 
 from __future__ import annotations
@@ -30,25 +33,32 @@ import itertools
 import json
 import math
 import os
+import sys
 import threading
+import zipfile
+from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pyarrow as pa
-import pyarrow.csv
-import pyarrow.parquet
-from distributed import Client, Future, LocalCluster, get_worker, progress, wait
 from fmpy import extract, read_model_description
 from fmpy.model_description import ModelDescription
 
 from driveline.catalog import MODELS
 
+from ..console import CommandParser, Progress, optional
 from .runner import StepRefused, simulate
 from .start_values import refusals
+
+if TYPE_CHECKING:
+    import pyarrow as pa
+    from distributed import Client, Future
+
+COMMAND = "driveline-fmus sweep"
+EXTRA = "sweep"
 
 Value = float | int | str
 Point = dict[str, Value]
@@ -132,6 +142,14 @@ class Timing:
     steps_per_turn: int = 360
     duration: float | None = None
     step_size: float | None = None
+
+    def __post_init__(self) -> None:
+        for name, count in (("turns", self.turns), ("steps per turn", self.steps_per_turn)):
+            if not (isinstance(count, int) and count >= 1):
+                raise ValueError(f"{name} must be a whole number of at least 1, got {count!r}")
+        for name, seconds in (("duration", self.duration), ("step", self.step_size)):
+            if seconds is not None and not (math.isfinite(seconds) and seconds > 0.0):
+                raise ValueError(f"the {name} must be a finite positive number of seconds, got {seconds!r}")
 
     def resolve(self, speed: float | None, default: tuple[float, float] | None) -> tuple[float, float]:
         """(stop time, step size) for a run at input speed ``speed`` [rad/s]."""
@@ -266,6 +284,8 @@ _UNPACK_LOCK = threading.Lock()
 
 def _unpacked(fmu: ShippedFmu) -> UnpackedFmu:
     """The FMU written, extracted and parsed once per worker process in the worker's scratch space."""
+    from distributed import get_worker
+
     with _UNPACK_LOCK:
         if fmu.digest not in _UNPACKED:
             folder = Path(get_worker().local_directory) / f"fmu-{fmu.digest[:16]}"
@@ -292,17 +312,15 @@ def _outcome(future: Future) -> dict[str, Any]:
     return {"status": "failed", "reason": f"the Dask task was {future.status}"}
 
 
-def critical_speed_margins(speeds: Sequence[float], layout: str = "") -> list[float] | None:
-    """``(|speed| - n_c) / n_c`` for the nearest ``n_c`` of the first three forward critical
-    speeds, or None while the catalog holds no ``CriticalSpeeds`` model.
+def critical_speeds(layout: str = "") -> list[float] | None:
+    """The first three forward critical speeds [rad/s] of the driveline ``layout``, or None while
+    the catalog holds no ``CriticalSpeeds`` model; a layout the model refuses raises ValueError.
 
-    The critical speeds are the outputs ``omega_crit_1..3`` of the catalog's ``CriticalSpeeds``
-    model, the code its FMU wraps, initialised at its start values with ``layout`` (its
-    ``layout`` parameter: a TOML file or the name of a shipped description): the sweep reads
-    the model through its declared interface only, runs on the client, which may not hold the
-    CriticalSpeeds FMU, and needs no FMU instance for it. The sign follows the model's
-    ``resonance_margin`` (negative below the critical speed); a speed that is zero or not
-    finite has no margin (NaN)."""
+    They are the outputs ``omega_crit_1..3`` of the catalog's ``CriticalSpeeds`` model, the code
+    its FMU wraps, initialised at its start values with ``layout`` (its ``layout`` parameter: a
+    TOML file or the name of a shipped description, read by the model's own loader): the sweep
+    reads the model through its declared interface only, runs on the client, which may not hold
+    the CriticalSpeeds FMU, and needs no FMU instance for it."""
     model_class = MODELS.get(CRITICAL_SPEEDS_MODEL)
     if model_class is None:
         return None
@@ -311,7 +329,13 @@ def critical_speed_margins(speeds: Sequence[float], layout: str = "") -> list[fl
     errors = model.initialize(0.0)
     if errors:
         raise ValueError(f"{CRITICAL_SPEEDS_MODEL} with layout {layout!r}: {'; '.join(errors)}")
-    critical = [getattr(model, f"omega_crit_{k}") for k in (1, 2, 3)]
+    return [getattr(model, f"omega_crit_{k}") for k in (1, 2, 3)]
+
+
+def critical_speed_margins(speeds: Sequence[float], critical: Sequence[float]) -> list[float]:
+    """``(|speed| - n_c) / n_c`` for the nearest ``n_c`` of the ``critical`` speeds. The sign
+    follows the ``CriticalSpeeds`` model's ``resonance_margin`` (negative below the critical
+    speed); a speed that is zero or not finite has no margin (NaN)."""
 
     def margin(speed: float) -> float:
         if not (math.isfinite(speed) and speed != 0.0):
@@ -322,6 +346,66 @@ def critical_speed_margins(speeds: Sequence[float], layout: str = "") -> list[fl
     return [margin(speed) for speed in speeds]
 
 
+@dataclass(frozen=True)
+class Plan:
+    """A sweep checked before anything runs: the FMU read, every point's names known to it, the
+    timing valid, the points the FMU would refuse (:func:`refused_points`, not run) and the
+    critical speeds of the margin (None when there is no margin)."""
+
+    fmu: ShippedFmu
+    points: Sequence[Point]
+    timing: Timing
+    refused: dict[int, str]
+    critical: list[float] | None
+
+    @classmethod
+    def of(cls, fmu: Path, points: Sequence[Point], timing: Timing = Timing(), layout: str = "") -> Plan:
+        """Raises ValueError for no points, unknown names or a refused layout, OSError or BadZipFile for an
+        unreadable FMU."""
+        if not points:
+            raise ValueError("no points to run")
+        shipped = ShippedFmu.read(fmu)
+        for point in points:
+            shipped.interface.split(point)
+        refused = refused_points(shipped.interface.model, points)
+        if shipped.interface.speed_start is None:
+            if layout:
+                raise ValueError(f"the layout sets the critical-speed margin, which needs an {SPEED} input: "
+                                 f"{shipped.interface.model} has none")
+            return cls(shipped, points, timing, refused, None)
+        return cls(shipped, points, timing, refused, critical_speeds(layout))
+
+
+def run(client: Client, plan: Plan, show_progress: bool = False) -> pa.Table:
+    """Run every point of ``plan`` on the client's workers; one row per point, in its order.
+
+    Columns: the points' names, ``status`` (ok/failed), ``reason`` (null when ok), the
+    metrics of :meth:`Interface.statistics` (null when failed) and, when available,
+    ``critical_speed_margin`` (see :func:`critical_speed_margins`).
+    """
+    pa = optional("pyarrow", EXTRA, COMMAND)
+    distributed = optional("distributed", EXTRA, COMMAND)
+    interface, points = plan.fmu.interface, plan.points
+    payload = client.scatter(plan.fmu, broadcast=True, hash=False)
+    futures = {i: client.submit(run_point, payload, point, plan.timing, pure=False)
+               for i, point in enumerate(points) if i not in plan.refused}
+    at = {future.key: points[i] for i, future in futures.items()}
+    with Progress("sweep", len(futures), enabled=show_progress) as shown:
+        for future in distributed.as_completed(futures.values()):
+            shown.advance(" ".join(f"{k}={v}" for k, v in at[future.key].items()) + f": {_outcome(future)['status']}")
+    rows = [{**point, **({"status": "failed", "reason": plan.refused[i]} if i in plan.refused
+                         else _outcome(futures[i]))} for i, point in enumerate(points)]
+    metrics = interface.metric_columns()
+    names = list(dict.fromkeys(name for point in points for name in point))
+    types = {"status": pa.string(), "reason": pa.string(), **{m: pa.float64() for m in metrics}}
+    columns = [*names, "status", "reason", *metrics]
+    table = pa.table({c: pa.array([row.get(c) for row in rows], types.get(c)) for c in columns})
+    if plan.critical is None:
+        return table
+    margins = critical_speed_margins([interface.speed(point) for point in points], plan.critical)
+    return table.append_column(MARGIN, pa.array(margins, pa.float64()))
+
+
 def sweep(
     client: Client,
     fmu: Path,
@@ -330,33 +414,8 @@ def sweep(
     show_progress: bool = False,
     layout: str = "",
 ) -> pa.Table:
-    """Run every point on the client's workers; one row per point, in the order of ``points``.
-
-    Columns: the points' names, ``status`` (ok/failed), ``reason`` (null when ok), the
-    metrics of :meth:`Interface.statistics` (null when failed) and, when available,
-    ``critical_speed_margin`` (see :func:`critical_speed_margins`).
-    """
-    shipped = ShippedFmu.read(fmu)
-    interface = shipped.interface
-    for point in points:  # unknown names raise before anything runs
-        interface.split(point)
-    refused = refused_points(interface.model, points)
-    payload = client.scatter(shipped, broadcast=True, hash=False)
-    futures = {i: client.submit(run_point, payload, point, timing, pure=False)
-               for i, point in enumerate(points) if i not in refused}
-    if show_progress:
-        progress(list(futures.values()))
-    wait(list(futures.values()))
-    rows = [{**point, **({"status": "failed", "reason": refused[i]} if i in refused else _outcome(futures[i]))}
-            for i, point in enumerate(points)]
-    metrics = interface.metric_columns()
-    names = list(dict.fromkeys(name for point in points for name in point))
-    types = {"status": pa.string(), "reason": pa.string(), **{m: pa.float64() for m in metrics}}
-    columns = [*names, "status", "reason", *metrics]
-    table = pa.table({c: pa.array([row.get(c) for row in rows], types.get(c)) for c in columns})
-    speeds = [interface.speed(point) for point in points]
-    margins = None if interface.speed_start is None else critical_speed_margins(speeds, layout)
-    return table if margins is None else table.append_column(MARGIN, pa.array(margins, pa.float64()))
+    """:func:`run` of the :class:`Plan` of these arguments."""
+    return run(client, Plan.of(fmu, points, timing, layout), show_progress)
 
 
 def refused_points(model: str, points: Sequence[Point]) -> dict[int, str]:
@@ -371,26 +430,62 @@ def write_table(table: pa.Table, path: Path) -> None:
     """Parquet, or CSV when ``path`` ends in ``.csv``."""
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".csv":
-        pyarrow.csv.write_csv(table, path)
+        optional("pyarrow.csv", EXTRA, COMMAND).write_csv(table, path)
     else:
-        pyarrow.parquet.write_table(table, path)
+        optional("pyarrow.parquet", EXTRA, COMMAND).write_table(table, path)
+
+
+def failure_reasons(table: pa.Table) -> Counter[str]:
+    """How many runs failed for each distinct reason."""
+    return Counter(r for s, r in zip(table.column("status").to_pylist(), table.column("reason").to_pylist())
+                   if s == "failed")
+
+
+def print_reasons(reasons: Counter[str]) -> None:
+    """Each distinct reason of failed runs with their number, most frequent first, on standard error."""
+    for reason, count in reasons.most_common():
+        print(f"  {count} failed: {reason}", file=sys.stderr)
 
 
 @contextmanager
 def open_client(scheduler: str | None = None, workers: int = 2) -> Iterator[Client]:
     """A client of the scheduler at ``scheduler``, else of a local cluster of ``workers``
     single-threaded worker processes (closed on exit)."""
+    distributed = optional("distributed", EXTRA, COMMAND)
     if scheduler:
-        with Client(scheduler) as client:
+        with distributed.Client(scheduler) as client:
             yield client
         return
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
-    with cluster, Client(cluster) as client:
+    cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
+    with cluster, distributed.Client(cluster) as client:
         yield client
 
 
+def _workers(text: str) -> int:
+    """An argparse type: the number of local workers, at least 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number of at least 1, got {text}")
+    return value
+
+
+def _fmu_file(models: Path, model: str) -> Path:
+    """The FMU ``model`` in ``models``; ValueError naming the FMUs there when it is not one of them."""
+    path = models / f"{model}.fmu"
+    if path.is_file():
+        return path
+    if not models.is_dir():
+        raise ValueError(f"no folder {models} of built FMUs (`driveline-fmus build` builds them; --models names another)")
+    built = sorted(p.stem for p in models.glob("*.fmu"))
+    there = f"the FMUs there: {', '.join(built)}" if built else "none is there"
+    raise ValueError(f"no FMU {path} ({there}; `driveline-fmus build` builds them)")
+
+
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = CommandParser(description=__doc__.splitlines()[0])
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--grid", nargs="+", metavar="AXIS", help="name=v1,v2,... or name=start:stop:count")
     source.add_argument("--points", type=Path, help="CSV or JSON file of points")
@@ -400,7 +495,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--steps-per-turn", type=int, default=360)
     parser.add_argument("--duration", type=float, help="run length [s] instead of whole turns")
     parser.add_argument("--step", type=float, help="communication step size [s]")
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, help="local cluster size")
+    parser.add_argument("--workers", type=_workers, default=os.cpu_count() or 1, help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
     parser.add_argument(
         "--layout", default="", help="driveline of the critical-speed margin: TOML file or shipped name"
@@ -410,22 +505,23 @@ def main(argv: list[str] | None = None) -> None:
 
     try:
         points = grid(dict(map(parse_axis, args.grid))) if args.grid else read_points(args.points)
-    except ValueError as error:
+        timing = Timing(args.turns, args.steps_per_turn, args.duration, args.step)
+        plan = Plan.of(_fmu_file(args.models, args.model), points, timing, args.layout)
+    except (ValueError, OSError, zipfile.BadZipFile) as error:
         parser.error(str(error))
-    timing = Timing(args.turns, args.steps_per_turn, args.duration, args.step)
-    fmu = args.models / f"{args.model}.fmu"
-    refused = refused_points(Interface.of(fmu).model, points) if fmu.is_file() else {}
-    if points and len(refused) == len(points):
-        parser.exit(1, f"refused: every point; the first: {refused[0]}\n")
+    if len(plan.refused) == len(points):
+        print_reasons(Counter(plan.refused.values()))
+        sys.exit(f"{COMMAND}: every point refused, none run")
+    optional("pyarrow", EXTRA, COMMAND)  # before the cluster starts
     with open_client(args.scheduler, args.workers) as client:
         print(f"{len(points)} runs of {args.model} on {client.scheduler.address}")
-        try:
-            table = sweep(client, fmu, points, timing, True, args.layout)
-        except ValueError as error:
-            parser.error(str(error))
+        table = run(client, plan, show_progress=True)
     write_table(table, args.out)
-    failures = table.column("status").to_pylist().count("failed")
-    print(f"\n{table.num_rows} runs, {failures} failed -> {args.out}")
+    reasons = failure_reasons(table)
+    print(f"{table.num_rows} runs, {reasons.total()} failed -> {args.out}")
+    print_reasons(reasons)
+    if reasons.total() == table.num_rows:
+        sys.exit(f"{COMMAND}: every run failed")
 
 
 if __name__ == "__main__":

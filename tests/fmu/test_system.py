@@ -56,14 +56,17 @@ def test_the_system_has_the_source_the_coupling_and_the_watcher_when_there_is_on
     assert (system.WATCHER in models) == (system.WATCHER in MODELS)
 
 
-def test_system_structures_are_valid_ssp_1_0(driveline_ssp, native_ssp):
-    """Both packages, against the SSP 1.0 schemas that pyssp-standard ships (loaded once: seconds)."""
+def test_system_structures_are_valid_ssp_1_0(driveline_ssp, native_ssp, fmi2_dir, native_dir):
+    """Both packages, and both of the vehicle launch, against the SSP 1.0 schemas that pyssp-standard
+    ships (loaded once: seconds)."""
     if importlib.util.find_spec("pyssp_standard") is None or importlib.util.find_spec("xmlschema") is None:
         pytest.skip("pyssp-standard is not installed on this platform (pip install '.[interop]')")
     import xmlschema
 
     schema = xmlschema.XMLSchema(str(importlib.resources.files("pyssp_standard") / "resources" / "SystemStructureDescription.xsd"))
-    for package in (driveline_ssp, native_ssp):
+    launch = system.vehicle_launch()
+    launch_packages = (system.write_ssp(launch, fmi2_dir), system.write_ssp(launch, fmi2_dir, native_dir))
+    for package in (driveline_ssp, native_ssp, *launch_packages):
         with zipfile.ZipFile(package) as archive:
             schema.validate(archive.read("SystemStructure.ssd").decode())
 

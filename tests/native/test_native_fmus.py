@@ -72,7 +72,7 @@ def test_binary_needs_only_libc_and_libm_and_exports_only_fmi(native_dir, tmp_pa
         library.write_bytes(archive.read(binaries[0]))
     dynamic = subprocess.run(["readelf", "-d", str(library)], capture_output=True, text=True, check=True).stdout
     needed = {line.split("[")[1].rstrip("]") for line in dynamic.splitlines() if "(NEEDED)" in line}
-    assert needed == {"libc.so.6", "libm.so.6"}
+    assert "libc.so.6" in needed and needed <= {"libc.so.6", "libm.so.6"}  # libm only if the model calls it
     symbols = subprocess.run(["nm", "-D", "--defined-only", str(library)], capture_output=True, text=True,
                              check=True).stdout.split()[2::3]
     assert symbols and all(symbol.startswith(f"fmi{fmi}") for symbol in symbols)

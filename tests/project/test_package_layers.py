@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[2]
 LAYERS = (
     "driveline",
     "fmu_src",
+    "fmu_harness.console",  # what the commands show: one-line errors, progress, missing extras
     "fmu_harness.packaging",
     "fmu_harness.doc_pages",
     "fmu_harness.runs",

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from fmu_harness import cli
-from fmu_harness.packaging import FMI_VERSIONS, documentation, fmu_path, native
+from fmu_harness.packaging import FMI_VERSIONS, documentation, fmu_path, native, toolchain
 
 from conftest import SLOW_SECONDS, measured
 from support.fmu_documentation import assert_documentation
@@ -108,11 +108,18 @@ def test_every_command_has_help(command, capsys):
 
 @pytest.mark.fmu
 def test_build_command_builds_one_model(tmp_path):
-    """The console script's build, in a process of its own as a user runs it."""
+    """The console script's build, in a process of its own as a user runs it: by default the native
+    FMU's binary for this machine alone, each stage's progress shown, n of N."""
     run = subprocess.run([sys.executable, "-m", "fmu_harness.cli", "build", "--dest", str(tmp_path), "--fmi", "2",
-                          "--no-references", "--host-only", "SpeedSource"], capture_output=True, text=True, timeout=300,
-                         cwd=ROOT)
+                          "--no-references", "SpeedSource"], capture_output=True, text=True, timeout=300, cwd=ROOT)
     assert run.returncode == 0, run.stderr[-2000:]
+    progress = run.stderr.splitlines()
+    assert progress[0] == "Python FMUs [1/1] SpeedSource FMI 2.0"
+    host = toolchain.host_platform()
+    compiled = [line.split("[")[1].split("]")[0].split("/") for line in progress
+                if line.startswith(f"native FMUs: compiling for {host.tuple} [")]
+    assert compiled[0][0] == "1" and compiled[-1][0] == compiled[-1][1] == compiled[0][1]
+    assert f"native FMUs: linking [1/1] SpeedSource{host.suffix} for {host.tuple}" in progress
     built = fmu_path(tmp_path, "SpeedSource")
     native_built = native.fmu_path(tmp_path, "SpeedSource")  # the model has a C port too
     assert run.stdout.split() == [str(built), str(native_built)]

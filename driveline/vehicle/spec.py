@@ -1,0 +1,90 @@
+"""Interface of the ``VehicleDriveline`` FMU: the single source for the FMI 2.0 and 3.0 builds."""
+
+from __future__ import annotations
+
+import math
+
+from ..variables import DefaultExperiment, ModelSpec, Variable
+from . import compact_car as car
+
+POSITIVE = {"min": 0.0, "min_exclusive": True}
+SIDES = ("left", "right")
+
+
+def _per_side(name: str, causality: str, start: tuple[float, float] | float, text: str, unit: str | None,
+              display: str | None = None, **bounds: float | bool) -> tuple[Variable, ...]:
+    starts = start if isinstance(start, tuple) else (start, start)
+    return tuple(Variable(f"{name}_{side}", causality, value, text.format(side=side), unit, display, **bounds)
+                 for side, value in zip(SIDES, starts))
+
+
+SPEC = ModelSpec(
+    name="VehicleDriveline",
+    description=(
+        "Front-wheel drive between the motor and the road without the joints: motor, reduction gear and "
+        "open differential inertia, halfshafts (torsional stiffness and damping from each joint's output "
+        "angle to its wheel), wheels, tyres with transient slip saturating at the road's friction, the car's "
+        "mass, rolling resistance, drag and grade. Each joint's quantities in its own frame (Z' towards its "
+        "wheel: forward, the right joint turns negatively). Defaults: a 2011 Nissan Leaf."
+    ),
+    variables=(
+        Variable("ratio", "parameter", car.RATIO, "Overall ratio i: motor speed / differential case speed", "1",
+                 **POSITIVE),
+        Variable("J_motor", "parameter", car.MOTOR_INERTIA, "Motor rotor inertia (with the gear's input shaft)",
+                 "kg.m2", min=0.0),
+        Variable("J_diff", "parameter", car.DIFFERENTIAL_INERTIA,
+                 "Differential case and final gear inertia, at the case's speed", "kg.m2", min=0.0),
+        Variable("J_side", "parameter", car.SIDE_INERTIA,
+                 "Inertia of one side gear with the joint's housing, at its own speed (the differential's "
+                 "internal degree of freedom)", "kg.m2", **POSITIVE),
+        *_per_side("k", "parameter", (car.TORSIONAL_STIFFNESS_LEFT, car.TORSIONAL_STIFFNESS_RIGHT),
+                   "Torsional stiffness of the {side} halfshaft, joint output to wheel", "N.m/rad", min=0.0),
+        *_per_side("c", "parameter", car.TORSIONAL_DAMPING, "Torsional damping of the {side} halfshaft",
+                   "N.m.s/rad", min=0.0),
+        Variable("J_wheel", "parameter", car.WHEEL_INERTIA,
+                 "Polar inertia of one wheel with its tyre (front and rear alike)", "kg.m2", **POSITIVE),
+        Variable("r_wheel", "parameter", car.WHEEL_RADIUS, "Rolling radius of the tyres", "m", "mm", **POSITIVE),
+        Variable("m_vehicle", "parameter", car.MASS, "Mass of the car with its load", "kg", **POSITIVE),
+        Variable("front_share", "parameter", car.FRONT_SHARE, "Front axle's share of the weight", "1",
+                 min=0.0, max=1.0, min_exclusive=True),
+        Variable("C_slip", "parameter", car.SLIP_STIFFNESS,
+                 "Longitudinal slip stiffness of one front tyre: force per unit slip at small slip", "N", **POSITIVE),
+        Variable("sigma_slip", "parameter", car.RELAXATION_LENGTH, "Relaxation length of the longitudinal slip",
+                 "m", "mm", **POSITIVE),
+        *_per_side("mu_road", "parameter", car.ROAD_FRICTION,
+                   "Tyre-road friction coefficient under the {side} front wheel", "1", **POSITIVE),
+        Variable("f_roll", "parameter", car.ROLLING_RESISTANCE, "Rolling resistance coefficient", "1", min=0.0),
+        Variable("rho_air", "parameter", car.AIR_DENSITY, "Air density", "kg/m3", min=0.0),
+        Variable("c_drag", "parameter", car.DRAG_COEFFICIENT, "Aerodynamic drag coefficient", "1", min=0.0),
+        Variable("A_front", "parameter", car.FRONTAL_AREA, "Frontal area", "m2", min=0.0),
+        Variable("grade", "parameter", 0.0, "Road grade angle, uphill positive", "rad", "deg",
+                 min=-math.radians(30.0), max=math.radians(30.0)),
+        Variable("v_low", "parameter", 0.1,
+                 "Low-speed regularisation: the slip's speed |v| + v_low, rolling resistance's sign tanh(v / v_low)",
+                 "m/s", "km/h", **POSITIVE),
+        Variable("v_start", "parameter", 0.0, "Car speed at the start time (rolling without slip)", "m/s", "km/h"),
+        Variable("T_motor", "input", 0.0, "Motor torque on its rotor, forward positive", "N.m"),
+        *_per_side("T_in", "input", 0.0,
+                   "Torque the {side} joint takes from its input shaft, the side gear (the joint's T_in)", "N.m"),
+        *_per_side("phi_out", "input", 0.0,
+                   "Output shaft angle of the {side} joint (the joint's phi_out), moving at omega_out over the step",
+                   "rad", "deg"),
+        *_per_side("omega_out", "input", 0.0, "Output shaft speed of the {side} joint (the joint's omega_out)",
+                   "rad/s", "rpm"),
+        *_per_side("omega_in", "output", 0.0, "Speed of the {side} side gear, the joint's input shaft",
+                   "rad/s", "rpm"),
+        *_per_side("alpha_in", "output", 0.0, "Angular acceleration of the {side} side gear", "rad/s2"),
+        *_per_side("T_load", "output", 0.0, "Torque in the {side} halfshaft, the joint's load torque", "N.m"),
+        Variable("T_reaction", "output", 0.0,
+                 "Torque of the drive's rotating parts on the powertrain housing about the axle direction "
+                 "(y): minus both joints' T_in, minus the rate of the parts' angular momentum", "N.m"),
+        Variable("omega_motor", "output", 0.0, "Motor speed", "rad/s", "rpm"),
+        *_per_side("omega_wheel", "output", 0.0, "Speed of the {side} front wheel", "rad/s", "rpm"),
+        *_per_side("F_x", "output", 0.0, "Longitudinal force of the road on the {side} front tyre", "N"),
+        *_per_side("slip", "output", 0.0, "Transient longitudinal slip of the {side} front tyre", "1"),
+        Variable("v_x", "output", 0.0, "Car speed", "m/s", "km/h"),
+        Variable("a_x", "output", 0.0, "Car acceleration", "m/s2"),
+        Variable("x", "output", 0.0, "Distance travelled from the start", "m"),
+    ),
+    default_experiment=DefaultExperiment(0.0, 4.0, 1e-4),
+)

@@ -1,0 +1,208 @@
+"""``driveline-fmus system PACKAGE.ssp``: run an SSP package of FMUs and write every output of every
+component to a CSV file, the time first, each column headed ``Component.variable [unit]``.
+
+The engine is the project's fixed-step Jacobi master (``master``, :func:`fmu_harness.runs.system.run_jacobi`,
+FMI 2.0 and 3.0 FMUs through fmpy), libcosim (``libcosim``, FMI 2.0) or Ecos (``ecos``), the engines
+of the importer matrix. ``--set Component.name=value`` binds a parameter (or an unconnected input's
+start value) in a copy of the package, so every engine runs the same bindings.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import tempfile
+import zipfile
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+from fmpy import read_model_description
+from fmpy.model_description import ModelDescription
+
+from .checks import importers
+from .runs import ssp_package
+from .runs.runner import StepRefused
+from .runs.ssp_package import PackageError, SspSystem
+from .runs.start_values import StartValuesRefused, check_start_values, engine_instances
+from .runs.system import run_jacobi
+from .studies.result_table import write_csv
+
+ENGINES = ("master", "libcosim", "ecos")
+PROGRESS_SHARE = 0.1  # a progress line every tenth of the run when stderr is no terminal
+
+
+class UsageError(ValueError):
+    """A mistake in the command line, found before any work starts."""
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """A parser whose refusal of the command line is one line (no usage block) and exit status 2."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _description(path: Path) -> ModelDescription:
+    try:
+        return read_model_description(str(path))
+    except Exception as error:  # noqa: BLE001 - fmpy raises many kinds for an unreadable FMU
+        raise PackageError(f"{path.name}: no readable FMU ({type(error).__name__}: {error})") from None
+
+
+def _unit(variable) -> str:
+    unit = variable.unit or (variable.declaredType.unit if variable.declaredType is not None else None)
+    return unit or "1"
+
+
+def _parse_value(kind: str, text: str) -> float | int | bool | str:
+    try:
+        if kind == "Real":
+            value = float(text)
+            if not math.isfinite(value):
+                raise ValueError
+            return value
+        if kind == "Integer":
+            return int(text)
+        if kind == "Boolean":
+            return {"true": True, "1": True, "false": False, "0": False}[text.lower()]
+        return text
+    except (KeyError, ValueError):
+        raise UsageError(f"--set: {text!r} is no {kind} value") from None
+
+
+def parameter_changes(settings: list[str], system: SspSystem, descriptions: dict[str, ModelDescription]
+                      ) -> dict[tuple[str, str], tuple[str, float | int | bool | str]]:
+    """``--set Component.name=value`` items, checked against the components' FMUs: the variable must be
+    a parameter or an input no connection feeds."""
+    connected = {end for _, end in system.connections}
+    changes = {}
+    for setting in settings:
+        target, equals, text = setting.partition("=")
+        component, dot, variable = target.partition(".")
+        if not (equals and dot and component and variable):
+            raise UsageError(f"--set {setting!r}: write Component.name=value")
+        system.component(component)
+        found = next((v for v in descriptions[component].modelVariables if v.name == variable), None)
+        if found is None:
+            raise UsageError(f"--set {setting!r}: component {component} has no variable {variable!r}")
+        if found.causality not in ("parameter", "input") or (component, variable) in connected:
+            raise UsageError(f"--set {setting!r}: {component}.{variable} is no parameter or unconnected input "
+                             f"(it is a connected {found.causality})" if (component, variable) in connected else
+                             f"--set {setting!r}: {component}.{variable} is an {found.causality}, not a parameter")
+        changes[component, variable] = (found.type, _parse_value(found.type, text))
+    return changes
+
+
+def output_columns(system: SspSystem, descriptions: dict[str, ModelDescription]) -> tuple[list[str], list[str]]:
+    """Every Real output of every component: (``instance.variable`` names, CSV headers)."""
+    names, headers = [], []
+    for component in system.components:
+        for variable in descriptions[component.name].modelVariables:
+            if variable.causality == "output" and variable.type == "Real":
+                names.append(f"{component.name}.{variable.name}")
+                headers.append(f"{component.name}.{variable.name} [{_unit(variable)}]")
+    return names, headers
+
+
+def progress_printer(stop_time: float, stream=sys.stderr) -> Callable[[int, int], None]:
+    """``on_step(k, n)``: the time reached, on one line rewritten on a terminal, else every tenth."""
+    interactive = stream.isatty()
+    last_shown = [-1]
+
+    def show(k: int, n: int) -> None:
+        share = k / n
+        tenth = int(share / PROGRESS_SHARE)
+        if interactive and (k == n or k % max(1, n // 200) == 0):
+            stream.write(f"\rsystem: t = {share * stop_time:.4g} of {stop_time:g} s ({100 * share:3.0f} %)")
+            stream.write("\n" if k == n else "")
+        elif not interactive and tenth != last_shown[0]:
+            last_shown[0] = tenth
+            stream.write(f"system: t = {share * stop_time:.4g} of {stop_time:g} s ({100 * share:.0f} %)\n")
+        stream.flush()
+
+    return show
+
+
+def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Path], outputs: list[str],
+               stop_time: float, step_size: float, on_step: Callable[[int, int], None]) -> np.ndarray:
+    """Rows of time and ``outputs`` for t_1 ... t_N from ``engine``."""
+    steps = int(round(stop_time / step_size))
+    if engine == "master":
+        return run_jacobi(fmus, {c.name: c.parameters for c in system.components}, system.connections,
+                          stop_time, step_size, outputs, on_step)
+    if engine == "libcosim":
+        session = importers.cosim_session(step_size, ssp=package)
+    else:
+        session = importers.ecos_session(step_size, ssp=package, parameter_set=system.parameter_set)
+    try:
+        rows = []
+        for k in range(steps):
+            if session.step() is False:
+                raise StepRefused(f"{engine} step", "refused", k * step_size, [])
+            rows.append([(k + 1) * step_size, *session.get(outputs)])
+            on_step(k + 1, steps)
+        return np.array(rows)
+    finally:
+        session.close()
+
+
+def _arguments(argv: list[str] | None) -> argparse.Namespace:
+    parser = OneLineParser(description=__doc__.splitlines()[0].strip("`"))
+    parser.add_argument("package", type=Path, help="the SSP package (.ssp)")
+    parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
+    parser.add_argument("--step", type=float, default=1e-3, help="communication step [s] (default 1e-3)")
+    parser.add_argument("--out", type=Path, help="CSV file to write (default: the package's name with .csv)")
+    parser.add_argument("--set", action="append", default=[], metavar="Component.name=value",
+                        help="bind a parameter or an unconnected input's start value; repeatable")
+    parser.add_argument("--engine", choices=ENGINES, default="master",
+                        help="master: the project's Jacobi master (fmpy); libcosim; ecos (default master)")
+    return parser.parse_args(argv)
+
+
+def run(args: argparse.Namespace, scratch: Path) -> Path:
+    """Check everything, then run and write the CSV file; the file's path."""
+    system = ssp_package.read(args.package)
+    stop_time = args.stop_time if args.stop_time is not None else system.stop_time
+    if stop_time is None:
+        raise UsageError("the package has no DefaultExperiment stop time: give --stop-time")
+    if not (math.isfinite(args.step) and args.step > 0.0 and math.isfinite(stop_time) and stop_time >= args.step):
+        raise UsageError(f"--step {args.step!r} and --stop-time {stop_time!r}: need 0 < step <= stop time, finite")
+    if abs(stop_time / args.step - round(stop_time / args.step)) > 1e-9 * stop_time / args.step:
+        raise UsageError(f"--stop-time {stop_time!r} is no whole number of steps of {args.step!r} s")
+    with zipfile.ZipFile(args.package) as archive:
+        archive.extractall(scratch / "package")
+    fmus = {c.name: scratch / "package" / c.source for c in system.components}
+    descriptions = {name: _description(path) for name, path in fmus.items()}
+    if args.engine == "libcosim" and any(d.fmiVersion != "2.0" for d in descriptions.values()):
+        raise UsageError("libcosim runs FMI 2.0 FMUs only; this package holds others")
+    changes = parameter_changes(args.set, system, descriptions)
+    package = args.package
+    if changes:
+        package = ssp_package.with_parameters(args.package, changes, scratch / args.package.name)
+        system = ssp_package.read(package)
+    check_start_values(engine_instances(ssp=package))
+    outputs, headers = output_columns(system, descriptions)
+    out = args.out or Path(args.package.name).with_suffix(".csv")
+    if not out.parent.is_dir():
+        raise UsageError(f"--out {out}: no folder {out.parent}")
+    rows = run_engine(args.engine, package, system, fmus, outputs, stop_time, args.step, progress_printer(stop_time))
+    return write_csv(out, ["time [s]", *headers], rows.tolist())
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = _arguments(argv)
+    try:
+        with tempfile.TemporaryDirectory(prefix="driveline-system-") as scratch:
+            out = run(args, Path(scratch))
+    except (UsageError, PackageError, StartValuesRefused) as error:
+        print(f"{sys.argv[0]}: error: {error}", file=sys.stderr)
+        sys.exit(2)
+    except StepRefused as error:
+        sys.exit(f"{sys.argv[0]}: the run stopped: {error}")
+    print(out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,259 @@
+/* VehicleDriveline: a front-wheel-drive car between the motor and the road without the joints (port of
+ * driveline/vehicle/dynamics.py and model.py).
+ *
+ * (V1)-(V9) are the labels of docs/vehicle_driveline.md. The state (dynamics.py's tuple, in its
+ * order) is the model's internal state; every expression keeps the Python core's order of
+ * operations, and where Python's float division or math.ceil raises, the step is refused with
+ * Python's words.
+ */
+#include <math.h>
+
+#include "driveline_constants.h"
+#include "fmu_instance.h"
+
+#define STATE (data->internal) /* dynamics.py's state tuple, VEHICLE_DYNAMICS_STATE_SIZE numbers */
+
+enum { CASE, DIFF, PHI_WHEEL_LEFT, WHEEL_LEFT, PHI_WHEEL_RIGHT, WHEEL_RIGHT, SPEED, TRAVEL, SLIP_LEFT, SLIP_RIGHT };
+
+static const char ZERO_DIVISION[] = "float division by zero"; /* ZeroDivisionError */
+
+/* The joints' inputs at the communication point (dynamics.Joints). */
+typedef struct {
+    double T_in_left, T_in_right, phi_out_left, phi_out_right, omega_out_left, omega_out_right;
+} Joints;
+
+/* Python's float division: where it raises, the first failure is kept and the result is 0 (the
+ * evaluation's results are then discarded). */
+static double divide(Failure *failure, double a, double b)
+{
+    if (b != 0.0) {
+        return a / b;
+    }
+    if (failure->kind == ERROR_NONE) {
+        *failure = FAILURE(ERROR_ZERO_DIVISION, ZERO_DIVISION);
+    }
+    return 0.0;
+}
+
+/* VehicleDrivelineModel._joints: in the drive's sense (the right joint's frame turns the other way) */
+static Joints joints_of(const ModelData *data)
+{
+    Joints joints = {VALUE(T_in_left), -VALUE(T_in_right), VALUE(phi_out_left), -VALUE(phi_out_right),
+                     VALUE(omega_out_left), -VALUE(omega_out_right)};
+    return joints;
+}
+
+/* (V1) case_inertia */
+static double case_inertia(const ModelData *data)
+{
+    return VALUE(ratio) * VALUE(ratio) * VALUE(J_motor) + VALUE(J_diff) + 2.0 * VALUE(J_side);
+}
+
+/* (V7) equivalent_mass */
+static double equivalent_mass(const ModelData *data, Failure *failure)
+{
+    return VALUE(m_vehicle) + divide(failure, 2.0 * VALUE(J_wheel), VALUE(r_wheel) * VALUE(r_wheel));
+}
+
+/* (V5) tyre_force */
+static double tyre_force(const ModelData *data, Failure *failure, double slip, double mu)
+{
+    double load = VALUE(m_vehicle) * VEHICLE_DYNAMICS_GRAVITY * cos(VALUE(grade)) * VALUE(front_share) / 2.0;
+    double limit = mu * load;
+    return limit * tanh(divide(failure, VALUE(C_slip) * slip, limit));
+}
+
+/* (V3) halfshaft_torques */
+static void halfshaft_torques(const ModelData *data, const double *state, const Joints *joints, double elapsed,
+                              double *left, double *right)
+{
+    double twist_left = joints->phi_out_left + joints->omega_out_left * elapsed - state[PHI_WHEEL_LEFT];
+    double twist_right = joints->phi_out_right + joints->omega_out_right * elapsed - state[PHI_WHEEL_RIGHT];
+    *left = VALUE(k_left) * twist_left + VALUE(c_left) * (joints->omega_out_left - state[WHEEL_LEFT]);
+    *right = VALUE(k_right) * twist_right + VALUE(c_right) * (joints->omega_out_right - state[WHEEL_RIGHT]);
+}
+
+/* (V8) road_load */
+static double road_load(const ModelData *data, Failure *failure, double v)
+{
+    double weight = VALUE(m_vehicle) * VEHICLE_DYNAMICS_GRAVITY;
+    double rolling = VALUE(f_roll) * weight * cos(VALUE(grade)) * tanh(divide(failure, v, VALUE(v_low)));
+    double drag = 0.5 * VALUE(rho_air) * VALUE(c_drag) * VALUE(A_front) * v * fabs(v);
+    return rolling + drag + weight * sin(VALUE(grade));
+}
+
+/* (V1)-(V9) rates */
+static void rates(const ModelData *data, Failure *failure, const double *state, const Joints *joints,
+                  double elapsed, double *rate)
+{
+    double T_left, T_right, v = state[SPEED], slip_speed;
+    double F_left = tyre_force(data, failure, state[SLIP_LEFT], VALUE(mu_road_left));
+    double F_right = tyre_force(data, failure, state[SLIP_RIGHT], VALUE(mu_road_right));
+    halfshaft_torques(data, state, joints, elapsed, &T_left, &T_right);
+    slip_speed = fabs(v) + VALUE(v_low);
+    rate[CASE] = divide(failure, VALUE(ratio) * VALUE(T_motor) - joints->T_in_left - joints->T_in_right,
+                        case_inertia(data));
+    rate[DIFF] = divide(failure, joints->T_in_right - joints->T_in_left, 2.0 * VALUE(J_side));
+    rate[PHI_WHEEL_LEFT] = state[WHEEL_LEFT];
+    rate[WHEEL_LEFT] = divide(failure, T_left - VALUE(r_wheel) * F_left, VALUE(J_wheel));
+    rate[PHI_WHEEL_RIGHT] = state[WHEEL_RIGHT];
+    rate[WHEEL_RIGHT] = divide(failure, T_right - VALUE(r_wheel) * F_right, VALUE(J_wheel));
+    rate[SPEED] = divide(failure, F_left + F_right - road_load(data, failure, v), equivalent_mass(data, failure));
+    rate[TRAVEL] = v;
+    rate[SLIP_LEFT] = divide(failure, VALUE(r_wheel) * state[WHEEL_LEFT] - v - slip_speed * state[SLIP_LEFT],
+                             VALUE(sigma_slip));
+    rate[SLIP_RIGHT] = divide(failure, VALUE(r_wheel) * state[WHEEL_RIGHT] - v - slip_speed * state[SLIP_RIGHT],
+                              VALUE(sigma_slip));
+}
+
+/* rate_bound */
+static double rate_bound(const ModelData *data, Failure *failure, double v)
+{
+    double J = VALUE(J_wheel), r = VALUE(r_wheel), mass;
+    double tyre = sqrt(divide(failure, VALUE(C_slip) * r * r, J * VALUE(sigma_slip)));
+    double slip_decay = divide(failure, fabs(v) + VALUE(v_low), VALUE(sigma_slip));
+    double left = sqrt(divide(failure, VALUE(k_left), J)) + divide(failure, VALUE(c_left), J);
+    double right = sqrt(divide(failure, VALUE(k_right), J)) + divide(failure, VALUE(c_right), J);
+    double wheel = right > left ? right : left; /* Python's max: the second only if greater */
+    double car;
+    mass = equivalent_mass(data, failure);
+    car = sqrt(divide(failure, 2.0 * VALUE(C_slip), VALUE(sigma_slip) * mass)) +
+          divide(failure, VALUE(f_roll) * VALUE(m_vehicle) * VEHICLE_DYNAMICS_GRAVITY, VALUE(v_low) * mass) +
+          divide(failure, VALUE(rho_air) * VALUE(c_drag) * VALUE(A_front) * fabs(v), mass);
+    return wheel + tyre + slip_decay + car;
+}
+
+/* substeps: the fewest internal steps with rate_bound * h_int <= RATE_STEP */
+static Failure substeps(const ModelData *data, double v, double step_size, long *count)
+{
+    Failure failure = NO_FAILURE;
+    double bound = rate_bound(data, &failure, v), steps;
+    if (failure.kind != ERROR_NONE) {
+        return failure;
+    }
+    steps = ceil(step_size * bound / VEHICLE_DYNAMICS_RATE_STEP);
+    if (isnan(steps)) {
+        return FAILURE(ERROR_VALUE, "cannot convert float NaN to integer");
+    }
+    if (isinf(steps)) {
+        return FAILURE(ERROR_OVERFLOW, "cannot convert float infinity to integer");
+    }
+    if (!(steps <= VEHICLE_DYNAMICS_MAX_SUBSTEPS)) {
+        return FAILURE(ERROR_VALUE, TOO_LONG);
+    }
+    *count = steps >= 1.0 ? (long)steps : 1;
+    return NO_FAILURE;
+}
+
+static void moved(const double *state, const double *slope, double h, double *out)
+{
+    int i;
+    for (i = 0; i < VEHICLE_DYNAMICS_STATE_SIZE; i++) {
+        out[i] = state[i] + h * slope[i];
+    }
+}
+
+/* advance of dynamics.py: classical Runge-Kutta in equal internal steps, the inputs held */
+static Failure integrate(ModelData *data, const Joints *joints, double step_size)
+{
+    double k1[VEHICLE_DYNAMICS_STATE_SIZE], k2[VEHICLE_DYNAMICS_STATE_SIZE], k3[VEHICLE_DYNAMICS_STATE_SIZE];
+    double k4[VEHICLE_DYNAMICS_STATE_SIZE], trial[VEHICLE_DYNAMICS_STATE_SIZE], h, t;
+    long count = 1, n;
+    int i;
+    Failure failure = substeps(data, STATE[SPEED], step_size, &count);
+    if (failure.kind != ERROR_NONE) {
+        return failure;
+    }
+    h = step_size / (double)count;
+    for (n = 0; n < count; n++) {
+        t = (double)n * h;
+        rates(data, &failure, STATE, joints, t, k1);
+        moved(STATE, k1, 0.5 * h, trial);
+        rates(data, &failure, trial, joints, t + 0.5 * h, k2);
+        moved(STATE, k2, 0.5 * h, trial);
+        rates(data, &failure, trial, joints, t + 0.5 * h, k3);
+        moved(STATE, k3, h, trial);
+        rates(data, &failure, trial, joints, t + h, k4);
+        if (failure.kind != ERROR_NONE) {
+            return failure;
+        }
+        for (i = 0; i < VEHICLE_DYNAMICS_STATE_SIZE; i++) {
+            STATE[i] = STATE[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+    return NO_FAILURE;
+}
+
+/* (V9) reaction_torque */
+static double reaction_torque(const ModelData *data, const Joints *joints, double case_acceleration)
+{
+    double momentum_inertia = VALUE(ratio) * VALUE(J_motor) + VALUE(J_diff) + 2.0 * VALUE(J_side);
+    return -(joints->T_in_left + joints->T_in_right) - momentum_inertia * case_acceleration;
+}
+
+/* VehicleDrivelineModel._evaluate: outputs at the state reached ``elapsed`` after the inputs' time */
+static Failure evaluate(ModelData *data, const Joints *joints, double elapsed)
+{
+    double rate[VEHICLE_DYNAMICS_STATE_SIZE], left, right;
+    Failure failure = NO_FAILURE;
+    rates(data, &failure, STATE, joints, elapsed, rate);
+    VALUE(omega_in_left) = STATE[CASE] + STATE[DIFF];
+    VALUE(omega_in_right) = -(STATE[CASE] - STATE[DIFF]);
+    VALUE(alpha_in_left) = rate[CASE] + rate[DIFF];
+    VALUE(alpha_in_right) = -(rate[CASE] - rate[DIFF]);
+    halfshaft_torques(data, STATE, joints, elapsed, &left, &right);
+    VALUE(T_load_left) = left;
+    VALUE(T_load_right) = -right;
+    VALUE(T_reaction) = reaction_torque(data, joints, rate[CASE]);
+    VALUE(omega_motor) = VALUE(ratio) * STATE[CASE];
+    VALUE(omega_wheel_left) = STATE[WHEEL_LEFT];
+    VALUE(omega_wheel_right) = STATE[WHEEL_RIGHT];
+    VALUE(slip_left) = STATE[SLIP_LEFT];
+    VALUE(slip_right) = STATE[SLIP_RIGHT];
+    VALUE(F_x_left) = tyre_force(data, &failure, STATE[SLIP_LEFT], VALUE(mu_road_left));
+    VALUE(F_x_right) = tyre_force(data, &failure, STATE[SLIP_RIGHT], VALUE(mu_road_right));
+    VALUE(v_x) = STATE[SPEED];
+    VALUE(a_x) = rate[SPEED];
+    VALUE(x) = STATE[TRAVEL];
+    return failure;
+}
+
+static void reset_internal(ModelData *data)
+{
+    int i;
+    for (i = 0; i < VEHICLE_DYNAMICS_STATE_SIZE; i++) {
+        STATE[i] = 0.0;
+    }
+}
+
+/* start_state: rolling at v_start without slip, each wheel at its joint's output angle */
+static Failure start(ModelData *data, double UNUSED start_time)
+{
+    Joints joints = joints_of(data);
+    Failure failure = NO_FAILURE;
+    double omega = divide(&failure, VALUE(v_start), VALUE(r_wheel));
+    double state[VEHICLE_DYNAMICS_STATE_SIZE] = {0.0};
+    int i;
+    state[CASE] = omega;
+    state[PHI_WHEEL_LEFT] = joints.phi_out_left;
+    state[WHEEL_LEFT] = omega;
+    state[PHI_WHEEL_RIGHT] = joints.phi_out_right;
+    state[WHEEL_RIGHT] = omega;
+    state[SPEED] = VALUE(v_start);
+    if (failure.kind != ERROR_NONE) {
+        return failure;
+    }
+    for (i = 0; i < VEHICLE_DYNAMICS_STATE_SIZE; i++) {
+        STATE[i] = state[i];
+    }
+    return evaluate(data, &joints, 0.0);
+}
+
+static Failure advance(ModelData *data, double UNUSED current_time, double step_size)
+{
+    Joints joints = joints_of(data);
+    Failure failure = integrate(data, &joints, step_size);
+    return failure.kind != ERROR_NONE ? failure : evaluate(data, &joints, step_size);
+}
+
+const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance};

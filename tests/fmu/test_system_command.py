@@ -1,0 +1,119 @@
+"""``driveline-fmus system``: any SSP package run to a CSV file by the project's master, libcosim or Ecos,
+with parameters set from the command line, and every mistake one line before any work."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import read_model_description
+
+from fmu_harness import system_command
+from fmu_harness.packaging import native
+from fmu_harness.runs import system
+
+STEP, STOP = 1e-3, 0.05
+
+
+@pytest.fixture(scope="module")
+def native_ssp(fmi2_dir: Path, native_dir: Path) -> Path:
+    return system.write_ssp(system.driveline(), fmi2_dir, native_dir)
+
+
+def _run(package: Path, out: Path, *options: str) -> tuple[list[str], np.ndarray]:
+    system_command.main([str(package), "--stop-time", str(STOP), "--step", str(STEP), "--out", str(out), *options])
+    with out.open() as handle:
+        rows = list(csv.reader(handle))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+def _master(fmi2_dir: Path, native_dir: Path, **coupling: float) -> np.ndarray:
+    """The package's system run by :func:`system.simulate` directly, the coupling's bindings changed."""
+    driveline = system.driveline()
+    components = tuple(dataclasses.replace(c, parameters={**c.parameters, **coupling}) if c.name == "coupling" else c
+                       for c in driveline.components)
+    changed = dataclasses.replace(driveline, components=components, stop_time=STOP, step_size=STEP)
+    return system.simulate(changed, fmi2_dir, natives=native_dir)
+
+
+def test_every_output_of_every_component_is_a_column_headed_with_its_unit(native_ssp, tmp_path, fmi2_dir, native_dir):
+    """Time first, then each Real output of each component in the order of the package and of the FMU's
+    model description, ``Component.variable [unit]``; the values are the master's, bit for bit."""
+    header, values = _run(native_ssp, tmp_path / "run.csv")
+    expected = ["time [s]"]
+    for component in system.driveline().components:
+        path = native.fmu_path(native_dir, component.model)
+        for v in read_model_description(str(path)).modelVariables:
+            if v.causality == "output" and v.type == "Real":
+                unit = v.unit or (v.declaredType and v.declaredType.unit) or "1"
+                expected.append(f"{component.name}.{v.name} [{unit}]")
+    assert header == expected
+    np.testing.assert_array_equal(values, _master(fmi2_dir, native_dir))
+
+
+def test_a_parameter_set_on_the_command_line_reaches_the_run(native_ssp, tmp_path, fmi2_dir, native_dir):
+    """``--set coupling.T_load=200`` (bound in the package at 150): the run is the master's with 200."""
+    _, values = _run(native_ssp, tmp_path / "run.csv", "--set", "coupling.T_load=200")
+    np.testing.assert_array_equal(values, _master(fmi2_dir, native_dir, T_load=200.0))
+
+
+@pytest.mark.parametrize("engine", ["libcosim", "ecos"])
+def test_the_engines_give_the_masters_results(engine, native_ssp, tmp_path, fmi2_dir, native_dir):
+    """The same Jacobi scheme in libcosim and Ecos, with a parameter set: every column within 1e-9 of its
+    largest magnitude (the importer matrix's tolerance; measured 7.7e-12 over 0.2 s), the sum of the
+    plunger accelerations of its terms' magnitude."""
+    if importlib.util.find_spec(f"{engine}py") is None:
+        pytest.skip(f"{engine}py is not installed on this platform (pip install '.[interop]')")
+    header, values = _run(native_ssp, tmp_path / "run.csv", "--engine", engine, "--set", "coupling.T_load=200")
+    reference = _master(fmi2_dir, native_dir, T_load=200.0)
+    scale = np.maximum(np.abs(reference).max(axis=0), 1e-300)
+    # a_plunger_sum cancels three plunger accelerations down to 1e-7 of them: its round-off is the terms'
+    mass = system.driveline().component("coupling").spec["m_plunger"].start
+    scale[header.index("coupling.a_plunger_sum [m/s2]")] = np.abs(
+        reference[:, header.index("coupling.F_plunger1 [N]")]).max() / mass
+    assert (np.abs(values - reference).max(axis=0) / scale).max() <= 1e-9
+
+
+@pytest.mark.parametrize(("options", "words"), [
+    (["--set", "coupling.T_load"], "write Component.name=value"),
+    (["--set", "wheel.T_load=1"], "no component 'wheel' (it has source, coupling, critical)"),
+    (["--set", "coupling.T_nope=1"], "has no variable 'T_nope'"),
+    (["--set", "coupling.T_in=1"], "coupling.T_in is an output, not a parameter"),
+    (["--set", "coupling.omega_in=1"], "it is a connected input"),
+    (["--set", "coupling.T_load=abc"], "'abc' is no Real value"),
+    (["--set", "coupling.kinematics=0.5"], "'0.5' is no Integer value"),
+    (["--set", "coupling.r=-0.01"], "coupling (TripodCoupling): parameter r = -10 mm must be positive"),
+    (["--step", "0"], "need 0 < step <= stop time"),
+    (["--step", "0.003"], "no whole number of steps"),
+    (["--engine", "dymola"], "invalid choice: 'dymola'"),
+])
+def test_a_mistake_is_one_line_and_status_2_before_any_work(options, words, native_ssp, tmp_path, capsys):
+    out = tmp_path / "run.csv"
+    with pytest.raises(SystemExit) as exit_status:
+        _run(native_ssp, out, *options)
+    err = capsys.readouterr().err
+    assert exit_status.value.code == 2
+    assert err.count("\n") == 1 and words in err and "error" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("package", ["missing.ssp", "not_a_package.ssp"])
+def test_a_file_that_is_no_package_is_one_line(package, tmp_path, capsys):
+    (tmp_path / "not_a_package.ssp").write_text("time,x\n0,1\n")
+    with pytest.raises(SystemExit) as exit_status:
+        system_command.main([str(tmp_path / package), "--stop-time", "1"])
+    err = capsys.readouterr().err
+    assert exit_status.value.code == 2 and err.count("\n") == 1 and package in err
+
+
+def test_a_refused_step_stops_the_run_naming_the_component(native_ssp, tmp_path, capsys):
+    """A bend beyond beta_max: the coupling refuses its first step; the run stops with its reason."""
+    with pytest.raises(SystemExit) as exit_status:
+        _run(native_ssp, tmp_path / "run.csv", "--set", "coupling.beta=1.0")
+    message = str(exit_status.value.code)
+    assert message.count("\n") == 0 and "the run stopped: coupling: " in message and "beta_max" in message
+    assert not (tmp_path / "run.csv").exists()

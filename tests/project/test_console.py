@@ -1,0 +1,53 @@
+"""What the commands show: progress rewritten in place on a terminal, throttled lines in a log,
+a missing optional package named with its extra."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from fmu_harness.console import Progress, optional
+
+
+class Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_progress_on_a_terminal_rewrites_one_line(monkeypatch):
+    monkeypatch.setenv("COLUMNS", "30")
+    stream = Terminal()
+    with Progress("build", 3, stream) as shown:
+        for item in ("a long name of the first item", "b", "c"):
+            shown.advance(item)
+    first = "build [1/3] a long name of the first item"[:29]  # cut to the terminal's width less one
+    assert stream.getvalue() == f"\r{first}\r{'build [2/3] b':<29}\r{'build [3/3] c':<13}\n"  # the longer one blanked
+
+
+def test_progress_in_a_log_shows_the_first_and_last_and_at_most_one_line_per_interval():
+    stream = io.StringIO()
+    with Progress("sweep", 100, stream, interval=3600.0) as shown:
+        for n in range(100):
+            shown.advance(f"run {n}")
+    assert stream.getvalue() == "sweep [1/100] run 0\nsweep [100/100] run 99\n"
+    every = io.StringIO()
+    with Progress("sweep", 3, every, interval=0.0) as shown:
+        for n in range(3):
+            shown.advance()
+    assert every.getvalue() == "sweep [1/3]\nsweep [2/3]\nsweep [3/3]\n"
+
+
+def test_disabled_progress_counts_silently():
+    stream = Terminal()
+    with Progress("build", 2, stream, enabled=False) as shown:
+        shown.advance("a")
+    assert stream.getvalue() == "" and shown.done == 1
+
+
+def test_a_missing_optional_package_ends_the_command_naming_its_extra():
+    with pytest.raises(SystemExit) as exited:
+        optional("a_package_that_is_not_there", "sweep", "driveline-fmus sweep")
+    assert exited.value.code == ("driveline-fmus sweep needs a_package_that_is_not_there, which is not installed: "
+                                 "pip install 'driveline-fmus[sweep]'")
+    assert optional("json", "sweep", "driveline-fmus sweep").__name__ == "json"
