@@ -4,8 +4,8 @@
  *        ["VR=VALUE..."]
  * Instantiates the FMU with its extracted RESOURCES folder (an absolute path: its shipped layouts),
  * initialises it at its start values (the optional Integer parameters set in initialisation mode),
- * then times ROUNDS rounds of STEPS steps, each one batched set of the Real inputs (their start values), doStep and one batched
- * get of the Real outputs; prints the best round's CPU nanoseconds per step.
+ * then times ROUNDS rounds of STEPS steps, each one batched set of the Real inputs (their start
+ * values), doStep and one batched get of the Real outputs; prints the best round's CPU nanoseconds per step.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <dlfcn.h>
