@@ -126,6 +126,11 @@ class SteppedModel(ABC):
     #: rotor's shipped layouts); the model finds them by name in the FMU's resources folder.
     resource_files: ClassVar[tuple[Path, ...]] = ()
 
+    def start_notice(self) -> str | None:
+        """What the log says once, at initialisation, of how the model reads inputs the host left at
+        their start values (a default it may not expect), or None; a warning, not a refusal."""
+        return None
+
     def extra_input_errors(self) -> list[str]:
         """Input checks the spec cannot declare, run once the declared ones pass."""
         return []

@@ -34,6 +34,7 @@ class ModelSlave(ModelAdapter, Fmi2Slave):
     causalities = Fmi2Causality
     variabilities = Fmi2Variability
     error_status = Fmi2Status.error
+    warning_status = Fmi2Status.warning
     deploy_command = "pythonfmu deploy"
 
     def __init_subclass__(cls, **kwargs: Any) -> None:

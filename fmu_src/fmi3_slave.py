@@ -48,6 +48,7 @@ class ModelSlave(ModelAdapter, Fmi3Slave):
     causalities = Fmi3Causality
     variabilities = Fmi3Variability
     error_status = Fmi3Status.error
+    warning_status = Fmi3Status.warning
     deploy_command = "pythonfmu3 deploy"
 
     def __init__(self, **kwargs: Any) -> None:

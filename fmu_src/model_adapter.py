@@ -39,6 +39,7 @@ _PLACEHOLDER = {"Real": float("nan"), "Integer": 0, "Boolean": False, "String": 
 _LOG_TEXTS_KEPT = 1024
 #: One category object for every message (the wrappers would build, and leak, a new one each time).
 _ERROR_CATEGORY = "logStatusError"
+_WARNING_CATEGORY = "logStatusWarning"
 
 
 class Phase(Enum):
@@ -83,6 +84,7 @@ class ModelAdapter:
     causalities: ClassVar[type[Enum]]
     variabilities: ClassVar[type[Enum]]
     error_status: ClassVar[Enum]
+    warning_status: ClassVar[Enum]
     author = "driveline-fmus contributors"
     license = "MIT"
     version = __version__
@@ -182,9 +184,10 @@ class ModelAdapter:
             self.phase = Phase.INITIALIZATION
 
     def exit_initialization_mode(self) -> None:
-        """Initialise the model at the start time. Parameters that no input can make valid enter
-        the error state here (the wrappers can only return OK: the reasons are logged and every
-        step is refused); bad inputs are logged and refuse every step until corrected."""
+        """Initialise the model at the start time. Parameters that no input can make valid, and
+        start values the model refuses (an input beyond its bounds, outputs it cannot compute),
+        enter the error state here, each reason logged once (the wrappers can only return OK:
+        every step is then refused)."""
         if self._in_phase("exitInitializationMode", Phase.INITIALIZATION):
             self.phase = Phase.STEPPING
             errors = self._guarded("exitInitializationMode", self.model.parameter_errors, [])
@@ -194,7 +197,13 @@ class ModelAdapter:
                 self.initialize_model()
 
     def initialize_model(self) -> None:
-        self._guarded("exitInitializationMode", lambda: self._report(self.model.initialize(self.start_time)))
+        errors = self._guarded("exitInitializationMode", lambda: self.model.initialize(self.start_time))
+        for reason in errors or ():
+            self._fail("exitInitializationMode", reason)
+        if errors == []:
+            notice = self.model.start_notice()
+            if notice is not None:
+                self.log(self.log_text(notice), self.warning_status, _WARNING_CATEGORY)
 
     def terminate(self) -> None:
         if self._in_phase("terminate", Phase.STEPPING):

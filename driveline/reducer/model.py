@@ -1,9 +1,9 @@
 """Time stepping of the universal reducer: integrates phi_in; ratio and strength are algebraic.
 
 The input speed is held over each step, so phi_in grows by ``omega_in * h`` and
-``phi_out = phi_in / i`` follows exactly, whatever alpha does between or within steps
+``phi_out = phi_in / i`` follows exactly, whatever the intersection angle does between or within steps
 (the RCRCR kinematics do not depend on it). The loads are the seed's quasi-static
-relations at its critical position, evaluated at the current alpha and torque.
+relations at its critical position, evaluated at the current intersection angle and torque.
 """
 
 from __future__ import annotations
@@ -25,8 +25,8 @@ class UniversalReducerModel(DrivenShaftModel):
         self.phi_out = self.phi_in / i
         self.omega_out = self.omega_in / i
         self.T_in = self.T_load / i
-        self.s_b = float(cylinder_slide(self.phi_in, self.alpha, self.e))
-        geometry = (self.alpha, self.z1, self.z2, self.module, self.e, self.L1)
+        self.s_b = float(cylinder_slide(self.phi_in, self.intersection_angle, self.e))
+        geometry = (self.intersection_angle, self.z1, self.z2, self.module, self.e, self.L1)
         loads = connecting_shaft_loads(self.T_in, *geometry)
         stress = shaft_stress(loads.M_C, loads.M_C1, self.r_shaft)
         self.M_E, self.M_C1 = float(loads.M_E), float(loads.M_C1)

@@ -9,7 +9,7 @@ from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 SINGULAR = "eq 21 is singular at 0 and 180 deg"
 #: Largest stress [Pa] of the connecting shaft an output may report: ten times the tensile strength of
 #: the strongest shaft steels (about 1 GPa). Beyond it no shaft carries the load and the rigid-body
-#: statics of eqs 18-21 describe nothing; near alpha = 180 deg eq 21 gave 3.2e19 Pa with status OK.
+#: statics of eqs 18-21 describe nothing; near an intersection angle of 180 deg eq 21 gave 3.2e19 Pa with status OK.
 MAX_STRESS = 1e10
 
 SPEC = ModelSpec(
@@ -17,7 +17,7 @@ SPEC = ModelSpec(
     description=(
         "Universal reducer (Gu, Chen 2016): few-teeth-difference planetary gear driven through an "
         "RCRCR mechanism, ratio z1/(z1 - z2) at any shaft intersection angle; lossless torques and the "
-        "seed's strength check of the connecting shaft (eqs 18-21). Angles: alpha = 180 deg is coaxial "
+        "seed's strength check of the connecting shaft (eqs 18-21). Angles: intersection_angle = 180 deg is coaxial "
         "shafts; phi_in = 0 with the eccentric normal to the bend plane."
     ),
     variables=(
@@ -37,17 +37,17 @@ SPEC = ModelSpec(
         Variable("sigma_allow", "parameter", 60e6,
                  "Allowable stress [sigma] of the connecting shaft (seed: 45 steel, 60 MPa)", "Pa", "MPa",
                  min=0.0, min_exclusive=True),
-        Variable("alpha_min", "parameter", math.radians(90.0),
-                 "Smallest accepted intersection angle alpha (guard, above 0 deg)", "rad", "deg",
+        Variable("intersection_angle_min", "parameter", math.radians(90.0),
+                 "Smallest accepted intersection angle (guard, above 0 deg)", "rad", "deg",
                  min=0.0, max=math.pi, min_exclusive=True),
-        Variable("alpha_max", "parameter", math.radians(170.0),
-                 "Largest accepted intersection angle alpha (guard, below 180 deg where eq 21 is singular)",
+        Variable("intersection_angle_max", "parameter", math.radians(170.0),
+                 "Largest accepted intersection angle (guard, below 180 deg where eq 21 is singular)",
                  "rad", "deg", min=0.0, max=math.pi, max_exclusive=True),
         Variable("phi_in_start", "parameter", 0.0, "Input shaft angle phi_in at the start time", "rad", "deg"),
         Variable("omega_in", "input", 1000.0 * math.pi / 30.0,
                  "Input (carrier) speed omega_H (held over a step)", "rad/s", "rpm"),
-        Variable("alpha", "input", math.radians(160.0),
-                 "Intersection angle alpha (= alpha_40) between the input and output axes; 180 deg = coaxial",
+        Variable("intersection_angle", "input", math.radians(160.0),
+                 "Intersection angle between the input and output axes, the seed's alpha (= alpha_40); 180 deg = coaxial",
                  "rad", "deg", min=0.0, max=math.pi),
         Variable("T_load", "input", 68.0,
                  "Load torque M_out acting on the output shaft (eq 18); the start value, input torque 10 N.m, "
@@ -58,9 +58,9 @@ SPEC = ModelSpec(
         Variable("speed_ratio", "output", 0.0, "Speed ratio omega_1 / omega_H = 1 / i = (z1 - z2) / z1", "1"),
         Variable("T_in", "output", 0.0, "Input torque M_in = M_out / i (eq 18, lossless)", "N.m"),
         Variable("s_b", "output", 0.0,
-                 "Slide of the connecting shaft in the cylindrical pair b, e cot(alpha/2) sin phi_in (eq 15)",
+                 "Slide of the connecting shaft in the cylindrical pair b, e cot(a/2) sin phi_in with a the intersection angle (eq 15)",
                  "m", "mm"),
-        Variable("M_E", "output", 0.0, "Moment M_E = 2 F_B L1 sin(alpha/2) at E (eq 19)", "N.m"),
+        Variable("M_E", "output", 0.0, "Moment M_E = 2 F_B L1 sin(a/2) at E, a the intersection angle (eq 19)", "N.m"),
         Variable("M_C1", "output", 0.0, "Torque M_C1 = F_t r2 on the connecting shaft at C (eq 20)", "N.m"),
         Variable("M_B", "output", 0.0, "Moment M_B at B from the balance eq 21", "N.m"),
         Variable("M_C", "output", 0.0, "Bending moment M_C at C from the balance eq 21", "N.m"),
@@ -73,13 +73,13 @@ SPEC = ModelSpec(
                  max=MAX_STRESS),
         Variable("utilisation", "output", 0.0, "sigma_eq / sigma_allow (at most 1 to pass the seed's check)", "1"),
         Variable("T_in_allow", "output", 0.0,
-                 "Input torque at which sigma_eq reaches sigma_allow at the current alpha", "N.m"),
+                 "Input torque at which sigma_eq reaches sigma_allow at the current intersection angle", "N.m"),
     ),
     default_experiment=DefaultExperiment(0.0, 0.5, 1e-3),
     relations=(
         Relation("z1", ">", "z2", reason="i = z1 / (z1 - z2)"),
-        Relation("alpha_min", "<=", "alpha_max"),
-        Relation("alpha", ">=", "alpha_min", reason=SINGULAR),
-        Relation("alpha", "<=", "alpha_max", reason=SINGULAR),
+        Relation("intersection_angle_min", "<=", "intersection_angle_max"),
+        Relation("intersection_angle", ">=", "intersection_angle_min", reason=SINGULAR),
+        Relation("intersection_angle", "<=", "intersection_angle_max", reason=SINGULAR),
     ),
 )

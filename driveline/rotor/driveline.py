@@ -270,7 +270,8 @@ class Driveline:
     def _batch(self, lines: FloatArray, grids: list[FloatArray]) -> list[FloatArray]:
         """Roots of the determinant along ``lines`` (rows ``(w_k, s_k, o_k)``) on their ``grids``, one batch."""
         w_k, s_k, o_k = lines.T
-        return find_roots_batch(lambda x, k: self.determinant(w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
+        return find_roots_batch(
+            lambda x, k: transfer.determinant_and_rounding(self._chain, w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
 
     @staticmethod
     def _take(roots: FloatArray, n: int | None) -> FloatArray:

@@ -29,7 +29,9 @@ from .loader import example_path, load_driveline, one_piece_shaft
 from .mechanism import MECHANISM_HINGE, MECHANISM_RIGID, mechanism_error
 from .spec import SPEC
 from .unbalance_outputs import UnbalanceOutputs
-from .work import NATIVE_CONSTANTS, estimate
+from .budget import Budget, spending
+from .budget import refusal as budget_refusal
+from .work import NATIVE_CONSTANTS, Work, estimate
 
 #: Orders watched at most, and the highest order (joints excite low orders: 1, 2, 3, 6).
 MAX_ORDERS = 16
@@ -161,42 +163,72 @@ def build_driveline(layout: str, shaft: dict[str, float]) -> Driveline:
     return driveline
 
 
-def analyse_structure(driveline: Driveline) -> Structure:
+def finite_element_work(driveline: Driveline) -> Work:
+    """The estimate whose finite-element stages (check, damped modes, response) those stages pay: theirs
+    depend on the driveline alone."""
+    return estimate(driveline, (1,), 1.0, CAMPBELL_POINTS, FE_ELEMENTS)
+
+
+def analyse_structure(driveline: Driveline, budget: Budget | None = None, work: Work | None = None) -> Structure:
     """Critical speeds (what lies beyond the search limit, a short, stiff shaft, reads as the
-    limit; the critical speeds found are counted) and the finite-element check's frequencies."""
-    found = driveline.critical_speeds(3)
+    limit; the critical speeds found are counted) and the finite-element check's frequencies,
+    paid from ``budget`` (a whole one if None), the check at its estimate (``work``)."""
+    budget = budget or Budget()
+    with spending(budget, "critical speeds"):
+        found = driveline.critical_speeds(3)
     critical = tuple(float(w) for w in found) + (SEARCH_LIMIT,) * (3 - found.size)
-    return Structure(driveline, critical, found.size, natural_frequencies(driveline))
+    with spending(budget, "FE check"):
+        budget.charge((work or finite_element_work(driveline)).units("FE check"))
+        natural = natural_frequencies(driveline)
+    return Structure(driveline, critical, found.size, natural)
 
 
-def whirl_table(structure: Structure, omega_max: float) -> WhirlTable:
+def whirl_table(structure: Structure, omega_max: float, budget: Budget | None = None) -> WhirlTable:
     """The Campbell table of the first two forward and backward whirl frequencies over
-    ``[0, omega_max]`` (``CAMPBELL_POINTS`` speeds, more where a branch bends); ValueError
-    when the finite-element check disagrees (:func:`implausibility`)."""
+    ``[0, omega_max]`` (``CAMPBELL_POINTS`` speeds, more where a branch bends), paid from ``budget`` (a
+    whole one if None);
+    ValueError when the finite-element check disagrees (:func:`implausibility`)."""
     spins = np.linspace(0.0, omega_max, CAMPBELL_POINTS)
-    table = WhirlTable(whirl_branches(structure.driveline, spins, WHIRL_MODES), WHIRL_MODES, SEARCH_LIMIT)
+    with spending(budget or Budget(), "Campbell table"):
+        branches = whirl_branches(structure.driveline, spins, WHIRL_MODES)
+    table = WhirlTable(branches, WHIRL_MODES, SEARCH_LIMIT)
     reason = implausibility(structure.natural, table)
     if reason is not None:
         raise ValueError(reason)
     return table
 
 
-def resonances(driveline: Driveline, orders: tuple[int, ...], omega_max: float) -> tuple[OrderResonance, ...]:
+def resonances(driveline: Driveline, orders: tuple[int, ...], omega_max: float,
+               budget: Budget | None = None) -> tuple[OrderResonance, ...]:
     """Every order resonance of ``orders`` (forward and backward whirl) up to ``2 omega_max``, or the
-    first forward one of each order when none lies there."""
-    found = driveline.order_resonances(orders, ("forward", "backward"), None, 2.0 * omega_max)
-    if not found:
-        found = driveline.order_resonances(orders, ("forward",), 1)
+    first forward one of each order when none lies there, paid from ``budget`` (a whole one if None)."""
+    with spending(budget or Budget(), "order resonances"):
+        found = driveline.order_resonances(orders, ("forward", "backward"), None, 2.0 * omega_max)
+        if not found:
+            found = driveline.order_resonances(orders, ("forward",), 1)
     if not found:
         raise ValueError(f"no order resonance of the orders {orders} below the search limit {SEARCH_LIMIT:g} rad/s")
     return tuple(found)
 
 
+def unbalance_outputs(driveline: Driveline, unbalances: tuple[Unbalance, ...], response_position: float,
+                      omega_max: float, budget: Budget, work: Work) -> UnbalanceOutputs:
+    """:meth:`UnbalanceOutputs.build`, its damped modes and response paid from ``budget`` at their
+    estimates ``work``."""
+    with spending(budget, "damped modes"):
+        budget.charge(work.units("damped modes"))
+    with spending(budget, "unbalance response"):
+        budget.charge(work.units("unbalance response"))
+    return UnbalanceOutputs.build(driveline, unbalances, response_position, omega_max)
+
+
 def analyse(driveline: Driveline, orders: tuple[int, ...], omega_max: float) -> Analysis:
-    """The whole analysis of one driveline: :func:`analyse_structure`, :func:`whirl_table`, :func:`resonances`."""
-    structure = analyse_structure(driveline)
-    return Analysis(structure.critical_speeds, structure.critical_speed_count, whirl_table(structure, omega_max),
-                    resonances(driveline, orders, omega_max))
+    """The whole analysis of one driveline within one budget: :func:`analyse_structure`, :func:`whirl_table`,
+    :func:`resonances`."""
+    budget, work = Budget(), estimate(driveline, orders, omega_max, CAMPBELL_POINTS, FE_ELEMENTS)
+    structure = analyse_structure(driveline, budget, work)
+    return Analysis(structure.critical_speeds, structure.critical_speed_count,
+                    whirl_table(structure, omega_max, budget), resonances(driveline, orders, omega_max, budget))
 
 
 class CriticalSpeedsModel(SteppedModel):
@@ -207,8 +239,9 @@ class CriticalSpeedsModel(SteppedModel):
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
                            for name in ("two_piece_propshaft", "two_piece_propshaft_hinged"))
     derived_parts = ANALYSIS_PARTS
-    native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d"),
-                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT, **NATIVE_CONSTANTS}
+    native_constants = {"MECHANISM_HINGE": MECHANISM_HINGE.format(index="%d", node="%d", least="%s"),
+                        "MECHANISM_RIGID": MECHANISM_RIGID, "SHEAR_CONFLICT": SHEAR_CONFLICT,
+                        "BUDGET_REFUSAL": budget_refusal("%s"), **NATIVE_CONSTANTS}
 
     def reset_internal_state(self) -> None:
         self._analysis: Analysis | None = None
@@ -244,18 +277,21 @@ class CriticalSpeedsModel(SteppedModel):
                 raise ValueError(f"the analysis would scan {work:.3g} shaft modes, more than the "
                                  f"{MAX_SEARCHED_MODES:.0f} accepted (shorter or stiffer shaft, fewer or "
                                  "lower orders, or a smaller omega_max)")
-            refusal = estimate(driveline, orders, self.omega_max, CAMPBELL_POINTS, FE_ELEMENTS).refusal()
+            work = estimate(driveline, orders, self.omega_max, CAMPBELL_POINTS, FE_ELEMENTS)
+            refusal = work.refusal()
             if refusal is not None:
                 raise ValueError(refusal)
-            structure = self._part("structure", self._key("structure"), lambda: analyse_structure(driveline))
-            whirl = self._part("whirl", self._key("whirl"), lambda: whirl_table(structure, self.omega_max))
+            budget = Budget()  # the parts analysed anew pay from it, the kept ones not again
+            structure = self._part("structure", self._key("structure"), lambda: analyse_structure(driveline, budget,
+                                                                                                   work))
+            whirl = self._part("whirl", self._key("whirl"), lambda: whirl_table(structure, self.omega_max, budget))
             found = self._part("resonances", self._key("resonances", orders),
-                               lambda: resonances(driveline, orders, self.omega_max))
+                               lambda: resonances(driveline, orders, self.omega_max, budget))
             analysis = Analysis(structure.critical_speeds, structure.critical_speed_count, whirl, found)
             unbalances = driveline.unbalances if self.layout else (
                 Unbalance(self.unbalance_position * driveline.length, self.unbalance),)
-            self._unbalance = self._part("unbalance", self._key("unbalance"), lambda: UnbalanceOutputs.build(
-                driveline, unbalances, self.response_position, self.omega_max))
+            self._unbalance = self._part("unbalance", self._key("unbalance"), lambda: unbalance_outputs(
+                driveline, unbalances, self.response_position, self.omega_max, budget, work))
             self._analysis = analysis
             self._resonance_speeds = analysis.resonance_speeds
         except (ValueError, ArithmeticError) as error:  # e.g. a diameter of 1e300 overflows

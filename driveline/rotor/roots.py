@@ -16,6 +16,13 @@ brackets at once, one vectorised call per stage:
    and at most ``DIP_RATIO`` of its larger neighbour is re-scanned on a finer
    sub-grid, all dips of one level together, recursively; a dip that persists
    down to the root tolerance is reported as a double root.
+
+Where ``f`` also returns its rounding level (the scaled determinant does), the
+search does not chase round-off: a dip whose bottom lies within ``ROUNDING``
+times its rounding level of zero is as deep as ``f`` resolves, a double root, not
+re-scanned; any other dip no deeper than ``ROUNDING`` times the rounding levels of
+its three points is ripple and is dropped. At most ``MAX_DIPS`` dips of one
+function are re-scanned; a function with more is refused (ArithmeticError).
 """
 
 from __future__ import annotations
@@ -28,8 +35,8 @@ from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
-#: ``f(x, k)``: the ``k[i]``-th function of a batch at ``x[i]``.
-BatchFunc = Callable[[FloatArray, IntArray], FloatArray]
+#: ``f(x, k)``: the ``k[i]``-th function of a batch at ``x[i]``, or that and its rounding level there.
+BatchFunc = Callable[[FloatArray, IntArray], FloatArray | tuple[FloatArray, FloatArray]]
 
 SUBGRID = 24
 #: Sub-grid levels: each divides the dip's width by SUBGRID / 2 (16 levels span 1e17).
@@ -37,6 +44,10 @@ MAX_DEPTH = 16
 #: A dip is examined when |f| there is below this fraction of its larger neighbour
 #: (an isolated hidden pair gives at most 1/9; neighbouring roots raise that).
 DIP_RATIO = 0.9
+#: A dip within this multiple of the rounding levels is round-off (a ripple measured at about one level).
+ROUNDING = 8.0
+#: Dips re-scanned at most on one function (all levels): a hidden pair costs one or two per level.
+MAX_DIPS = 512
 #: Iteration cap of the bracket refinement (it halves a bracket at least every third step).
 MAX_ITERATIONS = 200
 #: Default absolute and relative tolerance of a root.
@@ -71,10 +82,11 @@ def find_roots_batch(
     st = _Search(f, xtol, rtol)
     x = np.concatenate(xs)
     line = np.repeat(np.arange(len(xs)), [g.size for g in xs])
-    seq, fx = line.copy(), st.eval(x, line)
+    seq, (fx, rx) = line.copy(), st.eval(x, line)
+    st.rescans = np.zeros(len(xs), dtype=np.intp)
     depth = 0
     while x.size:
-        x, fx, line, seq = _scan(st, x, fx, line, seq, depth)
+        x, fx, rx, line, seq = _scan(st, x, fx, rx, line, seq, depth)
         depth += 1
     _refine(st)
     found = np.concatenate(st.roots)
@@ -92,19 +104,26 @@ class _Search:
         self.roots: list[FloatArray] = [np.empty(0)]
         self.lines: list[IntArray] = [np.empty(0, dtype=np.intp)]
         self.brackets: list[tuple[FloatArray, ...]] = []
+        self.rescans = np.zeros(0, dtype=np.intp)
 
-    def eval(self, x: FloatArray, line: IntArray) -> FloatArray:
+    def eval(self, x: FloatArray, line: IntArray) -> tuple[FloatArray, FloatArray]:
+        """``f`` at ``x`` on ``line`` and its rounding level (0 where ``f`` gives none)."""
         self.evaluations += x.size
-        return np.asarray(self.f(x, line), dtype=float) if x.size else np.empty(0)
+        if not x.size:
+            return np.empty(0), np.empty(0)
+        values = self.f(x, line)
+        if isinstance(values, tuple):
+            return np.asarray(values[0], dtype=float), np.asarray(values[1], dtype=float)
+        return np.asarray(values, dtype=float), np.zeros(x.size)
 
     def found(self, x: FloatArray, line: IntArray) -> None:
         self.roots.append(x)
         self.lines.append(line)
 
 
-def _scan(st: _Search, x: FloatArray, fx: FloatArray, line: IntArray, seq: IntArray, depth: int):
-    """Record the zeros and sign changes of the sampled sequences ``seq`` (``x`` ascending in each);
-    return the sub-grids of their dips, sampled, for the next level."""
+def _scan(st: _Search, x: FloatArray, fx: FloatArray, rx: FloatArray, line: IntArray, seq: IntArray, depth: int):
+    """Record the zeros and sign changes of the sampled sequences ``seq`` (``x`` ascending in each, ``f``
+    ``fx`` with rounding levels ``rx``); return the sub-grids of their dips, sampled, for the next level."""
     s = np.sign(fx)
     af = np.abs(fx)
     zero = s == 0.0
@@ -120,22 +139,31 @@ def _scan(st: _Search, x: FloatArray, fx: FloatArray, line: IntArray, seq: IntAr
     # has at most 1/9 of its larger neighbour's |f|. Shallow dips (round-off ripple
     # on a flat stretch) are not examined.
     dip &= af[1:-1] <= DIP_RATIO * np.maximum(af[:-2], af[2:])
+    # a dip whose bottom f does not resolve from zero is kept (a double root, below); one whose depth
+    # the rounding of its points explains is ripple
+    unresolved = af[1:-1] <= ROUNDING * rx[1:-1]
+    dip &= unresolved | (np.maximum(af[:-2], af[2:]) - af[1:-1] > ROUNDING * (rx[:-2] + rx[1:-1] + rx[2:]))
     i = np.flatnonzero(dip) + 1
     st.dips += i.size
     lo, hi, mid = x[i - 1], x[i + 1], x[i]
-    # a dip that persists down to the root tolerance is a double root
-    double = (hi - lo <= 2.0 * (st.xtol + st.rtol * np.abs(mid))) | (depth >= MAX_DEPTH)
+    # a dip that persists down to the root tolerance, or to f's rounding, is a double root
+    double = (hi - lo <= 2.0 * (st.xtol + st.rtol * np.abs(mid))) | (depth >= MAX_DEPTH) | unresolved[i - 1]
     st.doubles += int(np.count_nonzero(double))
     st.found(np.repeat(mid[double], 2), np.repeat(line[i][double], 2))
     i, lo, hi = i[~double], lo[~double], hi[~double]
+    st.rescans += np.bincount(line[i], minlength=st.rescans.size)
+    if np.any(st.rescans > MAX_DIPS):
+        raise ArithmeticError(f"the root search met more than {MAX_DIPS} dips on one line: "
+                              "rounding hides the roots there")
     t = np.linspace(0.0, 1.0, SUBGRID + 1)
     sub = lo[:, None] + (hi - lo)[:, None] * t[None, 1:-1]
     sub_line = np.repeat(line[i], SUBGRID - 1)
-    fsub = st.eval(sub.ravel(), sub_line).reshape(sub.shape)
+    fsub, rsub = (part.reshape(sub.shape) for part in st.eval(sub.ravel(), sub_line))
     xs = np.concatenate([lo[:, None], sub, hi[:, None]], axis=1)
     fs = np.concatenate([fx[i - 1][:, None], fsub, fx[i + 1][:, None]], axis=1)
+    rs = np.concatenate([rx[i - 1][:, None], rsub, rx[i + 1][:, None]], axis=1)
     width = SUBGRID + 1
-    return xs.ravel(), fs.ravel(), np.repeat(line[i], width), np.repeat(np.arange(i.size), width)
+    return xs.ravel(), fs.ravel(), rs.ravel(), np.repeat(line[i], width), np.repeat(np.arange(i.size), width)
 
 
 def _refine(st: _Search) -> None:
@@ -159,7 +187,7 @@ def _refine(st: _Search) -> None:
         if not active.size:
             break
         xt = a + t * (b - a)
-        ft = st.eval(xt, line[active])
+        ft = st.eval(xt, line[active])[0]
         keep = np.sign(ft) == np.sign(fa)  # the new point replaces a; else b becomes a
         c, fc = np.where(keep, a, b), np.where(keep, fa, fb)
         b, fb = np.where(keep, b, a), np.where(keep, fb, fa)

@@ -25,6 +25,7 @@ The determinant and the mode shape run the same propagation (:func:`_propagate`)
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -32,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import budget
 from .elements import EndCondition, PointElement, ShaftSegment
 
 FloatArray = NDArray[np.float64]
@@ -40,6 +42,8 @@ FloatArray = NDArray[np.float64]
 MAX_PIECE_PHASE = 2.0
 #: Bound of the accumulated log scale put back into the determinant (exp stays finite).
 LOG_SCALE_CLIP = 700.0
+#: The relative rounding of a double.
+EPS = float(np.finfo(float).eps)
 
 
 @dataclass(frozen=True)
@@ -69,6 +73,12 @@ class Chain:
         scale = np.array([1.0 / L0, 1.0, L0 / EI0, L0 * L0 / EI0])
         isotropic = all(element.isotropic for element in points)
         return cls(tuple(segments), tuple(map(tuple, at_node)), left, right, isotropic, scale)
+
+    @property
+    def stations(self) -> int:
+        """Nodes and point elements: the work model's stations, the steps of a propagation besides the
+        segments' pieces (:mod:`.budget`)."""
+        return len(self.points) + sum(len(node) for node in self.points)
 
 
 def _orthonormalize(Y: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -102,6 +112,11 @@ def _log_det(R: FloatArray) -> FloatArray:
 
 def _segment_pieces(beta1: FloatArray, length: float) -> int:
     return max(1, math.ceil(float(np.max(beta1, initial=0.0)) * length / MAX_PIECE_PHASE))
+
+
+def _pieces(beta1: FloatArray, length: float) -> NDArray[np.int64]:
+    """The pieces each point alone would cut a segment into (the C port's count, :mod:`.budget`'s units)."""
+    return np.maximum(np.ceil(beta1 * length / MAX_PIECE_PHASE), 1.0).astype(np.int64)
 
 
 def _initial(chain: Chain, n: int) -> FloatArray:
@@ -159,6 +174,8 @@ def _propagate(
     both grow), ``sign`` the factors of point elements that change the basis.
     """
     pair = not chain.isotropic
+    per_step = budget.ANISOTROPIC_STEP if pair else 1
+    budget.charge(per_step * chain.stations * w.size)
     sc = np.tile(chain.scale, 2) if pair else chain.scale
     ratio = sc[:, None] / sc[None, :]  # s~_i = sc_i s_i: entry (i, j) scales by sc_i / sc_j
     Y = _initial(chain, w.size)
@@ -191,6 +208,7 @@ def _propagate(
             backward = seg.beta1(-w, spin)
             log_scale -= backward * seg.length
             growth = np.maximum(growth, backward)
+        budget.charge(per_step * int(np.maximum(_pieces(growth, seg.length), min_pieces).sum()))
         p = max(_segment_pieces(growth, seg.length), min_pieces)
         piece = seg.length / p
         H = fields.get((seg, piece))
@@ -227,13 +245,21 @@ def determinant(chain: Chain, w: ArrayLike, spin: ArrayLike) -> FloatArray:
     Isotropic chains accept signed ``w`` (forward > 0, backward < 0); anisotropic
     chains take ``w > 0`` and return the 8x8-state determinant.
     """
+    return determinant_and_rounding(chain, w, spin)[0]
+
+
+def determinant_and_rounding(chain: Chain, w: ArrayLike, spin: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """:func:`determinant` and its rounding level: ``eps`` times the sum of the magnitudes of the terms
+    of the end determinant (``|a d| + |b c|`` of the 2x2, the 24 products of the 4x4) times the same
+    smooth factor. Near a root the terms cancel and ``f`` is their rounding: a dip of ``f`` as deep as
+    this level is no evidence of a root (a layout of extreme materials ripples there by about one level)."""
     w_arr, s_arr = np.broadcast_arrays(np.atleast_1d(np.asarray(w, float)), np.atleast_1d(np.asarray(spin, float)))
     w_flat, s_flat = w_arr.ravel(), s_arr.ravel()
-    f = np.empty(w_flat.size)
+    f, rounding = np.empty(w_flat.size), np.empty(w_flat.size)
     for start in range(0, w_flat.size, BATCH):  # memory bounded by BATCH points, whatever the grid
         part = slice(start, start + BATCH)
-        f[part] = _determinant(chain, w_flat[part].copy(), s_flat[part].copy())
-    return f.reshape(w_arr.shape)
+        f[part], rounding[part] = _determinant(chain, w_flat[part].copy(), s_flat[part].copy())
+    return f.reshape(w_arr.shape), rounding.reshape(w_arr.shape)
 
 
 #: Points propagated at once: a batch search evaluates every grid point of every line in one call,
@@ -242,16 +268,23 @@ def determinant(chain: Chain, w: ArrayLike, spin: ArrayLike) -> FloatArray:
 BATCH = 4096
 
 
-def _determinant(chain: Chain, w: FloatArray, spin: FloatArray) -> FloatArray:
-    """:func:`determinant` at the points ``w``, ``spin`` (1-D, equal sizes)."""
+#: The permutations of four columns: the terms of a 4x4 determinant.
+_PERMUTATIONS = np.array(list(itertools.permutations(range(4))))
+
+
+def _determinant(chain: Chain, w: FloatArray, spin: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """:func:`determinant_and_rounding` at the points ``w``, ``spin`` (1-D, equal sizes)."""
     Y, log_scale, sign = _propagate(chain, w, spin)
     sub = Y[:, _final_rows(chain), :]
     if chain.isotropic:
         f = sub[:, 0, 0] * sub[:, 1, 1] - sub[:, 0, 1] * sub[:, 1, 0]
+        terms = np.abs(sub[:, 0, 0] * sub[:, 1, 1]) + np.abs(sub[:, 0, 1] * sub[:, 1, 0])
     else:
         f = np.linalg.det(sub)
+        terms = np.abs(np.prod(sub[:, np.arange(4), _PERMUTATIONS], axis=2)).sum(axis=1)
     # keep the factor finite; sign and zeros are unaffected
-    return sign * f * np.exp(np.clip(log_scale, -LOG_SCALE_CLIP, LOG_SCALE_CLIP))
+    factor = np.exp(np.clip(log_scale, -LOG_SCALE_CLIP, LOG_SCALE_CLIP))
+    return sign * f * factor, EPS * terms * factor
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from .budget import seconds_units
 from .campbell import MAX_KNOTS
 from .driveline import POINTS_PER_ROOT, SEARCH_LIMIT, Driveline
 from .fem import elements_by_length
@@ -59,6 +60,11 @@ class Work:
     def total(self) -> float:
         return math.fsum(self.seconds)
 
+    def units(self, stage: str) -> int:
+        """The budget units of ``stage`` at its estimate (:func:`.budget.seconds_units`): a finite-element
+        stage's charge."""
+        return seconds_units(self.seconds[STAGES.index(stage)])
+
     def refusal(self) -> str | None:
         """Why the analysis is refused, or None: its estimate with each stage's, above the limit."""
         if self.total <= MAX_ANALYSIS_SECONDS:
@@ -78,7 +84,7 @@ def estimate(driveline: Driveline, orders: Sequence[int], omega_max: float, camp
     """The estimate of every stage of the analysis of ``driveline`` for ``orders`` up to ``omega_max``, with
     the Campbell table's ``campbell_points`` speeds (each on the full grid when the count check fails, and
     up to MAX_KNOTS more where the table is refined) and ``check_elements`` per segment in the FE check."""
-    stations = len(driveline.segments) + 1 + len(driveline.masses) + len(driveline.bearings) + len(driveline.joints)
+    stations = driveline._chain.stations
     senses = 1 if driveline.is_isotropic else 2
     per_pi = POINTS_PER_ROOT * (1 + driveline.freedoms) * senses
     kappa = driveline._kappa

@@ -16,7 +16,7 @@ class SpeedSourceModel(TimeSourceModel):
     def at_time(self, t: float) -> None:
         w = 2.0 * math.pi * self.sine_frequency
         a = self.sine_amplitude
-        self.omega = self.omega_start + self.ramp_rate * t + a * math.sin(w * t)
-        self.alpha = self.ramp_rate + a * w * math.cos(w * t)
+        self.omega_out = self.omega_out_start + self.ramp_rate * t + a * math.sin(w * t)
+        self.alpha_out = self.ramp_rate + a * w * math.cos(w * t)
         oscillation = a * (1.0 - math.cos(w * t)) / w if w > 0.0 else 0.0
-        self.phi = self.phi_start + self.omega_start * t + 0.5 * self.ramp_rate * t * t + oscillation
+        self.phi_out = self.phi_out_start + self.omega_out_start * t + 0.5 * self.ramp_rate * t * t + oscillation

@@ -11,19 +11,19 @@ RPM = math.pi / 30.0
 SPEC = ModelSpec(
     name="SpeedSource",
     description=(
-        "Shaft speed source: omega(t) = omega_start + ramp_rate t + sine_amplitude sin(2 pi sine_frequency t), "
-        "with the shaft angle integrated exactly. Drives the other FMUs in system simulations."
+        "Shaft speed source: omega_out(t) = omega_out_start + ramp_rate t + sine_amplitude sin(2 pi sine_frequency t), "
+        "with the shaft angle phi_out integrated exactly. Drives the other FMUs in system simulations."
     ),
     variables=(
-        Variable("omega_start", "parameter", 500.0 * RPM, "Speed at t = 0", "rad/s", "rpm"),
+        Variable("omega_out_start", "parameter", 500.0 * RPM, "Speed at t = 0", "rad/s", "rpm"),
         Variable("ramp_rate", "parameter", 2500.0 * RPM, "Slope of the speed ramp", "rad/s2"),
         Variable("sine_amplitude", "parameter", 50.0 * RPM, "Amplitude of the superposed speed oscillation",
                  "rad/s", "rpm", min=0.0),
         Variable("sine_frequency", "parameter", 5.0, "Frequency of the superposed speed oscillation", "Hz", min=0.0),
-        Variable("phi_start", "parameter", 0.0, "Shaft angle at t = 0", "rad", "deg"),
-        Variable("omega", "output", 0.0, "Shaft speed omega(t)", "rad/s", "rpm"),
-        Variable("phi", "output", 0.0, "Shaft angle, the exact integral of omega from t = 0", "rad", "deg"),
-        Variable("alpha", "output", 0.0, "Shaft acceleration d(omega)/dt", "rad/s2"),
+        Variable("phi_out_start", "parameter", 0.0, "Shaft angle at t = 0", "rad", "deg"),
+        Variable("omega_out", "output", 0.0, "Shaft speed omega_out(t)", "rad/s", "rpm"),
+        Variable("phi_out", "output", 0.0, "Shaft angle, the exact integral of omega_out from t = 0", "rad", "deg"),
+        Variable("alpha_out", "output", 0.0, "Shaft acceleration d(omega_out)/dt", "rad/s2"),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-3),
 )

@@ -5,9 +5,12 @@ from __future__ import annotations
 from ..model import DrivenShaftModel
 from .outputs import coupling_outputs
 from .plane_solver import Solution
-from .spec import CLOSED_FORM, EXACT, RATES_FROM_SAMPLES, SPEC
+from .spec import CLOSED_FORM, EXACT, RATES_AUTOMATIC, RATES_FROM_INPUTS, RATES_FROM_SAMPLES, SPEC
 
 BETA_LEAVES_RANGE = "beta extrapolated to the end of the step, beta + beta_dot h + beta_ddot h^2/2, leaves [0, beta_max]"
+RATES_ESTIMATED = ("beta_rate = 2 with beta_dot = beta_ddot = 0 at the start: the bend's rates are estimated from "
+                   "the beta samples until the host sets either non-zero (or their input derivatives), so the "
+                   "outputs at the start and after the first step have none, the second a constant rate")
 
 
 def sampled_rates(samples: tuple[tuple[float, float], ...]) -> tuple[float, float]:
@@ -34,9 +37,13 @@ class TripodCouplingModel(DrivenShaftModel):
     def reset_internal_state(self) -> None:
         self._solution: Solution | None = None  # warm start of the exact solver
         self._beta_samples: tuple[tuple[float, float], ...] = ()  # (time, beta), newest first, at most 2
+        self._rates_set = False  # beta_rate = 2: the host has set beta_dot or beta_ddot non-zero
 
     def internal_from_saved(self, state: dict) -> dict:
-        """The warm start (five floats, or none) and the bend samples (up to two pairs of floats)."""
+        """The warm start (five floats, or none), the bend samples (up to two pairs of floats) and
+        whether the host set the rates (a bool)."""
+        if not isinstance(state["_rates_set"], bool):
+            raise ValueError("the saved choice of the bend's rates is not a bool")
         samples = state["_beta_samples"]
         if not (isinstance(samples, tuple) and len(samples) <= 2
                 and all(isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(v, float) for v in pair)
@@ -50,7 +57,9 @@ class TripodCouplingModel(DrivenShaftModel):
             raise ValueError(f"the saved warm start of the solver is not {len(Solution._fields)} floats")
         return {"_solution": Solution(*saved)}
 
-    native_constants = {"RATES_FROM_SAMPLES": RATES_FROM_SAMPLES, "BETA_LEAVES_RANGE": BETA_LEAVES_RANGE}
+    native_constants = {"RATES_FROM_INPUTS": RATES_FROM_INPUTS, "RATES_FROM_SAMPLES": RATES_FROM_SAMPLES,
+                        "RATES_AUTOMATIC": RATES_AUTOMATIC, "BETA_LEAVES_RANGE": BETA_LEAVES_RANGE,
+                        "RATES_ESTIMATED": RATES_ESTIMATED}
 
     extra_parameter_probes = {"friction_needs_exact": {"mu": 0.05, "kinematics": CLOSED_FORM}}
 
@@ -59,9 +68,14 @@ class TripodCouplingModel(DrivenShaftModel):
             return [f"friction mu = {self.mu!r} needs the exact kinematics (kinematics = {EXACT})"]
         return []
 
+    def start_notice(self) -> str | None:
+        """The automatic rates with none set: the host learns that they are estimated, and how to give them."""
+        return RATES_ESTIMATED if self.beta_rate == RATES_AUTOMATIC and not self._rates_set else None
+
     def start(self, start_time: float) -> None:
         self._solution = None
         self._beta_samples = ()
+        self._rates_set = False
         super().start(start_time)
 
     def advance(self, current_time: float, step_size: float) -> None:
@@ -75,12 +89,13 @@ class TripodCouplingModel(DrivenShaftModel):
 
     def _evaluate(self, input_time: float, elapsed: float) -> None:
         """Outputs ``elapsed`` after ``input_time``, with speed and bend moved on by their rates."""
-        if self.beta_rate == RATES_FROM_SAMPLES:
+        beta_dot, beta_ddot = self.beta_dot, self.beta_ddot
+        if self.beta_rate != RATES_FROM_INPUTS:  # the samples are kept for the automatic choice too
             samples = ((input_time, self.beta),) + tuple(s for s in self._beta_samples if s[0] < input_time)
             self._beta_samples = samples[:2]
-            beta_dot, beta_ddot = sampled_rates(samples[:3])
-        else:
-            beta_dot, beta_ddot = self.beta_dot, self.beta_ddot
+            self._rates_set = self._rates_set or beta_dot != 0.0 or beta_ddot != 0.0
+            if self.beta_rate == RATES_FROM_SAMPLES or not self._rates_set:
+                beta_dot, beta_ddot = sampled_rates(samples[:3])
         beta = self.beta + (beta_dot + 0.5 * beta_ddot * elapsed) * elapsed
         if not 0.0 <= beta <= self.beta_max:
             raise ValueError(BETA_LEAVES_RANGE)

@@ -7,7 +7,9 @@ import math
 from ..variables import DefaultExperiment, ModelSpec, Relation, Variable
 
 CLOSED_FORM, EXACT = 0, 1
-RATES_FROM_INPUTS, RATES_FROM_SAMPLES = 0, 1
+#: The largest bend angle the model accepts with any beta_max: the declared max of beta and of beta_max.
+BETA_LIMIT = math.radians(60.0)
+RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 ARM_OUTPUTS = tuple(
     Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N")
     for name, text in (
@@ -32,7 +34,7 @@ SPEC = ModelSpec(
         Variable("m_plunger", "parameter", 0.2, "Plunger (sliding pin) mass m, eqs 28-34", "kg", min=0.0),
         Variable("beta_max", "parameter", math.radians(45.0),
                  "Largest accepted bend angle beta (guard; the exact solver is verified up to 60 deg)",
-                 "rad", "deg", min=0.0, max=math.radians(60.0)),
+                 "rad", "deg", min=0.0, max=BETA_LIMIT),
         Variable("kinematics", "parameter", CLOSED_FORM,
                  "Kinematics of phi_out: 0 = closed form (eq 18, small r/l), 1 = exact closed-loop solution",
                  type="Integer", min=CLOSED_FORM, max=EXACT),
@@ -50,8 +52,10 @@ SPEC = ModelSpec(
         Variable("omega_in", "input", 2000.0 * math.pi / 30.0,
                  "Input shaft speed omega_1 at the step's start (rising at alpha_in over the step)",
                  "rad/s", "rpm"),
-        Variable("beta", "input", math.radians(30.0), "Bend angle beta between input and output axes",
-                 "rad", "deg", min=0.0, max=math.radians(60.0)),
+        Variable("beta", "input", math.radians(30.0),
+                 "Bend angle beta between input and output axes, at most beta_max (start value 45 deg; the "
+                 "declared max is beta_max's own); a start value beyond it is refused at initialisation",
+                 "rad", "deg", min=0.0, max=BETA_LIMIT),
         Variable("alpha_in", "input", 0.0,
                  "Input shaft angular acceleration d(omega_in)/dt over the step: phi_in advances by "
                  "omega_in h + alpha_in h^2/2 and the outputs at the step's end use omega_in + alpha_in h",
@@ -61,8 +65,10 @@ SPEC = ModelSpec(
         Variable("phi_in", "output", 0.0, "Input shaft angle phi_1, integrated from omega_in", "rad", "deg"),
         Variable("phi_out", "output", 0.0, "Output shaft angle phi_0 (eq 18 or exact kinematics)", "rad", "deg"),
         Variable("delta_phi", "output", 0.0, "Angular deviation phi_out - phi_in (eq 18)", "rad", "deg"),
-        Variable("omega_out", "output", 0.0, "Output shaft speed, d(phi_out)/dt (consistent derivative of eq 18)",
-                 "rad/s", "rpm"),
+        Variable("omega_out", "output", 0.0,
+                 "Output shaft speed at the current bend, omega_in d(phi_out)/d(phi_in) (derivative of eq 18 or "
+                 "of the exact kinematics); d(phi_out)/dt only while beta is constant: a moving bend adds "
+                 "d(phi_out)/d(beta) beta_dot", "rad/s", "rpm"),
         Variable("omega_spin", "output", 0.0,
                  "Angular velocity of the output shaft about its own axis (T_in omega_in = T0 omega_spin "
                  "+ dKE/dt); differs from omega_out by the cone's geometric phase", "rad/s", "rpm"),
@@ -91,21 +97,26 @@ SPEC = ModelSpec(
                  "on its housing is -Rz_in (friction only)", "N"),
         Variable("P_friction", "output", 0.0, "Power dissipated by friction in the six sliding pairs", "W"),
         Variable("efficiency", "output", 1.0,
-                 "Instantaneous efficiency T_load omega_spin / (T_load omega_spin + P_friction); 1 without power flow",
+                 "Instantaneous efficiency, delivered over supplied power, with P_load = T_load omega_spin: drive "
+                 "(P_load >= 0) P_load / (P_load + P_friction), 1 without power flow; coast (the load drives, "
+                 "P_load + P_friction <= 0) (P_load + P_friction) / P_load; 0 in between (friction takes all)",
                  "1"),
         *ARM_OUTPUTS,
         # appended after every other variable: value references are positions, so those of
         # the variables above stay what hosts, SSP files and reference results know
         Variable("beta_dot", "input", 0.0,
-                 "Bend angle rate d(beta)/dt over the step (beta_rate = 0): the moving output bearing's "
+                 "Bend angle rate d(beta)/dt over the step (read as beta_rate says): the moving output bearing's "
                  "terms in the force balance; beta at the step's end is beta + beta_dot h + beta_ddot h^2/2",
                  "rad/s", derivative="beta"),
-        Variable("beta_ddot", "input", 0.0, "Bend angle acceleration d(beta_dot)/dt over the step (beta_rate = 0)",
+        Variable("beta_ddot", "input", 0.0,
+                 "Bend angle acceleration d(beta_dot)/dt over the step (read as beta_rate says)",
                  "rad/s2", derivative="beta_dot"),
-        Variable("beta_rate", "parameter", RATES_FROM_INPUTS,
+        Variable("beta_rate", "parameter", RATES_AUTOMATIC,
                  "Source of the bend angle's rates: 0 = the inputs beta_dot and beta_ddot, 1 = estimated "
-                 "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored)",
-                 type="Integer", min=RATES_FROM_INPUTS, max=RATES_FROM_SAMPLES),
+                 "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored), "
+                 "2 = automatic: the samples until the host sets beta_dot or beta_ddot non-zero (or their input "
+                 "derivatives), the inputs from then on; a warning at the start while both are 0",
+                 type="Integer", min=RATES_FROM_INPUTS, max=RATES_AUTOMATIC),
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
     relations=(

@@ -27,6 +27,115 @@ from driveline.rotor.work import MAX_ANALYSIS_SECONDS, STAGES, estimate
 #: The budgets of one analysis on the project's two-core machine: (seconds, bytes of memory).
 PYTHON_BUDGET = (30.0, 2 * 1024**3)
 NATIVE_BUDGET = (5.0, 500 * 1024**2)
+#: A layout of extreme materials found by a work fuzzer: its determinant ripples at about its rounding
+#: level near a close pair at 11 384 rad/s, where the root search once re-scanned 1.7 million points at
+#: a speed (12.9 s native, 25.4 s Python with ``ROUND_OFF_PARAMETERS``; estimated 0.105 s).
+ROUND_OFF_LAYOUT = """left_end = "free"
+right_end = "pinned"
+[[segments]]
+length = 0.8248646946212962
+outer_diameter = 0.17068998163927307
+wall_thickness = 0.0034137996327854615
+youngs_modulus = 5045815318195.618
+density = 3.907321004526678
+gyroscopic = false
+[[segments]]
+length = 0.8248646946212962
+outer_diameter = 0.2321754908004059
+wall_thickness = 2.3217549080040592e-05
+youngs_modulus = 210000000000.0
+density = 1.0171558428091914
+shear = false
+[[segments]]
+length = 0.8248646946212962
+outer_diameter = 0.019952451022759693
+wall_thickness = 0.00039904902045519386
+youngs_modulus = 110072829.65974881
+density = 0.020640445017250677
+gyroscopic = true
+[[bearings]]
+position = 0.7733679342663501
+kxx = 195.28871436131323
+kyy = 2011.146833880055
+damping = 16.8449620808454
+[[bearings]]
+position = 1.2189934173177135
+stiffness = 148605257.06885213
+[[unbalances]]
+position = 1.440681430980566
+amount = 8.265024109038702e-08
+"""
+ROUND_OFF_PARAMETERS = {"omega_max": 2.07419590242784, "omega": 2.07419590242784, "band": 0.1, "orders": "89"}
+#: A layout the work estimate accepts (0.2 s) whose anisotropic Campbell table exceeds the analysis's budget
+#: (driveline/rotor/budget.py) with ``BUDGET_PARAMETERS``: refused naming the Campbell table, natively
+#: after 1.7 s of CPU time (found by a work fuzzer's layout with two masses and a bearing added).
+BUDGET_LAYOUT = """left_end = "clamped"
+right_end = "pinned"
+[[segments]]
+length = 1.4059768799749384
+outer_diameter = 0.1251625266873248
+wall_thickness = 0.027209713019476382
+youngs_modulus = 3625575902.95697
+density = 15071.722950688541
+gyroscopic = false
+[[segments]]
+length = 1.086218955839054
+outer_diameter = 0.04380485269892381
+wall_thickness = 0.000687683508999283
+youngs_modulus = 180139481380.35928
+density = 168.9252328964127
+shear = false
+[[masses]]
+position = 1.6700359239882223
+mass = 38.23927134855459
+polar_inertia = 0.00036102597923154037
+diametral_inertia = 0.011247151157012181
+[[masses]]
+position = 0.34958642047857075
+mass = 16.148109072445408
+polar_inertia = 0.00015212135846689318
+diametral_inertia = 0.024173897033860112
+[[masses]]
+position = 0.799567379381423
+mass = 0.8583459474003896
+polar_inertia = 0.017098879389715754
+diametral_inertia = 0.0036039989582832637
+[[bearings]]
+position = 1.5449843227608087
+stiffness = 413.02545157194186
+damping = 160.81302708371194
+[[bearings]]
+position = 2.3792747480813317
+stiffness = 14706.556304412345
+damping = 62.10761727394972
+[[bearings]]
+position = 1.1969776055495367
+kxx = 2164449.7769301157
+kyy = 8121.219782890922
+[[hinges]]
+position = 0.9073154117425819
+[[hinges]]
+position = 0.48219320031474766
+bending_stiffness = 362618.8792222968
+[[unbalances]]
+position = 0.8674876301034313
+amount = 0.001144373592146762
+[[masses]]
+position = 0.1
+mass = 1.0
+polar_inertia = 0.001
+diametral_inertia = 0.002
+[[masses]]
+position = 0.30000000000000004
+mass = 2.0
+polar_inertia = 0.001
+diametral_inertia = 0.002
+[[bearings]]
+position = 0.2
+kxx = 10000.0
+kyy = 300000.0
+"""
+BUDGET_PARAMETERS = {"orders": "5,36", "omega_max": 65.536, "omega": 0.0}
 #: A tube of the shipped propshaft's size.
 TUBE = 'outer_diameter = 0.0762\nwall_thickness = 0.00165\nmaterial = "steel"'
 
@@ -92,6 +201,7 @@ def worst_cases() -> dict[str, tuple[str, dict]]:
         "smallest omega_max": (propshaft, slow),
         "largest omega_max": (propshaft, {"omega_max": fastest, "omega": 0.0}),
         "propshaft, 20 segments": (propshaft, {"omega": 0.0}),
+        "round-off ripple": (ROUND_OFF_LAYOUT, ROUND_OFF_PARAMETERS),
         "issue's 566 s layout": (layout_text(100, 1.4, 202, 202, 200), slow),
     }
 

@@ -420,10 +420,16 @@ def parameter_limit(path: str, name: str, value: Any, fragment: str) -> None:
 
 
 def bounded_output(path: str, values: dict[str, Any], fragment: str) -> None:
-    """Inputs whose outputs lie beyond a declared physical bound: logged at initialisation (OK, the
-    host may still correct them), every step refused with the bound named and the master asked to stop."""
+    """Start values whose outputs lie beyond a declared physical bound are refused at initialisation
+    as bad parameters are; the inputs among them set after initialisation refuse every step with the
+    bound named and the master asked to stop."""
+    _refused_parameters(Probe(path), values, fragment)
     probe = Probe(path)
-    expect(probe.initialize(values), "OK", what="exitInitializationMode")
+    inputs = {name: value for name, value in values.items() if probe.variables[name].causality == "input"}
+    expect(probe.initialize({name: value for name, value in values.items() if name not in inputs}), "OK",
+           what="exitInitializationMode")
+    for name, value in inputs.items():
+        probe.set(name, value)
     status, stop = probe.step_stopping(1e-3)
     expect(status, "Discard", what=f"doStep with {values}")
     if not stop or not any(fragment in text for text in probe.errors_logged()):

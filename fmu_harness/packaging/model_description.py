@@ -13,7 +13,11 @@ from collections.abc import Callable
 from driveline.variables import ModelSpec, Unit, Variable
 
 
-def _number(value: float | int) -> str:
+def number_text(value: float | int | bool) -> str:
+    """A number as both families' model descriptions write it: a float's repr (the shortest text
+    that reads back bit for bit), an integer as it is, a Boolean as XML's ``true``/``false``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
     return repr(float(value)) if isinstance(value, float) else str(value)
 
 
@@ -36,9 +40,9 @@ def _type_attributes(variable: Variable) -> dict[str, str]:
     if variable.display_unit is not None:
         attributes["displayUnit"] = variable.display_unit
     if variable.min is not None:
-        attributes["min"] = _number(variable.min)
+        attributes["min"] = number_text(variable.min)
     if variable.max is not None:
-        attributes["max"] = _number(variable.max)
+        attributes["max"] = number_text(variable.max)
     return attributes
 
 
@@ -62,6 +66,8 @@ def _complete(
         variable = spec[element.get("name")]
         element.set("description", variable.description)
         typed.attrib.update(_type_attributes(variable))
+        if variable.causality != "output" and variable.type != "String":  # pythonfmu writes 16 digits
+            typed.set("start", number_text(variable.start))
         if fmi3 and variable.derivative is not None:  # FMI 3.0: an input's derivative is an input too
             element.set("derivative", references[variable.derivative])
         if variable.causality == "output":

@@ -44,7 +44,7 @@ from ..console import Progress
 from . import documentation, toolchain
 from .archive import TOKEN_NAMESPACE, write_zip
 from .documentation import snake_case
-from .model_description import complete_fmi2, complete_fmi3
+from .model_description import complete_fmi2, complete_fmi3, number_text
 from .native_constants import HEADER as CONSTANTS_HEADER
 from .native_constants import constants_header
 
@@ -358,12 +358,6 @@ def input_derivatives(spec: ModelSpec) -> list[tuple[str, int, str]]:
 # -- model description ----------------------------------------------------------------------------
 
 
-def _number(value: float | int | bool | str) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return repr(float(value)) if isinstance(value, float) else str(value)
-
-
 _FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
 
 
@@ -402,7 +396,7 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
     for reference, v in enumerate(spec.variables):
         attributes = {"name": v.name, "valueReference": str(reference), "causality": v.causality,
                       "variability": v.effective_variability}
-        start = {} if v.causality == "output" else {"start": _number(v.start)}
+        start = {} if v.causality == "output" else {"start": number_text(v.start) if v.type != "String" else v.start}
         if fmi3 and v.type == "String":  # FMI 3.0: a String's start is an element
             element = ET.SubElement(variables, "String", attributes)
             if start:

@@ -85,11 +85,12 @@ def driveline() -> System:
     """Speed ramp 500 to 3000 rpm in 1 s with a 50 rpm, 5 Hz sine, into a tripod coupling bent
     20 degrees under 150 N.m; ``CriticalSpeeds`` on the output shaft when it exists."""
     components = [
-        Component("source", "SpeedSource", {"omega_start": 500.0 * RPM, "ramp_rate": 2500.0 * RPM,
+        Component("source", "SpeedSource", {"omega_out_start": 500.0 * RPM, "ramp_rate": 2500.0 * RPM,
                                             "sine_amplitude": 50.0 * RPM, "sine_frequency": 5.0}),
         Component("coupling", "TripodCoupling", {"kinematics": 1, "beta": math.radians(20.0), "T_load": 150.0}),
     ]
-    connections = [Connection(("source", "omega"), ("coupling", "omega_in"))]
+    connections = [Connection(("source", "omega_out"), ("coupling", "omega_in")),
+                   Connection(("source", "alpha_out"), ("coupling", "alpha_in"))]
     if WATCHER in MODELS:
         components.append(Component("critical", WATCHER, {}))
         connections += [

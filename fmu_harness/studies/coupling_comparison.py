@@ -40,7 +40,8 @@ COUPLINGS = (
     Coupling("TripodCoupling", "beta", 0.0, 1.0, {"kinematics": 1, "beta_max": math.radians(60.0)}),
     Coupling("CardanJoint", "beta", 0.0, 1.0, {"beta_max": math.radians(80.0)}),
     # The reducer's intersection angle is 180 deg for in-line shafts.
-    Coupling("UniversalReducer", "alpha", math.pi, -1.0, {"alpha_min": math.radians(10.0), "alpha_max": math.radians(179.0)}),
+    Coupling("UniversalReducer", "intersection_angle", math.pi, -1.0,
+             {"intersection_angle_min": math.radians(10.0), "intersection_angle_max": math.radians(179.0)}),
 )
 
 

@@ -305,6 +305,7 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
 {
     const char *layout = data->string_value[V_layout];
     int hinge = 0, node = 0, i;
+    char least[40];
     ErrorKind failed;
     if (layout[0] != '\0') {
         failed = driveline_from_layout(layout, data->cache->resources, out, error, ERROR_SIZE);
@@ -321,7 +322,8 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
     case MECHANISM_NONE:
         return failed;
     case MECHANISM_HINGE_FOLDS:
-        snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node);
+        python_format_g(driveline_least_resolved_stiffness(out), 6, least, sizeof least);
+        snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node, least);
         return ERROR_VALUE;
     case MECHANISM_RIGID_BODY:
         snprintf(error, ERROR_SIZE, "%s", MECHANISM_RIGID);
@@ -415,14 +417,15 @@ static double work_grid(double per_pi, double phase)
     return per_pi * phase / FMU_PI + 8.0;
 }
 
-/* work.estimate, then Work.refusal: ERROR_NONE, or the refusal (ERROR_VALUE) or a failure's kind
- * with its message in ``error``. */
+static const char *const STAGE_NAMES[WORK_STAGE_COUNT] = {WORK_STAGE_0, WORK_STAGE_1, WORK_STAGE_2,
+                                                          WORK_STAGE_3, WORK_STAGE_4, WORK_STAGE_5};
+
+/* work.estimate into ``seconds`` (one per stage), then Work.refusal: ERROR_NONE, or the refusal
+ * (ERROR_VALUE) or a failure's kind with its message in ``error``. */
 static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int n_orders, double omega_max,
-                              char *error)
+                              double seconds[WORK_STAGE_COUNT], char *error)
 {
-    static const char *const names[WORK_STAGE_COUNT] = {WORK_STAGE_0, WORK_STAGE_1, WORK_STAGE_2,
-                                                   WORK_STAGE_3, WORK_STAGE_4, WORK_STAGE_5};
-    double seconds[WORK_STAGE_COUNT], terms[ROTOR_MODEL_MAX_ORDERS + 1], per_pi, kappa, to_limit, resonances, check,
+    double terms[ROTOR_MODEL_MAX_ORDERS + 1], per_pi, kappa, to_limit, resonances, check,
         total, search;
     int seen[ROTOR_MODEL_MAX_ORDER + 1] = {0}, *counts, i, n = 0, stations, planes = 1, isotropic, freedoms, table = 0,
         response = 0;
@@ -493,7 +496,7 @@ static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int
     used = strlen(error);
     for (i = 0; i < WORK_STAGE_COUNT; i++) {
         python_format_g(seconds[i], 3, shown, sizeof shown);
-        snprintf(stage, sizeof stage, "%s%s %s s", i ? ", " : "", names[i], shown);
+        snprintf(stage, sizeof stage, "%s%s %s s", i ? ", " : "", STAGE_NAMES[i], shown);
         text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
     }
     python_format_g(ROTOR_WORK_MAX_ANALYSIS_SECONDS, 6, shown, sizeof shown);
@@ -503,9 +506,30 @@ static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int
     return ERROR_VALUE;
 }
 
+/* budget.seconds_units: the units of a stage estimated at ``seconds`` (rounded up) */
+static long long seconds_units(double seconds)
+{
+    return (long long)ceil(seconds / ROTOR_BUDGET_SECONDS_PER_UNIT);
+}
+
+/* The stage ``stage`` (work.STAGES) pays from ``budget`` from now on; ``seconds`` >= 0: its estimate, paid
+ * whole now (a finite-element stage). ERROR_NONE, or ERROR_VALUE when the budget is spent. */
+static ErrorKind spend(Budget *budget, int stage, double seconds, char *error)
+{
+    budget->stage = STAGE_NAMES[stage];
+    if (seconds >= 0.0) {
+        budget_charge(budget, seconds_units(seconds));
+    }
+    if (budget->spent) {
+        ROTOR_ERROR(error, ERROR_SIZE, ROTOR_BUDGET_SPENT);
+        return ERROR_VALUE;
+    }
+    return ERROR_NONE;
+}
+
 /* analyse_structure: the chain, the critical speeds (missing ones read as the search limit) and the
- * finite-element check's natural frequencies. */
-static ErrorKind analyse_structure(Analysis *analysis, char *error)
+ * finite-element check's natural frequencies, paid from ``budget`` (the check at its estimate). */
+static ErrorKind analyse_structure(Analysis *analysis, Budget *budget, const double *seconds, char *error)
 {
     double spins[3];
     int count = 0, i;
@@ -514,7 +538,9 @@ static ErrorKind analyse_structure(Analysis *analysis, char *error)
     if (failed) {
         return failed;
     }
-    failed = rotor_critical_speeds(analysis->chain, 3, spins, &count, error, ERROR_SIZE);
+    chain_set_budget(analysis->chain, budget);
+    failed = spend(budget, 0, -1.0, error);
+    failed = failed ? failed : rotor_critical_speeds(analysis->chain, 3, spins, &count, error, ERROR_SIZE);
     if (failed) {
         return failed;
     }
@@ -522,8 +548,9 @@ static ErrorKind analyse_structure(Analysis *analysis, char *error)
         analysis->critical[i] = i < count ? spins[i] : ROTOR_DRIVELINE_SEARCH_LIMIT;
     }
     analysis->critical_count = count;
-    return fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural,
-                                  &analysis->natural_count, error, ERROR_SIZE);
+    failed = spend(budget, 3, seconds[3], error);
+    return failed ? failed : fe_natural_frequencies(&analysis->driveline, ROTOR_MODEL_FE_ELEMENTS, &analysis->natural,
+                                                    &analysis->natural_count, error, ERROR_SIZE);
 }
 
 /* implausibility: the first two whirl frequencies at standstill must each match a natural
@@ -624,9 +651,10 @@ static ErrorKind unbalance_outputs(Analysis *analysis, const ModelData *data, ch
                                  &analysis->unbalance, error, ERROR_SIZE);
 }
 
-/* One part: kept when its key is unchanged, else dropped and computed anew (kept on success only). */
+/* One part: kept when its key is unchanged, else dropped and computed anew (kept on success only), paid
+ * from ``budget`` (the finite-element stages at their estimates ``seconds``). */
 static ErrorKind part(Analysis *analysis, const ModelData *data, Part which, const int *orders, int n_orders,
-                      char *error)
+                      Budget *budget, const double *seconds, char *error)
 {
     ErrorKind failed;
     if (key_matches(&analysis->keys[which], data, which, orders, n_orders)) {
@@ -638,18 +666,22 @@ static ErrorKind part(Analysis *analysis, const ModelData *data, Part which, con
         failed = build_driveline(data, &analysis->driveline, error);
         break;
     case PART_STRUCTURE:
-        failed = analyse_structure(analysis, error);
+        failed = analyse_structure(analysis, budget, seconds, error);
         break;
     case PART_WHIRL:
-        failed = whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
-                                 ROTOR_MODEL_WHIRL_MODES, &analysis->whirl, error, ERROR_SIZE);
+        failed = spend(budget, 2, -1.0, error);
+        failed = failed ? failed : whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
+                                                   ROTOR_MODEL_WHIRL_MODES, &analysis->whirl, error, ERROR_SIZE);
         failed = failed ? failed : implausibility(analysis, error);
         break;
     case PART_RESONANCES:
-        failed = resonances(analysis, orders, n_orders, VALUE(omega_max), error);
+        failed = spend(budget, 1, -1.0, error);
+        failed = failed ? failed : resonances(analysis, orders, n_orders, VALUE(omega_max), error);
         break;
     default:
-        failed = unbalance_outputs(analysis, data, error);
+        failed = spend(budget, 4, seconds[4], error);
+        failed = failed ? failed : spend(budget, 5, seconds[5], error);
+        failed = failed ? failed : unbalance_outputs(analysis, data, error);
         break;
     }
     if (!failed && !key_store(&analysis->keys[which], data, which, orders, n_orders)) {
@@ -684,7 +716,8 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     int orders[ROTOR_MODEL_MAX_ORDERS], n_orders = 0;
     size_t i;
     ErrorKind failed;
-    double work = 0.0;
+    double work = 0.0, seconds[WORK_STAGE_COUNT];
+    Budget budget = {ROTOR_BUDGET_UNITS, 0, "", ""}; /* the parts analysed anew pay from it, the kept ones not again */
     char error[ERROR_SIZE] = "", shown[40];
     if (analysis == NULL) {
         analysis = calloc(1, sizeof *analysis);
@@ -698,7 +731,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     if (!failed && analysed_for(analysis, data, orders, n_orders)) {
         return;
     }
-    failed = failed ? failed : part(analysis, data, PART_DRIVELINE, orders, n_orders, error);
+    failed = failed ? failed : part(analysis, data, PART_DRIVELINE, orders, n_orders, &budget, seconds, error);
     failed = failed ? failed : searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
     if (!failed && !(work <= ROTOR_MODEL_MAX_SEARCHED_MODES)) {
         python_format_g(work, 3, shown, sizeof shown);
@@ -707,9 +740,19 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
                  "fewer or lower orders, or a smaller omega_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);
         failed = ERROR_VALUE;
     }
-    failed = failed ? failed : work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), error);
+    failed = failed ? failed : work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), seconds, error);
+    if (analysis->chain != NULL) {
+        chain_set_budget(analysis->chain, &budget);
+    }
     for (i = 0; !failed && i < sizeof later / sizeof later[0]; i++) {
-        failed = part(analysis, data, later[i], orders, n_orders, error);
+        failed = part(analysis, data, later[i], orders, n_orders, &budget, seconds, error);
+    }
+    if (analysis->chain != NULL) {
+        chain_set_budget(analysis->chain, NULL);
+    }
+    if (failed && budget.spent) {
+        snprintf(error, sizeof error, BUDGET_REFUSAL, budget.spent_in);
+        failed = ERROR_VALUE;
     }
     if (failed) {
         messages_add(out, "driveline: ", error,

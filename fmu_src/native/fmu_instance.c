@@ -93,7 +93,10 @@ static void step(Instance *instance, double current_time, double step_size)
 
 static const char *category_of(Status status)
 {
-    return status == STATUS_ERROR ? "logStatusError" : status == STATUS_DISCARD ? "logStatusDiscard" : "logAll";
+    return status == STATUS_ERROR     ? "logStatusError"
+           : status == STATUS_DISCARD ? "logStatusDiscard"
+           : status == STATUS_WARNING ? "logStatusWarning"
+                                      : "logAll";
 }
 
 void instance_log(Instance *instance, Status status, const char *first, ...)
@@ -250,7 +253,17 @@ Status instance_exit_initialization(Instance *instance)
         return STATUS_ERROR;
     }
     initialize(instance, instance->start_time);
-    instance_log_messages(instance, STATUS_ERROR); /* inputs the host may still correct: logged, and OK */
+    if (instance->messages.count) { /* start values the model refuses (an input beyond its bounds): Error */
+        instance_log_messages(instance, STATUS_ERROR);
+        instance->mode = MODE_ERROR;
+        return STATUS_ERROR;
+    }
+    if (model_hooks.start_notice != NULL) {
+        const char *notice = model_hooks.start_notice(&instance->data);
+        if (notice != NULL) {
+            instance_log(instance, STATUS_WARNING, notice, (const char *)NULL);
+        }
+    }
     instance->mode = MODE_STEP;
     return STATUS_OK;
 }

@@ -25,8 +25,9 @@
 #define FMU_MESSAGE_SIZE 1024 /* a message names a layout file by its absolute path: room for a long one */
 #define FMU_MAX_MESSAGES 48
 /* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
- * five-number warm start); a new count needs a new STATE_FORMAT (fmu_instance.c). */
-#define FMU_INTERNAL_SLOTS 11
+ * five-number warm start, the bend samples, the rates' choice); a new count needs a new
+ * STATE_FORMAT (fmu_state.c). */
+#define FMU_INTERNAL_SLOTS 12
 /* Longest String value accepted, in characters (code points; model_adapter.MAX_STRING), and so
  * in bytes of UTF-8 at most four times that. */
 #define FMU_MAX_STRING 4096
@@ -130,7 +131,7 @@ typedef struct {
 
 typedef enum { MODE_INSTANTIATED, MODE_INITIALIZATION, MODE_STEP, MODE_TERMINATED, MODE_ERROR } Mode;
 
-typedef enum { STATUS_OK = 0, STATUS_DISCARD = 2, STATUS_ERROR = 3 } Status;
+typedef enum { STATUS_OK = 0, STATUS_WARNING = 1, STATUS_DISCARD = 2, STATUS_ERROR = 3 } Status;
 
 typedef struct Instance Instance;
 /* Hands one message to the host's logger of the instance's FMI version (as data, never a format). */
@@ -167,7 +168,7 @@ typedef struct {
  * The physics returns NO_FAILURE, or the arithmetic failure Python raises. A model whose outputs
  * are functions of time alone gives ``at_time`` (start: at the start time, step: at its end); the
  * others give ``start`` and ``advance``.
- * A NULL ``reset_internal`` or ``extra_*_errors`` means none. A model with derived data builds it
+ * A NULL ``reset_internal``, ``extra_*_errors`` or ``start_notice`` means none. A model with derived data builds it
  * in ``extra_parameter_errors`` (run before every initialisation and step, once the declared
  * checks pass) into ``data->cache->derived``, keyed by the parameters it was built for, and gives
  * ``free_derived``; NULL: the model has none. */
@@ -179,6 +180,7 @@ typedef struct {
     void (*extra_parameter_errors)(const ModelData *data, Messages *out);
     void (*extra_input_errors)(const ModelData *data, Messages *out);
     void (*free_derived)(void *derived);
+    const char *(*start_notice)(const ModelData *data); /* SteppedModel.start_notice: logged once, a warning */
 } ModelHooks;
 
 extern const ModelHooks model_hooks;

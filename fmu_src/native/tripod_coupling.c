@@ -18,10 +18,12 @@
 /* the exact solver's warm start (plane_solver.Solution): a flag, then phi_in, x, y, dx/dphi, dy/dphi */
 #define HAS_SOLUTION (data->internal[0])
 #define SOLUTION (data->internal + 1)
-/* the bend samples of the last two communication points (beta_rate = RATES_FROM_SAMPLES), newest
+/* the bend samples of the last two communication points (beta_rate: the samples or automatic), newest
  * first: their count, then time and beta of each (TripodCouplingModel._beta_samples) */
 #define SAMPLE_COUNT (data->internal[6])
 #define SAMPLES (data->internal + 7)
+/* beta_rate = RATES_AUTOMATIC: 1 once the host has set beta_dot or beta_ddot non-zero (_rates_set) */
+#define RATES_SET (data->internal[11])
 
 static const char MATH_DOMAIN[] = "math domain error";           /* ValueError */
 static const char ZERO_DIVISION[] = "float division by zero";      /* ZeroDivisionError */
@@ -451,7 +453,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     double phi_in = VALUE(phi_in), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
     double cos_beta, sin_beta, rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin;
     double output_power, total;
-    if (INTEGER(beta_rate) == RATES_FROM_SAMPLES) {
+    if (INTEGER(beta_rate) != RATES_FROM_INPUTS) { /* the samples are kept for the automatic choice too */
         double samples[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         int count = 1, k;
         samples[0] = input_time;
@@ -463,7 +465,12 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
                 count++;
             }
         }
-        sampled_rates(samples, count, &beta_dot, &beta_ddot);
+        if (beta_dot != 0.0 || beta_ddot != 0.0) {
+            RATES_SET = 1.0;
+        }
+        if (INTEGER(beta_rate) == RATES_FROM_SAMPLES || RATES_SET == 0.0) {
+            sampled_rates(samples, count, &beta_dot, &beta_ddot);
+        }
         SAMPLE_COUNT = count < 2 ? count : 2;
         for (k = 0; k < 4; k++) {
             SAMPLES[k] = samples[k];
@@ -560,12 +567,13 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     return guard.failure;
 }
 
-/* The warm start and the bend samples are empty at the start, as TripodCouplingModel.start leaves
- * them: reset clears them and a refused start is undone. */
+/* The warm start, the bend samples and the rates' choice are empty at the start, as
+ * TripodCouplingModel.start leaves them: reset clears them and a refused start is undone. */
 static Failure start(ModelData *data, double start_time)
 {
     HAS_SOLUTION = 0.0;
     SAMPLE_COUNT = 0.0;
+    RATES_SET = 0.0;
     VALUE(phi_in) = VALUE(phi_in_start);
     return evaluate(data, start_time, 0.0);
 }
@@ -585,4 +593,11 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     }
 }
 
-const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors};
+/* TripodCouplingModel.start_notice: the automatic rates with none set are estimated, and the log says so. */
+static const char *start_notice(const ModelData *data)
+{
+    return INTEGER(beta_rate) == RATES_AUTOMATIC && RATES_SET == 0.0 ? RATES_ESTIMATED : NULL;
+}
+
+const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors,
+                                .start_notice = start_notice};

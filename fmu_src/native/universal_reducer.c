@@ -17,13 +17,13 @@ typedef struct {
  * twisted by M_C1): sigma = M/W, tau = T/(2W), sigma_eq = sqrt(sigma^2 + 4 tau^2), W = pi r^3/4. */
 static void connecting_shaft(const ModelData *data, double M_in, double i, double cube, Loads *loads)
 {
-    double half = 0.5 * VALUE(alpha), M_out = i * M_in, F_B = M_in / VALUE(e);
+    double half = 0.5 * VALUE(intersection_angle), M_out = i * M_in, F_B = M_in / VALUE(e);
     double F_t = 2.0 * M_out / (VALUE(module) * INTEGER(z1)), shared, section_modulus;
     loads->moment_E = 2.0 * F_B * VALUE(L1) * sin(half);
     loads->moment_C1 = F_t * 0.5 * VALUE(module) * INTEGER(z2);
     shared = loads->moment_E / (2.0 * sin(half));
-    loads->moment_B = loads->moment_C1 / sin(VALUE(alpha)) + shared;
-    loads->moment_C = loads->moment_C1 * cos(VALUE(alpha)) / sin(VALUE(alpha)) + shared;
+    loads->moment_B = loads->moment_C1 / sin(VALUE(intersection_angle)) + shared;
+    loads->moment_C = loads->moment_C1 * cos(VALUE(intersection_angle)) / sin(VALUE(intersection_angle)) + shared;
     section_modulus = 0.25 * FMU_PI * cube;
     loads->sigma = loads->moment_C / section_modulus;
     loads->tau = loads->moment_C1 / (2.0 * section_modulus);
@@ -33,7 +33,7 @@ static void connecting_shaft(const ModelData *data, double M_in, double i, doubl
 static Failure evaluate(ModelData *data, double input_time UNUSED)
 {
     double i = (double)INTEGER(z1) / (double)(INTEGER(z1) - INTEGER(z2)); /* eqs 4, 17 */
-    double half = 0.5 * VALUE(alpha), cube = pow(VALUE(r_shaft), 3.0);
+    double half = 0.5 * VALUE(intersection_angle), cube = pow(VALUE(r_shaft), 3.0);
     Loads loads, unit;
     if (isinf(cube)) {
         return FAILURE(ERROR_OVERFLOW, "(34, 'Numerical result out of range')"); /* Python's float ** says so */

@@ -191,14 +191,14 @@ def test_steps_keep_the_ratio_exact_while_alpha_varies() -> None:
     i = 6.8
     h = 1e-3
     for k in range(1000):
-        model.alpha = math.radians(130.0 + 35.0 * math.sin(7.0 * k * h))
+        model.intersection_angle = math.radians(130.0 + 35.0 * math.sin(7.0 * k * h))
         model.omega_in = 150.0 * (1.0 + 0.5 * math.sin(3.0 * k * h))
         assert model.step(k * h, h) == []
         assert model.omega_out == pytest.approx(model.omega_in / i, rel=1e-15)
         assert model.phi_out == pytest.approx(model.phi_in / i, rel=1e-15)
         assert model.speed_ratio == pytest.approx(5.0 / 34.0, rel=1e-15)
         assert model.T_in * model.omega_in == pytest.approx(model.T_load * model.omega_out, rel=1e-14)
-        assert model.s_b == float(mechanics.cylinder_slide(model.phi_in, model.alpha, E))
+        assert model.s_b == float(mechanics.cylinder_slide(model.phi_in, model.intersection_angle, E))
 
 
 def test_start_values_pass_the_strength_check() -> None:
@@ -226,9 +226,9 @@ def test_strength_outputs_scale_with_the_torque() -> None:
 @pytest.mark.parametrize(
     ("name", "value", "fragment"),
     [
-        ("alpha", math.pi, "input alpha = 180 deg must not exceed alpha_max = 170 deg (eq 21 is singular at 0 and"),
-        ("alpha", math.radians(60.0), "input alpha = 60 deg must not be below alpha_min = 90 deg"),
-        ("alpha", -0.1, "input alpha = -0.1 rad is below its minimum"),
+        ("intersection_angle", math.pi, "input intersection_angle = 180 deg must not exceed intersection_angle_max = 170 deg (eq 21 is singular at 0 and"),
+        ("intersection_angle", math.radians(60.0), "input intersection_angle = 60 deg must not be below intersection_angle_min = 90 deg"),
+        ("intersection_angle", -0.1, "input intersection_angle = -0.1 rad is below its minimum"),
         ("omega_in", math.nan, "input omega_in = nan is not finite"),
         ("T_load", -math.inf, "input T_load = -inf is not finite"),
     ],
@@ -245,8 +245,9 @@ def test_invalid_input_is_refused_and_leaves_the_state(name: str, value: float, 
         (dict(z2=0), "parameter z2 = 0 is below its minimum 1"),
         (dict(module=0.0), "parameter module = 0 mm must be positive"),
         (dict(r_shaft=0.0), "parameter r_shaft = 0 mm must be positive"),
-        (dict(alpha_max=math.pi), "parameter alpha_max = 180 deg must be below 180 deg"),
-        (dict(alpha_min=2.0, alpha_max=1.9), "parameter alpha_min = 114.592 deg must not exceed alpha_max = 108.862 deg"),
+        (dict(intersection_angle_max=math.pi), "parameter intersection_angle_max = 180 deg must be below 180 deg"),
+        (dict(intersection_angle_min=2.0, intersection_angle_max=1.9),
+         "parameter intersection_angle_min = 114.592 deg must not exceed intersection_angle_max = 108.862 deg"),
     ],
 )
 def test_invalid_parameters_are_refused(values: dict, fragment: str) -> None:

@@ -22,7 +22,10 @@ from driveline.rotor import (
     load_driveline,
     one_piece_shaft,
 )
-from driveline.rotor.roots import BatchReport, find_roots_batch
+from driveline.rotor import transfer
+from driveline.rotor.loader import loads_driveline
+from driveline.rotor.roots import MAX_DIPS, BatchReport, find_roots_batch
+from fmu_harness.checks.analysis_work import ROUND_OFF_LAYOUT
 
 from support.rotor_checks import drivelines, rayleigh
 
@@ -145,6 +148,67 @@ def test_no_spurious_roots_from_dips_or_round_off():
     ripple = lambda x: 0.3 + 1e-16 * np.sin(1e6 * x)
     rep = find_roots(ripple, np.linspace(0.0, 1.0, 101))
     assert rep.roots[0].size == 0 and rep.dips_examined == 0
+
+
+def test_a_dip_at_the_rounding_level_is_a_double_root_not_a_chase():
+    """A double root under a ripple of +-1e-9 that changes sign on every sub-grid (round-off as a badly
+    conditioned determinant shows it): told that rounding level, the search stops where the dip's bottom
+    reaches it and reports a double root there; told nothing, it chases the ripple's dips and sign
+    changes level after level until the per-line cap refuses it."""
+    def f(x):
+        return (x - 0.5) ** 2 + 1e-9 * (0.5 + np.sin(1e13 * x))
+
+    told = find_roots_batch(lambda x, k: (f(x), np.full(x.size, 1e-9)), [GRID - 0.0123])
+    assert told.double_roots == 1 and told.evaluations == GRID.size
+    assert np.allclose(told.roots[0], 0.5, rtol=0, atol=1e-4)  # |f| <= 8e-9 within 9e-5 of the root
+    with pytest.raises(ArithmeticError, match="dips on one line"):
+        find_roots(f, GRID - 0.0123)
+
+
+def test_ripple_as_deep_as_the_rounding_is_not_examined():
+    """Dips of 1e-6 +- 1e-7 with a rounding level of 2e-8 at every point: resolved from zero, but no
+    deeper than 8 times the rounding of their three points, so dropped; told no rounding, the same
+    dips are examined (and found to hold no root)."""
+    def f(x):
+        return 1e-6 + 1e-7 * np.sin(40.0 * x)
+
+    told = find_roots_batch(lambda x, k: (f(x), np.full(x.size, 2e-8)), [GRID])
+    blind = find_roots(f, GRID)
+    assert told.dips_examined == 0 and told.roots[0].size == 0
+    assert blind.dips_examined > 0 and blind.roots[0].size == 0
+
+
+@pytest.mark.parametrize("periods, refused", [(200, False), (600, True)])
+def test_at_most_max_dips_are_rescanned_on_one_line(periods, refused):
+    """Positive dips of a cosine, ten grid points a period, each examined on two levels: 200 periods
+    stay under MAX_DIPS re-scans, 600 are refused with the rule named; a second line in the same
+    batch does not share the first one's count."""
+    grid = np.linspace(0.1, 2.0 * np.pi * periods + 0.1, 10 * periods + 1)
+
+    def f(x, k):
+        return 1.0001 + np.cos(x)
+
+    if refused:
+        with pytest.raises(ArithmeticError, match=f"more than {MAX_DIPS} dips on one line"):
+            find_roots_batch(f, [grid])
+    else:
+        report = find_roots_batch(f, [grid, grid])
+        assert MAX_DIPS < report.dips_examined < 2 * MAX_DIPS and not any(r.size for r in report.roots)
+
+
+def test_the_round_off_layout_is_searched_in_a_bounded_number_of_evaluations():
+    """The layout of extreme materials whose determinant ripples at about its rounding level near a
+    close pair at 11 384 rad/s (docs/critical_speeds.md): at standstill the search once took 1.7
+    million evaluations; now the pair is a double root and the search takes well under a thousand."""
+    driveline = loads_driveline(ROUND_OFF_LAYOUT)
+    for spin in (0.0, 0.051854897560696):
+        grid = driveline._grid(4.0e4, 1.0)
+        report = find_roots_batch(
+            lambda x, k: transfer.determinant_and_rounding(driveline._chain, x, spin), [grid])
+        roots = report.roots[0]
+        assert report.evaluations < 1000 and report.double_roots >= 1
+        assert np.allclose(roots[:2], [98.4798381, 312.0615041], rtol=1e-8)
+        assert np.count_nonzero(np.abs(roots - 11384.045) < 1e-2) == 2
 
 
 def test_roots_come_lowest_first():

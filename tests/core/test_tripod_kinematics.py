@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from driveline.tripod import closed_form, exact, geometry, plane_solver
+from driveline.tripod.model import TripodCouplingModel
 
 R, L = 0.026, 0.700  # seed 000's worked example
 PHI = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
@@ -119,3 +120,39 @@ def test_plane_formulation_agrees_with_the_newton_closure(r_over_l, beta_deg):
         # both use finite-difference Jacobians: measured worst 1.5e-8 (beta = 60 deg, r/l = 0.2)
         assert ratio == pytest.approx(reference.speed_ratio[k], abs=5e-8)
         assert solution.cone_angle == pytest.approx(reference.cone_angle[k], abs=1e-13)
+
+
+
+@pytest.mark.parametrize("kinematics", [0, 1])
+def test_omega_out_is_the_speed_at_the_current_bend_not_the_angles_rate_while_beta_moves(kinematics):
+    """omega_out = omega_in d(phi_out)/d(phi_in), as its description says: d(phi_out)/dt (central
+    difference over 1e-6 s, within 1e-8) at a held bend; while beta moves at 4.36 rad/s (5 -> 30 deg
+    in 0.1 s) d(phi_out)/dt is omega_out + d(phi_out)/d(beta) beta_dot (3.5e-3 rad/s at 15 deg), the
+    last term from phi_out at beta +- 1e-6 rad, within 1e-3 of itself."""
+    h, beta0, rate = 1e-6, np.radians(15.0), np.radians(25.0) / 0.1
+
+    def model(beta: float, phi_in: float, beta_dot: float = 0.0) -> TripodCouplingModel:
+        coupling = TripodCouplingModel()
+        coupling.kinematics, coupling.beta, coupling.beta_dot, coupling.phi_in_start = kinematics, beta, beta_dot, phi_in
+        assert coupling.initialize(0.0) == []
+        return coupling
+
+    def run(beta_dot: float) -> tuple[float, float]:
+        """d(phi_out)/dt and omega_out at t = h."""
+        coupling = model(beta0, 0.3, beta_dot)
+        angles, speeds = [coupling.phi_out], [coupling.omega_out]
+        for k in range(2):
+            coupling.beta = beta0 + beta_dot * k * h
+            assert coupling.step(k * h, h) == []
+            angles.append(coupling.phi_out)
+            speeds.append(coupling.omega_out)
+        return (angles[2] - angles[0]) / (2 * h), speeds[1]
+
+    angle_rate, speed = run(0.0)
+    assert angle_rate == pytest.approx(speed, rel=1e-8)
+    angle_rate, speed = run(rate)
+    phi_in = 0.3 + TripodCouplingModel().omega_in * h
+    bend_term = (model(beta0 + rate * h + 1e-6, phi_in).phi_out
+                 - model(beta0 + rate * h - 1e-6, phi_in).phi_out) / 2e-6 * rate
+    assert abs(bend_term) > 3e-3  # rad/s: the difference the description names is there
+    assert angle_rate - speed == pytest.approx(bend_term, rel=1e-3)

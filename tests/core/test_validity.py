@@ -138,5 +138,5 @@ def test_declarations_are_plain_data(name):
 def test_the_variable_table_shows_the_rules():
     table = markdown(MODELS["UniversalReducer"].spec)
     assert "| `module` | parameter | m (mm) | 0.002 | > 0 |  |" in table
-    assert "| `alpha_max` | parameter | rad (deg) | 2.96706 | 0 | < 3.14159 |" in table
+    assert "| `intersection_angle_max` | parameter | rad (deg) | 2.96706 | 0 | < 3.14159 |" in table
     assert "`z1 > z2` (i = z1 / (z1 - z2))" in table and "inclusive min or max" in table

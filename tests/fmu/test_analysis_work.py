@@ -12,7 +12,9 @@ from benchmarks.analysis_work import over_budget
 from driveline.rotor.loader import example_path, load_driveline, loads_driveline
 from driveline.rotor.model import CAMPBELL_POINTS, FE_ELEMENTS, CriticalSpeedsModel
 from driveline.rotor.work import MAX_ANALYSIS_SECONDS, estimate
-from fmu_harness.checks.analysis_work import layout_text, measure, worst_cases
+from driveline.rotor.budget import refusal
+from fmu_harness.checks.analysis_work import BUDGET_LAYOUT, BUDGET_PARAMETERS, layout_text, measure, worst_cases
+from fmu_harness.checks.work_fuzzer import BUDGETS, CASE_LAYOUT, run_limited
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
 
@@ -54,3 +56,22 @@ def test_the_worst_inputs_the_limits_allow_stay_within_the_budgets(native_dir, t
     assert set(worst_cases()) >= {"most stations", "most orders", "smallest omega_max", "largest omega_max"}
     results = measure(tmp_path, native.fmu_path(native_dir, "CriticalSpeeds", "2"))
     assert over_budget(results) == []
+
+
+def test_an_analysis_beyond_its_budget_is_refused_naming_the_stage_within_the_budget(family):
+    """BUDGET_LAYOUT, accepted by the estimate, spends the analysis's budget (driveline/rotor/budget.py) in
+    its Campbell table: refused at initialisation with the stage named, in the same words in both
+    families (the Python FMUs log it at initialisation and refuse the first step), within the family's
+    budget of CPU time (measured 1.4 s native, 5.8 s Python on a busy machine); initialised with the
+    shipped two-piece layout instead, the tunable change of layout to it is refused at that step alike.
+    Each run in a process under a limit of CPU time and address space."""
+    expected = f"driveline: {refusal('Campbell table')}"
+    start = {"layout": BUDGET_LAYOUT, "start": BUDGET_PARAMETERS, "changes": []}
+    changed = {"layout": BUDGET_LAYOUT, "start": {**BUDGET_PARAMETERS, "layout": "two_piece_propshaft"},
+               "changes": [{"layout": CASE_LAYOUT}]}
+    seconds, memory = BUDGETS[family.name]
+    for case, refused_at in ((start, 0), (changed, 1)):
+        run = run_limited(family.path("CriticalSpeeds"), case, BUDGETS[family.name])
+        assert [a["status"] == "OK" for a in run["analyses"]] == [True] * refused_at + [False]
+        assert expected in run["analyses"][refused_at]["message"]
+        assert all(a["seconds"] < seconds for a in run["analyses"]) and run["peak"] < memory

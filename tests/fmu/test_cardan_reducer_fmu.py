@@ -44,7 +44,7 @@ def test_cardan_acceleration_includes_the_input_acceleration(fmu_path):
 
 @pytest.mark.parametrize("alpha_deg", [95.0, 135.0, 160.0, 170.0])
 def test_reducer_ratio_is_exact_at_any_angle(fmu_path, alpha_deg):
-    result = simulate(fmu_path("UniversalReducer"), 0.5, 1e-3, inputs={"alpha": math.radians(alpha_deg), "T_load": 68.0})
+    result = simulate(fmu_path("UniversalReducer"), 0.5, 1e-3, inputs={"intersection_angle": math.radians(alpha_deg), "T_load": 68.0})
     i = transmission_ratio(34, 29)
     assert i == pytest.approx(6.8)
     np.testing.assert_allclose(result["omega_out"], result["omega_out"][0], rtol=1e-15)
@@ -55,7 +55,7 @@ def test_reducer_ratio_is_exact_at_any_angle(fmu_path, alpha_deg):
 def test_reducer_ratio_holds_while_the_angle_and_speed_change(fmu_path):
     result = simulate(
         fmu_path("UniversalReducer"), 1.0, 1e-3,
-        inputs={"alpha": lambda t: math.radians(130 + 35 * math.sin(7 * t)), "omega_in": lambda t: 100 + 50 * math.sin(3 * t)},
+        inputs={"intersection_angle": lambda t: math.radians(130 + 35 * math.sin(7 * t)), "omega_in": lambda t: 100 + 50 * math.sin(3 * t)},
     )
     np.testing.assert_allclose(result["phi_out"] * 6.8, result["phi_in"], rtol=1e-14)
     assert np.ptp(result["omega_out"]) > 1.0  # the speed did change

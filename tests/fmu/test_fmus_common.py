@@ -101,3 +101,29 @@ def test_the_fmi3_start_time_is_read_from_a_python_hosts_call_only():
     assert fmi3EnterInitializationMode(None, False, 0.0, 7, False, 0.0) == 7.0
     assert math.isnan(fmi3EnterInitializationMode(None, False, 0.0, math.nan, False, 0.0))
     assert host_start_time(sys._getframe()) is None  # a host written in C leaves no such frame
+
+
+#: Start values beyond what the model accepts with its default parameters, and a fragment of the reason.
+REFUSED_STARTS = [
+    ("TripodCoupling", {"beta": 0.9}, "input beta = 51.5662 deg must not exceed beta_max = 45 deg"),
+    ("CardanJoint", {"beta": 0.9}, "input beta = 51.5662 deg must not exceed beta_max = 45 deg"),
+    ("TripodCoupling", {"omega_in": math.nan}, "input omega_in = nan is not finite"),
+]
+
+
+@pytest.mark.parametrize("name, start, reason", REFUSED_STARTS)
+def test_a_start_value_the_model_refuses_is_refused_at_initialisation_with_one_message(family, fmi, name, start,
+                                                                                      reason):
+    """Before: beta = 0.9 rad under beta_max = 45 deg passed ExitInitializationMode with OK and
+    outputs 0, the reason logged there and again at the first step. Now the native FMUs return
+    Error there, the Python FMUs (whose wrappers return OK) enter the error state; either way the
+    reason is logged once, at initialisation, and no step is taken."""
+    with family.open(name, fmi) as fmu:
+        try:
+            fmu.initialize(start)
+        except StepRefused as refused:
+            assert family.name == "native" and refused.status == "Error"
+        at_initialisation = [record.message for record in fmu.log]
+        assert len(at_initialisation) == 1 and reason in at_initialisation[0], at_initialisation
+        with pytest.raises(StepRefused):
+            fmu.step(1e-3)

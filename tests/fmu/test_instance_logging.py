@@ -33,7 +33,9 @@ def test_each_refusal_is_logged_to_the_instance_that_refused(family, pair, fmi):
             assert any("beta" in message for message in refused.value.messages), refused.value.messages
             assert refusing.log[-1].message == refused.value.messages[-1]
             assert other.log == logged_by_other
-        assert len(first.log) == len(second.log) == len(refused.value.messages)
+        # each logged its refusal alone (TripodCoupling also its warning of the estimated bend rates)
+        refusals = [[record for record in fmu.log if record.status != "Warning"] for fmu in (first, second)]
+        assert len(refusals[0]) == len(refusals[1]) == len(refused.value.messages)
 
 
 def test_two_joint_cardan_shaft_reports_the_first_joints_refusal(fmi, fmu_dir):

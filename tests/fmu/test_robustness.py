@@ -13,7 +13,7 @@ import pytest
 
 from driveline.catalog import MODELS
 from fmu_harness import packaging
-from fmu_harness.checks import robustness
+from fmu_harness.checks import robustness, work_fuzzer
 from fmu_harness.packaging import native
 from fmu_harness.checks.failing_model import FailingModel
 
@@ -77,3 +77,15 @@ def test_every_variable_value_and_model_and_a_long_soak(paths: robustness.FmuPat
             if (c.fmi, c.kind, c.name) not in sampled]
     slow_results = robustness.run_all(rest)
     assert not robustness.failures(slow_results), _report(slow_results)
+
+
+def test_the_work_fuzzer_finds_no_analysis_beyond_its_budget(paths: robustness.FmuPath, family: str,
+                                                             fmi_versions: list[str]):
+    """The work fuzzer's short run (fmu_harness.checks.work_fuzzer; benchmarks/work_fuzzer.py runs it long):
+    the layout that took 12.9 s native and 25.4 s in the Python core, and two random layouts of extreme
+    materials with omega_max near the estimate's edge, each initialised and changed twice in a process
+    under a limit of CPU time and address space: no analysis (accepted or refused) beyond the family's
+    budget (5 s and 500 MB native, 30 s and 2 GB Python), and that layout accepted throughout."""
+    results = work_fuzzer.fuzz({family: paths("CriticalSpeeds", fmi_versions[0])}, 3, seed=3)
+    assert work_fuzzer.over_budget(results) == []
+    assert [analysis["status"] for analysis in results[0][family]["analyses"]] == ["OK"] * 3

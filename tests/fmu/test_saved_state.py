@@ -77,9 +77,9 @@ def test_foreign_or_damaged_bytes_are_refused_with_the_reason(make, reason, tmp_
 
 
 @pytest.mark.parametrize("change, reason", [
-    (lambda values: values.pop("omega"), r"differs in \['omega'\]"),
+    (lambda values: values.pop("omega_out"), r"differs in \['omega_out'\]"),
     (lambda values: values.update(extra=1.0), r"differs in \['extra'\]"),
-    (lambda values: values.update(omega="fast"), "omega is a str, not a float"),
+    (lambda values: values.update(omega_out="fast"), "omega_out is a str, not a float"),
     (lambda values: values.update(time=True), "time is a bool, not a float"),
     (lambda values: values.update(_initialized=1), "_initialized is a int, not a bool"),
 ])

@@ -609,7 +609,6 @@ def test_file_checks(lib, tmp_path, monkeypatch):
 
 SWAPPED_LOADS = """
 import ctypes, json, sys
-sys.path[:0] = sys.argv[4:]
 from support.native_rotor import CDriveline
 lib = ctypes.CDLL(sys.argv[1])
 outcomes = set()
@@ -642,11 +641,14 @@ def test_a_fifo_swapped_in_while_loading_is_refused_without_blocking(lib, tmp_pa
                 os.link(source, link)
                 os.replace(link, path)
 
+    # the script imports the tests' support package: the tests folder goes first on its PYTHONPATH
+    tests_on_path = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        filter(None, (str(Path(__file__).parents[1]), os.environ.get("PYTHONPATH"))))}
     swapper = threading.Thread(target=swap, daemon=True)
     swapper.start()
     try:
-        done = subprocess.run([sys.executable, "-c", SWAPPED_LOADS, lib._name, str(path), "20000",
-                               str(Path(__file__).parents[1])], capture_output=True, text=True, timeout=30)
+        done = subprocess.run([sys.executable, "-c", SWAPPED_LOADS, lib._name, str(path), "20000"],
+                              env=tests_on_path, capture_output=True, text=True, timeout=30)
     finally:
         loading = False
         swapper.join()

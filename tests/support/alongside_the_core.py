@@ -75,9 +75,10 @@ def random_runs(draw: st.DrawFn, model_name: str) -> Run:
 
 def expect_refused_parameters(fmu: FmuInstance, values: dict[str, Any], errors: list[str],
                               reason: Callable[[str], str] = str) -> None:
-    """Values whose parameters the core refuses (``errors``) are refused at initialisation with the
-    core's reasons (as ``reason`` keeps them): Error from the native FMUs; the Python FMUs' wrappers
-    return OK there, so they log the reasons after the call's name and refuse every step."""
+    """Values whose parameters or start values the core refuses (``errors``) are refused at
+    initialisation with the core's reasons (as ``reason`` keeps them): Error from the native FMUs;
+    the Python FMUs' wrappers return OK there, so they log the reasons after the call's name and
+    refuse every step."""
     first = len(fmu.log)
     expected = [reason(error) for error in errors]
     try:

@@ -202,6 +202,10 @@ static ErrorKind slopes_of(const Chain *chain, const Found *found, double *slope
     free(w);
     free(spin);
     free(f);
+    if (chain_budget_spent(chain)) {
+        ROTOR_ERROR(error, size, ROTOR_BUDGET_SPENT);
+        return ERROR_VALUE;
+    }
     return ERROR_NONE;
 }
 
@@ -432,6 +436,10 @@ static ErrorKind spline_error(const Chain *chain, const Found *found, const Bran
     free(at_spin);
     free(f);
     cubic_spline_free(&spline);
+    if (status == ERROR_NONE && chain_budget_spent(chain)) {
+        ROTOR_ERROR(error, size, ROTOR_BUDGET_SPENT);
+        status = ERROR_VALUE;
+    }
     return status;
 }
 

@@ -1,9 +1,11 @@
-/* Whether the supports hold a driveline still (mechanism.py): a moment-free hinge with too few
+/* Whether the supports hold a driveline still (mechanism.py): a moment-free hinge (or one softer than
+ * RESOLVED_HINGE_SHARE EI / L, whose mode double precision does not resolve) with too few
  * supports on its sides leaves the shaft a mechanism with a zero-frequency mode. The shaft is rigid
  * between its free hinges; a piece is held by two fixed points at distinct nodes or a clamped end,
  * and a held piece fixes the hinge it shares with its neighbour, repeated until nothing changes. */
 #include <stdlib.h>
 
+#include "elements.h"
 #include "rotor.h"
 
 /* mechanism._unheld_piece for one plane (``plane`` 0: kxx, 1: kyy): the first piece the supports
@@ -64,9 +66,22 @@ static int unheld_piece(const Driveline *d, int plane, const int *hinges, int n_
     return -1;
 }
 
+double driveline_least_resolved_stiffness(const Driveline *driveline)
+{
+    double stiffest = 0.0;
+    int i;
+    for (i = 0; i < driveline->n_segments; i++) {
+        const RotorSegment *s = &driveline->segments[i];
+        double EI = s->youngs_modulus * segment_second_moment(s);
+        stiffest = i == 0 || EI > stiffest ? EI : stiffest; /* Python's max: the first of equal ones */
+    }
+    return ROTOR_MECHANISM_RESOLVED_HINGE_SHARE * stiffest / driveline_length(driveline);
+}
+
 int driveline_mechanism(const Driveline *driveline, int *hinge_index, int *hinge_node)
 {
     int *hinges, *held, n_hinges = 0, i, k, plane, found = MECHANISM_NONE;
+    double least = driveline_least_resolved_stiffness(driveline);
     hinges = malloc(((size_t)driveline->n_hinges + 1) * sizeof *hinges);
     held = malloc(((size_t)driveline->n_hinges + 1) * sizeof *held);
     if (hinges == NULL || held == NULL) {
@@ -76,7 +91,7 @@ int driveline_mechanism(const Driveline *driveline, int *hinge_index, int *hinge
     }
     for (i = 0; i < driveline->n_hinges; i++) { /* the sorted distinct nodes of the free hinges */
         int node = driveline->hinges[i].node, at = 0;
-        if (driveline->hinges[i].bending_stiffness != 0.0) {
+        if (!(driveline->hinges[i].bending_stiffness < least)) {
             continue;
         }
         while (at < n_hinges && hinges[at] < node) {
@@ -102,7 +117,7 @@ int driveline_mechanism(const Driveline *driveline, int *hinge_index, int *hinge
         }
         *hinge_node = piece > 0 ? hinges[piece - 1] : hinges[0];
         for (i = 0; i < driveline->n_hinges; i++) {
-            if (driveline->hinges[i].node == *hinge_node && driveline->hinges[i].bending_stiffness == 0.0) {
+            if (driveline->hinges[i].node == *hinge_node && driveline->hinges[i].bending_stiffness < least) {
                 *hinge_index = i;
                 break;
             }

@@ -22,6 +22,7 @@ typedef struct {
     double w, s, o;
     double *x;
     int count, capacity;
+    int rescans; /* dips re-scanned on the line (at most ROTOR_ROOTS_MAX_DIPS) */
     char *error;
     size_t size;
 } Search;
@@ -44,11 +45,23 @@ static ErrorKind speed_error(const char *name, double value, char *error, size_t
     return ERROR_VALUE;
 }
 
-static double line_f(const Search *st, double x)
+/* the determinant at x on the line, and its rounding level into *rounding (NULL: not asked) */
+static double line_f(const Search *st, double x, double *rounding)
 {
     double w = st->w * x, spin = st->s * x + st->o, f;
-    chain_determinant(st->chain, 1, &w, &spin, &f);
+    chain_determinant_rounding(st->chain, 1, &w, &spin, &f, rounding);
     return f;
+}
+
+/* ERROR_NONE, or ERROR_VALUE with ROTOR_BUDGET_SPENT once the chain's budget is spent (every search stops
+ * at its next evaluation; the model names the stage) */
+static ErrorKind budget_left(const Chain *chain, char *error, size_t size)
+{
+    if (chain_budget_spent(chain)) {
+        ROTOR_ERROR(error, size, ROTOR_BUDGET_SPENT);
+        return ERROR_VALUE;
+    }
+    return ERROR_NONE;
 }
 
 /* x appended to the roots found; ERROR_NONE, or ERROR_VALUE out of memory */
@@ -82,7 +95,11 @@ static ErrorKind refine(Search *st, double a, double b, double fa, double fb)
     double c, fc, t = 0.5;
     int iteration;
     for (iteration = 0; iteration < ROTOR_ROOTS_MAX_ITERATIONS; iteration++) {
-        double xt = a + t * (b - a), ft = line_f(st, xt), xm, fm, tlim, xi, phi;
+        double xt = a + t * (b - a), ft = line_f(st, xt, NULL), xm, fm, tlim, xi, phi;
+        ErrorKind spent = budget_left(st->chain, st->error, st->size);
+        if (spent != ERROR_NONE) {
+            return spent;
+        }
         if (sign_of(ft) == sign_of(fa)) { /* the new point replaces a; else b becomes a */
             c = a;
             fc = fa;
@@ -124,10 +141,12 @@ static ErrorKind refine(Search *st, double a, double b, double fa, double fb)
     return ERROR_ARITHMETIC;
 }
 
-/* roots._scan for one sampled sequence: its zeros and sign changes, then its dips re-scanned on
- * sub-grids of SUBGRID steps (a dip that persists down to the root tolerance is a double root).
- * ERROR_NONE, or the failure's kind with the message in st->error. */
-static ErrorKind scan(Search *st, const double *x, const double *fx, int n, int depth)
+/* roots._scan for one sampled sequence (f fx, rounding levels rx): its zeros and sign changes, then its
+ * dips re-scanned on sub-grids of SUBGRID steps (a dip that persists down to the root tolerance or to the
+ * rounding of f is a double root, one that the rounding of its points explains is dropped; more than
+ * MAX_DIPS re-scans on the line are refused). ERROR_NONE, or the failure's kind with the message in
+ * st->error. */
+static ErrorKind scan(Search *st, const double *x, const double *fx, const double *rx, int n, int depth)
 {
     int i, j;
     ErrorKind failed;
@@ -144,29 +163,47 @@ static ErrorKind scan(Search *st, const double *x, const double *fx, int n, int 
     }
     for (i = 1; i + 1 < n; i++) {
         double s = sign_of(fx[i]), lo = x[i - 1], hi = x[i + 1], mid = x[i];
-        double a0 = fabs(fx[i - 1]), a1 = fabs(fx[i]), a2 = fabs(fx[i + 1]);
-        double sx[ROTOR_ROOTS_SUBGRID + 1], sf[ROTOR_ROOTS_SUBGRID + 1];
+        double a0 = fabs(fx[i - 1]), a1 = fabs(fx[i]), a2 = fabs(fx[i + 1]), larger = a0 > a2 ? a0 : a2;
+        double sx[ROTOR_ROOTS_SUBGRID + 1], sf[ROTOR_ROOTS_SUBGRID + 1], sr[ROTOR_ROOTS_SUBGRID + 1];
+        int unresolved = a1 <= ROTOR_ROOTS_ROUNDING * rx[i];
         if (!(sign_of(fx[i - 1]) == s && s == sign_of(fx[i + 1]) && s != 0.0)) {
             continue;
         }
-        if (!(a1 < a0 && a1 <= a2 && a1 <= ROTOR_ROOTS_DIP_RATIO * (a0 > a2 ? a0 : a2))) {
+        if (!(a1 < a0 && a1 <= a2 && a1 <= ROTOR_ROOTS_DIP_RATIO * larger)) {
             continue;
         }
-        if (hi - lo <= 2.0 * (ROTOR_ROOTS_XTOL + ROTOR_ROOTS_RTOL * fabs(mid)) || depth >= ROTOR_ROOTS_MAX_DEPTH) {
+        if (!unresolved && !(larger - a1 > ROTOR_ROOTS_ROUNDING * (rx[i - 1] + rx[i] + rx[i + 1]))) {
+            continue; /* ripple */
+        }
+        if (hi - lo <= 2.0 * (ROTOR_ROOTS_XTOL + ROTOR_ROOTS_RTOL * fabs(mid)) || depth >= ROTOR_ROOTS_MAX_DEPTH ||
+            unresolved) {
             if ((failed = found(st, mid)) != ERROR_NONE || (failed = found(st, mid)) != ERROR_NONE) {
                 return failed;
             }
             continue;
         }
+        if (++st->rescans > ROTOR_ROOTS_MAX_DIPS) {
+            if (st->error != NULL && st->size > 0) {
+                snprintf(st->error, st->size,
+                         "the root search met more than %d dips on one line: rounding hides the roots there",
+                         ROTOR_ROOTS_MAX_DIPS);
+            }
+            return ERROR_ARITHMETIC;
+        }
         sx[0] = lo;
         sf[0] = fx[i - 1];
+        sr[0] = rx[i - 1];
         for (j = 1; j < ROTOR_ROOTS_SUBGRID; j++) {
             sx[j] = lo + (hi - lo) * (j * (1.0 / ROTOR_ROOTS_SUBGRID)); /* numpy.linspace(0, 1, SUBGRID + 1) */
-            sf[j] = line_f(st, sx[j]);
+            sf[j] = line_f(st, sx[j], &sr[j]);
+            if ((failed = budget_left(st->chain, st->error, st->size)) != ERROR_NONE) {
+                return failed;
+            }
         }
         sx[ROTOR_ROOTS_SUBGRID] = hi;
         sf[ROTOR_ROOTS_SUBGRID] = fx[i + 1];
-        if ((failed = scan(st, sx, sf, ROTOR_ROOTS_SUBGRID + 1, depth + 1)) != ERROR_NONE) {
+        sr[ROTOR_ROOTS_SUBGRID] = rx[i + 1];
+        if ((failed = scan(st, sx, sf, sr, ROTOR_ROOTS_SUBGRID + 1, depth + 1)) != ERROR_NONE) {
             return failed;
         }
     }
@@ -183,17 +220,20 @@ static int compare_doubles(const void *a, const void *b)
  * or the failure's kind with the message in st->error */
 static ErrorKind find_roots(Search *st, const double *grid, int n)
 {
-    double *fx = malloc((size_t)n * sizeof *fx);
+    double *fx = malloc(2 * (size_t)n * sizeof *fx), *rx;
     int i;
     ErrorKind status;
     if (fx == NULL) {
         ROTOR_ERROR(st->error, st->size, ROTOR_OUT_OF_MEMORY);
         return ERROR_VALUE;
     }
-    for (i = 0; i < n; i++) {
-        fx[i] = line_f(st, grid[i]);
+    rx = fx + n;
+    status = ERROR_NONE;
+    for (i = 0; i < n && status == ERROR_NONE; i++) {
+        fx[i] = line_f(st, grid[i], &rx[i]);
+        status = budget_left(st->chain, st->error, st->size);
     }
-    status = scan(st, grid, fx, n, 0);
+    status = status != ERROR_NONE ? status : scan(st, grid, fx, rx, n, 0);
     free(fx);
     if (status == ERROR_NONE && st->count > 1) {
         qsort(st->x, (size_t)st->count, sizeof *st->x, compare_doubles);
@@ -257,7 +297,7 @@ static ErrorKind search_line(const Chain *chain, const RotorLine *line, double x
     st.s = line->s;
     st.o = line->o;
     st.x = NULL;
-    st.count = st.capacity = 0;
+    st.count = st.capacity = st.rescans = 0;
     st.error = error;
     st.size = size;
     status = find_roots(&st, grid, n);
@@ -417,10 +457,16 @@ static ErrorKind roots_by_whirl(const Chain *chain, const RotorLine *cases, int 
                 status = ERROR_VALUE;
                 break;
             }
-            for (i = 0; i < roots->count; i++) {
+            for (i = 0; i < roots->count && status == ERROR_NONE; i++) {
                 double x = roots->x[i];
                 kinds[i] = chain_forward_fraction(chain, cases[c].w * x, cases[c].s * x + cases[c].o) >= 0.5;
                 kinds[roots->count + i] = !kinds[i];
+                status = budget_left(chain, error, size);
+            }
+            if (status != ERROR_NONE) {
+                free(kinds);
+                kinds = NULL;
+                break;
             }
             status = take(roots, kinds, n, &forward[c], error, size);
             status = status != ERROR_NONE ? status : take(roots, kinds + roots->count, n, &backward[c], error, size);
@@ -605,6 +651,11 @@ ErrorKind rotor_critical_speeds(const Chain *chain, int n, double *spins, int *c
         for (i = 0; i < found_count; i++) {
             shares[i].spin = found_list[i].spin;
             shares[i].share = chain_forward_fraction(chain, found_list[i].spin, found_list[i].spin);
+            if ((failed = budget_left(chain, error, size)) != ERROR_NONE) {
+                free(shares);
+                free(found_list);
+                return failed;
+            }
         }
         qsort(shares, (size_t)found_count, sizeof *shares, compare_shares);
         for (i = 0; i < found_count && *count < n; i++) {

@@ -86,6 +86,8 @@ typedef struct {
  * MECHANISM_RIGID_BODY when the whole shaft moves rigidly; -1: out of memory. */
 enum { MECHANISM_NONE = 0, MECHANISM_HINGE_FOLDS = 1, MECHANISM_RIGID_BODY = 2 };
 int driveline_mechanism(const Driveline *driveline, int *hinge_index, int *hinge_node);
+/* mechanism.least_resolved_stiffness: RESOLVED_HINGE_SHARE EI / L, below which a hinge folds as a free one */
+double driveline_least_resolved_stiffness(const Driveline *driveline);
 
 /* The parameters of loader.one_piece_shaft (the FMU's one-piece tube). */
 typedef struct {
@@ -110,6 +112,17 @@ ErrorKind driveline_from_text(const char *text, size_t length, const char *sourc
 double driveline_length(const Driveline *driveline);
 
 /* ---- transfer.c: the scaled frequency determinant (transfer.py) ---------------------------- */
+/* budget.Budget: the units left to one analysis (budget.py); ``stage`` the stage paying now, ``spent_in``
+ * the one that found it spent. Spending is sticky: a spent budget pays nothing more, and every search
+ * stops at its next evaluation (chain_budget_spent) with ROTOR_BUDGET_SPENT. */
+typedef struct {
+    long long left;
+    int spent;
+    const char *stage, *spent_in;
+} Budget;
+void budget_charge(Budget *budget, long long units);
+#define ROTOR_BUDGET_SPENT "the analysis's work budget is spent"
+
 typedef struct Chain Chain; /* transfer.Chain of a driveline (it keeps no pointer to it) */
 /* transfer.Chain.build into *out; ERROR_NONE, or ERROR_VALUE with the message (Driveline's checks,
  * elements.Bearing._undamped_stiffness's on cross-coupling, out of memory) */
@@ -123,6 +136,14 @@ double chain_kappa(const Chain *chain);
 int chain_freedoms(const Chain *chain);
 /* transfer.determinant at ``n`` points (w[i], spin[i]); signed w for an isotropic chain. */
 void chain_determinant(const Chain *chain, size_t n, const double *w, const double *spin, double *f);
+/* transfer.determinant_and_rounding: f and its rounding level at ``n`` points (rounding NULL: f alone) */
+void chain_determinant_rounding(const Chain *chain, size_t n, const double *w, const double *spin, double *f,
+                                double *rounding);
+/* the budget every propagation on the chain pays from (NULL: none), and whether it is spent */
+void chain_set_budget(Chain *chain, Budget *budget);
+int chain_budget_spent(const Chain *chain);
+/* Chain.stations: nodes and point elements */
+int chain_stations(const Chain *chain);
 /* transfer.mode_shape(chain, w, spin, 4).forward_fraction */
 double chain_forward_fraction(const Chain *chain, double w, double spin);
 

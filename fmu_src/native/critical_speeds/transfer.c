@@ -11,6 +11,7 @@
 
 #include "elements.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,6 +42,8 @@ struct Chain {
     double kappa;
     double scale[4];    /* Chain.scale: [1/L0, 1, L0/EI0, L0^2/EI0] */
     double ratio[4][4]; /* scale_i / scale_j */
+    int stations;       /* Chain.stations: nodes and point elements */
+    Budget *budget;     /* what every propagation pays (budget.py), NULL: nothing */
 };
 
 /* The propagated basis: ``rows`` x ``cols`` (4 x 2 isotropic, 8 x 4 anisotropic). */
@@ -526,7 +529,7 @@ static void field_product(double Hf[4][4], double Hb[4][4], Basis *Y)
 static void propagate(const Chain *chain, double w, double spin, int min_pieces, Basis *Y, double *log_scale,
                       double *sign, Gram *trace)
 {
-    int pair = !chain->isotropic, k, i, j, piece_count;
+    int pair = !chain->isotropic, k, i, j, piece_count, per_step = pair ? ROTOR_BUDGET_ANISOTROPIC_STEP : 1;
     const int *free_rows = FREE_COMPONENTS[chain->left];
     double R[4][4], T[4][4];
     Y->rows = pair ? 8 : 4;
@@ -541,6 +544,7 @@ static void propagate(const Chain *chain, double w, double spin, int min_pieces,
     }
     *log_scale = 0.0;
     *sign = 1.0;
+    budget_charge(chain->budget, (long long)per_step * chain->stations);
     trace_add(trace, Y, NULL, NULL);
     for (k = 0; k < chain->n_segments; k++) {
         const ChainSegment *seg = &chain->segments[k];
@@ -559,6 +563,7 @@ static void propagate(const Chain *chain, double w, double spin, int min_pieces,
         if (piece_count < min_pieces) {
             piece_count = min_pieces;
         }
+        budget_charge(chain->budget, (long long)per_step * piece_count);
         piece = seg->length / piece_count;
         field_matrix(chain, seg, w, spin, piece, Hf);
         if (pair) {
@@ -590,23 +595,66 @@ static int final_rows(const Chain *chain, const Basis *Y, double S[4][4])
     return Y->cols;
 }
 
-/* transfer.determinant */
-void chain_determinant(const Chain *chain, size_t n, const double *w, const double *spin, double *f)
+/* the sum of the magnitudes of the 24 terms of the 4x4 determinant of S, its permutations in lexicographic
+ * order summed as numpy sums 24 numbers (eight running sums, combined pairwise) */
+static double determinant_terms(double S[4][4])
+{
+    double r[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    int a, b, c, term = 0;
+    for (a = 0; a < 4; a++) {
+        for (b = 0; b < 4; b++) {
+            for (c = 0; c < 4 && b != a; c++) {
+                if (c != a && c != b) {
+                    r[term % 8] += fabs(S[0][a] * S[1][b] * S[2][c] * S[3][6 - a - b - c]);
+                    term++;
+                }
+            }
+        }
+    }
+    return ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
+}
+
+/* transfer.determinant_and_rounding (rounding NULL: transfer.determinant) */
+void chain_determinant_rounding(const Chain *chain, size_t n, const double *w, const double *spin, double *f,
+                                double *rounding)
 {
     size_t i;
     for (i = 0; i < n; i++) {
         Basis Y;
-        double log_scale, sign, S[4][4], d;
+        double log_scale, sign, S[4][4], d, terms, factor;
+        if (chain_budget_spent(chain)) { /* the caller stops: no work after the budget */
+            f[i] = 0.0;
+            if (rounding != NULL) {
+                rounding[i] = 0.0;
+            }
+            continue;
+        }
         propagate(chain, w[i], spin[i], 1, &Y, &log_scale, &sign, NULL);
         final_rows(chain, &Y, S);
-        d = chain->isotropic ? S[0][0] * S[1][1] - S[0][1] * S[1][0] : lu_det(4, S);
+        if (chain->isotropic) {
+            d = S[0][0] * S[1][1] - S[0][1] * S[1][0];
+            terms = fabs(S[0][0] * S[1][1]) + fabs(S[0][1] * S[1][0]);
+        } else {
+            terms = determinant_terms(S);
+            d = lu_det(4, S);
+        }
         if (log_scale > ROTOR_TRANSFER_LOG_SCALE_CLIP) { /* keep the factor finite; sign and zeros are unaffected */
             log_scale = ROTOR_TRANSFER_LOG_SCALE_CLIP;
         } else if (log_scale < -ROTOR_TRANSFER_LOG_SCALE_CLIP) {
             log_scale = -ROTOR_TRANSFER_LOG_SCALE_CLIP;
         }
-        f[i] = sign * d * exp(log_scale);
+        factor = exp(log_scale);
+        f[i] = sign * d * factor;
+        if (rounding != NULL) {
+            rounding[i] = DBL_EPSILON * terms * factor;
+        }
     }
+}
+
+/* transfer.determinant */
+void chain_determinant(const Chain *chain, size_t n, const double *w, const double *spin, double *f)
+{
+    chain_determinant_rounding(chain, n, w, spin, f, NULL);
 }
 
 /* The right singular vector of the smallest singular value of the n x n matrix A (one-sided Jacobi). */
@@ -768,6 +816,8 @@ ErrorKind chain_new(const Driveline *driveline, Chain **out, char *error, size_t
         return ERROR_VALUE;
     }
     chain->n_segments = driveline->n_segments;
+    chain->stations = n_nodes + n_points;
+    chain->budget = NULL;
     chain->left = driveline->left;
     chain->right = driveline->right;
     chain->isotropic = 1;
@@ -850,4 +900,34 @@ double chain_kappa(const Chain *chain)
 int chain_freedoms(const Chain *chain)
 {
     return chain->freedoms;
+}
+
+void chain_set_budget(Chain *chain, Budget *budget)
+{
+    chain->budget = budget;
+}
+
+int chain_budget_spent(const Chain *chain)
+{
+    return chain->budget != NULL && chain->budget->spent;
+}
+
+int chain_stations(const Chain *chain)
+{
+    return chain->stations;
+}
+
+/* budget.Budget.charge: pays ``units``, or marks the budget spent (sticky) when they exceed what is left */
+void budget_charge(Budget *budget, long long units)
+{
+    if (budget == NULL || budget->spent) {
+        return;
+    }
+    if (units > budget->left) {
+        budget->left = -1;
+        budget->spent = 1;
+        budget->spent_in = budget->stage;
+        return;
+    }
+    budget->left -= units;
 }
