@@ -28,6 +28,17 @@ RATE_STEP = 0.25
 MAX_SUBSTEPS = 10_000
 TOO_LONG = f"the communication step needs more than {MAX_SUBSTEPS} internal steps of the drive's fastest mode"
 
+#: The longest communication step h of a Jacobi master coupling the drive with its two joints, for the
+#: differential's internal mode on each side (a side gear against its halfshaft, angular frequency omega,
+#: damping ratio zeta, :func:`internal_modes`): ``omega h <= min(JACOBI_OMEGA_STEP, JACOBI_DAMPING_STEP zeta)``.
+#: The joints pass the halfshaft's torque back one step late: held over the step, an undamped spring gives
+#: a step map of determinant 1 + (omega h)^2 / 2, unstable at any step, so the limit falls with the
+#: damping. Measured in the vehicle launch (J_side 0.0075 to 0.03 kg.m2, k_left and the dampings halved
+#: and doubled): the loop diverges above omega h = 0.25 at zeta = 0.12, 0.29 to 0.32 at zeta = 0.16,
+#: 0.31 to 0.34 from zeta = 0.23 on; the constants keep below every one (docs/vehicle_launch.md).
+JACOBI_OMEGA_STEP = 0.28
+JACOBI_DAMPING_STEP = 1.5
+
 #: Positions in the state tuple.
 CASE, DIFF, PHI_WHEEL_LEFT, WHEEL_LEFT, PHI_WHEEL_RIGHT, WHEEL_RIGHT, SPEED, TRAVEL, SLIP_LEFT, SLIP_RIGHT = range(10)
 STATE_SIZE = 10
@@ -185,3 +196,15 @@ def reaction_torque(drive: Drive, joints: Joints, case_acceleration: float) -> f
     (the motor turning the wheels' way, ``ratio`` times as fast as the case)."""
     momentum_inertia = drive.ratio * drive.J_motor + drive.J_diff + 2.0 * drive.J_side
     return -(joints.T_in_left + joints.T_in_right) - momentum_inertia * case_acceleration
+
+
+def internal_modes(drive: Drive) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Angular frequency [rad/s] and damping ratio of the differential's internal mode on each side with the
+    joints outside: a side gear (``J_side``) against its halfshaft (the wheel held)."""
+    return tuple((math.sqrt(k / drive.J_side), c / (2.0 * math.sqrt(k * drive.J_side)))
+                 for k, c in ((drive.k_left, drive.c_left), (drive.k_right, drive.c_right)))
+
+
+def jacobi_step_limit(drive: Drive) -> float:
+    """The longest communication step of a Jacobi master coupling the drive with its joints [s]."""
+    return min(min(JACOBI_OMEGA_STEP, JACOBI_DAMPING_STEP * zeta) / omega for omega, zeta in internal_modes(drive))

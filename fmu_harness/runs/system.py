@@ -24,7 +24,7 @@ from __future__ import annotations
 import argparse
 import math
 import zipfile
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -134,6 +134,11 @@ def vehicle_launch() -> System:
     return System("VehicleLaunch", tuple(components), tuple(connections), 4.0, 1e-4)
 
 
+#: The launch's Gauss-Seidel order: the drive first, whose outputs the joints pass on within the step
+#: (their T_in depends directly on T_load and alpha_in), then the joints, then the mounts they load.
+LAUNCH_ORDER = ("motor", "drive", "joint_left", "joint_right", "mounts")
+
+
 def systems() -> tuple[System, ...]:
     """Every system the build packages."""
     return driveline(), vehicle_launch()
@@ -228,11 +233,15 @@ Port = tuple[str, str]
 
 def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, object]],
                connections: Collection[tuple[Port, Port]], stop_time: float, step_size: float,
-               outputs: list[str], on_step: Callable[[int, int], None] | None = None) -> np.ndarray:
+               outputs: list[str], on_step: Callable[[int, int], None] | None = None,
+               order: Sequence[str] | None = None) -> np.ndarray:
     """The fixed-step Jacobi master: instances ``{name: FMU}`` with their start values, connections
     ``((instance, output), (instance, input))``; rows of t_k and ``outputs`` (``"instance.variable"``)
     for t_1 ... t_N. ``on_step(k, N)`` is called after each step. A refused step raises
-    :class:`StepRefused` with the instance's name before its reasons."""
+    :class:`StepRefused` with the instance's name before its reasons. With ``order`` (every instance's
+    name) it is a Gauss-Seidel master instead: the instances step one after the other in that order,
+    each with its inputs set just before from the outputs as they are then (those of the instances
+    already stepped at t_k+1)."""
     instances = {name: FmuInstance(path, name) for name, path in fmus.items()}
     try:
 
@@ -251,17 +260,11 @@ def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, o
         ports = [tuple(name.split(".", 1)) for name in outputs]
         steps = int(round(stop_time / step_size))
         rows = []
+        groups = [list(instances)] if order is None else [[name] for name in order]
+        sweeps = [(group, [(start, end) for start, end in connections if end[0] in group]) for group in groups]
         for k in range(steps):
-            transfers = [(end, value(start)) for start, end in connections]
-            for (name, variable), transferred in transfers:
-                instances[name].set({variable: transferred})
-            for name, instance in instances.items():
-                instance.time = k * step_size
-                try:
-                    instance.step(step_size)
-                except StepRefused as refused:
-                    raise StepRefused(f"{name}: {refused.call}", refused.status, refused.time,
-                                      refused.messages) from None
+            for group, into in sweeps:
+                _step(instances, group, into, k, step_size)
             rows.append([(k + 1) * step_size, *(value(port) for port in ports)])
             if on_step is not None:
                 on_step(k + 1, steps)
@@ -271,7 +274,23 @@ def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, o
             instance.close()
 
 
-def simulate(system: System, models: Path, outputs: list[str] | None = None, natives: Path | None = None) -> np.ndarray:
+def _step(instances: Mapping[str, FmuInstance], names: list[str], connections: list[tuple[Port, Port]], k: int,
+          step_size: float) -> None:
+    """Set the inputs of ``connections`` from their outputs as they are, then step ``names`` from t_k."""
+    transfers = [(end, instances[start[0]].get([start[1]])[0]) for start, end in connections]
+    for (name, variable), transferred in transfers:
+        instances[name].set({variable: transferred})
+    for name in names:
+        instance = instances[name]
+        instance.time = k * step_size
+        try:
+            instance.step(step_size)
+        except StepRefused as refused:
+            raise StepRefused(f"{name}: {refused.call}", refused.status, refused.time, refused.messages) from None
+
+
+def simulate(system: System, models: Path, outputs: list[str] | None = None, natives: Path | None = None,
+             order: Sequence[str] | None = None) -> np.ndarray:
     """Run ``system`` with the FMUs of :func:`component_fmus`; rows of t_k and ``outputs``
     (default: all Real outputs) for t_1 ... t_N. Parameters an FMU would refuse raise
     ``StartValuesRefused`` before any FMU is loaded."""
@@ -280,7 +299,7 @@ def simulate(system: System, models: Path, outputs: list[str] | None = None, nat
     return run_jacobi({c.name: fmus[c.model] for c in system.components},
                       {c.name: c.parameters for c in system.components},
                       [(connection.start, connection.end) for connection in system.connections],
-                      system.stop_time, system.step_size, outputs or system.outputs())
+                      system.stop_time, system.step_size, outputs or system.outputs(), order=order)
 
 
 def main(argv: list[str] | None = None) -> None:
