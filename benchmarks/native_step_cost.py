@@ -49,6 +49,7 @@ def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path, integers: dict[str
     library = native.host_library(unzipdir, description.coSimulation.modelIdentifier, fmi)
     done = subprocess.run([str(timer), str(library), fmi, token, description.defaultExperiment.stepSize,
                            str(C_STEPS), str(C_ROUNDS), " ".join(map(str, inputs)), " ".join(map(str, outputs)),
+                           str((unzipdir / "resources").absolute()),
                            " ".join(f"{references[name]}={value}" for name, value in integers.items())],
                           check=True, capture_output=True, text=True)
     return float(done.stdout)

@@ -1,10 +1,11 @@
 /* Per-step cost of a native FMU from a C host (no Python in the process), for the benchmarks.
  *
- * Usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS "IN_VR..." "OUT_VR..." ["VR=VALUE..."]
- * Instantiates and initialises the FMU at its start values (the optional Integer parameters set in
- * initialisation mode), then times ROUNDS rounds of STEPS
- * steps, each one batched set of the Real inputs (their start values), doStep and one batched
- * get of the Real outputs; prints the best round's CPU nanoseconds per step.
+ * Usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS "IN_VR..." "OUT_VR..." RESOURCES
+ *        ["VR=VALUE..."]
+ * Instantiates the FMU with its extracted RESOURCES folder (an absolute path: its shipped layouts),
+ * initialises it at its start values (the optional Integer parameters set in initialisation mode),
+ * then times ROUNDS rounds of STEPS steps, each one batched set of the Real inputs (their start
+ * values), doStep and one batched get of the Real outputs; prints the best round's CPU nanoseconds per step.
  */
 #define _POSIX_C_SOURCE 199309L
 #include <dlfcn.h>
@@ -16,7 +17,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 
-#define MAX_SIGNALS 64
+#define MAX_SIGNALS 128
 
 static void logger2(fmi2ComponentEnvironment environment, fmi2String name, fmi2Status status, fmi2String category,
                     fmi2String message, ...)
@@ -82,8 +83,10 @@ int main(int argc, char **argv)
     double values[MAX_SIGNALS], results[MAX_SIGNALS], h, t = 0.0, best = 1e300;
     int inputs, outputs, integers, integer[MAX_SIGNALS], steps, rounds, round, k, fmi3;
     void *library, *instance;
-    if (argc != 9 && argc != 10) {
-        fprintf(stderr, "usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS IN_VRS OUT_VRS [VR=VALUE...]\n");
+    char resources[4096];
+    if (argc != 10 && argc != 11) {
+        fprintf(stderr, "usage: native_step_timer LIBRARY 2|3 TOKEN STEP_SIZE STEPS ROUNDS IN_VRS OUT_VRS RESOURCES "
+                        "[VR=VALUE...]\n");
         return 2;
     }
     fmi3 = argv[2][0] == '3';
@@ -92,7 +95,8 @@ int main(int argc, char **argv)
     rounds = atoi(argv[6]);
     inputs = parse(argv[7], in);
     outputs = parse(argv[8], out);
-    integers = argc == 10 ? parse_integers(argv[9], integer_vr, integer) : 0;
+    integers = argc == 11 ? parse_integers(argv[10], integer_vr, integer) : 0;
+    snprintf(resources, sizeof resources, fmi3 ? "%s/" : "file://%s", argv[9]);
     library = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
     if (library == NULL || steps < 1 || rounds < 1) {
         fprintf(stderr, "cannot load %s\n", argv[1]);
@@ -117,7 +121,7 @@ int main(int argc, char **argv)
         LOAD(get, "fmi3GetFloat64");
         LOAD(step, "fmi3DoStep");
         LOAD(release, "fmi3FreeInstance");
-        instance = instantiate("timer", argv[3], "", 0, 0, 0, 0, NULL, 0, NULL, logger3, NULL);
+        instance = instantiate("timer", argv[3], resources, 0, 0, 0, 0, NULL, 0, NULL, logger3, NULL);
         if (instance == NULL || enter(instance, 0, 0.0, 0.0, 0, 0.0) != fmi3OK ||
             set_integer(instance, integer_vr, (size_t)integers, integer, (size_t)integers) != fmi3OK ||
             leave(instance) != fmi3OK ||
@@ -158,7 +162,7 @@ int main(int argc, char **argv)
         LOAD(get, "fmi2GetReal");
         LOAD(step, "fmi2DoStep");
         LOAD(release, "fmi2FreeInstance");
-        instance = instantiate("timer", fmi2CoSimulation, argv[3], "", &callbacks, 0, 0);
+        instance = instantiate("timer", fmi2CoSimulation, argv[3], resources, &callbacks, 0, 0);
         if (instance == NULL || setup(instance, 0, 0.0, 0.0, 0, 0.0) != fmi2OK || enter(instance) != fmi2OK ||
             set_integer(instance, integer_vr, (size_t)integers, integer) != fmi2OK || leave(instance) != fmi2OK || get(instance, in, (size_t)inputs, values) != fmi2OK) {
             return 3;

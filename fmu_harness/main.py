@@ -1,8 +1,7 @@
 """The main job: simulate the project's FMUs through fmpy and write results and figures.
 
 Usage: ``driveline-fmus run [--models models] [--out results]`` (or ``python -m fmu_harness.main``)
-after ``driveline-fmus build``. The studies run the native FMUs (``models/native/``; PowertrainMounts its
-FMI 2.0 Python FMU until its C port); the Python FMUs
+after ``driveline-fmus build``. The studies run the native FMUs (``models/native/``); the Python FMUs
 are compared with them in a process of their own (:mod:`fmu_harness.checks.python_fmu_check`), so that
 the pythonfmu wrapper's exit-time defect cannot end the main job.
 """
@@ -20,7 +19,7 @@ from .studies import coupling_comparison, critical_speed_study, mounts_study, tr
 def simulate(models: Path, out: Path) -> list[Path]:
     """Run every study on the native FMUs below ``models``, then the Python FMUs' check; the files written."""
     fmus = {name: native.fmu_path(models, name) for name in ("TripodCoupling", "CardanJoint", "UniversalReducer",
-                                                             "CriticalSpeeds")}
+                                                             "CriticalSpeeds", "PowertrainMounts")}
     missing = [str(path) for path in fmus.values() if not path.exists()]
     if missing:
         raise SystemExit(f"driveline-fmus run: no native FMU {', '.join(missing)}: build the FMUs first with "
@@ -30,7 +29,7 @@ def simulate(models: Path, out: Path) -> list[Path]:
         "tripod coupling": lambda: tripod_study.write(fmus["TripodCoupling"], out),
         "coupling comparison": lambda: coupling_comparison.write(fmus["CardanJoint"].parent, out),
         "critical speeds": lambda: critical_speed_study.write(fmus["CriticalSpeeds"], out),
-        "powertrain mounts": lambda: mounts_study.write(_mounts_fmu(models), out),
+        "powertrain mounts": lambda: mounts_study.write(fmus["PowertrainMounts"], out),
         "Python FMUs against native": lambda: python_fmu_check.run(models, models, out),
     }
     written = []
@@ -39,13 +38,6 @@ def simulate(models: Path, out: Path) -> list[Path]:
             written += study()
             shown.advance(name)
     return written
-
-
-def _mounts_fmu(models: Path) -> Path:
-    """The native PowertrainMounts FMU once the model has its C port, else its FMI 2.0 Python FMU."""
-    if "PowertrainMounts" in native.native_models():
-        return native.fmu_path(models, "PowertrainMounts")
-    return models / "PowertrainMounts.fmu"
 
 
 def main(argv: list[str] | None = None) -> None:

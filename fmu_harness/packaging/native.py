@@ -475,13 +475,26 @@ def build_description(name: str, sources: list[str]) -> bytes:
 # -- build ------------------------------------------------------------------------------------------
 
 
+#: Models that read layout files and are not CriticalSpeeds compile the layout reader of CriticalSpeeds'
+#: library too: the header and the modules it lists (``critical_speeds/toml.h``).
+LAYOUT_READER = NATIVE_SRC / "critical_speeds" / "toml.h"
+READS_LAYOUTS = ("PowertrainMounts",)
+
+
+def _layout_reader_sources() -> dict[str, bytes]:
+    folder = LAYOUT_READER.parent
+    names = [LAYOUT_READER.name, *sorted(_MODULE_LINE.findall(LAYOUT_READER.read_text()))]
+    return {f"{folder.name}/{file}": (folder / file).read_bytes() for file in names}
+
+
 def _library_sources(name: str) -> dict[str, bytes]:
     """The model's library folder (``critical_speeds/rotor.h`` and the like), by relative path."""
     folder = library_folder(name)
+    reader = _layout_reader_sources() if name in READS_LAYOUTS else {}
     if not folder.is_dir():
-        return {}
-    return {f"{folder.name}/{path.name}": path.read_bytes() for path in sorted(folder.iterdir())
-            if path.suffix in (".c", ".h") and path.is_file()}
+        return reader
+    return {**reader, **{f"{folder.name}/{path.name}": path.read_bytes() for path in sorted(folder.iterdir())
+                         if path.suffix in (".c", ".h") and path.is_file()}}
 
 
 def resource_files(name: str) -> dict[str, bytes]:

@@ -20,7 +20,12 @@ import re
 SHARED = {
     "driveline.rotor.driveline": ("SEARCH_LIMIT", "EXCITED_SHARE", "POINTS_PER_ROOT", "GRID_OFFSET", "LEAD_POINTS",
                                   "DIRECTION_POINTS", "LEAD_RATIO"),
-    "driveline.rotor.loader": ("MAX_FILE_BYTES", "MAX_NESTING", "MAX_SEGMENTS", "MAX_POINT_ELEMENTS", "NODE_SNAP"),
+    "driveline.layout_files": ("MAX_FILE_BYTES", "MAX_NESTING"),
+    "driveline.rotor.loader": ("MAX_SEGMENTS", "MAX_POINT_ELEMENTS", "NODE_SNAP"),
+    "driveline.mounts.layout": ("MAX_MOUNTS", "ROTATION_TOLERANCE"),
+    "driveline.mounts.rigid_body": ("MIN_FREQUENCY_RATIO",),
+    "driveline.mounts.joints": ("MIN_DIRECTION",),
+    "driveline.mounts.exact_step": ("THETA_13", "MAX_SQUARINGS"),
     "driveline.rotor.elements": ("_SERIES_LIMIT",),
     "driveline.rotor.transfer": ("MAX_PIECE_PHASE", "LOG_SCALE_CLIP"),
     "driveline.rotor.budget": ("ANISOTROPIC_STEP", "UNITS", "SECONDS_PER_UNIT"),

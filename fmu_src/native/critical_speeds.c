@@ -186,18 +186,6 @@ static ErrorKind fsum(const double *values, int n, double *sum, char *error)
     return kind;
 }
 
-/* Python's format(value, spec) for 'g' specs: C's, but for the spelling of inf and nan. */
-static void python_g(double value, int digits, char *out, size_t size)
-{
-    if (isnan(value)) {
-        snprintf(out, size, "nan");
-    } else if (isinf(value)) {
-        snprintf(out, size, value > 0 ? "inf" : "-inf");
-    } else {
-        snprintf(out, size, "%.*g", digits, value);
-    }
-}
-
 /* ---- parse_orders ------------------------------------------------------------------------------ */
 
 /* The code point of UTF-8 ``text`` at ``at`` (of ``end``), its byte count in ``*bytes``; a byte
@@ -334,7 +322,7 @@ static ErrorKind build_driveline(const ModelData *data, Driveline *out, char *er
     case MECHANISM_NONE:
         return failed;
     case MECHANISM_HINGE_FOLDS:
-        python_g(driveline_least_resolved_stiffness(out), 6, least, sizeof least);
+        python_format_g(driveline_least_resolved_stiffness(out), 6, least, sizeof least);
         snprintf(error, ERROR_SIZE, MECHANISM_HINGE, hinge, node, least);
         return ERROR_VALUE;
     case MECHANISM_RIGID_BODY:
@@ -503,15 +491,15 @@ static ErrorKind work_refusal(const Driveline *driveline, const int *orders, int
     if (total <= ROTOR_WORK_MAX_ANALYSIS_SECONDS) {
         return ERROR_NONE;
     }
-    python_g(total, 3, shown, sizeof shown);
+    python_format_g(total, 3, shown, sizeof shown);
     snprintf(error, ERROR_SIZE, "the analysis would take about %s s (", shown);
     used = strlen(error);
     for (i = 0; i < WORK_STAGE_COUNT; i++) {
-        python_g(seconds[i], 3, shown, sizeof shown);
+        python_format_g(seconds[i], 3, shown, sizeof shown);
         snprintf(stage, sizeof stage, "%s%s %s s", i ? ", " : "", STAGE_NAMES[i], shown);
         text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
     }
-    python_g(ROTOR_WORK_MAX_ANALYSIS_SECONDS, 6, shown, sizeof shown);
+    python_format_g(ROTOR_WORK_MAX_ANALYSIS_SECONDS, 6, shown, sizeof shown);
     snprintf(stage, sizeof stage, "), more than the %s s accepted ", shown);
     text_append(error, ERROR_SIZE, &used, stage, strlen(stage));
     text_append(error, ERROR_SIZE, &used, WORK_ADVICE, strlen(WORK_ADVICE));
@@ -597,8 +585,8 @@ static ErrorKind implausibility(const Analysis *analysis, char *error)
         }
         nearest = analysis->natural[found];
         if (!(fabs(nearest - frequency) <= ROTOR_MODEL_PLAUSIBLE_DEVIATION * frequency)) {
-            python_g(frequency, 6, frequency_shown, sizeof frequency_shown);
-            python_g(nearest, 6, nearest_shown, sizeof nearest_shown);
+            python_format_g(frequency, 6, frequency_shown, sizeof frequency_shown);
+            python_format_g(nearest, 6, nearest_shown, sizeof nearest_shown);
             snprintf(error, ERROR_SIZE,
                      "the whirl frequency %s rad/s at standstill has no counterpart in the finite-element check "
                      "(nearest %s rad/s): the parameters are beyond what double precision resolves",
@@ -746,7 +734,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     failed = failed ? failed : part(analysis, data, PART_DRIVELINE, orders, n_orders, &budget, seconds, error);
     failed = failed ? failed : searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
     if (!failed && !(work <= ROTOR_MODEL_MAX_SEARCHED_MODES)) {
-        python_g(work, 3, shown, sizeof shown);
+        python_format_g(work, 3, shown, sizeof shown);
         snprintf(error, sizeof error,
                  "the analysis would scan %s shaft modes, more than the %.0f accepted (shorter or stiffer shaft, "
                  "fewer or lower orders, or a smaller omega_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);

@@ -43,21 +43,11 @@ void messages_add(Messages *out, const char *first, ...)
     out->count++;
 }
 
-/* Python's format(value, '.6g') (glibc would print a negative NaN as "-nan"). */
-static void python_g6(double value, char *out, size_t size)
-{
-    if (isnan(value)) {
-        snprintf(out, size, "nan");
-    } else {
-        snprintf(out, size, "%.6g", value);
-    }
-}
-
 /* A number as a message shows it: an Integer's digits, a Real's repr(), or in the display unit. */
 static void show(double value, int integer, int display, const VariableInfo *v, char *out, size_t size)
 {
     if (display) {
-        python_g6(v->display_factor * value + v->display_offset, out, size);
+        python_format_g(v->display_factor * value + v->display_offset, 6, out, size);
     } else if (integer) {
         snprintf(out, size, "%ld", (long)value);
     } else {

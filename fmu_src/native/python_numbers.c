@@ -217,3 +217,14 @@ ErrorKind python_fsum_strided(const double *first, int count, size_t stride, dou
     *sum = high;
     return ERROR_NONE;
 }
+
+void python_format_g(double value, int digits, char *out, size_t size)
+{
+    if (isnan(value)) {
+        snprintf(out, size, "nan");
+    } else if (isinf(value)) {
+        snprintf(out, size, value > 0 ? "inf" : "-inf");
+    } else {
+        snprintf(out, size, "%.*g", digits, value);
+    }
+}

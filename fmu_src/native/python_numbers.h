@@ -18,5 +18,8 @@ ErrorKind python_fsum(const double values[], int count, double *sum, const char 
 ErrorKind python_fsum_strided(const double *first, int count, size_t stride, double *sum, const char **message);
 /* Python's repr() of a float: shortest round-trip digits, "inf", "nan", "-0.0", "1e-05". */
 void python_float_repr(double value, char *out, size_t size);
+/* Python's format(value, '.<digits>g'): C's %g, but for the spelling of inf and nan (glibc would print a
+ * negative NaN as "-nan"). */
+void python_format_g(double value, int digits, char *out, size_t size);
 
 #endif

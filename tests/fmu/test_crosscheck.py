@@ -4,7 +4,6 @@ _ref.opt alone (fmpy's simulate_fmu) reproduces its _ref.csv."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from fmpy import read_model_description
 
 from fmu_harness.checks import crosscheck
@@ -16,8 +15,6 @@ def test_rerun_from_the_reference_files_matches(model_name, fmi, fmu_path, tmp_p
 
 
 def test_native_rerun_from_the_reference_files_matches(model_name, fmi, native_dir, tmp_path):
-    if model_name not in native.native_models():
-        pytest.skip(f"{model_name} has no C port")
     rerun_matches(native.fmu_path(native_dir, model_name, fmi), model_name, tmp_path)
 
 

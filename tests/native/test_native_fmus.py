@@ -26,7 +26,7 @@ from fmu_harness.packaging import native, toolchain
 from fmu_harness.runs.runner import FmuInstance, StepRefused
 from fmu_harness.runs.scenario import scenario
 from support.alongside_the_core import expect_refused_parameters
-from support.native_agreement import TOLERANCE, beyond_tolerance, deviation, up_to_the_toml_reason
+from support.native_agreement import TOLERANCE, beyond_tolerance, deviation, refusals, up_to_the_toml_reason
 from support.fmu_documentation import assert_documentation
 
 NATIVE = native.native_models()
@@ -42,16 +42,17 @@ def _standard_run(path: Path, name: str, **open_options) -> np.ndarray:
         return fmu.run(case.stop_time, case.step_size, case.signals())
 
 
-def test_the_models_without_a_c_port_are_skipped(native_dir):
-    """CriticalSpeeds is native once its rotor library (every module rotor.h lists) is there."""
-    ported = ("TripodCoupling", "CardanJoint", "UniversalReducer", "SpeedSource")
-    folder = native.library_folder("CriticalSpeeds")
-    assert native.library_modules("CriticalSpeeds") == sorted(path.name for path in folder.glob("*.c"))
-    assert {"layout.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c", "damped.c"} <= set(
-        native.library_modules("CriticalSpeeds"))
-    complete = all((native.library_folder("CriticalSpeeds") / module).exists()
-                   for module in native.library_modules("CriticalSpeeds"))
-    assert NATIVE == [name for name in MODELS if name in ported or (name == "CriticalSpeeds" and complete)]
+def test_every_model_has_its_c_port_built(native_dir):
+    """A model with a library folder is native once every module its headers list is there:
+    CriticalSpeeds' rotor library, PowertrainMounts' (which compiles the layout reader of
+    CriticalSpeeds' too); today every catalog model is."""
+    for name, modules in (("CriticalSpeeds", {"layout.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c",
+                                              "damped.c", "toml.c", "layout_file.c"}),
+                          ("PowertrainMounts", {"layout.c", "dense.c"})):
+        folder = native.library_folder(name)
+        assert native.library_modules(name) == sorted(path.name for path in folder.glob("*.c"))
+        assert modules <= set(native.library_modules(name))
+    assert NATIVE == list(MODELS)
     built = {path.relative_to(native_dir).as_posix() for path in native_dir.rglob("*.fmu")}
     assert built == {f"{native.SUBDIR[fmi]}/{name}.fmu" for name in NATIVE for fmi in VERSIONS}
 
@@ -494,18 +495,6 @@ def test_critical_speeds_layout_file_orders_change_and_ramp_match_the_python_fmu
         assert beyond_tolerance(reference, native_run) == {}, (parameters, changes, ramp)
 
 
-def _refusals(path: Path, parameters: dict) -> list[str]:
-    """The reasons ``parameters`` are refused for at initialisation: the native FMU's Error, the
-    Python FMU's messages (logged after the call's name, the wrappers returning OK)."""
-    with FmuInstance(path) as fmu:
-        first = len(fmu.log)
-        try:
-            fmu.initialize(parameters)
-        except StepRefused as refused:
-            return refused.messages
-        return [message.removeprefix("exitInitializationMode: ") for message in fmu.messages_since(first)]
-
-
 @pytest.mark.parametrize("name", CRITICAL)
 def test_critical_speeds_refuses_like_the_python_fmu(native_dir, fmu_path, tmp_path, name, fmi):
     """Bad orders, bad layout values and files, the work limit, the plausibility check: refused with
@@ -523,8 +512,8 @@ def test_critical_speeds_refuses_like_the_python_fmu(native_dir, fmu_path, tmp_p
         {"D_outer": 1e200, "D_inner": 0.0}, {"orders": "1,2", "D_outer": 1e-100, "D_inner": 0.0},
     ]
     for parameters in cases:
-        expected = [up_to_the_toml_reason(m) for m in _refusals(fmu_path(name, fmi), parameters)]
-        found = [up_to_the_toml_reason(m) for m in _refusals(_native(native_dir, name, fmi), parameters)]
+        expected = [up_to_the_toml_reason(m) for m in refusals(fmu_path(name, fmi), parameters)]
+        found = [up_to_the_toml_reason(m) for m in refusals(_native(native_dir, name, fmi), parameters)]
         assert found == expected, parameters
 
 

@@ -27,7 +27,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 
-#define MAX_SIGNALS 64
+#define MAX_SIGNALS 128
 #define MAX_TEXT 4096
 
 typedef struct {

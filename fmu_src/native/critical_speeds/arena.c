@@ -10,22 +10,22 @@ typedef union {
     double d;
 } Aligned;
 
-struct Block {
-    Block *next;
+struct ArenaBlock {
+    ArenaBlock *next;
     size_t used, size;
     Aligned data[];
 };
 
 void *arena_alloc(Arena *arena, size_t count)
 {
-    Block *block = arena->blocks;
+    ArenaBlock *block = arena->blocks;
     size_t units = (count + sizeof(Aligned) - 1) / sizeof(Aligned);
     if (units == 0) {
         units = 1;
     }
     if (block == NULL || block->size - block->used < units) {
         size_t size = units > 4096 ? units : 4096;
-        block = malloc(sizeof(Block) + size * sizeof(Aligned));
+        block = malloc(sizeof(ArenaBlock) + size * sizeof(Aligned));
         if (block == NULL) {
             return NULL;
         }
@@ -41,7 +41,7 @@ void *arena_alloc(Arena *arena, size_t count)
 void arena_free(Arena *arena)
 {
     while (arena->blocks != NULL) {
-        Block *next = arena->blocks->next;
+        ArenaBlock *next = arena->blocks->next;
         free(arena->blocks);
         arena->blocks = next;
     }

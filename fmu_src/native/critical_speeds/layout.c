@@ -26,13 +26,6 @@ typedef struct {
     double value;
 } Station;
 
-typedef struct {
-    char *error;
-    size_t size;
-    const char *source;
-    Arena *arena;
-} Loader;
-
 static const char *const TOP_KEYS[] = {"bearings", "hinges", "left_end", "masses", "materials", "name",
                                        "right_end", "segments", "unbalances", NULL};
 static const char *const MATERIAL_KEYS[] = {"density", "youngs_modulus", NULL};
@@ -48,108 +41,16 @@ static const char *const UNBALANCE_KEYS[] = {"amount", "label", "node", "phase",
 static const char *const HINGE_KEYS[] = {"bending_stiffness", "label", "node", "position", NULL};
 static const char *const END_NAMES[] = {"free", "pinned", "clamped"};
 
-static Value *get(const Value *table, const char *key)
-{
-    return toml_find(table, key, strlen(key));
-}
-
-/* Python's order of str: code points, which UTF-8 bytes keep. */
-static int key_before(const char *a, size_t na, const char *b, size_t nb)
-{
-    int order = memcmp(a, b, na < nb ? na : nb);
-    return order < 0 || (order == 0 && na < nb);
-}
-
-/* loader._unknown: the first (sorted) key not in ``allowed``. */
-static ErrorKind unknown(const Loader *loader, const char *where, const Value *table, const char *const *allowed)
-{
-    const Item *item, *first = NULL;
-    char list[512] = "";
-    int i;
-    for (item = table->first; item != NULL; item = item->next) {
-        int known = 0;
-        for (i = 0; allowed[i] != NULL && !known; i++) {
-            known = strlen(allowed[i]) == item->key_length && memcmp(allowed[i], item->key, item->key_length) == 0;
-        }
-        if (!known && (first == NULL || key_before(item->key, item->key_length, first->key, first->key_length))) {
-            first = item;
-        }
-    }
-    if (first == NULL) {
-        return ERROR_NONE;
-    }
-    for (i = 0; allowed[i] != NULL; i++) {
-        if (i > 0) {
-            strcat(list, ", ");
-        }
-        strcat(list, allowed[i]);
-    }
-    {
-        Value key = {V_STRING, 0, 0, 0, 0, NULL, 0, 0, 0.0, NULL, NULL, 0};
-        key.text = first->key;
-        key.length = first->key_length;
-        return layout_error(loader->error, loader->size, "%s: unknown key %v (allowed: %s)", where, &key, list);
-    }
-}
-
-/* loader._number */
-static ErrorKind number(const Loader *loader, const char *where, const char *key, const Value *value, int positive,
-                        int signed_, double *out)
-{
-    double v;
-    if (value->kind != V_INTEGER && value->kind != V_FLOAT) {
-        return layout_error(loader->error, loader->size, "%s.%s must be a number, got %v", where, key, value);
-    }
-    v = value->kind == V_INTEGER ? (double)value->integer : value->number;
-    if (!isfinite(v)) {
-        return layout_error(loader->error, loader->size, "%s.%s must be finite, got %v", where, key, value);
-    }
-    if (positive && v <= 0.0) {
-        return layout_error(loader->error, loader->size, "%s.%s must be > 0, got %v", where, key, value);
-    }
-    if (v < 0.0 && !signed_) {
-        return layout_error(loader->error, loader->size, "%s.%s must be >= 0, got %v", where, key, value);
-    }
-    *out = v;
-    return ERROR_NONE;
-}
-
-/* loader._number of an optional key (``fallback`` when absent, as t.get(key, 0.0)) */
+/* loader._number of an optional key (``fallback`` when absent, as t.layout_get(key, 0.0)) */
 static ErrorKind number_or(const Loader *loader, const char *where, const Value *table, const char *key,
                            double fallback, int signed_, double *out)
 {
-    const Value *value = get(table, key);
+    const Value *value = layout_get(table, key);
     if (value == NULL) {
         *out = fallback;
         return ERROR_NONE;
     }
-    return number(loader, where, key, value, 0, signed_, out);
-}
-
-/* loader._table_list and loader._counted: the tables of ``key`` (NULL with count 0 if absent). */
-static ErrorKind counted(const Loader *loader, const Value *data, const char *key, int limit, const Value **list)
-{
-    const Value *items = get(data, key);
-    const Item *item;
-    *list = items;
-    if (items == NULL) {
-        return ERROR_NONE;
-    }
-    if (items->kind != V_ARRAY) {
-        return layout_error(loader->error, loader->size, "%s must be an array of tables ([[%s]])", key, key);
-    }
-    for (item = items->first; item != NULL; item = item->next) {
-        if (item->value->kind != V_TABLE) {
-            return layout_error(loader->error, loader->size, "%s must be an array of tables ([[%s]])", key, key);
-        }
-    }
-    if (items->count > (size_t)limit) {
-        char count[32];
-        snprintf(count, sizeof count, "%lu", (unsigned long)items->count);
-        return layout_error(loader->error, loader->size, "%s [[%s]] tables are more than the %d accepted", count, key,
-                    limit);
-    }
-    return ERROR_NONE;
+    return layout_number(loader, where, key, value, 0, signed_, out);
 }
 
 static int list_count(const Value *list)
@@ -195,7 +96,7 @@ static ErrorKind check_driveline(const Loader *loader, const Driveline *d)
 /* loader._materials */
 static ErrorKind materials(const Loader *loader, const Value *data, Material **out, int *count)
 {
-    const Value *table = get(data, "materials");
+    const Value *table = layout_get(data, "materials");
     const Item *item;
     int n = 0;
     ErrorKind failed;
@@ -225,19 +126,19 @@ static ErrorKind materials(const Loader *loader, const Value *data, Material **o
         if (t->kind != V_TABLE) {
             return layout_error(loader->error, loader->size, "%s must be a table", where);
         }
-        if ((failed = unknown(loader, where, t, MATERIAL_KEYS)) != ERROR_NONE) {
+        if ((failed = layout_unknown(loader, where, t, MATERIAL_KEYS)) != ERROR_NONE) {
             return failed;
         }
-        E = get(t, "youngs_modulus");
-        rho = get(t, "density");
+        E = layout_get(t, "youngs_modulus");
+        rho = layout_get(t, "density");
         if (rho == NULL || E == NULL) {
             return layout_error(loader->error, loader->size, "%s: missing key %r", where,
                         rho == NULL ? "density" : "youngs_modulus");
         }
         m->name = item->key;
         m->length = item->key_length;
-        if ((failed = number(loader, where, "youngs_modulus", E, 1, 0, &m->E)) != ERROR_NONE ||
-            (failed = number(loader, where, "density", rho, 1, 0, &m->rho)) != ERROR_NONE) {
+        if ((failed = layout_number(loader, where, "youngs_modulus", E, 1, 0, &m->E)) != ERROR_NONE ||
+            (failed = layout_number(loader, where, "density", rho, 1, 0, &m->rho)) != ERROR_NONE) {
             return failed;
         }
         *count = n + 1;
@@ -248,7 +149,7 @@ static ErrorKind materials(const Loader *loader, const Value *data, Material **o
 /* loader._flag */
 static ErrorKind flag(const Loader *loader, const char *where, const Value *t, const char *key, int *out)
 {
-    const Value *value = get(t, key);
+    const Value *value = layout_get(t, key);
     if (value == NULL) {
         return ERROR_NONE;
     }
@@ -274,7 +175,7 @@ static const char *material_names(const Loader *loader, const Material *mats, in
         return NULL;
     }
     for (i = 0; i < count; i++) { /* insertion sort */
-        for (j = i; j > 0 && key_before(mats[i].name, mats[i].length, mats[order[j - 1]].name,
+        for (j = i; j > 0 && layout_key_before(mats[i].name, mats[i].length, mats[order[j - 1]].name,
                                         mats[order[j - 1]].length);
              j--) {
             order[j] = order[j - 1];
@@ -305,26 +206,26 @@ static ErrorKind segment(const Loader *loader, int i, const Value *t, const Mate
     int have_E = 0, have_rho = 0, k;
     ErrorKind failed;
     snprintf(where, sizeof where, "segments[%d]", i);
-    if ((failed = unknown(loader, where, t, SEGMENT_KEYS)) != ERROR_NONE) {
+    if ((failed = layout_unknown(loader, where, t, SEGMENT_KEYS)) != ERROR_NONE) {
         return failed;
     }
-    if (get(t, "length") == NULL) {
+    if (layout_get(t, "length") == NULL) {
         return layout_error(loader->error, loader->size, "%s: missing key 'length'", where);
     }
-    if ((failed = number(loader, where, "length", get(t, "length"), 1, 0, &s->length)) != ERROR_NONE) {
+    if ((failed = layout_number(loader, where, "length", layout_get(t, "length"), 1, 0, &s->length)) != ERROR_NONE) {
         return failed;
     }
-    if ((get(t, "outer_diameter") == NULL) == (get(t, "outer_radius") == NULL)) {
+    if ((layout_get(t, "outer_diameter") == NULL) == (layout_get(t, "outer_radius") == NULL)) {
         return layout_error(loader->error, loader->size, "%s: give exactly one of 'outer_diameter' or 'outer_radius'",
                             where);
     }
-    outer_key = get(t, "outer_diameter") != NULL ? "outer_diameter" : "outer_radius";
-    if ((failed = number(loader, where, outer_key, get(t, outer_key), 1, 0, &d_out)) != ERROR_NONE) {
+    outer_key = layout_get(t, "outer_diameter") != NULL ? "outer_diameter" : "outer_radius";
+    if ((failed = layout_number(loader, where, outer_key, layout_get(t, outer_key), 1, 0, &d_out)) != ERROR_NONE) {
         return failed;
     }
     d_out *= outer_key[6] == 'r' ? 2.0 : 1.0;
     for (k = 0; k < 3; k++) {
-        if (get(t, inner_keys[k]) != NULL) {
+        if (layout_get(t, inner_keys[k]) != NULL) {
             if (inner_key != NULL) {
                 return layout_error(loader->error, loader->size,
                             "%s: give at most one of 'inner_diameter', 'inner_radius', 'wall_thickness'", where);
@@ -333,8 +234,8 @@ static ErrorKind segment(const Loader *loader, int i, const Value *t, const Mate
         }
     }
     if (inner_key != NULL) {
-        value = get(t, inner_key);
-        if ((failed = number(loader, where, inner_key, value, 0, 0, &v)) != ERROR_NONE) {
+        value = layout_get(t, inner_key);
+        if ((failed = layout_number(loader, where, inner_key, value, 0, 0, &v)) != ERROR_NONE) {
             return failed;
         }
         if (inner_key[0] == 'w') {
@@ -352,13 +253,13 @@ static ErrorKind segment(const Loader *loader, int i, const Value *t, const Mate
             if (d_in >= d_out) {
                 return layout_error(loader->error, loader->size,
                             "%s.%s = %v must be smaller than the outer size (%s = %v)", where, inner_key, value,
-                            outer_key, get(t, outer_key));
+                            outer_key, layout_get(t, outer_key));
             }
         }
     }
     s->outer_diameter = d_out;
     s->inner_diameter = d_in;
-    if ((value = get(t, "material")) != NULL) {
+    if ((value = layout_get(t, "material")) != NULL) {
         int m = n_mats;
         if (value->kind == V_STRING) {
             for (m = 0; m < n_mats; m++) {
@@ -380,14 +281,14 @@ static ErrorKind segment(const Loader *loader, int i, const Value *t, const Mate
         s->density = mats[m].rho;
         have_E = have_rho = 1;
     }
-    if ((value = get(t, "youngs_modulus")) != NULL) {
-        if ((failed = number(loader, where, "youngs_modulus", value, 1, 0, &s->youngs_modulus)) != ERROR_NONE) {
+    if ((value = layout_get(t, "youngs_modulus")) != NULL) {
+        if ((failed = layout_number(loader, where, "youngs_modulus", value, 1, 0, &s->youngs_modulus)) != ERROR_NONE) {
             return failed;
         }
         have_E = 1;
     }
-    if ((value = get(t, "density")) != NULL) {
-        if ((failed = number(loader, where, "density", value, 1, 0, &s->density)) != ERROR_NONE) {
+    if ((value = layout_get(t, "density")) != NULL) {
+        if ((failed = layout_number(loader, where, "density", value, 1, 0, &s->density)) != ERROR_NONE) {
             return failed;
         }
         have_rho = 1;
@@ -403,7 +304,7 @@ static ErrorKind segment(const Loader *loader, int i, const Value *t, const Mate
         return failed;
     }
     s->poisson_ratio = 0.3;
-    if ((nu = get(t, "poisson_ratio")) != NULL) {
+    if ((nu = layout_get(t, "poisson_ratio")) != NULL) {
         double x = nu->kind == V_INTEGER ? (double)nu->integer : nu->kind == V_FLOAT ? nu->number : NAN;
         /* an integer is in (-1, 0.5) just when it is 0, its double too */
         if (!(-1.0 < x && x < 0.5)) {
@@ -419,7 +320,7 @@ static ErrorKind segment(const Loader *loader, int i, const Value *t, const Mate
 /* loader._station */
 static ErrorKind station(const Loader *loader, const char *where, const Value *t, int n_nodes, Station *out)
 {
-    const Value *node = get(t, "node"), *position = get(t, "position");
+    const Value *node = layout_get(t, "node"), *position = layout_get(t, "position");
     if ((node != NULL) == (position != NULL)) {
         return layout_error(loader->error, loader->size, "%s: give exactly one of 'node' or 'position'", where);
     }
@@ -439,7 +340,7 @@ static ErrorKind station(const Loader *loader, const char *where, const Value *t
         out->value = out->node;
         return ERROR_NONE;
     }
-    return number(loader, where, "position", position, 0, 0, &out->value);
+    return layout_number(loader, where, "position", position, 0, 0, &out->value);
 }
 
 /* loader._unbalance */
@@ -451,7 +352,7 @@ static ErrorKind unbalance(const Loader *loader, int i, const Value *t, const do
     double position, right = ends[n_ends - 1];
     ErrorKind failed;
     snprintf(where, sizeof where, "unbalances[%d]", i);
-    if ((failed = unknown(loader, where, t, UNBALANCE_KEYS)) != ERROR_NONE ||
+    if ((failed = layout_unknown(loader, where, t, UNBALANCE_KEYS)) != ERROR_NONE ||
         (failed = station(loader, where, t, n_ends, &at)) != ERROR_NONE) {
         return failed;
     }
@@ -460,11 +361,11 @@ static ErrorKind unbalance(const Loader *loader, int i, const Value *t, const do
         return layout_error(loader->error, loader->size, "%s.position = %g m lies beyond the right end (%g m)", where,
                     at.value, right);
     }
-    if (get(t, "amount") == NULL) {
+    if (layout_get(t, "amount") == NULL) {
         return layout_error(loader->error, loader->size, "%s: missing key 'amount'", where);
     }
     u->position = right < position ? right : position;
-    if ((failed = number(loader, where, "amount", get(t, "amount"), 0, 0, &u->amount)) != ERROR_NONE ||
+    if ((failed = layout_number(loader, where, "amount", layout_get(t, "amount"), 0, 0, &u->amount)) != ERROR_NONE ||
         (failed = number_or(loader, where, t, "phase", 0.0, 1, &u->phase)) != ERROR_NONE) {
         return failed;
     }
@@ -586,14 +487,14 @@ static ErrorKind cut(const Loader *loader, const RotorSegment *old, int n_old, S
 static ErrorKind pair(const Loader *loader, const char *where, const Value *t, const char *key, const char *xx,
                       const char *yy, int positive, double *x, double *y)
 {
-    const Value *iso = get(t, key), *vx = get(t, xx), *vy = get(t, yy);
+    const Value *iso = layout_get(t, key), *vx = layout_get(t, xx), *vy = layout_get(t, yy);
     ErrorKind failed;
     if (iso != NULL) {
         if (vx != NULL || vy != NULL) {
             return layout_error(loader->error, loader->size, "%s: give either %r or %r/%r, not both", where, key, xx,
                                 yy);
         }
-        if ((failed = number(loader, where, key, iso, positive, 0, x)) != ERROR_NONE) {
+        if ((failed = layout_number(loader, where, key, iso, positive, 0, x)) != ERROR_NONE) {
             return failed;
         }
         *y = *x;
@@ -609,14 +510,14 @@ static ErrorKind pair(const Loader *loader, const char *where, const Value *t, c
         *x = *y = 0.0;
         return ERROR_NONE;
     }
-    if ((failed = number(loader, where, xx, vx, positive, 0, x)) != ERROR_NONE) {
+    if ((failed = layout_number(loader, where, xx, vx, positive, 0, x)) != ERROR_NONE) {
         return failed;
     }
     if (vy == NULL) {
         *y = *x;
         return ERROR_NONE;
     }
-    return number(loader, where, yy, vy, positive, 0, y);
+    return layout_number(loader, where, yy, vy, positive, 0, y);
 }
 
 /* loader._mass, _bearing, _hinge of entry ``i`` of ``kind`` (0, 1, 2) at ``node`` */
@@ -625,17 +526,17 @@ static ErrorKind point_element(const Loader *loader, Driveline *d, int kind, int
     char where[40];
     ErrorKind failed;
     snprintf(where, sizeof where, "%s[%d]", kind == 0 ? "masses" : kind == 1 ? "bearings" : "hinges", i);
-    if ((failed = unknown(loader, where, t, kind == 0 ? MASS_KEYS : kind == 1 ? BEARING_KEYS : HINGE_KEYS)) !=
+    if ((failed = layout_unknown(loader, where, t, kind == 0 ? MASS_KEYS : kind == 1 ? BEARING_KEYS : HINGE_KEYS)) !=
         ERROR_NONE) {
         return failed;
     }
     if (kind == 0) {
         RotorMass *m = &d->masses[d->n_masses];
         m->node = node;
-        if (get(t, "mass") == NULL) {
+        if (layout_get(t, "mass") == NULL) {
             return layout_error(loader->error, loader->size, "%s: missing key 'mass'", where);
         }
-        if ((failed = number(loader, where, "mass", get(t, "mass"), 0, 0, &m->mass)) != ERROR_NONE ||
+        if ((failed = layout_number(loader, where, "mass", layout_get(t, "mass"), 0, 0, &m->mass)) != ERROR_NONE ||
             (failed = number_or(loader, where, t, "polar_inertia", 0.0, 0, &m->polar_inertia)) != ERROR_NONE ||
             (failed = number_or(loader, where, t, "diametral_inertia", 0.0, 0, &m->diametral_inertia)) != ERROR_NONE) {
             return failed;
@@ -659,7 +560,7 @@ static ErrorKind point_element(const Loader *loader, Driveline *d, int kind, int
         RotorHinge *h = &d->hinges[d->n_hinges];
         int n_nodes = d->n_segments + 1;
         if (!(0 < node && node < n_nodes - 1)) {
-            const Value *at = get(t, "node");
+            const Value *at = layout_get(t, "node");
             if (at != NULL) {
                 char shown[32];
                 snprintf(shown, sizeof shown, "%lld", at->integer);
@@ -669,7 +570,7 @@ static ErrorKind point_element(const Loader *loader, Driveline *d, int kind, int
             }
             return layout_error(loader->error, loader->size,
                                 "%s.position = %v m must be an inner node (1..%d), not an end",
-                        where, get(t, "position"), n_nodes - 2);
+                        where, layout_get(t, "position"), n_nodes - 2);
         }
         h->node = node;
         if ((failed = number_or(loader, where, t, "bending_stiffness", 0.0, 0, &h->bending_stiffness)) != ERROR_NONE) {
@@ -683,7 +584,7 @@ static ErrorKind point_element(const Loader *loader, Driveline *d, int kind, int
 /* loader's end condition of ``key`` (free when absent) */
 static ErrorKind end_condition(const Loader *loader, const Value *data, const char *key, EndCondition *out)
 {
-    const Value *v = get(data, key);
+    const Value *v = layout_get(data, key);
     int i;
     *out = END_FREE;
     if (v == NULL) {
@@ -704,7 +605,7 @@ static ErrorKind load(const Loader *loader, const Value *data, Driveline *d)
     static const char *const kinds[] = {"masses", "bearings", "hinges"};
     static const int limits[] = {ROTOR_LOADER_MAX_POINT_ELEMENTS, ROTOR_LOADER_MAX_POINT_ELEMENTS,
                                  ROTOR_LOADER_MAX_POINT_ELEMENTS};
-    const Value *name = get(data, "name"), *segs, *unbs, *tables[3];
+    const Value *name = layout_get(data, "name"), *segs, *unbs, *tables[3];
     const Item *item;
     Material *mats;
     RotorSegment *old;
@@ -712,7 +613,7 @@ static ErrorKind load(const Loader *loader, const Value *data, Driveline *d)
     int *nodes[3], counts[3], n_mats, n_old, n_unb, i, kind;
     double *ends;
     ErrorKind failed;
-    if ((failed = unknown(loader, loader->source, data, TOP_KEYS)) != ERROR_NONE) {
+    if ((failed = layout_unknown(loader, loader->source, data, TOP_KEYS)) != ERROR_NONE) {
         return failed;
     }
     if (name != NULL && name->kind != V_STRING) {
@@ -721,7 +622,7 @@ static ErrorKind load(const Loader *loader, const Value *data, Driveline *d)
     if ((failed = end_condition(loader, data, "left_end", &d->left)) != ERROR_NONE ||
         (failed = end_condition(loader, data, "right_end", &d->right)) != ERROR_NONE ||
         (failed = materials(loader, data, &mats, &n_mats)) != ERROR_NONE ||
-        (failed = counted(loader, data, "segments", ROTOR_LOADER_MAX_SEGMENTS, &segs)) != ERROR_NONE) {
+        (failed = layout_counted(loader, data, "segments", ROTOR_LOADER_MAX_SEGMENTS, &segs)) != ERROR_NONE) {
         return failed;
     }
     n_old = list_count(segs);
@@ -741,7 +642,7 @@ static ErrorKind load(const Loader *loader, const Value *data, Driveline *d)
         }
         ends[i + 1] = ends[i] + old[i].length;
     }
-    if ((failed = counted(loader, data, "unbalances", ROTOR_LOADER_MAX_POINT_ELEMENTS, &unbs)) != ERROR_NONE) {
+    if ((failed = layout_counted(loader, data, "unbalances", ROTOR_LOADER_MAX_POINT_ELEMENTS, &unbs)) != ERROR_NONE) {
         return failed;
     }
     n_unb = list_count(unbs);
@@ -756,7 +657,7 @@ static ErrorKind load(const Loader *loader, const Value *data, Driveline *d)
         d->n_unbalances = i + 1;
     }
     for (kind = 0; kind < 3; kind++) {
-        if ((failed = counted(loader, data, kinds[kind], limits[kind], &tables[kind])) != ERROR_NONE) {
+        if ((failed = layout_counted(loader, data, kinds[kind], limits[kind], &tables[kind])) != ERROR_NONE) {
             return failed;
         }
         counts[kind] = list_count(tables[kind]);
@@ -794,22 +695,18 @@ static ErrorKind load(const Loader *loader, const Value *data, Driveline *d)
     return check_driveline(loader, d);
 }
 
-/* loader._nesting_errors: brackets anywhere (strings too) nest at most MAX_NESTING deep. */
-static ErrorKind nesting_errors(const char *text, size_t length, const char *source, char *error, size_t size)
+static ErrorKind loads_driveline(const char *text, size_t length, const char *source, void *out, char *error,
+                                 size_t size)
 {
-    size_t i;
-    int depth = 0;
-    for (i = 0; i < length; i++) {
-        if (text[i] == '[' || text[i] == '{') {
-            if (++depth > ROTOR_LOADER_MAX_NESTING) {
-                return layout_error(error, size, "%s: brackets nest deeper than %d levels", source,
-                                    ROTOR_LOADER_MAX_NESTING);
-            }
-        } else if ((text[i] == ']' || text[i] == '}') && depth > 0) {
-            depth--;
-        }
-    }
-    return ERROR_NONE;
+    return driveline_from_text(text, length, source, out, error, size);
+}
+
+/* model.build_driveline for a layout: a ".toml" file or a shipped name (loader.example_path). */
+ErrorKind driveline_from_layout(const char *layout, const char *resources, Driveline *out, char *error, size_t size)
+{
+    static const LayoutNames names = {"driveline file", "example"};
+    memset(out, 0, sizeof *out);
+    return layout_file_load(layout, resources, &names, loads_driveline, out, error, size);
 }
 
 void driveline_free(Driveline *driveline)
@@ -828,26 +725,19 @@ ErrorKind driveline_from_text(const char *text, size_t length, const char *sourc
     Arena arena = {NULL};
     Loader loader;
     Value *root;
-    const char *reason;
     ErrorKind status;
     memset(out, 0, sizeof *out);
     if (size > 0) {
         error[0] = '\0';
     }
-    if ((status = nesting_errors(text, length, source, error, size)) != ERROR_NONE) {
-        return status;
-    }
-    if (toml_utf8_error((const unsigned char *)text, length, &reason) >= 0) {
-        return layout_error(error, size, "%s: malformed TOML: the text is not UTF-8 (%s)", source, reason);
-    }
-    if ((status = toml_read(text, length, source, &arena, &root, error, size)) != ERROR_NONE) {
-        arena_free(&arena);
-        return status;
-    }
     loader.error = error;
     loader.size = size;
     loader.source = source;
     loader.arena = &arena;
+    if ((status = layout_parse(text, length, &loader, &root)) != ERROR_NONE) {
+        arena_free(&arena);
+        return status;
+    }
     status = load(&loader, root, out);
     arena_free(&arena);
     if (status != ERROR_NONE) {

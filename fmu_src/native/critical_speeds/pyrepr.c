@@ -1,7 +1,7 @@
 /* Python's repr() of the strings the rotor library's messages show (unicode_repr; a float's is
  * python_float_repr of the shared python_numbers.c). Every function writes at most ``size`` bytes,
  * always terminated. */
-#include "rotor.h"
+#include "toml.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,19 +1,31 @@
-/* The layouts' TOML-subset reader and what its messages need, for the modules that read a layout:
+/* The layouts' TOML-subset reader and the rules every model's layout files share
+ * (driveline/layout_files.py), for the modules that read a layout (the rotor library's layout.c, the
+ * PowertrainMounts port, which compiles these modules too):
  *   messages.c     the messages: Python's repr() of the values read, the loader's format (%r, %v, %g)
+ *   pyrepr.c       Python's repr() of the values the messages show
  *   arena.c        the memory of one reading, freed at once
  *   toml.c         the TOML-subset reader (tomllib.loads)
- *   layout_file.c  a layout by name or file: the file read as loader._read_regular_file does
- * Internal to the rotor library (rotor.h is its interface). */
+ *   layout_file.c  a layout by name or file (layout_files.read_layout, shipped_path), its text parsed
+ *                  (layout_files.parse) and the loaders' shared checks (unknown, number, counted) */
 #ifndef TOML_H
 #define TOML_H
 
 #include <stddef.h>
 
-#include "rotor.h"
+#include "../python_numbers.h"
 
 /* Tables and arrays nested below the document at the most (deeper is refused as malformed TOML:
  * a bound on a key's parts and on the stack of text_put_repr). */
-#define TREE_DEPTH (4 * ROTOR_LOADER_MAX_NESTING)
+#define TREE_DEPTH (4 * DRIVELINE_LAYOUT_FILES_MAX_NESTING)
+
+/* ---- pyrepr.c -------------------------------------------------------------------------------- */
+/* repr() of a Python str holding the UTF-8 ``text`` cut to its first ``max_chars`` code points (0: all). */
+void python_str_repr(const char *text, size_t max_chars, char *out, size_t size);
+/* The same for ``length`` bytes (the text may hold NUL characters). */
+void python_str_repr_n(const char *text, size_t length, size_t max_chars, char *out, size_t size);
+/* Appends ``count`` bytes to the text of ``*used`` bytes in ``out`` (``size`` bytes), cut to fit,
+ * always terminated; ``*used`` grows by what was written. */
+void text_append(char *out, size_t size, size_t *used, const char *bytes, size_t count);
 
 /* ---- messages (messages.c) ----------------------------------------------------------------- */
 
@@ -25,10 +37,10 @@ typedef struct {
 
 /* ---- the arena (arena.c) ------------------------------------------------------------------- */
 
-typedef struct Block Block;
+typedef struct ArenaBlock ArenaBlock;
 
 typedef struct {
-    Block *blocks;
+    ArenaBlock *blocks;
 } Arena;
 
 void *arena_alloc(Arena *arena, size_t count);
@@ -82,5 +94,46 @@ Value *toml_find(const Value *table, const char *key, size_t key_length);
 long toml_utf8_error(const unsigned char *bytes, size_t length, const char **reason);
 /* a character of a bare key */
 int toml_bare_key_char(int c);
+
+/* ---- layout files (layout_file.c) ---------------------------------------------------------- */
+
+/* A reading of one layout: where its messages go, the file's name in them, its memory. */
+typedef struct {
+    char *error;
+    size_t size;
+    const char *source;
+    Arena *arena;
+} Loader;
+
+/* How a model's messages call its layout files: "driveline file" and "example" (read_layout's
+ * ``what``, shipped_path's ``what``). */
+typedef struct {
+    const char *file, *shipped;
+} LayoutNames;
+
+/* A model's loads(text, source): the layout of ``length`` bytes of text into ``out``; ERROR_NONE or the
+ * failure's kind with the message. */
+typedef ErrorKind (*LayoutLoads)(const char *text, size_t length, const char *source, void *out, char *error,
+                                 size_t size);
+
+/* A layout: a file path ending in ".toml" (any case; relative to the working directory; messages name it
+ * by its absolute path, as pathlib's absolute()), read as layout_files.read_layout does, or the name of a
+ * layout shipped in ``resources`` (the FMU's resources folder: layout_files.shipped_path), given to
+ * ``loads``. ERROR_NONE, or the failure's kind with the message. */
+ErrorKind layout_file_load(const char *layout, const char *resources, const LayoutNames *names, LayoutLoads loads,
+                           void *out, char *error, size_t size);
+/* layout_files.parse: the nesting check, then toml_read into ``loader->arena``. */
+ErrorKind layout_parse(const char *text, size_t length, const Loader *loader, Value **root);
+/* Python's order of str: code points, which UTF-8 bytes keep. */
+int layout_key_before(const char *a, size_t na, const char *b, size_t nb);
+/* the value of ``key`` in ``table``, NULL if absent */
+Value *layout_get(const Value *table, const char *key);
+/* layout_files.unknown: the first (sorted) key of ``table`` not in ``allowed`` (NULL-terminated). */
+ErrorKind layout_unknown(const Loader *loader, const char *where, const Value *table, const char *const *allowed);
+/* layout_files.number */
+ErrorKind layout_number(const Loader *loader, const char *where, const char *key, const Value *value, int positive,
+                        int signed_, double *out);
+/* layout_files.table_list and counted: the tables of ``key`` (NULL if absent). */
+ErrorKind layout_counted(const Loader *loader, const Value *data, const char *key, int limit, const Value **list);
 
 #endif
