@@ -430,7 +430,7 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
     if fmi3:
         ET.SubElement(variables, "Float64", name="time", valueReference=str(len(spec.variables)),
                       causality="independent", variability="continuous", description="Simulation time")
-    for k, state in enumerate(spec.states):
+    for k, state in enumerate(() if MODELS[spec.name].co_simulation_only else spec.states):
         source = spec[state.derivative]
         attributes = {"name": state.derivative_name, "valueReference": str(derivative_reference(spec, fmi, k)),
                       "causality": "local", "variability": "continuous",
