@@ -6,7 +6,9 @@ one) in each engine, each run a process of its own so that an engine aborting is
 
 * **initialisation**: the parameter ``r = -1 m``, which the FMU refuses at
   ``ExitInitializationMode`` (native: Error; Python: OK, every step refused);
-* **step**: the input ``beta = 1.2 rad`` (above its maximum), refused at every step (Discard).
+* **step**: the input ``beta = 1.2 rad`` (above its maximum) set once initialisation is over (as a
+  start value the FMU refuses it at ``ExitInitializationMode`` already), refused at every step
+  (Discard).
 
 The engines: fmpy's ``simulate_fmu``, libcosim and Ecos (:mod:`.importers`, their start-value
 check switched off to observe the engine itself) and the project's master
@@ -32,7 +34,8 @@ from .worker import answer, answer_in
 RESULT = "engine refusal: "
 MODEL = "TripodCoupling"
 #: The refusals: the start value that causes each.
-REFUSALS = {"initialisation": {"r": -1.0}, "step": {"beta": 1.2}}
+#: Refusal -> (start values, inputs set once initialisation is over).
+REFUSALS = {"initialisation": ({"r": -1.0}, {}), "step": ({}, {"beta": 1.2})}
 STEP_SIZE, STEPS = 1e-3, 3
 #: Engine name -> (package it needs, what the table calls it; ``{version}``: the package's version).
 ENGINES = {
@@ -46,24 +49,31 @@ ENGINES = {
 FAMILIES = ("native", "Python")
 
 
-def observe(engine: str, path: Path, values: dict[str, float]) -> str:
-    """Run ``STEPS`` steps of the FMU at ``path`` with start values ``values`` in ``engine`` and say
-    what the engine did (in the worker process)."""
+def observe(engine: str, path: Path, values: dict[str, float], inputs: dict[str, float]) -> str:
+    """Run ``STEPS`` steps of the FMU at ``path`` with start values ``values`` and ``inputs`` set
+    after initialisation in ``engine`` and say what the engine did (in the worker process)."""
     if engine == "fmpy":
-        from fmpy import simulate_fmu
+        import numpy as np
+        from fmpy import read_model_description, simulate_fmu
         from fmpy.fmi1 import FMICallException
 
+        # fmpy applies its input table at initialisation too: its first row holds the start values
+        start = {v.name: float(v.start) for v in read_model_description(str(path)).modelVariables if v.name in inputs}
+        signals = np.array([(0.0, *(start[name] for name in inputs)), (STEP_SIZE / 2, *inputs.values())],
+                           dtype=[("time", float)] + [(name, float) for name in inputs]) if inputs else None
         try:
             rows = simulate_fmu(str(path), stop_time=STEPS * STEP_SIZE, output_interval=STEP_SIZE,
-                                start_values=values)
+                                start_values=values, input=signals)
         except FMICallException as error:
             return f"raises FMICallException: {error}"
         return f"stops at the refusal and returns {len(rows)} of {STEPS + 1} rows, no exception"
     if engine == "master":
-        from ..runs.runner import StepRefused, simulate
+        from ..runs.runner import FmuInstance, StepRefused
 
         try:
-            simulate(path, STEPS * STEP_SIZE, STEP_SIZE, start_values=values)
+            with FmuInstance(path) as instance:
+                instance.initialize(values, 0.0)
+                instance.run(STEPS * STEP_SIZE, STEP_SIZE, inputs)
         except StepRefused as refused:
             return f"raises StepRefused at {refused.call} ({refused.status}) with the FMU's reason"
         return "runs to the end"
@@ -75,6 +85,7 @@ def observe(engine: str, path: Path, values: dict[str, float]) -> str:
     session_of = importers.cosim_session if engine.startswith("libcosim") else importers.ecos_session
     try:
         session = session_of(STEP_SIZE, {"m": path}, start_values=start, checked=engine.endswith("checked"))
+        session.set({f"m.{name}": value for name, value in inputs.items()})
         answers = [session.step() for _ in range(STEPS)]
         session.close()
     except StartValuesRefused as refused:
@@ -125,7 +136,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.worker:
         engine, path, refusal = args.worker
-        answer(RESULT, observe(engine, Path(path), REFUSALS[refusal]))
+        answer(RESULT, observe(engine, Path(path), *REFUSALS[refusal]))
     text = table(args.models)
     print(text)
     if args.update:

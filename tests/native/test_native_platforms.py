@@ -72,7 +72,7 @@ def test_linux_binaries_load_on_glibc_2_17(release_dir, name, fmi, platform):
     versions = _glibc_versions(binary)
     assert versions and max(versions) <= (2, 17)
     assert binary.header.machine_type.name == {"x86_64": "X86_64", "aarch64": "AARCH64"}[platform.tuple.split("-")[0]]
-    assert set(binary.libraries) == {"libc.so.6", "libm.so.6"}
+    assert "libc.so.6" in binary.libraries and set(binary.libraries) <= {"libc.so.6", "libm.so.6"}  # libm if called
     assert {s.name for s in binary.exported_symbols if s.name}.issubset({s.name for s in binary.dynamic_symbols})
     assert all(s.name.startswith(f"fmi{fmi}") for s in binary.exported_symbols)
 
