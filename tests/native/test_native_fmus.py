@@ -122,7 +122,8 @@ def test_every_start_value_is_the_specs_bit_for_bit_in_both_families(native_dir,
     16 digits: omega_in 209.4395102393195 against the native 209.43951023931953)."""
     spec = MODELS[name].spec
     python, native = (read_model_description(str(path)) for path in (fmu_path(name, fmi), _native(native_dir, name, fmi)))
-    written = [{v.name: v.start for v in d.modelVariables if v.causality != "independent"} for d in (python, native)]
+    written = [{v.name: v.start for v in d.modelVariables if v.causality != "independent"
+                and not v.name.startswith("der(")} for d in (python, native)]  # the native Model Exchange's
     assert written[0] == written[1]
     for variable in spec.variables:
         text = written[1][variable.name]
