@@ -23,26 +23,41 @@ test uses, so that test files carry none:
 FMI 2.0 FMUs without the slow and importer tests (``-m "not slow and not importers" --fmi 2``),
 and does not even import the modules that hold slow tests only (ROSS takes seconds to import):
 ``python -m pytest -q -n 2 --quick``.
+
+With ``-n`` (pytest-xdist's default ``load`` distribution), a worker takes a whole work unit at a
+time (:func:`work_unit`: a test file, or the part of it for one family of FMUs), the costliest unit
+left first by ``tests/durations.json`` (:func:`pytest_xdist_make_scheduler`): a module's fixtures
+are set up on one worker only, and the run does not end on a long unit started last. Linear
+algebra runs on one thread per process (:data:`ONE_THREAD`): the workers already use every core.
 """
 
 from __future__ import annotations
 
-import json
 import os
-import resource
-import sys
-import time
-import warnings
-from collections.abc import Callable
-from datetime import datetime, timezone
-from pathlib import Path
 
-import pytest
+#: Set before numpy loads (here, in the workers, which inherit it, and in the processes tests
+#: start): OpenBLAS's own threads, competing with the other worker for two cores, cost five to
+#: fifteen times the CPU time of one thread (measured 2026-11-27, load 13: numpy eigvals of
+#: 200 x 200, 1.39 s of CPU against 0.09 s; two rotor test files, 45 s against 19 s).
+ONE_THREAD = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+for _variable in ONE_THREAD:
+    os.environ.setdefault(_variable, "1")
 
-from driveline.catalog import MODELS
-from fmu_harness import packaging
-from fmu_harness.packaging import native, toolchain
-from support.families import Family, NativeFamily, PythonFamily
+import json  # noqa: E402 (after the thread count is set)
+import resource  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+import warnings  # noqa: E402
+from collections.abc import Callable  # noqa: E402
+from datetime import datetime, timezone  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import pytest  # noqa: E402
+
+from driveline.catalog import MODELS  # noqa: E402
+from fmu_harness import packaging  # noqa: E402
+from fmu_harness.packaging import native, toolchain  # noqa: E402
+from support.families import Family, NativeFamily, PythonFamily  # noqa: E402
 
 FmuPath = Callable[..., Path]
 
@@ -50,6 +65,8 @@ FMU_FIXTURES = {"fmu_store", "native_dir", "release_dir", "family"}
 IMPORTER_MODULES = ("fmu_harness.checks.importers", "fmu_harness.checks.interop", "fmu_harness.checks.engine_refusals")
 VERSION_PARAMETERS = ("fmi", "version")
 SLOW_MODEL = "CriticalSpeeds"
+#: The ids of the family parameters: the session's ``family`` and the robustness suite's (robustness.FAMILIES).
+FAMILY_IDS = (PythonFamily.name, NativeFamily.name)
 DURATIONS = Path(__file__).with_name("durations.json")
 SLOW_SECONDS = 0.5  # CPU seconds of a test at which it is slow
 RELEASE_FIXTURE = "release_dir"  # the five-platform build: its cost depends on ziglang's cache
@@ -80,6 +97,38 @@ def slow_modules(durations: dict[str, float]) -> set[str]:
     for nodeid, seconds in durations.items():
         by_file.setdefault(nodeid.split("::")[0], []).append(seconds)
     return {path for path, times in by_file.items() if min(times) >= SLOW_SECONDS}
+
+
+def work_unit(nodeid: str) -> str:
+    """The tests a worker runs in a row with ``-n``: those of one file, or of one file and one
+    family of FMUs where its tests take one (a ``python`` or ``native`` parameter): the robustness
+    suite's fixtures run every case of a family once."""
+    path, _, name = nodeid.partition("::")
+    family = next((p for p in name.partition("[")[2].rstrip("]").split("-") if p in FAMILY_IDS), "")
+    return f"{path}[{family}]" if family else path
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log):
+    """pytest-xdist's ``load`` distribution by :func:`work_unit`, the costliest unit left first
+    (its tests' CPU seconds summed from ``tests/durations.json``; an unmeasured test counts 0)."""
+    if config.getvalue("dist") != "load":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    costs: dict[str, float] = {}
+    for nodeid, seconds in measured().items():
+        costs[work_unit(nodeid)] = costs.get(work_unit(nodeid), 0.0) + seconds
+
+    class CostliestUnitFirst(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return work_unit(nodeid)
+
+        def _assign_work_unit(self, node) -> None:
+            self.workqueue.move_to_end(max(self.workqueue, key=lambda unit: costs.get(unit, 0.0)), last=False)
+            super()._assign_work_unit(node)
+
+    return CostliestUnitFirst(config, log)
 
 
 def selected_versions(config: pytest.Config) -> list[str]:

@@ -20,6 +20,7 @@ where a perturbation crosses a threshold, so for those an undeclared change alon
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import Any
@@ -78,8 +79,15 @@ def core_at(model: str, values: dict[str, Any]) -> SteppedModel:
 
 
 def valid(model: str, values: dict[str, Any]) -> bool:
-    """Whether the core accepts these parameters and inputs (a refused set shows nothing)."""
-    core = core_at(model, values)
+    """Whether the core accepts these parameters and inputs (a refused set shows nothing); asked
+    once per set of values in a process (the FMUs of a model ask alike: for CriticalSpeeds, an
+    analysis each)."""
+    return _valid(model, tuple(sorted(values.items())))
+
+
+@functools.cache
+def _valid(model: str, values: tuple[tuple[str, Any], ...]) -> bool:
+    core = core_at(model, dict(values))
     return not (core.parameter_errors() or core.input_errors())
 
 
