@@ -312,9 +312,8 @@ def pytest_fixture_setup(fixturedef: pytest.FixtureDef, request: pytest.FixtureR
     own = total - _NESTED.pop()
     if _NESTED:
         _NESTED[-1] += total
-    if fixturedef.argname not in SHARED_BUILDS:
-        key = (request.node.nodeid, fixturedef.argname)
-        _FIXTURE_COSTS[key] = _FIXTURE_COSTS.get(key, 0.0) + own
+    if fixturedef.argname not in SHARED_BUILDS:  # set up again (another parameter upstream): the new one's cost
+        _FIXTURE_COSTS[request.node.nodeid, fixturedef.argname] = own
 
 
 @pytest.hookimpl(hookwrapper=True)

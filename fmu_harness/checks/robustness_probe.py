@@ -1,4 +1,5 @@
-"""One robustness case, run in a process of its own: ``python -m fmu_harness.checks.robustness_probe CASE_JSON``.
+"""One robustness case, run in a process of its own: ``python -m fmu_harness.checks.robustness_probe CASE_JSON``,
+or forked from a host of cases (``--serve``, :func:`serve`) that imported this module once.
 
 The case names a procedure of this module, its arguments and the departures from the standard
 its outcome is checked with (none for the native FMUs; the wrappers' for the Python FMUs,
@@ -14,8 +15,11 @@ import json
 import math
 import os
 import pickle
+import signal
 import sys
+import tempfile
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -587,8 +591,55 @@ def soak(path: str, name: str, alternations: int) -> None:
     probe.close()
 
 
+def serve() -> None:
+    """``python -m fmu_harness.checks.robustness_probe --serve``: a host of cases. Each line on
+    stdin, ``{"case": CASE_JSON, "time_limit": seconds}``, is run in a child forked from this
+    process, which imported fmpy and the procedures once (0.2 s of CPU that a process of its own
+    pays for each case): the case still has a process of its own, which may crash or hang alone.
+    Each case is answered with one line on stdout: the child's exit code (minus the signal that
+    ended it), its stdout and stderr, and whether it was killed at the time limit (``hung``)."""
+    answers = os.fdopen(os.dup(sys.stdout.fileno()), "w")
+    for line in sys.stdin:
+        request = json.loads(line)
+        answers.write(json.dumps(_forked(request["case"], request["time_limit"])) + "\n")
+        answers.flush()
+
+
+def _forked(case: str, time_limit: float) -> dict[str, Any]:
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        started = time.monotonic()
+        child = os.fork()
+        if child == 0:
+            try:
+                os.dup2(os.open(os.devnull, os.O_RDONLY), 0)
+                os.dup2(out.fileno(), 1)
+                os.dup2(err.fileno(), 2)
+                main([case])
+            finally:
+                os._exit(1)  # main leaves with os._exit(0) once the verdict is printed
+        hung, delay = False, 0.001
+        while not (ended := os.waitpid(child, os.WNOHANG))[0]:
+            if time.monotonic() - started > time_limit:
+                os.kill(child, signal.SIGKILL)
+                ended, hung = os.waitpid(child, 0), True
+                break
+            time.sleep(delay)
+            delay = min(2 * delay, 0.02)
+        seconds = time.monotonic() - started
+        out.seek(0)
+        err.seek(0)
+        return {"returncode": os.waitstatus_to_exitcode(ended[1]), "hung": hung, "seconds": seconds,
+                "stdout": out.read().decode("utf-8", "replace"), "stderr": err.read().decode("utf-8", "replace")}
+
+
 def main(argv: list[str] | None = None) -> None:
-    case = json.loads((argv or sys.argv[1:])[0])
+    arguments = argv or sys.argv[1:]
+    if arguments == ["--serve"]:
+        serve()
+        return
+    case = json.loads(arguments[0])
     Probe.departures = frozenset(case["departures"])
     try:
         globals()[case["procedure"]](*case["arguments"])

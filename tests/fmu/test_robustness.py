@@ -7,13 +7,16 @@ outcome instead. Cases of a model without a C port are skipped for the native FM
 
 from __future__ import annotations
 
+import os
+import signal
+import time
 from pathlib import Path
 
 import pytest
 
 from driveline.catalog import MODELS
 from fmu_harness import packaging
-from fmu_harness.checks import robustness, work_fuzzer
+from fmu_harness.checks import robustness, robustness_probe, work_fuzzer
 from fmu_harness.packaging import native
 from fmu_harness.checks.failing_model import FailingModel
 
@@ -89,3 +92,27 @@ def test_the_work_fuzzer_finds_no_analysis_beyond_its_budget(paths: robustness.F
     results = work_fuzzer.fuzz({family: paths("CriticalSpeeds", fmi_versions[0])}, 3, seed=3)
     assert work_fuzzer.over_budget(results) == []
     assert [analysis["status"] for analysis in results[0][family]["analyses"]] == ["OK"] * 3
+
+
+def test_a_case_whose_process_dies_or_outlives_its_limit_is_a_crash_or_a_hang(monkeypatch, tmp_path):
+    """The columns can count: a case's forked process killed by a signal, or ended without a
+    verdict, is a crash; one still running at its time limit is killed and is a hang."""
+    fmu = tmp_path / "Any.fmu"
+    fmu.touch()
+    case = robustness.Case("any", "any", "any", (str(fmu),), "2", time_limit=0.5)
+    outcomes = {"signal": lambda argv: os.kill(os.getpid(), signal.SIGKILL), "no verdict": lambda argv: None,
+                "endless": lambda argv: time.sleep(60)}
+    verdicts = {}
+    for name, procedure in outcomes.items():
+        monkeypatch.setattr(robustness_probe, "main", procedure)
+        answer = robustness_probe._forked("{}", case.time_limit)
+
+        class Host:
+            def run(self, case):
+                return answer
+
+        verdicts[name] = robustness.run(case, Host())
+    assert [r.verdict for r in verdicts.values()] == ["crash", "crash", "hang"]
+    assert verdicts["signal"].detail.startswith(f"exit code -{int(signal.SIGKILL)}")
+    assert verdicts["no verdict"].detail.startswith("exit code 1")
+    assert verdicts["endless"].seconds < 10

@@ -24,8 +24,11 @@ PROGRESS = re.compile(r".+ \[\d+/\d+\]( |$)")  # a progress line (fmu_harness.co
 PROJECT = ("pyproject.toml", "README.md", "LICENSE", "driveline", "fmu_src", "fmu_harness", "docs")
 
 
-def _wheel(folder: Path) -> Path:
-    """The project's wheel, built from a copy of its tree (setuptools writes build/ into the tree)."""
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The project's wheel, built once for the module from a copy of its tree (setuptools writes
+    build/ into the tree)."""
+    folder = tmp_path_factory.mktemp("wheel")
     tree = folder / "tree"
     for name in PROJECT:
         source = ROOT / name
@@ -54,8 +57,8 @@ def _environment(folder: Path, wheel: Path) -> Path:
     return python
 
 
-def test_wheel_carries_what_the_native_build_needs(tmp_path):
-    with zipfile.ZipFile(_wheel(tmp_path)) as archive:
+def test_wheel_carries_what_the_native_build_needs(wheel):
+    with zipfile.ZipFile(wheel) as archive:
         names = set(archive.namelist())
     sources = {f"fmu_src/native/{path.relative_to(native.NATIVE_SRC).as_posix()}"
                for path in native.NATIVE_SRC.rglob("*") if path.suffix in (".c", ".h")}
@@ -63,8 +66,8 @@ def test_wheel_carries_what_the_native_build_needs(tmp_path):
     assert sources and sources | pages | {"fmu_src/LICENSE", "driveline/rotor/data/two_piece_propshaft.toml"} <= names
 
 
-def test_installed_wheel_builds_every_fmu_and_both_systems(tmp_path):
-    python = _environment(tmp_path, _wheel(tmp_path))
+def test_installed_wheel_builds_every_fmu_and_both_systems(wheel, tmp_path):
+    python = _environment(tmp_path, wheel)
     work = tmp_path / "empty"
     work.mkdir()
     where = subprocess.run([str(python), "-c", "import driveline, fmu_src; print(driveline.__file__, fmu_src.__file__)"],
