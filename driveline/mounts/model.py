@@ -33,8 +33,6 @@ class PowertrainMountsModel(SteppedModel):
     """The ``PowertrainMounts`` co-simulation model."""
 
     spec = SPEC
-    co_simulation_only = ("co-simulation only: PowertrainMounts' C port gives no Model Exchange evaluate hook yet "
-                          "(its 12 states are declared in the spec)")
     # every input loaded, the joints' and motor's directions off the axes (a direction's part along
     # itself or along the shaft is dropped), a mean torque (the sag's motor axis)
     dependency_points = ({**{name: 100.0 * (-1) ** k * (1 + k % 5) for k, name in enumerate(INPUTS)},

@@ -262,6 +262,11 @@ def _extra_message(model: type[SteppedModel], probe: dict[str, float]) -> str:
     return f"    {{V_{shown}, {_template(errors[0])}}},"
 
 
+def _references(variables: list[Variable]) -> str:
+    """A C list of the variables' value references, ended by -1."""
+    return ", ".join([*(f"V_{v.name}" for v in variables), "-1"])
+
+
 def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
     """``model_variables.h`` and ``model_variables.c`` of ``model``'s spec and own checks."""
     spec = model.spec
@@ -333,9 +338,9 @@ const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 }};
 
 /* -1 ends each list */
-const int model_checked[MODEL_CHECKED_COUNT + 1] = {{{", ".join([*(f"V_{v.name}" for v in checked), "-1"])}}};
+const int model_checked[MODEL_CHECKED_COUNT + 1] = {{{_references(checked)}}};
 const int model_checked_from[4] = {{{", ".join(map(str, starts))}}};
-const int model_real_outputs[MODEL_REAL_OUTPUT_COUNT + 1] = {{{", ".join([*(f"V_{v.name}" for v in real_outputs), "-1"])}}};
+const int model_real_outputs[MODEL_REAL_OUTPUT_COUNT + 1] = {{{_references(real_outputs)}}};
 """
     if spec.relations:
         source += f"""

@@ -79,12 +79,17 @@ static void mount_map(const Mount *m, const double centre[3], double out[3][6])
     dense_multiply(&m->axes[0][0], &t[0][0], &out[0][0], 3, 3, 6);
 }
 
-/* joints.joint_frame: columns X', Y', Z'; 0 with the message */
+/* joints.joint_frame: columns X', Y', Z'; 0 with the message (also for a length that overflows) */
 static int joint_frame(const double shaft[3], const double bend[3], const char *side, double frame[3][3], char *error)
 {
-    double length = norm3(shaft), z[3], x[3], y[3], along, sine, shown;
+    double length = norm3(shaft), bend_length = norm3(bend), z[3], x[3], y[3], along, sine, shown;
     char text[40];
     int k;
+    if (isinf(length) || isinf(bend_length)) {
+        snprintf(error, ERROR_SIZE, "the %s direction of the %s joint is too long (its length overflows)",
+                 isinf(length) ? "halfshaft" : "bend-plane", side);
+        return 0;
+    }
     if (!(length >= MOUNTS_JOINTS_MIN_DIRECTION)) {
         python_format_g(length, 3, text, sizeof text);
         snprintf(error, ERROR_SIZE, "the halfshaft direction of the %s joint has no length (%s)", side, text);
@@ -98,7 +103,7 @@ static int joint_frame(const double shaft[3], const double bend[3], const char *
         x[k] = bend[k] - along * z[k];
     }
     sine = norm3(x);
-    shown = fmax(norm3(bend), 1.0);
+    shown = fmax(bend_length, 1.0);
     if (!(sine >= MOUNTS_JOINTS_MIN_DIRECTION * shown)) {
         snprintf(error, ERROR_SIZE,
                  "the bend-plane direction of the %s joint is parallel to its halfshaft direction or zero: it must "
@@ -364,6 +369,11 @@ static int build(System *s, const ModelData *data, char *error)
     }
     vector_of(data, motor, axis);
     length = norm3(axis);
+    if (isinf(length)) {
+        snprintf(error, ERROR_SIZE, "the motor axis (motor_axis_x, motor_axis_y, motor_axis_z) is too long (its "
+                 "length overflows)");
+        return 0;
+    }
     if (!(length > 0.0)) {
         snprintf(error, ERROR_SIZE, "the motor axis (motor_axis_x, motor_axis_y, motor_axis_z) has no length");
         return 0;
