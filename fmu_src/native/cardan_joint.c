@@ -1,8 +1,8 @@
 /* CardanJoint: exact kinematics of a Cardan (Hooke) joint, seed 003 (port of driveline/cardan/).
  *
  * (C1)-(C5) are the labels of docs/cardan_joint.md. g1 = phi_in - phase; the input speed is held
- * over a step, so phi_in grows by omega_in h; a_1 is the backward difference of the last two
- * omega_in samples (driveline/cardan/model.py).
+ * over a step, so phi_in grows by omega_in h; a_1 is the input alpha_in once the host set it non-zero,
+ * the backward difference of the last two omega_in samples until then (driveline/cardan/model.py).
  */
 #include <math.h>
 
@@ -11,31 +11,36 @@
 #define OMEGA_SAMPLE (data->internal[0]) /* omega_in of the last evaluation [rad/s] */
 #define SAMPLE_TIME (data->internal[1])  /* time of that evaluation [s] */
 #define HAS_SAMPLE (data->internal[2])   /* 1 once there was an evaluation */
+#define ACCELERATION_SET (data->internal[3]) /* 1 once the host set alpha_in non-zero */
 
 static void reset_internal(ModelData *data)
 {
     OMEGA_SAMPLE = 0.0;
     SAMPLE_TIME = 0.0;
     HAS_SAMPLE = 0.0;
+    ACCELERATION_SET = 0.0;
 }
 
 /* Outputs at the current phi_in; input_time is the communication point of the inputs. */
 static Failure evaluate(ModelData *data, double input_time)
 {
     double elapsed = HAS_SAMPLE != 0.0 ? input_time - SAMPLE_TIME : 0.0;
-    double alpha_in = elapsed > 0.0 ? (VALUE(omega_in) - OMEGA_SAMPLE) / elapsed : 0.0;
+    double alpha_in;
     double gamma1 = VALUE(phi_in) - VALUE(phase), beta = VALUE(beta), cos_beta = cos(beta);
     double sin_cos = sin(beta) * cos(gamma1), denominator = 1.0 - sin_cos * sin_cos;
     /* (C2) unwrapped: g1 = n pi + r with |r| <= pi/2, g2 = n pi + atan2(sin r, cos b cos r) */
     double half_turns = nearbyint(gamma1 / FMU_PI), rest = gamma1 - half_turns * FMU_PI;
     double ratio = cos_beta / denominator; /* (C3) */
+    ACCELERATION_SET = ACCELERATION_SET != 0.0 || VALUE(alpha_in) != 0.0;
+    alpha_in = ACCELERATION_SET != 0.0 ? VALUE(alpha_in)
+               : elapsed > 0.0         ? (VALUE(omega_in) - OMEGA_SAMPLE) / elapsed
+                                       : 0.0;
     OMEGA_SAMPLE = VALUE(omega_in);
     SAMPLE_TIME = input_time;
     HAS_SAMPLE = 1.0;
     VALUE(phi_out) = VALUE(phase) + (half_turns * FMU_PI + atan2(sin(rest), cos_beta * cos(rest)));
     VALUE(speed_ratio) = ratio;
     VALUE(omega_out) = VALUE(omega_in) * ratio;
-    VALUE(alpha_in) = alpha_in;
     /* (C4): a2 = a1 cos b / D - omega_1^2 cos b sin^2 b sin 2 g1 / D^2 */
     VALUE(alpha_out) = alpha_in * cos_beta / denominator - VALUE(omega_in) * VALUE(omega_in) * cos_beta *
                                                                (1.0 - cos_beta * cos_beta) * sin(2.0 * gamma1) /
@@ -47,5 +52,11 @@ static Failure evaluate(ModelData *data, double input_time)
 
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {
-    .reset_internal = reset_internal, .start = start, .advance = advance, .evaluate = evaluate};
+/* CardanJointModel.start_notice: alpha_in left at 0 is estimated, and the log says so. */
+static const char *start_notice(const ModelData *data)
+{
+    return ACCELERATION_SET == 0.0 ? ACCELERATION_ESTIMATED : NULL;
+}
+
+const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance,
+                                .evaluate = evaluate, .start_notice = start_notice};
