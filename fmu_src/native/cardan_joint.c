@@ -45,7 +45,38 @@ static Failure evaluate(ModelData *data, double input_time)
     return NO_FAILURE;
 }
 
+/* The exact partial derivatives of the outputs with respect to phi_in, beta, omega_in and T_load, from
+ * (C2)-(C5) differentiated: with D = 1 - sin^2 b cos^2 g1 and the ratio r = cos b / D (C3),
+ * d phi_out / d g1 = r, d phi_out / d b = sin b sin 2 g1 / (2 D), a2 = a1 r + omega_1^2 d r / d g1 (C4);
+ * a1 is held (the speed samples are history, not a function of the inputs). */
+static Failure jacobian(const ModelData *data, double partial[])
+{
+    double gamma1 = VALUE(phi_in) - VALUE(phase), beta = VALUE(beta), omega = VALUE(omega_in);
+    double s = sin(beta), c = cos(beta), cos_g = cos(gamma1), sin_2g = sin(2.0 * gamma1);
+    double d = 1.0 - s * s * cos_g * cos_g, ratio = c / d;
+    double d_g = s * s * sin_2g, d_gg = 2.0 * s * s * cos(2.0 * gamma1); /* derivatives of D */
+    double d_b = -2.0 * s * c * cos_g * cos_g, d_gb = 2.0 * s * c * sin_2g;
+    double ratio_g = -c * d_g / (d * d), ratio_b = -s / d - c * d_b / (d * d);
+    double ratio_gg = -c * (d_gg / (d * d) - 2.0 * d_g * d_g / (d * d * d));
+    double ratio_gb = s * d_g / (d * d) - c * d_gb / (d * d) + 2.0 * c * d_g * d_b / (d * d * d);
+    PARTIAL(phi_out, phi_in) = ratio;
+    PARTIAL(phi_out, beta) = s * sin_2g / (2.0 * d);
+    PARTIAL(speed_ratio, phi_in) = ratio_g;
+    PARTIAL(speed_ratio, beta) = ratio_b;
+    PARTIAL(omega_out, phi_in) = omega * ratio_g;
+    PARTIAL(omega_out, beta) = omega * ratio_b;
+    PARTIAL(omega_out, omega_in) = ratio;
+    PARTIAL(alpha_out, phi_in) = VALUE(alpha_in) * ratio_g + omega * omega * ratio_gg;
+    PARTIAL(alpha_out, beta) = VALUE(alpha_in) * ratio_b + omega * omega * ratio_gb;
+    PARTIAL(alpha_out, omega_in) = 2.0 * omega * ratio_g;
+    PARTIAL(T_in, phi_in) = VALUE(T_load) * ratio_g;
+    PARTIAL(T_in, beta) = VALUE(T_load) * ratio_b;
+    PARTIAL(T_in, T_load) = ratio;
+    PARTIAL(speed_fluctuation, beta) = s / (c * c) + s; /* d (tan b sin b) / d b */
+    return NO_FAILURE;
+}
+
 DRIVEN_SHAFT_HOOKS(evaluate)
 
-const ModelHooks model_hooks = {
-    .reset_internal = reset_internal, .start = start, .advance = advance, .evaluate = evaluate};
+const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance,
+                                .evaluate = evaluate, .jacobian = jacobian};
