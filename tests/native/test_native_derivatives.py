@@ -16,8 +16,9 @@ and cannot take the complex step. The adjoint identity v^T (J w) = (J^T v)^T w h
 
 from __future__ import annotations
 
-import zipfile
 import xml.etree.ElementTree as ET
+import zipfile
+from ctypes import c_double, c_uint
 
 import numpy as np
 import pytest
@@ -239,3 +240,16 @@ def test_outside_step_mode_the_call_is_an_error(native_dir, tmp_path, fmi):
         assert refused.value.status == 3
         assert log[-1] == f"fmi{fmi}GetDirectionalDerivative is not allowed in {mode}"
     fmu.freeInstance()
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+def test_a_null_array_is_an_error(native_dir, tmp_path, interface, fmi):
+    """The C call with the unknowns' references missing (NULL, one unknown named): Error, logged."""
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    model = ModelExchange(path, fmi, {}, tmp_path, interface=interface)
+    knowns, seed, sensitivity = (c_uint * 1)(3), (c_double * 1)(1.0), (c_double * 1)()
+    arguments = (None, 1, knowns, 1, seed, 1, sensitivity, 1) if fmi == "3" else (None, 1, knowns, 1, seed, sensitivity)
+    with pytest.raises(FMICallException) as refused:
+        getattr(model.fmu, f"fmi{fmi}GetDirectionalDerivative")(model.fmu.component, *arguments)
+    assert refused.value.status == 3
+    assert model.log[-1] == f"fmi{fmi}GetDirectionalDerivative: null array"
