@@ -14,7 +14,7 @@ import math
 import sys
 import tempfile
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -99,11 +99,12 @@ def parameter_changes(settings: list[str], system: SspSystem, descriptions: dict
     return changes
 
 
-def step_limit_error(system: SspSystem, descriptions: dict[str, ModelDescription], step: float) -> str | None:
-    """Why ``step`` is too long for a component whose model states a limit for a Jacobi coupling (every
-    engine here couples so): a ``VehicleDriveline``'s differential mode; None when no limit is passed."""
+def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) -> str | None:
+    """Why ``step`` is too long for a component whose model (``models``: each component's model name)
+    states a limit for a Jacobi coupling (every engine here couples so): a ``VehicleDriveline``'s
+    differential mode; None when no limit is passed."""
     for component in system.components:
-        if descriptions[component.name].modelName != "VehicleDriveline":
+        if models[component.name] != "VehicleDriveline":
             continue
         values = {v.name: v.start for v in MODELS["VehicleDriveline"].spec.variables} | component.parameters
         drive = Drive(*(float(values[name]) for name in Drive._fields))
@@ -206,7 +207,7 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
         package = ssp_package.with_parameters(args.package, changes, scratch / args.package.name)
         system = ssp_package.read(package)
     check_start_values(engine_instances(ssp=package))
-    reason = step_limit_error(system, descriptions, args.step)
+    reason = step_limit_error(system, {name: d.modelName for name, d in descriptions.items()}, args.step)
     if reason is not None:
         raise UsageError(reason)
     outputs, headers = output_columns(system, descriptions)

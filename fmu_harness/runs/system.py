@@ -276,8 +276,8 @@ def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, o
                unpacked: Mapping[str, tuple[str, ModelDescription]] | None = None) -> np.ndarray:
     """The fixed-step Jacobi master: instances ``{name: FMU}`` with their start values, connections
     ``((instance, output), (instance, input))``; rows of t_k and ``outputs`` (``"instance.variable"``)
-    for t_1 ... t_N. ``on_step(k, N)`` is called after each step. A refused step raises
-    :class:`StepRefused` with the instance's name before its reasons. With ``order`` (every instance's
+    for t_1 ... t_N. ``on_step(k, N)`` is called after each step. A refused step or initialisation
+    raises :class:`StepRefused` with the instance's name before its reasons. With ``order`` (every instance's
     name) it is a Gauss-Seidel master instead: the instances step one after the other in that order,
     each with its inputs set just before from the outputs as they are then (those of the instances
     already stepped at t_k+1). ``unpacked``: ``{name: (extracted folder, model description)}`` of
@@ -294,8 +294,8 @@ def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, o
             instance.enter_initialization(parameters.get(name, {}))
         for start, end in connections:
             instances[end[0]].set({end[1]: instances[start[0]].get([start[1]])[0]})
-        for instance in instances.values():
-            instance.exit_initialization()
+        for name, instance in instances.items():
+            _named(name, instance.exit_initialization)
 
         ports = [tuple(name.split(".", 1)) for name in outputs]
         record = Reading(instances, ports)
@@ -323,10 +323,15 @@ def _step(instances: Mapping[str, FmuInstance], names: list[str], k: int, step_s
     for name in names:
         instance = instances[name]
         instance.time = k * step_size
-        try:
-            instance.step(step_size)
-        except StepRefused as refused:
-            raise StepRefused(f"{name}: {refused.call}", refused.status, refused.time, refused.messages) from None
+        _named(name, instance.step, step_size)
+
+
+def _named(name: str, call: Callable[..., None], *arguments: object) -> None:
+    """``call(*arguments)`` of the instance ``name``; its :class:`StepRefused` names the instance first."""
+    try:
+        call(*arguments)
+    except StepRefused as refused:
+        raise StepRefused(f"{name}: {refused.call}", refused.status, refused.time, refused.messages) from None
 
 
 def simulate(system: System, models: Path, outputs: list[str] | None = None, natives: Path | None = None,

@@ -110,10 +110,8 @@ def test_a_file_that_is_no_package_is_one_line(package, tmp_path, capsys):
     assert exit_status.value.code == 2 and err.count("\n") == 1 and package in err
 
 
-@pytest.mark.xfail(reason="a start value beyond beta_max is now refused at initialisation, and that stop "
-                          "does not yet name the component", strict=False)
 def test_a_refused_step_stops_the_run_naming_the_component(native_ssp, tmp_path, capsys):
-    """A bend beyond beta_max: the coupling refuses its first step; the run stops with its reason."""
+    """A bend beyond beta_max: the coupling refuses it at initialisation; the run stops naming it, with its reason."""
     with pytest.raises(SystemExit) as exit_status:
         _run(native_ssp, tmp_path / "run.csv", "--set", "coupling.beta=1.0")
     message = str(exit_status.value.code)
