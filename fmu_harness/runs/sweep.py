@@ -94,7 +94,7 @@ SPECIFIC: dict[str, tuple[tuple[str, str], ...]] = {
 """Further (output, statistic) columns per model name."""
 
 DEFAULT_MODEL = "TripodCoupling"
-DEFAULT_MASTER = "jacobi"
+DEFAULT_MASTER = "gauss-seidel"
 """The master of a system sweep: see docs/sweeps.md for the measured choice."""
 
 CRITICAL_SPEEDS_MODEL = "CriticalSpeeds"
@@ -551,7 +551,7 @@ def check_scheduler(address: str, seconds: float = CONNECT_SECONDS) -> None:
         raise ValueError(f"--scheduler {address}: no scheduler answers there ({error.strerror or error})") from None
 
 
-def _workers(text: str) -> int:
+def workers_count(text: str) -> int:
     """An argparse type: the number of local workers, at least 1."""
     try:
         value = int(text)
@@ -560,6 +560,11 @@ def _workers(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be a whole number of at least 1, got {text}")
     return value
+
+
+def default_workers() -> int:
+    """Local workers by default: one per core."""
+    return os.cpu_count() or 1
 
 
 def _fmu_file(models: Path, model: str) -> Path:
@@ -572,6 +577,29 @@ def _fmu_file(models: Path, model: str) -> Path:
     built = sorted(p.stem for p in models.glob("*.fmu"))
     there = f"the FMUs there: {', '.join(built)}" if built else "none is there"
     raise ValueError(f"no FMU {path} ({there}; `driveline-fmus build` builds them)")
+
+
+def run_plan(plan: Plan, scheduler: str | None, workers: int) -> pa.Table:
+    """:func:`run` of a checked plan on the scheduler at ``scheduler`` or a local cluster of ``workers``,
+    with progress; ends the command first when every point is refused (naming the reasons) or an
+    optional package the run needs is missing."""
+    if len(plan.refused) == len(plan.points):
+        print_reasons(Counter(plan.refused.values()))
+        sys.exit(f"{COMMAND}: every point refused, none run")
+    optional("pyarrow", EXTRA, COMMAND)  # before the cluster starts
+    if isinstance(plan.fmu, ShippedSystem) and plan.fmu.master == "libcosim":
+        optional("libcosimpy", "interop", f"{COMMAND} --master libcosim")
+    what = plan.fmu.interface.name if isinstance(plan.fmu, ShippedSystem) else plan.fmu.interface.model
+    with open_client(scheduler, workers) as client:
+        print(f"{len(plan.points)} runs of {what} on {client.scheduler.address}")
+        return run(client, plan, show_progress=True)
+
+
+def read_table(path: Path) -> pa.Table:
+    """A table :func:`write_table` wrote."""
+    if path.suffix.lower() == ".csv":
+        return optional("pyarrow.csv", EXTRA, COMMAND).read_csv(path)
+    return optional("pyarrow.parquet", EXTRA, COMMAND).read_table(path)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -589,7 +617,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--step", type=float, help="communication step size [s] (needed by a system)")
     parser.add_argument("--master", choices=MASTERS, default=DEFAULT_MASTER,
                         help=f"the master of a system sweep (default {DEFAULT_MASTER})")
-    parser.add_argument("--workers", type=_workers, default=os.cpu_count() or 1, help="local cluster size")
+    parser.add_argument("--workers", type=workers_count, default=default_workers(), help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
     parser.add_argument(
         "--layout", default="", help="driveline of the critical-speed margin: TOML file or shipped name"
@@ -610,16 +638,7 @@ def main(argv: list[str] | None = None) -> None:
             check_scheduler(args.scheduler)
     except (ValueError, OSError, zipfile.BadZipFile) as error:
         parser.error(str(error))
-    if len(plan.refused) == len(points):
-        print_reasons(Counter(plan.refused.values()))
-        sys.exit(f"{COMMAND}: every point refused, none run")
-    optional("pyarrow", EXTRA, COMMAND)  # before the cluster starts
-    if isinstance(plan.fmu, ShippedSystem) and plan.fmu.master == "libcosim":
-        optional("libcosimpy", "interop", f"{COMMAND} --master libcosim")
-    what = plan.fmu.interface.name if isinstance(plan.fmu, ShippedSystem) else plan.fmu.interface.model
-    with open_client(args.scheduler, args.workers) as client:
-        print(f"{len(points)} runs of {what} on {client.scheduler.address}")
-        table = run(client, plan, show_progress=True)
+    table = run_plan(plan, args.scheduler, args.workers)
     write_table(table, args.out)
     reasons = failure_reasons(table)
     print(f"{table.num_rows} runs, {reasons.total()} failed -> {args.out}")

@@ -29,6 +29,7 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.model_description import ModelDescription
 
+from ..studies.order_tracking import third_order_peak
 from ..system_command import step_limit_error
 from . import ssp_package
 from .ssp_package import SspSystem
@@ -55,6 +56,14 @@ SYSTEM_METRICS: dict[str, tuple[tuple[str, str], ...]] = {
 }
 """(output, statistic) metric columns of the systems the project packages; any other system gets
 ``min``, ``max`` and ``mean`` of every Real output of every component."""
+ORDER_METRICS: dict[str, tuple[tuple[str, str], ...]] = {
+    "VehicleLaunch": (("joint_left.phi_in", "mounts.pitch_ddot"),),
+}
+"""(shaft angle, signal) of each third-order metric of a system: the peak third-order amplitude of the
+signal over the run and the shaft speed there (:func:`fmu_harness.studies.order_tracking.third_order_peak`),
+columns ``<signal>_order3_peak`` and ``<signal>_order3_speed``. For the launch: the powertrain's pitch
+acceleration over the left joint's turns (the right joint turns negatively in its own frame)."""
+ORDER_COLUMNS = ("order3_peak", "order3_speed")
 GENERIC = ("min", "max", "mean")
 
 
@@ -124,12 +133,18 @@ class SystemInterface:
             return list(known)
         return [(output, statistic) for output in self.outputs for statistic in GENERIC]
 
+    def orders(self) -> list[tuple[str, str]]:
+        """(shaft angle, signal) of each third-order metric (:data:`ORDER_METRICS`)."""
+        return [pair for pair in ORDER_METRICS.get(self.name, ()) if set(pair) <= set(self.outputs)]
+
     def metric_columns(self) -> list[str]:
-        return [f"{output}_{statistic}" for output, statistic in self.statistics()]
+        return [f"{output}_{statistic}" for output, statistic in self.statistics()] + [
+            f"{signal}_{column}" for _, signal in self.orders() for column in ORDER_COLUMNS]
 
     def recorded(self) -> list[str]:
         """The outputs a run records: those of the metrics."""
-        return list(dict.fromkeys(output for output, _ in self.statistics()))
+        ordered = [name for pair in self.orders() for name in pair]
+        return list(dict.fromkeys([*(output for output, _ in self.statistics()), *ordered]))
 
     def refusal(self, point: Point, step_size: float, master: str) -> str | None:
         """Why the point is not run: the first start value a component would refuse (the spec's bounds
@@ -204,8 +219,12 @@ def run_system(interface: SystemInterface, unpacked: UnpackedSystem, point: Poin
     if not np.all(np.isfinite(rows)):
         raise ValueError("the run gave values that are not finite")
     column = {name: rows[:, i + 1] for i, name in enumerate(outputs)}
-    return {f"{output}_{statistic}": float(STATISTICS[statistic](column[output]))
-            for output, statistic in interface.statistics()}
+    metrics = {f"{output}_{statistic}": float(STATISTICS[statistic](column[output]))
+               for output, statistic in interface.statistics()}
+    for shaft, signal in interface.orders():
+        found = third_order_peak(rows[:, 0], column[shaft], column[signal])
+        metrics |= {f"{signal}_{name}": value for name, value in zip(ORDER_COLUMNS, found)}
+    return metrics
 
 
 def stop_and_step(interface: SystemInterface, duration: float | None, step_size: float | None) -> tuple[float, float]:
