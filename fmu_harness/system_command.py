@@ -14,23 +14,19 @@ import math
 import sys
 import tempfile
 import zipfile
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
-from driveline.catalog import MODELS
-from driveline.vehicle import dynamics
-from driveline.vehicle.dynamics import Drive
-
 from .checks import importers
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
 from .runs.start_values import StartValuesRefused, check_start_values, engine_instances
-from .runs.system import run_jacobi
+from .runs.system import run_jacobi, step_limit_error
 from .studies.result_table import write_csv
 
 ENGINES = ("master", "libcosim", "ecos")
@@ -97,26 +93,6 @@ def parameter_changes(settings: list[str], system: SspSystem, descriptions: dict
                              f"--set {setting!r}: {component}.{variable} is an {found.causality}, not a parameter")
         changes[component, variable] = (found.type, _parse_value(found.type, text))
     return changes
-
-
-def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) -> str | None:
-    """Why ``step`` is too long for a component whose model (``models``: each component's model name)
-    states a limit for a Jacobi coupling (every engine here couples so): a ``VehicleDriveline``'s
-    differential mode; None when no limit is passed."""
-    for component in system.components:
-        if models[component.name] != "VehicleDriveline":
-            continue
-        values = {v.name: v.start for v in MODELS["VehicleDriveline"].spec.variables} | component.parameters
-        drive = Drive(*(float(values[name]) for name in Drive._fields))
-        limit = dynamics.jacobi_step_limit(drive)
-        if step > limit:
-            modes = "; ".join(f"{side} {omega:.4g} rad/s, damping ratio {zeta:.3g}"
-                              for side, (omega, zeta) in zip(("left", "right"), dynamics.internal_modes(drive)))
-            return (f"{component.name} (VehicleDriveline): --step {step!r} s is above {limit:.3g} s, the longest step "
-                    f"at which its differential's internal mode ({modes}) stays stable with the joints' torques "
-                    f"one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, {dynamics.JACOBI_DAMPING_STEP} "
-                    "zeta)): take a shorter step")
-    return None
 
 
 def output_columns(system: SspSystem, descriptions: dict[str, ModelDescription]) -> tuple[list[str], list[str]]:

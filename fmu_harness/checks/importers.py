@@ -25,9 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..runs.libcosim_run import NANOSECONDS
 from ..runs.start_values import check_start_values, engine_instances
-
-NANOSECONDS = 1_000_000_000
 
 
 @dataclass
@@ -161,34 +160,3 @@ def cosim_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp:
     session.resources.callback(slaves.clear)  # the slaves live as long as the session
     return session
 
-
-def cosim_run(package: Path, step_size: float, stop_time: float, outputs: list[str]) -> np.ndarray:
-    """The SSP ``package`` run whole in libcosim (its start values checked first, as by
-    :func:`cosim_session`): ``stop_time / step_size`` steps in one call, the ``outputs``
-    (``"instance.variable"``, Real) recorded in libcosim's time-series observer; rows of time
-    and ``outputs`` for t_1 ... t_N. No Python runs per step. A refused step raises RuntimeError."""
-    check_start_values(engine_instances(ssp=package))
-    from libcosimpy.CosimEnums import CosimVariableType
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-
-    log_output_level(CosimLogLevel.ERROR)
-    steps = int(round(stop_time / step_size))
-    execution = CosimExecution.from_ssp_file(ssp_path=str(package), step_size=round(step_size * NANOSECONDS))
-    observer = CosimObserver.create_time_series(buffer_size=steps + 1)
-    execution.add_observer(observer=observer)
-    references = {f"{info.name.decode()}.{variable.name.decode()}": (info.index, variable.reference)
-                  for info in execution.slave_infos() for variable in execution.slave_variables(slave_index=info.index)
-                  if variable.type == CosimVariableType.REAL.value}
-    for name in outputs:
-        observer.start_time_series(*references[name], CosimVariableType.REAL)
-    if not execution.step(step_count=steps):
-        raise RuntimeError(f"libcosim: a step of {package.name} was refused before {stop_time} s")
-    columns = []
-    for name in outputs:
-        _, numbers, values = observer.time_series_real_samples(*references[name], from_step=1, sample_count=steps)
-        if len(values) != steps or list(numbers[:1]) != [1]:
-            raise RuntimeError(f"libcosim recorded {len(values)} of {steps} steps of {name}")
-        columns.append(values)
-    return np.column_stack([(np.arange(steps) + 1.0) * step_size, *columns])

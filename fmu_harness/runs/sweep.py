@@ -25,8 +25,8 @@ row with its reason; a point whose parameters break the spec's bounds or relatio
 FMU would refuse at initialisation, is not run (:mod:`fmu_harness.runs.start_values`). The command
 ends non-zero when every run failed and names the distinct reasons, before any worker starts when
 every point is refused so. Its arguments, the FMU or package, the layout and the scheduler's
-address are checked before the cluster starts; Dask and pyarrow (the ``sweep`` extra) are imported when a sweep runs, so ``--help``
-needs neither.
+address are checked before the cluster starts; Dask and pyarrow (the ``sweep`` extra) are imported
+when a sweep runs, so ``--help`` needs neither.
 """
 
 from __future__ import annotations
@@ -60,7 +60,15 @@ from driveline.catalog import MODELS
 from ..console import CommandParser, Progress, optional
 from .runner import StepRefused, simulate
 from .start_values import refusals
-from .system_sweep import MASTERS, STATISTICS, SystemInterface, UnpackedSystem, run_system, stop_and_step
+from .system_sweep import (
+    MASTERS,
+    STATISTICS,
+    DerivedMetrics,
+    SystemInterface,
+    UnpackedSystem,
+    run_system,
+    stop_and_step,
+)
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -293,11 +301,12 @@ class ShippedSystem:
     master: str
 
     @classmethod
-    def read(cls, path: Path, duration: float | None, step_size: float | None, master: str) -> ShippedSystem:
+    def read(cls, path: Path, duration: float | None, step_size: float | None, master: str,
+             derived: Sequence[DerivedMetrics] = ()) -> ShippedSystem:
         """Raises ValueError for a package that cannot be read, a bad timing or an unknown master."""
         if master not in MASTERS:
             raise ValueError(f"no master {master!r} (the masters: {', '.join(MASTERS)})")
-        interface = SystemInterface.of(path)
+        interface = SystemInterface.of(path, derived)
         data = path.read_bytes()
         return cls(interface, hashlib.sha256(data).hexdigest(), data, *stop_and_step(interface, duration, step_size),
                    master)
@@ -429,14 +438,15 @@ class Plan:
 
     @classmethod
     def of_system(cls, package: Path, points: Sequence[Point], duration: float | None, step_size: float | None,
-                  master: str) -> Plan:
+                  master: str, derived: Sequence[DerivedMetrics] = ()) -> Plan:
         """A sweep of the SSP system ``package`` (:mod:`fmu_harness.runs.system_sweep`): every run lasts
-        ``duration`` (default the package's stop time) in steps of ``step_size`` by ``master``. Raises
+        ``duration`` (default the package's stop time) in steps of ``step_size`` by ``master``, with the
+        ``derived`` metrics besides the system's own. Raises
         ValueError for no points, a package that cannot be read, a bad timing or an unknown name; the
         points a component would refuse or whose step is too long are not run."""
         if not points:
             raise ValueError("no points to run")
-        shipped = ShippedSystem.read(package, duration, step_size, master)
+        shipped = ShippedSystem.read(package, duration, step_size, master, derived)
         for point in points:
             shipped.interface.changes(point)
         found = {i: shipped.interface.refusal(point, shipped.step_size, master) for i, point in enumerate(points)}
@@ -613,7 +623,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--turns", type=int, default=1, help=f"run length in turns of {SPEED} (default 1)")
     parser.add_argument("--steps-per-turn", type=int, default=360)
-    parser.add_argument("--duration", type=float, help="run length [s] instead of whole turns (a system: its stop time)")
+    parser.add_argument("--duration", type=float,
+                        help="run length [s] instead of whole turns (of a system: instead of its stop time)")
     parser.add_argument("--step", type=float, help="communication step size [s] (needed by a system)")
     parser.add_argument("--master", choices=MASTERS, default=DEFAULT_MASTER,
                         help=f"the master of a system sweep (default {DEFAULT_MASTER})")

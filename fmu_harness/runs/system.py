@@ -33,11 +33,14 @@ import numpy as np
 from fmpy.model_description import ModelDescription
 
 from driveline.catalog import MODELS
+from driveline.vehicle import dynamics
+from driveline.vehicle.dynamics import Drive
 from driveline.variables import UNITS, ModelSpec, Variable
 
 from ..packaging import fmu_path, native
 from .runner import FmuInstance, StepRefused
 from .ssp import SSC, SSD, SSV
+from .ssp_package import SspSystem
 from .start_values import Instance, StartValuesRefused, check_start_values
 
 for prefix, uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
@@ -332,6 +335,26 @@ def _named(name: str, call: Callable[..., None], *arguments: object) -> None:
         call(*arguments)
     except StepRefused as refused:
         raise StepRefused(f"{name}: {refused.call}", refused.status, refused.time, refused.messages) from None
+
+
+def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) -> str | None:
+    """Why ``step`` is too long for a component whose model (``models``: each component's model name)
+    states a limit for a Jacobi coupling (every engine here couples so): a ``VehicleDriveline``'s
+    differential mode; None when no limit is passed."""
+    for component in system.components:
+        if models[component.name] != "VehicleDriveline":
+            continue
+        values = {v.name: v.start for v in MODELS["VehicleDriveline"].spec.variables} | component.parameters
+        drive = Drive(*(float(values[name]) for name in Drive._fields))
+        limit = dynamics.jacobi_step_limit(drive)
+        if step > limit:
+            modes = "; ".join(f"{side} {omega:.4g} rad/s, damping ratio {zeta:.3g}"
+                              for side, (omega, zeta) in zip(("left", "right"), dynamics.internal_modes(drive)))
+            return (f"{component.name} (VehicleDriveline): --step {step!r} s is above {limit:.3g} s, the longest step "
+                    f"at which its differential's internal mode ({modes}) stays stable with the joints' torques "
+                    f"one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, {dynamics.JACOBI_DAMPING_STEP} "
+                    "zeta)): take a shorter step")
+    return None
 
 
 def simulate(system: System, models: Path, outputs: list[str] | None = None, natives: Path | None = None,

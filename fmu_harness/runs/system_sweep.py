@@ -10,7 +10,7 @@ Masters (``--master``): ``jacobi``, the project's fixed-step Jacobi master
 (:func:`fmu_harness.runs.system.run_jacobi`); ``gauss-seidel``, the same master stepping the
 components one after the other in the package's order (for ``VehicleLaunch.ssp`` that is
 :data:`fmu_harness.runs.system.LAUNCH_ORDER`); ``libcosim``, libcosim's Jacobi master running the
-whole launch in C++ (:func:`fmu_harness.checks.importers.cosim_run`; the ``interop`` extra). A point
+whole launch in C++ (:func:`fmu_harness.runs.libcosim_run.cosim_run`; the ``interop`` extra). A point
 whose start values a component would refuse, or whose step is above a ``VehicleDriveline``'s
 limit for a Jacobi coupling (``jacobi`` and ``libcosim``), is not run: its row fails with the reason.
 """
@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import tempfile
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -29,12 +29,11 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.model_description import ModelDescription
 
-from ..studies.order_tracking import third_order_peak
-from ..system_command import step_limit_error
 from . import ssp_package
+from .libcosim_run import cosim_run
 from .ssp_package import SspSystem
 from .start_values import refusals
-from .system import run_jacobi
+from .system import run_jacobi, step_limit_error
 
 MASTERS = ("jacobi", "gauss-seidel", "libcosim")
 JOIN = "+"
@@ -56,14 +55,18 @@ SYSTEM_METRICS: dict[str, tuple[tuple[str, str], ...]] = {
 }
 """(output, statistic) metric columns of the systems the project packages; any other system gets
 ``min``, ``max`` and ``mean`` of every Real output of every component."""
-ORDER_METRICS: dict[str, tuple[tuple[str, str], ...]] = {
-    "VehicleLaunch": (("joint_left.phi_in", "mounts.pitch_ddot"),),
-}
-"""(shaft angle, signal) of each third-order metric of a system: the peak third-order amplitude of the
-signal over the run and the shaft speed there (:func:`fmu_harness.studies.order_tracking.third_order_peak`),
-columns ``<signal>_order3_peak`` and ``<signal>_order3_speed``. For the launch: the powertrain's pitch
-acceleration over the left joint's turns (the right joint turns negatively in its own frame)."""
-ORDER_COLUMNS = ("order3_peak", "order3_speed")
+
+
+@dataclass(frozen=True)
+class DerivedMetrics:
+    """Metric columns a study computes from a run's recorded outputs on the worker (the shudder map's
+    third-order peak, :mod:`fmu_harness.shudder_map`): ``compute(time, {output: values})`` gives the
+    values of ``columns`` from the ``outputs`` it names. ``compute`` travels to the workers by
+    reference: a module-level function of an importable module."""
+
+    outputs: tuple[str, ...]
+    columns: tuple[str, ...]
+    compute: Callable[[np.ndarray, dict[str, np.ndarray]], Sequence[float]]
 GENERIC = ("min", "max", "mean")
 
 
@@ -91,10 +94,13 @@ class SystemInterface:
     package: SspSystem
     outputs: tuple[str, ...]
     """Every Real output as ``component.variable``."""
+    derived: tuple[DerivedMetrics, ...] = ()
 
     @classmethod
-    def of(cls, path: Path) -> SystemInterface:
-        """Raises :class:`ssp_package.PackageError` (a ValueError) for a package that cannot be read."""
+    def of(cls, path: Path, derived: Sequence[DerivedMetrics] = ()) -> SystemInterface:
+        """The package's interface with the ``derived`` metrics; raises :class:`ssp_package.PackageError`
+        (a ValueError) for a package that cannot be read, ValueError for a derived metric's output the
+        system has not."""
         package = ssp_package.read(path)
         connected = {end for _, end in package.connections}
         descriptions = _descriptions(path, package)
@@ -102,8 +108,11 @@ class SystemInterface:
                     if v.causality == "parameter" or (v.causality == "input" and (c.name, v.name) not in connected)}
         outputs = tuple(f"{c.name}.{v.name}" for c in package.components for v in descriptions[c.name].modelVariables
                         if v.causality == "output" and v.type in ("Real", "Float64"))
+        missing = sorted({name for metrics in derived for name in metrics.outputs} - set(outputs))
+        if missing:
+            raise ValueError(f"{', '.join(missing)}: no Real output of {package.name}")
         return cls(package.name, {c.name: descriptions[c.name].modelName for c in package.components},
-                   settable, package, outputs)
+                   settable, package, outputs, tuple(derived))
 
     def changes(self, point: Point) -> dict[Target, tuple[str, Value]]:
         """``{(component, variable): (type, value)}`` of a point; ValueError for a name the system cannot set."""
@@ -133,18 +142,14 @@ class SystemInterface:
             return list(known)
         return [(output, statistic) for output in self.outputs for statistic in GENERIC]
 
-    def orders(self) -> list[tuple[str, str]]:
-        """(shaft angle, signal) of each third-order metric (:data:`ORDER_METRICS`)."""
-        return [pair for pair in ORDER_METRICS.get(self.name, ()) if set(pair) <= set(self.outputs)]
-
     def metric_columns(self) -> list[str]:
         return [f"{output}_{statistic}" for output, statistic in self.statistics()] + [
-            f"{signal}_{column}" for _, signal in self.orders() for column in ORDER_COLUMNS]
+            column for metrics in self.derived for column in metrics.columns]
 
     def recorded(self) -> list[str]:
         """The outputs a run records: those of the metrics."""
-        ordered = [name for pair in self.orders() for name in pair]
-        return list(dict.fromkeys([*(output for output, _ in self.statistics()), *ordered]))
+        derived = [name for metrics in self.derived for name in metrics.outputs]
+        return list(dict.fromkeys([*(output for output, _ in self.statistics()), *derived]))
 
     def refusal(self, point: Point, step_size: float, master: str) -> str | None:
         """Why the point is not run: the first start value a component would refuse (the spec's bounds
@@ -188,7 +193,8 @@ class UnpackedSystem:
         for component in interface.package.components:
             fmus[component.name] = folder / "package" / component.source
             if component.source not in by_source:
-                unzipdir = extract(str(fmus[component.name]), unzipdir=folder / "extracted" / Path(component.source).stem)
+                target = folder / "extracted" / Path(component.source).stem
+                unzipdir = extract(str(fmus[component.name]), unzipdir=target)
                 by_source[component.source] = (unzipdir, read_model_description(unzipdir))
         return cls(path, fmus, {c.name: by_source[c.source] for c in interface.package.components})
 
@@ -208,8 +214,6 @@ def run_system(interface: SystemInterface, unpacked: UnpackedSystem, point: Poin
     outputs = interface.recorded()
     system = interface.system(point)
     if master == "libcosim":
-        from ..checks.importers import cosim_run
-
         package = ssp_package.with_parameters(unpacked.path, interface.changes(point), scratch / unpacked.path.name)
         rows = cosim_run(package, step_size, stop_time, outputs)
     else:
@@ -221,9 +225,9 @@ def run_system(interface: SystemInterface, unpacked: UnpackedSystem, point: Poin
     column = {name: rows[:, i + 1] for i, name in enumerate(outputs)}
     metrics = {f"{output}_{statistic}": float(STATISTICS[statistic](column[output]))
                for output, statistic in interface.statistics()}
-    for shaft, signal in interface.orders():
-        found = third_order_peak(rows[:, 0], column[shaft], column[signal])
-        metrics |= {f"{signal}_{name}": value for name, value in zip(ORDER_COLUMNS, found)}
+    for derived in interface.derived:
+        values = derived.compute(rows[:, 0], {name: column[name] for name in derived.outputs})
+        metrics |= {name: float(value) for name, value in zip(derived.columns, values, strict=True)}
     return metrics
 
 

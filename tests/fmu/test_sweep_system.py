@@ -17,9 +17,10 @@ import numpy as np
 import pyarrow.csv
 import pytest
 
-from fmu_harness.runs import shudder_map, system
+from fmu_harness import shudder_map
+from fmu_harness.runs import system
 from fmu_harness.runs.sweep import Plan, main, run
-from fmu_harness.runs.system_sweep import ORDER_METRICS, STATISTICS, SYSTEM_METRICS
+from fmu_harness.runs.system_sweep import STATISTICS, SYSTEM_METRICS, DerivedMetrics
 from fmu_harness.studies.order_tracking import third_order_peak
 
 STOP, STEP = 2.0, 8e-4
@@ -72,7 +73,7 @@ def master_metrics(fmi2_dir: Path, native_dir: Path, point: dict, order: tuple[s
                        for c in launch.components)
     changed = dataclasses.replace(launch, components=components, stop_time=STOP, step_size=step)
     metrics = SYSTEM_METRICS["VehicleLaunch"]
-    (shaft, signal), = ORDER_METRICS["VehicleLaunch"]
+    shaft, signal = shudder_map.SHAFT, shudder_map.SIGNAL
     outputs = list(dict.fromkeys([*(output for output, _ in metrics), shaft, signal]))
     rows = system.simulate(changed, fmi2_dir, outputs, natives=native_dir, order=order)
     found = {f"{output}_{statistic}": float(STATISTICS[statistic](rows[:, 1 + outputs.index(output)]))
@@ -88,7 +89,8 @@ def test_a_system_sweep_on_a_scheduler_gives_the_masters_runs(launch_ssp, schedu
     the joint's beta_max, which the FMU refuses at initialisation, fails its row with the FMU's reason."""
     from distributed import Client
 
-    plan = Plan.of_system(launch_ssp, [*POINTS, {"joint_right.beta": 1.0}], STOP, STEP, "gauss-seidel")
+    plan = Plan.of_system(launch_ssp, [*POINTS, {"joint_right.beta": 1.0}], STOP, STEP, "gauss-seidel",
+                          (shudder_map.THIRD_ORDER,))
     with Client(scheduler) as client:
         *rows, beyond = run(client, plan).to_pylist()
     assert [row["status"] for row in rows] == ["ok", "ok"] and beyond["status"] == "failed"
@@ -106,7 +108,7 @@ def test_the_libcosim_master_gives_the_jacobi_masters_metrics(launch_ssp, schedu
     project's Jacobi master's (the engines' agreement in tests/fmu/test_vehicle_launch.py), at 4e-4 s."""
     from distributed import Client
 
-    plan = Plan.of_system(launch_ssp, POINTS[:1], STOP, 4e-4, "libcosim")
+    plan = Plan.of_system(launch_ssp, POINTS[:1], STOP, 4e-4, "libcosim", (shudder_map.THIRD_ORDER,))
     with Client(scheduler) as client:
         row = run(client, plan).to_pylist()[0]
     assert row["status"] == "ok"
@@ -196,3 +198,10 @@ def test_grid_values_reach_every_joined_target(launch_ssp):
     assert bound["joint_left"]["beta"] == bound["joint_right"]["beta"] == 0.25
     assert bound["joint_left"]["l"] == 0.45 and bound["joint_right"]["l"] == 0.70
     assert np.isclose(bound["motor"]["T_level"], 140.0)
+
+
+def test_a_derived_metric_needs_outputs_the_system_has(launch_ssp):
+    """A study's metric naming an output the package has not is refused before anything runs."""
+    nowhere = DerivedMetrics(("mounts.nope",), ("nope_peak",), shudder_map.pitch_third_order)
+    with pytest.raises(ValueError, match="mounts.nope: no Real output of VehicleLaunch"):
+        Plan.of_system(launch_ssp, POINTS, STOP, STEP, "gauss-seidel", (nowhere,))

@@ -1,28 +1,31 @@
 """The launch shudder map: the peak third-order powertrain acceleration of the vehicle launch over the
 joints' bend angle, the launch torque and the joints' friction coefficient, through the sweep layer.
 
-Usage::
+Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
 
-    python -m fmu_harness.runs.shudder_map [--package models/native/VehicleLaunch.ssp] [--count 8]
+    driveline-fmus map [--package models/native/VehicleLaunch.ssp] [--count 8]
         [--duration 4] [--step 2e-4] [--master gauss-seidel] [--workers N | --scheduler tcp://host:8786]
         [--out results/shudder_map.parquet] [--figure results/shudder_map.png]
-    python -m fmu_harness.runs.shudder_map --figure-only [--out ...] [--figure ...]
+    driveline-fmus map --figure-only [--out ...] [--figure ...]
 
 The grid: ``--count`` values each of both joints' ``beta`` (5 to 20 deg), ``motor.T_level`` (20 to
 100 % of the default car's motor peak, :data:`driveline.vehicle.compact_car.MOTOR_PEAK_TORQUE`) and
 both joints' ``mu`` (0.02 to 0.1), the cartesian product (512 launches at the default 8), each one
-launch of :mod:`fmu_harness.runs.system_sweep` with its metrics, among them
+launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and :data:`THIRD_ORDER`:
 ``mounts.pitch_ddot_order3_peak``, the peak third-order amplitude of the powertrain's pitch
-acceleration over the launch. The table goes to ``--out``, the figure (a panel per friction
+acceleration over the left joint's turns (:func:`fmu_harness.studies.order_tracking.third_order_peak`;
+the right joint turns negatively in its own frame), and ``mounts.pitch_ddot_order3_speed``, the joint's
+speed there. A launch whose joint turns less than the order tracking's window fails with that reason. The table goes to ``--out``, the figure (a panel per friction
 coefficient: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the
 figure from a table written before.
 """
 
 from __future__ import annotations
 
+import importlib
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -30,21 +33,32 @@ import numpy as np
 
 from driveline.vehicle.compact_car import MOTOR_PEAK_TORQUE
 
-from ..console import CommandParser
-from ..studies import figures
-from . import sweep
+from .console import CommandParser
+from .runs import sweep
+from .runs.system_sweep import DerivedMetrics
+from .studies import figures
+from .studies.order_tracking import third_order_peak
 
 if TYPE_CHECKING:
     import pyarrow as pa
 
-COMMAND = "python -m fmu_harness.runs.shudder_map"
+COMMAND = "driveline-fmus map"
+SHAFT, SIGNAL = "joint_left.phi_in", "mounts.pitch_ddot"
 BETA = "joint_left.beta+joint_right.beta"
 TORQUE = "motor.T_level"
 MU = "joint_left.mu+joint_right.mu"
-PEAK = "mounts.pitch_ddot_order3_peak"
+PEAK = f"{SIGNAL}_order3_peak"
 BETA_RANGE = (math.radians(5.0), math.radians(20.0))
 TORQUE_RANGE = (0.2 * MOTOR_PEAK_TORQUE, MOTOR_PEAK_TORQUE)
 MU_RANGE = (0.02, 0.1)
+
+
+def pitch_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tuple[float, float]:
+    """The peak third-order pitch acceleration [rad/s2] over the left joint's turns and its speed there [rad/s]."""
+    return third_order_peak(time, outputs[SHAFT], outputs[SIGNAL])
+
+
+THIRD_ORDER = DerivedMetrics((SHAFT, SIGNAL), (PEAK, f"{SIGNAL}_order3_speed"), pitch_third_order)
 
 
 def axes(count: int) -> dict[str, list[float]]:
@@ -91,7 +105,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--duration", type=float, default=4.0, help="launch length [s] (default 4)")
     parser.add_argument("--step", type=float, default=2e-4, help="communication step [s] (default 2e-4)")
     parser.add_argument("--master", choices=sweep.MASTERS, default=sweep.DEFAULT_MASTER)
-    parser.add_argument("--workers", type=sweep.workers_count, default=sweep.default_workers(), help="local cluster size")
+    parser.add_argument("--workers", type=sweep.workers_count, default=sweep.default_workers(),
+                        help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
     parser.add_argument("--out", type=Path, default=Path("results") / "shudder_map.parquet", help=".parquet or .csv")
     parser.add_argument("--figure", type=Path, default=Path("results") / "shudder_map.png")
@@ -105,7 +120,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     if args.count < 2:
         parser.error(f"--count must be at least 2, got {args.count}")
     try:
-        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count)), args.duration, args.step, args.master)
+        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count)), args.duration, args.step, args.master,
+                                    (THIRD_ORDER,))
         if args.scheduler:
             sweep.check_scheduler(args.scheduler)
     except (ValueError, OSError) as error:
@@ -121,4 +137,5 @@ def main(argv: Sequence[str] | None = None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    # Dask pickles ``__main__`` functions by value; run the module's own import instead.
+    importlib.import_module(__spec__.name).main()
