@@ -85,16 +85,27 @@ class System:
         return [f"{c.name}.{v.name}" for c in self.components for v in c.spec.of("output") if v.type == "Real"]
 
 
-def driveline() -> System:
-    """Speed ramp 500 to 3000 rpm in 1 s with a 50 rpm, 5 Hz sine, into a tripod coupling bent
-    20 degrees under 150 N.m; ``CriticalSpeeds`` on the output shaft when it exists."""
+#: The couplings the driveline system takes and their bindings: bent 20 degrees under 150 N.m (the
+#: tripod with its exact kinematics).
+COUPLINGS = {
+    "TripodCoupling": {"kinematics": 1, "beta": math.radians(20.0), "T_load": 150.0},
+    "CardanJoint": {"beta": math.radians(20.0), "T_load": 150.0},
+}
+#: What the source feeds the coupling's input shaft (every coupling of COUPLINGS has both inputs): its
+#: output shaft's speed and acceleration.
+SOURCE_TO_COUPLING = (("omega_out", "omega_in"), ("alpha_out", "alpha_in"))
+
+
+def driveline(coupling: str = "TripodCoupling") -> System:
+    """Speed ramp 500 to 3000 rpm in 1 s with a 50 rpm, 5 Hz sine, into ``coupling`` (one of
+    :data:`COUPLINGS`) bent 20 degrees under 150 N.m; ``CriticalSpeeds`` on the output shaft when it
+    exists. The source's speed and acceleration feed the coupling's ``omega_in`` and ``alpha_in``."""
     components = [
         Component("source", "SpeedSource", {"omega_out_start": 500.0 * RPM, "ramp_rate": 2500.0 * RPM,
                                             "sine_amplitude": 50.0 * RPM, "sine_frequency": 5.0}),
-        Component("coupling", "TripodCoupling", {"kinematics": 1, "beta": math.radians(20.0), "T_load": 150.0}),
+        Component("coupling", coupling, COUPLINGS[coupling]),
     ]
-    connections = [Connection(("source", "omega_out"), ("coupling", "omega_in")),
-                   Connection(("source", "alpha_out"), ("coupling", "alpha_in"))]
+    connections = [Connection(("source", output), ("coupling", name)) for output, name in SOURCE_TO_COUPLING]
     if WATCHER in MODELS:
         components.append(Component("critical", WATCHER, {}))
         connections += [
