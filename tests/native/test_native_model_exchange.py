@@ -29,16 +29,16 @@ import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
-from support.dependency_points import points
 
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
+from support.dependency_points import points
 from support.model_exchange import ModelExchange
 
 NATIVE = [name for name in native.native_models() if not MODELS[name].co_simulation_only]
 ROUNDING = 1e-9  # relative: what two exact integrations of a linear state differ by
-#: Inputs stepped from 0 at the start time where held start inputs leave the states at rest: a load at
+#: Inputs stepped from 0 at LOAD_STEP_TIME where held start inputs leave the states at rest: a load at
 #: the centre of gravity, the joints' and the motor's
 LOAD_STEPS = {"PowertrainMounts": {"F_z": 4000.0, "M_y": 800.0, "Rx_in_left": -900.0, "Rz_in_left": 1500.0,
                                    "T_in_right": -600.0, "T_motor": 300.0}}
