@@ -98,6 +98,14 @@ class PowertrainMountsModel(SteppedModel):
         self._propagator = propagator
         self._show(state, held + rates * step_size)
 
+    def evaluate(self, time: float) -> None:
+        """Model Exchange (the native FMUs): accelerations and mount forces at the current state
+        under the inputs now (their rates are co-simulation's alone), the system built if needed."""
+        errors = self.extra_parameter_errors()
+        if errors:
+            raise ValueError(errors[0])
+        self._show(self._values(COORDINATES + VELOCITIES), self._system.inputs @ self._values(INPUTS))
+
     def _show(self, state: np.ndarray, force: np.ndarray) -> None:
         """Motion and mount-force outputs of ``state`` under the generalised ``force``."""
         system = self._system

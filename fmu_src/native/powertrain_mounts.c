@@ -690,5 +690,47 @@ static Failure evaluate(ModelData *data, double time UNUSED)
     return NO_FAILURE;
 }
 
+/* Directional derivatives: the model is linear, its partials constant. The accelerations (A s + B G u)[6:]
+ * by the states and the loads (their rates: none, as in evaluate), each mount's force by the states
+ * (show's mount forces); the states' own rows and der(<state>)'s are the layer's. */
+static Failure jacobian(const ModelData *data, double partial[])
+{
+    const System *s = data->cache->derived;
+    int i, j, k, n;
+    if (s == NULL) {
+        return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
+    }
+    for (i = 0; i < 6; i++) {
+        double *row = partial + model_jacobian_rows[ACCELERATION_VARIABLES[i]] * MODEL_COLUMN_COUNT;
+        for (k = 0; k < 12; k++) {
+            row[model_jacobian_columns[STATE_VARIABLES[k]]] = s->a[6 + i][k];
+        }
+        for (k = 0; k < N_INPUTS; k++) {
+            double sum = 0.0;
+            for (j = 0; j < 6; j++) {
+                sum += s->b[6 + i][j] * s->inputs[j][k];
+            }
+            row[model_jacobian_columns[model_input_derivatives[k].input]] = sum;
+        }
+    }
+    for (n = 0; n < s->layout.count; n++) {
+        const Mount *m = &s->layout.mounts[n];
+        for (i = 0; i < 3; i++) {
+            double *row = partial + model_jacobian_rows[V_F_x_mount1 + 3 * n + i] * MODEL_COLUMN_COUNT;
+            for (j = 0; j < 6; j++) {
+                double moved = 0.0, speed = 0.0;
+                for (k = 0; k < 3; k++) {
+                    moved -= m->axes[k][i] * m->stiffness[k] * s->maps[n][k][j];
+                    speed -= m->axes[k][i] * m->damping[k] * s->maps[n][k][j];
+                }
+                row[model_jacobian_columns[STATE_VARIABLES[j]]] = moved;
+                row[model_jacobian_columns[STATE_VARIABLES[6 + j]]] = speed;
+            }
+        }
+    }
+    return NO_FAILURE;
+}
+
 const ModelHooks model_hooks = {.start = start, .advance = advance, .evaluate = evaluate,
-                                .extra_parameter_errors = extra_parameter_errors, .free_derived = free_system};
+                                .extra_parameter_errors = extra_parameter_errors, .free_derived = free_system,
+                                .jacobian = jacobian};
