@@ -15,8 +15,6 @@ class VehicleDrivelineModel(SteppedModel):
     left joint turns positively and the right one negatively (ISO 8855, y to the left)."""
 
     spec = SPEC
-    co_simulation_only = ("co-simulation only: VehicleDriveline's state holds the wheels' angles, which are no "
-                          "outputs (a Model Exchange state is an output of the spec)")
     # rolling slowly on a grade with every input set: the road load (rolling resistance within its
     # regularisation, v_low) and the halfshafts act
     dependency_points = ({"v_start": 0.05, "grade": 0.05, "T_motor": 120.0, "T_in_left": 300.0, "T_in_right": -280.0,
@@ -43,6 +41,12 @@ class VehicleDrivelineModel(SteppedModel):
         the right joint's quantities change sign)."""
         return Joints(self.T_in_left, -self.T_in_right, self.phi_out_left, -self.phi_out_right,
                       self.omega_out_left, -self.omega_out_right)
+
+    def step_size_errors(self, step_size: float) -> list[str]:
+        return dynamics.step_limit_errors(self._drive(), step_size)
+
+    def step_notice(self, step_size: float) -> str | None:
+        return dynamics.step_limit_notice(self._drive(), step_size)
 
     def start(self, start_time: float) -> None:
         drive, joints = self._drive(), self._joints()
@@ -71,3 +75,11 @@ class VehicleDrivelineModel(SteppedModel):
         self.F_x_left = dynamics.tyre_force(drive, self.slip_left, drive.mu_road_left)
         self.F_x_right = dynamics.tyre_force(drive, self.slip_right, drive.mu_road_right)
         self.v_x, self.a_x, self.x = state[dynamics.SPEED], rate[dynamics.SPEED], state[dynamics.TRAVEL]
+        self.phi_wheel_left, self.phi_wheel_right = state[dynamics.PHI_WHEEL_LEFT], state[dynamics.PHI_WHEEL_RIGHT]
+        self.alpha_wheel_left, self.alpha_wheel_right = rate[dynamics.WHEEL_LEFT], rate[dynamics.WHEEL_RIGHT]
+        self.slip_dot_left, self.slip_dot_right = rate[dynamics.SLIP_LEFT], rate[dynamics.SLIP_RIGHT]
+
+    def rounding_scales(self) -> dict[str, float]:
+        """The slips' rates start as r_wheel (v_start / r_wheel) - v_start, zero but for rounding (eq V6)."""
+        scale = 2.0 * abs(self.v_start) / self.sigma_slip
+        return {"slip_dot_left": scale, "slip_dot_right": scale}
