@@ -16,6 +16,7 @@ HALFSHAFT = ("k_{side}", "c_{side}", "phi_out_{side}", "omega_out_{side}", "phi_
 TYRE = ("m_vehicle", "grade", "front_share", "C_slip")
 CAR = ("m_vehicle", "J_wheel", "r_wheel", "f_roll", "rho_air", "c_drag", "A_front", "grade", "v_low", "v_x")
 ROLLING = ("v_start", "r_wheel")  # the start: rolling at v_start without slip
+V_MAX = 150.0  # m/s, the fastest start: 540 km/h
 
 
 def _side(names: tuple[str, ...], side: str) -> tuple[str, ...]:
@@ -78,7 +79,9 @@ SPEC = ModelSpec(
         Variable("v_low", "parameter", 0.1,
                  "Low-speed regularisation: the slip's speed |v| + v_low, rolling resistance's sign tanh(v / v_low)",
                  "m/s", "km/h", **POSITIVE),
-        Variable("v_start", "parameter", 0.0, "Car speed at the start time (rolling without slip)", "m/s", "km/h"),
+        Variable("v_start", "parameter", 0.0, "Car speed at the start time (rolling without slip), within 540 km/h "
+                 "either way: beyond any road car (the drag's v |v| overflows from 1e154 m/s on)", "m/s", "km/h",
+                 min=-V_MAX, max=V_MAX),
         Variable("T_motor", "input", 0.0, "Motor torque on its rotor, forward positive", "N.m"),
         *_per_side("T_in", "input", 0.0,
                    "Torque the {side} joint takes from its input shaft, the side gear (the joint's T_in)", "N.m"),
