@@ -271,3 +271,14 @@ def test_the_step_limits_follow_the_differential_mode():
     assert model.step(0.0, 1.03e-3) == []
     free = model_checks.started(VehicleDrivelineModel, k_left=0.0, k_right=0.0)._drive()
     assert dynamics.jacobi_step_limit(free) == dynamics.divergence_step_limit(free) == math.inf
+
+
+def test_a_start_speed_beyond_any_road_car_is_refused_as_a_parameter():
+    """1e300 m/s made the drag v |v| and a_x -inf at initialisation (found by the random runs): the bound
+    of v_start refuses it, and the fastest start allowed gives finite outputs."""
+    fast = VehicleDrivelineModel()
+    fast.v_start = 1e300
+    assert fast.initialize(0.0) == ["parameter v_start = 1e+300 m/s is above its maximum 150.0 m/s"]
+    fastest = VehicleDrivelineModel()
+    fastest.v_start = -150.0
+    assert fastest.initialize(0.0) == [] and math.isfinite(fastest.a_x) and fastest.a_x > 0.0
