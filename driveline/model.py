@@ -132,6 +132,10 @@ class SteppedModel(ABC):
     #: step and to the value it has at each other point.
     dependency_points: ClassVar[tuple[dict[str, Any], ...]] = ()
 
+    #: The stop time of the model's standard run (``fmu_harness/runs/scenario.py``: 100 steps), where
+    #: the default experiment's would make a step the model refuses (None: the default experiment's).
+    scenario_stop_time: ClassVar[float | None] = None
+
     #: Why the model's native FMU offers co-simulation only ("": Model Exchange beside it, its states
     #: the spec's ``states``): a state the spec cannot name as an output.
     co_simulation_only: ClassVar[str] = ""

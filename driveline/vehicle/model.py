@@ -22,6 +22,8 @@ class VehicleDrivelineModel(SteppedModel):
                           "omega_out_right": -27.0},)
 
     native_constants = {"TOO_LONG": dynamics.TOO_LONG}
+    # 100 steps of 1 ms, within the step limit (1.04 ms with the defaults: dynamics.divergence_step_limit)
+    scenario_stop_time = 0.1
 
     def reset_internal_state(self) -> None:
         self._state: tuple[float, ...] = (0.0,) * dynamics.STATE_SIZE
