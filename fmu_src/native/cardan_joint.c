@@ -12,6 +12,7 @@
 #define SAMPLE_TIME (data->internal[1])  /* time of that evaluation [s] */
 #define HAS_SAMPLE (data->internal[2])   /* 1 once there was an evaluation */
 #define ACCELERATION_SET (data->internal[3]) /* 1 once the host set alpha_in non-zero */
+#define ACCELERATION_USED (data->internal[4]) /* a_1 of the last evaluation [rad/s2] */
 
 static void reset_internal(ModelData *data)
 {
@@ -19,6 +20,7 @@ static void reset_internal(ModelData *data)
     SAMPLE_TIME = 0.0;
     HAS_SAMPLE = 0.0;
     ACCELERATION_SET = 0.0;
+    ACCELERATION_USED = 0.0;
 }
 
 /* Outputs at the current phi_in; input_time is the communication point of the inputs. */
@@ -35,6 +37,7 @@ static Failure evaluate(ModelData *data, double input_time)
     alpha_in = ACCELERATION_SET != 0.0 ? VALUE(alpha_in)
                : elapsed > 0.0         ? (VALUE(omega_in) - OMEGA_SAMPLE) / elapsed
                                        : 0.0;
+    ACCELERATION_USED = alpha_in;
     OMEGA_SAMPLE = VALUE(omega_in);
     SAMPLE_TIME = input_time;
     HAS_SAMPLE = 1.0;
@@ -50,6 +53,39 @@ static Failure evaluate(ModelData *data, double input_time)
     return NO_FAILURE;
 }
 
+/* The exact partial derivatives of the outputs with respect to phi_in, beta, omega_in and T_load, from
+ * (C2)-(C5) differentiated: with D = 1 - sin^2 b cos^2 g1 and the ratio r = cos b / D (C3),
+ * d phi_out / d g1 = r, d phi_out / d b = sin b sin 2 g1 / (2 D), a2 = a1 r + omega_1^2 d r / d g1 (C4);
+ * a1 is the input alpha_in (d a2 / d a1 = r), or, until the host sets it, the estimate from the speed
+ * samples, held (history, not a function of the inputs). */
+static Failure jacobian(const ModelData *data, double partial[])
+{
+    double gamma1 = VALUE(phi_in) - VALUE(phase), beta = VALUE(beta), omega = VALUE(omega_in);
+    double s = sin(beta), c = cos(beta), cos_g = cos(gamma1), sin_2g = sin(2.0 * gamma1);
+    double d = 1.0 - s * s * cos_g * cos_g, ratio = c / d;
+    double d_g = s * s * sin_2g, d_gg = 2.0 * s * s * cos(2.0 * gamma1); /* derivatives of D */
+    double d_b = -2.0 * s * c * cos_g * cos_g, d_gb = 2.0 * s * c * sin_2g;
+    double ratio_g = -c * d_g / (d * d), ratio_b = -s / d - c * d_b / (d * d);
+    double ratio_gg = -c * (d_gg / (d * d) - 2.0 * d_g * d_g / (d * d * d));
+    double ratio_gb = s * d_g / (d * d) - c * d_gb / (d * d) + 2.0 * c * d_g * d_b / (d * d * d);
+    PARTIAL(phi_out, phi_in) = ratio;
+    PARTIAL(phi_out, beta) = s * sin_2g / (2.0 * d);
+    PARTIAL(speed_ratio, phi_in) = ratio_g;
+    PARTIAL(speed_ratio, beta) = ratio_b;
+    PARTIAL(omega_out, phi_in) = omega * ratio_g;
+    PARTIAL(omega_out, beta) = omega * ratio_b;
+    PARTIAL(omega_out, omega_in) = ratio;
+    PARTIAL(alpha_out, phi_in) = ACCELERATION_USED * ratio_g + omega * omega * ratio_gg;
+    PARTIAL(alpha_out, beta) = ACCELERATION_USED * ratio_b + omega * omega * ratio_gb;
+    PARTIAL(alpha_out, alpha_in) = ratio;
+    PARTIAL(alpha_out, omega_in) = 2.0 * omega * ratio_g;
+    PARTIAL(T_in, phi_in) = VALUE(T_load) * ratio_g;
+    PARTIAL(T_in, beta) = VALUE(T_load) * ratio_b;
+    PARTIAL(T_in, T_load) = ratio;
+    PARTIAL(speed_fluctuation, beta) = s / (c * c) + s; /* d (tan b sin b) / d b */
+    return NO_FAILURE;
+}
+
 DRIVEN_SHAFT_HOOKS(evaluate)
 
 /* CardanJointModel.start_notice: alpha_in left at 0 is estimated, and the log says so. */
@@ -59,4 +95,5 @@ static const char *start_notice(const ModelData *data)
 }
 
 const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance,
-                                .evaluate = evaluate, .start_notice = start_notice};
+                                .evaluate = evaluate, .start_notice = start_notice,
+                                .jacobian = jacobian};
