@@ -164,25 +164,19 @@ def _refusal(path, fmi: str, folder, interface: str, call, point: dict | None = 
     return refused.value.status, model.log[-1]
 
 
-def _every_known(unknowns, seed):
-    """A call asking the derivatives of ``unknowns(rows, columns)`` by every known, seeded ``seed(n)``
-    (n knowns)."""
-    return lambda fmu, rows, columns: fmu.getDirectionalDerivative(unknowns(rows, columns), columns,
-                                                                   seed(len(columns)))
-
-
 HOSTILE = {
-    "an unknown reference": (_every_known(lambda rows, columns: [9999], lambda n: [1.0] * n),
+    "an unknown reference": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([9999], columns, [1.0] * len(columns)),
                              3, "value reference 9999 is no unknown (a Real output or a state derivative)"),
-    "an input as unknown": (_every_known(lambda rows, columns: [columns[1]], lambda n: [1.0] * n),
+    "an input as unknown": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([columns[1]], columns,
+                                                                                    [1.0] * len(columns)),
                             3, "value reference 4 (beta) is no unknown (a Real output or a state derivative)"),
     "an output as known": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, [rows[1]], [1.0]),
                            3, "value reference 7 (phi_out) is no known (a Real input or a continuous state)"),
     "a parameter as known": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, [0], [1.0]),
                              3, "value reference 0 (beta_max) is no known (a Real input or a continuous state)"),
-    "a NaN seed": (_every_known(lambda rows, columns: rows, lambda n: [1.0, np.nan, *[0.0] * (n - 2)]),
+    "a NaN seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1.0, np.nan] + [0.0] * (len(columns) - 2)),
                    3, "seed[1] = nan is not finite"),
-    "an overflowing seed": (_every_known(lambda rows, columns: rows, lambda n: [1e308] * n),
+    "an overflowing seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1e308] * len(columns)),
                             2, "the directional derivative at t = 0.0 s overflows: the seed is too large"),
 }
 
@@ -199,11 +193,11 @@ def test_a_hostile_call_gets_a_status_and_a_reason(native_dir, tmp_path, case, i
 @pytest.mark.parametrize("interface", INTERFACES)
 def test_fmi3_sizes_that_do_not_match_are_refused(native_dir, tmp_path, interface):
     path = native.fmu_path(native_dir, "CardanJoint", "3")
-    rows, columns = derivatives.references("CardanJoint", "3")
     directional = _refusal(path, "3", tmp_path / "d", interface,
                            lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1.0] * 4, 3))
     adjoint = _refusal(path, "3", tmp_path / "a", interface,
                        lambda fmu, rows, columns: fmu.getAdjointDerivative(rows, columns, [1.0] * 3, 4))
+    rows, columns = derivatives.references("CardanJoint", "3")
     assert directional == (3, "fmi3GetDirectionalDerivative: nSeed, nSensitivity = 4, 3 where the knowns and "
                               f"unknowns give {len(columns)}, {len(rows)} (scalar variables only)")
     assert adjoint == (3, "fmi3GetAdjointDerivative: nSeed, nSensitivity = 3, 4 where the unknowns and knowns "
@@ -244,7 +238,7 @@ def test_outside_step_mode_the_call_is_an_error(native_dir, tmp_path, fmi):
                 fmu.setupExperiment(startTime=0.0)
                 fmu.enterInitializationMode()
         with pytest.raises(FMICallException) as refused:
-            fmu.getDirectionalDerivative(rows, columns, [1.0] * 4)
+            fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))
         assert refused.value.status == 3
         assert log[-1] == f"fmi{fmi}GetDirectionalDerivative is not allowed in {mode}"
     fmu.freeInstance()
