@@ -274,14 +274,15 @@ static void internal_mode(const ModelData *data, double k, double c, double *ome
  * divergence_step_limit (omega h <= DIVERGENCE_OMEGA_STEP): the shorter side's; inf without stiffness */
 static double step_limit(const ModelData *data, int jacobi)
 {
-    double omega[2], zeta[2], limit = HUGE_VAL, side_limit;
+    double omega[2], zeta[2], limit = HUGE_VAL, side_limit, damped;
     int i;
     internal_mode(data, VALUE(k_left), VALUE(c_left), &omega[0], &zeta[0]);
     internal_mode(data, VALUE(k_right), VALUE(c_right), &omega[1], &zeta[1]);
     for (i = 0; i < 2; i++) {
         if (omega[i] > 0.0) {
-            side_limit = !jacobi ? VEHICLE_DYNAMICS_DIVERGENCE_OMEGA_STEP
-                                 : fmin(VEHICLE_DYNAMICS_JACOBI_OMEGA_STEP, VEHICLE_DYNAMICS_JACOBI_DAMPING_STEP * zeta[i]);
+            damped = VEHICLE_DYNAMICS_JACOBI_DAMPING_STEP * zeta[i];
+            side_limit = jacobi ? fmin(VEHICLE_DYNAMICS_JACOBI_OMEGA_STEP, damped)
+                                : VEHICLE_DYNAMICS_DIVERGENCE_OMEGA_STEP;
             side_limit = side_limit / omega[i];
             limit = side_limit < limit ? side_limit : limit;
         }
