@@ -110,7 +110,8 @@ def measure(engine: str, path: Path, refusal: str) -> str:
     if result is not None:
         return result
     if done.returncode < 0:
-        said = next((line.strip() for line in done.stderr.splitlines() if "terminate called" in line), "")
+        said = "; ".join(" ".join(line.split()) for line in done.stderr.splitlines()
+                         if "terminate called" in line or line.strip().startswith("what():"))
         return f"the process dies of {signal.Signals(-done.returncode).name}" + (f' ("{said}")' if said else "")
     return f"the process exits with {done.returncode}: {(done.stderr.strip().splitlines() or [''])[-1]}"
 
