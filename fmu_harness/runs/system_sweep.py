@@ -55,7 +55,8 @@ SYSTEM_METRICS: dict[str, tuple[tuple[str, str], ...]] = {
     ),
 }
 """(output, statistic) metric columns of the systems the project packages; any other system gets
-``min``, ``max`` and ``mean`` of every Real output of every component."""
+the :data:`GENERIC` statistics of every Real output of every component."""
+GENERIC = ("min", "max", "mean")
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,6 @@ class DerivedMetrics:
     outputs: tuple[str, ...]
     columns: tuple[str, ...]
     compute: Callable[[np.ndarray, dict[str, np.ndarray]], Sequence[float]]
-GENERIC = ("min", "max", "mean")
 
 
 def targets(name: str) -> list[Target]:
