@@ -123,7 +123,7 @@ def test_a_tiny_shudder_map_on_a_local_cluster(launch_ssp, tmp_path, capsys):
     """The map's command with 2 values per axis (8 launches of 2 s) on a local cluster of one worker: a
     row per launch; at 20 % torque the joint turns less than the order tracking's window, which the
     row's reason says; at full torque the peak grows with the friction coefficient at either bend angle;
-    a figure with a panel per friction coefficient."""
+    a figure with a panel per friction coefficient, drawn the same again from the table alone."""
     out, figure = tmp_path / "map.csv", tmp_path / "map.png"
     shudder_map.main(["--package", str(launch_ssp), "--count", "2", "--duration", str(STOP), "--step", str(STEP),
                       "--workers", "1", "--out", str(out), "--figure", str(figure)])
@@ -137,6 +137,8 @@ def test_a_tiny_shudder_map_on_a_local_cluster(launch_ssp, tmp_path, capsys):
         assert full[beta, 0.1] > full[beta, 0.02] > 0.0
     captured = capsys.readouterr()
     assert "8 launches, 4 failed" in captured.out and "sweep [8/8]" in captured.err
+    shudder_map.main(["--figure-only", "--out", str(out), "--figure", str(tmp_path / "again.png")])
+    assert (tmp_path / "again.png").read_bytes() == figure.read_bytes()
 
 
 def test_refused_points_are_not_run_and_carry_their_reason(launch_ssp):
