@@ -17,9 +17,9 @@ launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and :da
 ``mounts.pitch_ddot_order3_peak``, the peak third-order amplitude of the powertrain's pitch
 acceleration over the left joint's turns (:func:`fmu_harness.studies.order_tracking.third_order_peak`;
 the right joint turns negatively in its own frame), and ``mounts.pitch_ddot_order3_speed``, the joint's
-speed there. A launch whose joint turns less than the order tracking's window fails with that reason. The table goes to ``--out``, the figure (a panel per friction
-coefficient: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the
-figure from a table written before.
+speed there. A launch whose joint turns less than the order tracking's window fails with that
+reason. The table goes to ``--out``, the figure (a panel per friction coefficient: the peak over bend
+angle and torque) to ``--figure``; ``--figure-only`` draws the figure from a table written before.
 """
 
 from __future__ import annotations
