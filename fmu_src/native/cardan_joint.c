@@ -53,7 +53,7 @@ static Failure evaluate(ModelData *data, double input_time)
     return NO_FAILURE;
 }
 
-/* The exact partial derivatives of the outputs with respect to phi_in, beta, omega_in and T_load, from
+/* The exact partial derivatives of the outputs with respect to phi_in, beta, omega_in, alpha_in, T_load, from
  * (C2)-(C5) differentiated: with D = 1 - sin^2 b cos^2 g1 and the ratio r = cos b / D (C3),
  * d phi_out / d g1 = r, d phi_out / d b = sin b sin 2 g1 / (2 D), a2 = a1 r + omega_1^2 d r / d g1 (C4);
  * a1 is the input alpha_in (d a2 / d a1 = r), or, until the host sets it, the estimate from the speed

@@ -165,17 +165,18 @@ def _refusal(path, fmi: str, folder, interface: str, call, point: dict | None = 
 
 
 HOSTILE = {
-    "an unknown reference": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([9999], columns, [1.0] * 4),
+    "an unknown reference": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([9999], columns, [1.0] * len(columns)),
                              3, "value reference 9999 is no unknown (a Real output or a state derivative)"),
-    "an input as unknown": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([columns[1]], columns, [1.0] * 4),
+    "an input as unknown": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([columns[1]], columns,
+                                                                                    [1.0] * len(columns)),
                             3, "value reference 4 (beta) is no unknown (a Real output or a state derivative)"),
     "an output as known": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, [rows[1]], [1.0]),
                            3, "value reference 7 (phi_out) is no known (a Real input or a continuous state)"),
     "a parameter as known": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, [0], [1.0]),
                              3, "value reference 0 (beta_max) is no known (a Real input or a continuous state)"),
-    "a NaN seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1.0, np.nan, 0.0, 0.0]),
+    "a NaN seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1.0, np.nan] + [0.0] * (len(columns) - 2)),
                    3, "seed[1] = nan is not finite"),
-    "an overflowing seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1e308] * 4),
+    "an overflowing seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1e308] * len(columns)),
                             2, "the directional derivative at t = 0.0 s overflows: the seed is too large"),
 }
 
@@ -196,10 +197,11 @@ def test_fmi3_sizes_that_do_not_match_are_refused(native_dir, tmp_path, interfac
                            lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1.0] * 4, 3))
     adjoint = _refusal(path, "3", tmp_path / "a", interface,
                        lambda fmu, rows, columns: fmu.getAdjointDerivative(rows, columns, [1.0] * 3, 4))
+    rows, columns = derivatives.references("CardanJoint", "3")
     assert directional == (3, "fmi3GetDirectionalDerivative: nSeed, nSensitivity = 4, 3 where the knowns and "
-                              "unknowns give 4, 9 (scalar variables only)")
+                              f"unknowns give {len(columns)}, {len(rows)} (scalar variables only)")
     assert adjoint == (3, "fmi3GetAdjointDerivative: nSeed, nSensitivity = 3, 4 where the unknowns and knowns "
-                          "give 9, 4 (scalar variables only)")
+                          f"give {len(rows)}, {len(columns)} (scalar variables only)")
 
 
 def test_a_point_a_step_would_refuse_is_discarded_with_its_reason(native_dir, tmp_path, fmi):
@@ -211,11 +213,11 @@ def test_a_point_a_step_would_refuse_is_discarded_with_its_reason(native_dir, tm
         rows, columns = derivatives.references("CardanJoint", fmi)
         model.set({"beta": 1.0})
         with pytest.raises(FMICallException) as refused:
-            model.fmu.getDirectionalDerivative(rows, columns, [1.0] * 4)
+            model.fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))
         assert refused.value.status == 2
         assert model.log[-1] == "input beta = 57.2958 deg must not exceed beta_max = 45 deg"
         model.set({"beta": 0.5})
-        assert len(model.fmu.getDirectionalDerivative(rows, columns, [1.0] * 4)) == len(rows)
+        assert len(model.fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))) == len(rows)
         model.close()
 
 
@@ -236,7 +238,7 @@ def test_outside_step_mode_the_call_is_an_error(native_dir, tmp_path, fmi):
                 fmu.setupExperiment(startTime=0.0)
                 fmu.enterInitializationMode()
         with pytest.raises(FMICallException) as refused:
-            fmu.getDirectionalDerivative(rows, columns, [1.0] * 4)
+            fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))
         assert refused.value.status == 3
         assert log[-1] == f"fmi{fmi}GetDirectionalDerivative is not allowed in {mode}"
     fmu.freeInstance()
