@@ -232,6 +232,7 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
     top.plot([p.crossing for p in reached], [p.frequency for p in reached], **ring, label="3 x f_shaft = f_mode")
     top.plot([p.measured[1] for p in reached], [3.0 * p.measured[1] / (2.0 * np.pi) for p in reached], **dot,
              label="measured third-order peak")
+    top.set_facecolor("black")  # where no window is centred, as where the spectrum is 0
     top.set_xlim(left, right)
     top.set_ylim(0.0, SPECTRUM_TOP)
     top.set_ylabel("frequency [Hz]")
@@ -255,7 +256,7 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
     bottom.set_ylabel("third-order amplitude / its peak [1]")
     bottom.set_title("Each mount mode's share of the powertrain's acceleration, third order: crossing (ring), "
                      "peak (dot),\nthe peak's speed against the crossing's", fontsize=10)
-    bottom.legend(loc="upper right", fontsize=8)
+    bottom.legend(loc="upper left", fontsize=8)
     bottom.grid(alpha=0.3)
     return fig
 
