@@ -5,7 +5,7 @@ critical speeds and the finite-element check, Campbell table from 41 speeds, ord
 1, 2, 3 up to twice ``omega_max = 1500 rad/s``) and its parts, for the one-piece tube of the
 FMU's defaults, the shipped two-piece example, and the same tube cut into 20 equal segments with
 a joint mass at every node (the issue's targets: 50 ms and 0.5 s). A change of ``orders`` costs
-the resonances alone, one of ``omega_max`` the whirl table and the resonances. CPU time of the
+the resonances alone, one of ``omega_in_max`` the whirl table and the resonances. CPU time of the
 process, best of five runs after a warm-up.
 
 The second table is the whole initialisation of the FMUs (parameters set, the analysis with the

@@ -2,7 +2,7 @@
 
 ``python -m benchmarks.work_fuzzer [--cases N] [--seed S]`` (default 200 cases, seed 1): the cases of
 :mod:`fmu_harness.checks.work_fuzzer` (the issue's layout first, then random layouts of extreme
-materials with ``omega_max`` near the estimate's edge and two tunable changes), each in a process of its
+materials with ``omega_in_max`` near the estimate's edge and two tunable changes), each in a process of its
 own under a limit of CPU time and address space, on the Python FMU ``models/CriticalSpeeds.fmu`` and the
 native one ``models/native/CriticalSpeeds.fmu`` (``python build_fmu.py --fmi 2 CriticalSpeeds``); prints the
 table per family and exits 1 if any analysis exceeds its budget (Python 30 s and 2 GB, native 5 s and

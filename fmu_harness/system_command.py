@@ -21,16 +21,12 @@ import numpy as np
 from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
-from driveline.catalog import MODELS
-from driveline.vehicle import dynamics
-from driveline.vehicle.dynamics import Drive
-
 from .checks import importers
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
 from .runs.start_values import StartValuesRefused, check_start_values, engine_instances
-from .runs.system import run_jacobi
+from .runs.system import run_jacobi, step_limit_error
 from .studies.result_table import write_csv
 
 ENGINES = ("master", "libcosim", "ecos")
@@ -97,25 +93,6 @@ def parameter_changes(settings: list[str], system: SspSystem, descriptions: dict
                              f"--set {setting!r}: {component}.{variable} is an {found.causality}, not a parameter")
         changes[component, variable] = (found.type, _parse_value(found.type, text))
     return changes
-
-
-def step_limit_error(system: SspSystem, descriptions: dict[str, ModelDescription], step: float) -> str | None:
-    """Why ``step`` is too long for a component whose model states a limit for a Jacobi coupling (every
-    engine here couples so): a ``VehicleDriveline``'s differential mode; None when no limit is passed."""
-    for component in system.components:
-        if descriptions[component.name].modelName != "VehicleDriveline":
-            continue
-        values = {v.name: v.start for v in MODELS["VehicleDriveline"].spec.variables} | component.parameters
-        drive = Drive(*(float(values[name]) for name in Drive._fields))
-        limit = dynamics.jacobi_step_limit(drive)
-        if step > limit:
-            modes = "; ".join(f"{side} {omega:.4g} rad/s, damping ratio {zeta:.3g}"
-                              for side, (omega, zeta) in zip(("left", "right"), dynamics.internal_modes(drive)))
-            return (f"{component.name} (VehicleDriveline): --step {step!r} s is above {limit:.3g} s, the longest step "
-                    f"at which its differential's internal mode ({modes}) stays stable with the joints' torques "
-                    f"one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, {dynamics.JACOBI_DAMPING_STEP} "
-                    "zeta)): take a shorter step")
-    return None
 
 
 def output_columns(system: SspSystem, descriptions: dict[str, ModelDescription]) -> tuple[list[str], list[str]]:
@@ -206,7 +183,7 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
         package = ssp_package.with_parameters(args.package, changes, scratch / args.package.name)
         system = ssp_package.read(package)
     check_start_values(engine_instances(ssp=package))
-    reason = step_limit_error(system, descriptions, args.step)
+    reason = step_limit_error(system, {name: d.modelName for name, d in descriptions.items()}, args.step)
     if reason is not None:
         raise UsageError(reason)
     outputs, headers = output_columns(system, descriptions)

@@ -19,6 +19,9 @@ test uses, so that test files carry none:
   runs and writes their times into the file (the others' stay); without ``-n`` and without
   ``TESTS`` (``--collect-only`` will do) it also drops the tests no longer collected.
 
+``--cpu-total`` prints the CPU seconds the file holds for the selected tests (with ``--collect-only``, what
+a run of them costs without running it).
+
 ``--fmi 2`` (or ``3``) builds and tests one FMI version only. ``--quick`` is the core and the
 FMI 2.0 FMUs without the slow and importer tests (``-m "not slow and not importers" --fmi 2``),
 and does not even import the modules that hold slow tests only (ROSS takes seconds to import):
@@ -67,6 +70,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                      help='the quick run: -m "not slow and not importers" --fmi 2, slow-only modules not imported')
     parser.addoption("--update-durations", action="store_true",
                      help=f"measure the tests run and write their CPU times into {DURATIONS.name}")
+    parser.addoption("--cpu-total", action="store_true",
+                     help=f"print the CPU seconds {DURATIONS.name} holds for the selected tests (with --collect-only: "
+                          "what a run of them costs, without running it)")
 
 
 def measured() -> dict[str, float]:
@@ -237,6 +243,26 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     if dropped:
         config.hook.pytest_deselected(items=dropped)
         items[:] = kept
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """With ``--cpu-total``, the selected tests' CPU seconds as last measured: the number the docs quote
+    for the quick run and the whole suite, generated (the session's FMU builds and collection are no
+    test's, so a run costs more; its wall time depends on the load and the workers)."""
+    if not session.config.getoption("cpu_total") or hasattr(session.config, "workerinput"):
+        return
+    durations = measured()
+    by_file: dict[str, float] = {}
+    for item in session.items:
+        path = item.nodeid.split("::")[0]
+        by_file[path] = by_file.get(path, 0.0) + durations.get(item.nodeid, 0.0)
+    unmeasured = sum(item.nodeid not in durations for item in session.items)
+    costliest = sorted(by_file.items(), key=lambda found: -found[1])[:3]
+    updated = json.loads(DURATIONS.read_text())["updated"] if DURATIONS.exists() else "never"
+    session.config.get_terminal_writer().line(
+        f"cpu total: {sum(by_file.values()):.0f} s of CPU for {len(session.items)} tests ({unmeasured} not measured; "
+        f"tests/{DURATIONS.name} of {updated}); costliest files: "
+        + ", ".join(f"{path} {seconds:.0f} s" for path, seconds in costliest))
 
 
 def _cpu_seconds() -> float:

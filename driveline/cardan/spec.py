@@ -36,12 +36,13 @@ SPEC = ModelSpec(
         Variable("omega_out", "output", 0.0,
                  "Output shaft speed omega_2 = omega_1 cos beta / (1 - sin^2 beta cos^2 gamma_1) (C3)",
                  "rad/s", "rpm", depends_on=(*JOINT, "omega_in")),
-        Variable("alpha_in", "output", 0.0,
-                 "Input acceleration a_1 used in alpha_out: backward difference of the last two "
-                 "omega_in samples", "rad/s2", depends_on=("omega_in",), initial_depends_on=()),
+        Variable("alpha_in", "input", 0.0,
+                 "Input shaft angular acceleration a_1 = d(omega_in)/dt, used in alpha_out (C4); until the host "
+                 "sets it non-zero (or omega_in's input derivative), the backward difference of the last two "
+                 "omega_in samples instead, said in the log at the start", "rad/s2", derivative="omega_in"),
         Variable("alpha_out", "output", 0.0,
-                 "Output shaft acceleration a_2 (C4) with a_1 = alpha_in", "rad/s2",
-                 depends_on=(*JOINT, "omega_in")),
+                 "Output shaft acceleration a_2 (C4) with a_1 = alpha_in (or its estimate while alpha_in is 0)",
+                 "rad/s2", depends_on=(*JOINT, "omega_in", "alpha_in")),
         Variable("T_in", "output", 0.0,
                  "Input torque from the power balance T_in omega_1 = T_load omega_2", "N.m",
                  depends_on=(*JOINT, "T_load")),

@@ -56,7 +56,7 @@ class Budget:
 def refusal(stage: str) -> str:
     """The refusal of an analysis whose budget ``stage`` exhausted."""
     return (f"the analysis would exceed its work budget (about {SECONDS:g} s) in the {stage} "
-            "(fewer stations or segments, fewer or lower orders, or a smaller omega_max)")
+            "(fewer stations or segments, fewer or lower orders, or a smaller omega_in_max)")
 
 
 _ACTIVE: ContextVar[Budget | None] = ContextVar("budget", default=None)

@@ -4,9 +4,9 @@ The driveline is analysed at initialisation and again when a tunable parameter c
 and only in the parts the change affects: the structure (critical speeds and the
 finite-element check) per set of structural parameters, the Campbell table of the first
 two forward and backward whirl frequencies (each branch a cubic spline, sorted per step)
-per ``omega_max`` as well, the order resonances up to twice ``omega_max`` per
+per ``omega_in_max`` as well, the order resonances up to twice ``omega_in_max`` per
 ``orders`` as well, and the unbalance outputs (:mod:`.unbalance_outputs`) per structure,
-bearing damping, unbalance parameters and ``omega_max``. ``band`` only enters the per-step lookup.
+bearing damping, unbalance parameters and ``omega_in_max``. ``band`` only enters the per-step lookup.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ MAX_SEARCHED_MODES = 250.0
 #: Finite-element plausibility check of every analysis (:func:`implausibility`).
 FE_ELEMENTS = 4
 PLAUSIBLE_DEVIATION = 0.02
-CAMPBELL_POINTS = 41  # spline knots over [0, omega_max], more where a branch bends (campbell.SPLINE_RTOL)
+CAMPBELL_POINTS = 41  # spline knots over [0, omega_in_max], more where a branch bends (campbell.SPLINE_RTOL)
 WHIRL_MODES = 2
 SHAFT_PARAMETERS = ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", "Jp_joint", "Jd_joint", "k_bearing",
                     "shear")
@@ -54,9 +54,9 @@ UNBALANCE_PARAMETERS = ("unbalance", "unbalance_position", "response_position")
 ANALYSIS_PARTS = {
     "driveline": SHAFT_PARAMETERS + DAMPING_PARAMETERS,
     "structure": SHAFT_PARAMETERS,
-    "whirl": SHAFT_PARAMETERS + ("omega_max",),
-    "resonances": SHAFT_PARAMETERS + ("omega_max",),
-    "unbalance": SHAFT_PARAMETERS + DAMPING_PARAMETERS + UNBALANCE_PARAMETERS + ("omega_max",),
+    "whirl": SHAFT_PARAMETERS + ("omega_in_max",),
+    "resonances": SHAFT_PARAMETERS + ("omega_in_max",),
+    "unbalance": SHAFT_PARAMETERS + DAMPING_PARAMETERS + UNBALANCE_PARAMETERS + ("omega_in_max",),
 }
 
 
@@ -235,8 +235,8 @@ class CriticalSpeedsModel(SteppedModel):
     """The ``CriticalSpeeds`` co-simulation model."""
 
     spec = SPEC
-    # the first forward whirl moves with the table's range (omega_max) by 1e-11 rad/s at 800 rad/s
-    dependency_points = ({"omega": 800.0, "omega_max": 3000.0, "orders": "3", "band": 0.3},
+    # the first forward whirl moves with the table's range (omega_in_max) by 1e-11 rad/s at 800 rad/s
+    dependency_points = ({"omega_in": 800.0, "omega_in_max": 3000.0, "orders": "3", "band": 0.3},
                          {"layout": "two_piece_propshaft"})
     derived_state = ("_analysis", "_analysed_for", "_resonance_speeds", "_parts", "_unbalance")
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml"
@@ -265,9 +265,9 @@ class CriticalSpeedsModel(SteppedModel):
 
     def extra_parameter_errors(self) -> list[str]:
         """Analyse what a changed parameter affects: the structure (critical speeds, finite-element
-        check) only when a structural parameter changed, the Campbell table when it or ``omega_max``
+        check) only when a structural parameter changed, the Campbell table when it or ``omega_in_max``
         did, the order resonances when either or ``orders`` did, the unbalance outputs when the
-        structure, the damping, the unbalance parameters or ``omega_max`` did. Its errors are the checks."""
+        structure, the damping, the unbalance parameters or ``omega_in_max`` did. Its errors are the checks."""
         key = self._key("unbalance", self.orders)  # every parameter of the analysis
         if key == self._analysed_for:
             return []
@@ -275,26 +275,26 @@ class CriticalSpeedsModel(SteppedModel):
             orders = parse_orders(self.orders)
             driveline = self._part("driveline", self._key("driveline"), lambda: build_driveline(
                 self.layout, {n: getattr(self, n) for n in SHAFT_PARAMETERS + DAMPING_PARAMETERS}))
-            work = searched_modes(driveline, orders, self.omega_max)
+            work = searched_modes(driveline, orders, self.omega_in_max)
             if not work <= MAX_SEARCHED_MODES:
                 raise ValueError(f"the analysis would scan {work:.3g} shaft modes, more than the "
                                  f"{MAX_SEARCHED_MODES:.0f} accepted (shorter or stiffer shaft, fewer or "
-                                 "lower orders, or a smaller omega_max)")
-            work = estimate(driveline, orders, self.omega_max, CAMPBELL_POINTS, FE_ELEMENTS)
+                                 "lower orders, or a smaller omega_in_max)")
+            work = estimate(driveline, orders, self.omega_in_max, CAMPBELL_POINTS, FE_ELEMENTS)
             refusal = work.refusal()
             if refusal is not None:
                 raise ValueError(refusal)
             budget = Budget()  # the parts analysed anew pay from it, the kept ones not again
             structure = self._part("structure", self._key("structure"), lambda: analyse_structure(driveline, budget,
                                                                                                    work))
-            whirl = self._part("whirl", self._key("whirl"), lambda: whirl_table(structure, self.omega_max, budget))
+            whirl = self._part("whirl", self._key("whirl"), lambda: whirl_table(structure, self.omega_in_max, budget))
             found = self._part("resonances", self._key("resonances", orders),
-                               lambda: resonances(driveline, orders, self.omega_max, budget))
+                               lambda: resonances(driveline, orders, self.omega_in_max, budget))
             analysis = Analysis(structure.critical_speeds, structure.critical_speed_count, whirl, found)
             unbalances = driveline.unbalances if self.layout else (
                 Unbalance(self.unbalance_position * driveline.length, self.unbalance),)
             self._unbalance = self._part("unbalance", self._key("unbalance"), lambda: unbalance_outputs(
-                driveline, unbalances, self.response_position, self.omega_max, budget, work))
+                driveline, unbalances, self.response_position, self.omega_in_max, budget, work))
             self._analysis = analysis
             self._resonance_speeds = analysis.resonance_speeds
         except (ValueError, ArithmeticError) as error:  # e.g. a diameter of 1e300 overflows
@@ -311,7 +311,7 @@ class CriticalSpeedsModel(SteppedModel):
 
     def evaluate(self) -> None:
         analysis = self._analysis
-        speed = abs(self.omega)
+        speed = abs(self.omega_in)
         self.omega_crit_1, self.omega_crit_2, self.omega_crit_3 = analysis.critical_speeds
         self.critical_speed_count = analysis.critical_speed_count
         whirl = analysis.whirl(speed)

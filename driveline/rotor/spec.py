@@ -8,12 +8,12 @@ STRUCTURE = "Driveline structure (tunable: a change is re-analysed at the next s
 #: The parameters of the structure, what every output is computed from (``depends_on``)
 SHAFT = ("L_shaft", "D_outer", "D_inner", "E", "density", "m_joint", "Jp_joint", "Jd_joint", "k_bearing", "shear",
          "layout")
-WHIRL = (*SHAFT, "omega", "omega_max")
+WHIRL = (*SHAFT, "omega_in", "omega_in_max")
 RESONANCE = (*WHIRL, "orders")
-UNBALANCE = (*SHAFT, "omega", "c_bearing", "unbalance", "unbalance_position")
-#: Smallest accepted omega_max [rad/s], far below any driveline speed and far above where the
-#: whirl and damping tables' splines over [0, omega_max] overflow (their knot spacing squared).
-OMEGA_MAX_MIN = 1e-3
+UNBALANCE = (*SHAFT, "omega_in", "c_bearing", "unbalance", "unbalance_position")
+#: Smallest accepted omega_in_max [rad/s], far below any driveline speed and far above where the
+#: whirl and damping tables' splines over [0, omega_in_max] overflow (their knot spacing squared).
+OMEGA_IN_MAX_MIN = 1e-3
 
 SPEC = ModelSpec(
     name="CriticalSpeeds",
@@ -67,14 +67,14 @@ SPEC = ModelSpec(
                  "Excitation orders watched for resonance (1, 2: Cardan joints; 3: tripod coupling)",
                  type="String", variability="tunable"),
         Variable("band", "parameter", 0.1,
-                 "Warning band: resonance_warning when |omega - resonance speed| < band * resonance speed",
+                 "Warning band: resonance_warning when |omega_in - resonance speed| < band * resonance speed",
                  "1", min=0.0, variability="tunable"),
-        Variable("omega_max", "parameter", 1500.0,
-                 "Largest accepted |omega|; the whirl frequencies are tabulated up to it (at least "
-                 f"{OMEGA_MAX_MIN:g} rad/s: the splines of the whirl and damping tables over [0, omega_max] "
+        Variable("omega_in_max", "parameter", 1500.0,
+                 "Largest accepted |omega_in|; the whirl frequencies are tabulated up to it (at least "
+                 f"{OMEGA_IN_MAX_MIN:g} rad/s: the splines of the whirl and damping tables over [0, omega_in_max] "
                  "overflow at tiny spans: 1e-140 rad/s measured)", "rad/s", "rpm",
-                 min=OMEGA_MAX_MIN, variability="tunable"),
-        Variable("omega", "input", 300.0, "Current shaft speed (sign ignored)", "rad/s", "rpm"),
+                 min=OMEGA_IN_MAX_MIN, variability="tunable"),
+        Variable("omega_in", "input", 300.0, "Current shaft speed (sign ignored)", "rad/s", "rpm"),
         Variable("omega_crit_1", "output", 0.0,
                  "First bending critical speed: synchronous whirl that unbalance excites (1e5 rad/s when none "
                  "lies below that search limit)", "rad/s", "rpm", depends_on=SHAFT),
@@ -93,9 +93,9 @@ SPEC = ModelSpec(
                  "rad/s", "rpm", depends_on=WHIRL),
         Variable("whirl_backward_2", "output", 0.0, "Second backward whirl frequency at the current speed",
                  "rad/s", "rpm", depends_on=WHIRL),
-        Variable("speed_ratio", "output", 0.0, "|omega| / omega_crit_1", "1", depends_on=(*SHAFT, "omega")),
+        Variable("speed_ratio", "output", 0.0, "|omega_in| / omega_crit_1", "1", depends_on=(*SHAFT, "omega_in")),
         Variable("resonance_order", "output", 0,
-                 "Order k of the closest order resonance (k |omega| = whirl), closest by relative margin",
+                 "Order k of the closest order resonance (k |omega_in| = whirl), closest by relative margin",
                  type="Integer", depends_on=RESONANCE),
         Variable("resonance_whirl", "output", 0,
                  "Whirl direction of the closest order resonance: 1 forward, -1 backward", type="Integer",
@@ -103,7 +103,7 @@ SPEC = ModelSpec(
         Variable("resonance_speed", "output", 0.0, "Shaft speed of the closest order resonance", "rad/s", "rpm",
                  depends_on=RESONANCE),
         Variable("resonance_margin", "output", 0.0,
-                 "(|omega| - resonance_speed) / resonance_speed: negative below the resonance", "1",
+                 "(|omega_in| - resonance_speed) / resonance_speed: negative below the resonance", "1",
                  depends_on=RESONANCE),
         Variable("resonance_count", "output", 0,
                  "Number of order resonances (all watched orders, both whirl directions) within the band",
@@ -117,13 +117,13 @@ SPEC = ModelSpec(
                  "Largest force a bearing transmits at the current speed (major semi-axis of its force orbit)", "N",
                  depends_on=UNBALANCE),
         Variable("damping_ratio", "output", 0.0,
-                 "Damping ratio of the unbalance-excited whirl mode whose damped frequency is nearest |omega|", "1",
+                 "Damping ratio of the unbalance-excited whirl mode whose damped frequency is nearest |omega_in|", "1",
                  depends_on=(*WHIRL, "c_bearing")),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-2),
     relations=(
         Relation("D_inner", "<", "D_outer"),
-        Relation("omega", "<=", "omega_max"),
-        Relation("omega", ">=", "omega_max", scale=-1.0),
+        Relation("omega_in", "<=", "omega_in_max"),
+        Relation("omega_in", ">=", "omega_in_max", scale=-1.0),
     ),
 )

@@ -21,7 +21,7 @@ from pathlib import Path
 from driveline.rotor.loader import MAX_POINT_ELEMENTS, MAX_SEGMENTS, load_driveline
 from driveline.rotor.model import (CAMPBELL_POINTS, FE_ELEMENTS, MAX_ORDER, MAX_ORDERS, MAX_SEARCHED_MODES,
                                    CriticalSpeedsModel, parse_orders, searched_modes)
-from driveline.rotor.spec import OMEGA_MAX_MIN
+from driveline.rotor.spec import OMEGA_IN_MAX_MIN
 from driveline.rotor.work import MAX_ANALYSIS_SECONDS, STAGES, estimate
 
 #: The budgets of one analysis on the project's two-core machine: (seconds, bytes of memory).
@@ -65,7 +65,7 @@ stiffness = 148605257.06885213
 position = 1.440681430980566
 amount = 8.265024109038702e-08
 """
-ROUND_OFF_PARAMETERS = {"omega_max": 2.07419590242784, "omega": 2.07419590242784, "band": 0.1, "orders": "89"}
+ROUND_OFF_PARAMETERS = {"omega_in_max": 2.07419590242784, "omega_in": 2.07419590242784, "band": 0.1, "orders": "89"}
 #: A layout the work estimate accepts (0.2 s) whose anisotropic Campbell table exceeds the analysis's budget
 #: (driveline/rotor/budget.py) with ``BUDGET_PARAMETERS``: refused naming the Campbell table, natively
 #: after 1.7 s of CPU time (found by a work fuzzer's layout with two masses and a bearing added).
@@ -135,7 +135,7 @@ position = 0.2
 kxx = 10000.0
 kyy = 300000.0
 """
-BUDGET_PARAMETERS = {"orders": "5,36", "omega_max": 65.536, "omega": 0.0}
+BUDGET_PARAMETERS = {"orders": "5,36", "omega_in_max": 65.536, "omega_in": 0.0}
 #: A tube of the shipped propshaft's size.
 TUBE = 'outer_diameter = 0.0762\nwall_thickness = 0.00165\nmaterial = "steel"'
 
@@ -158,12 +158,12 @@ def layout_text(segments: int, length: float, masses: int, bearings: int, unbala
 
 
 def accepted(text: str, parameters: dict) -> bool:
-    """Whether the work limits accept ``text`` with ``parameters`` (``orders``, ``omega_max``)."""
+    """Whether the work limits accept ``text`` with ``parameters`` (``orders``, ``omega_in_max``)."""
     with tempfile.NamedTemporaryFile("w", suffix=".toml") as file:
         file.write(text)
         file.flush()
         driveline = load_driveline(file.name)
-    orders, omega_max = parse_orders(parameters.get("orders", "1,2,3")), parameters.get("omega_max", 1500.0)
+    orders, omega_max = parse_orders(parameters.get("orders", "1,2,3")), parameters.get("omega_in_max", 1500.0)
     work = estimate(driveline, orders, omega_max, CAMPBELL_POINTS, FE_ELEMENTS)
     return searched_modes(driveline, orders, omega_max) <= MAX_SEARCHED_MODES and work.refusal() is None
 
@@ -176,7 +176,7 @@ def _most(make, top: int) -> int:
 def worst_cases() -> dict[str, tuple[str, dict]]:
     """Layout text and parameters of the worst inputs the limits allow, each kind at its edge, the
     propshaft engineer's shaft, and the issue's 566 s layout (refused)."""
-    slow = {"omega_max": OMEGA_MAX_MIN, "orders": "1", "omega": 0.0}
+    slow = {"omega_in_max": OMEGA_IN_MAX_MIN, "orders": "1", "omega_in": 0.0}
 
     def stations(n: int) -> tuple[str, dict]:
         return layout_text(n, 1.4, 2 * (n + 1), 2 * (n + 1), min(MAX_POINT_ELEMENTS, 2 * n)), slow
@@ -190,17 +190,17 @@ def worst_cases() -> dict[str, tuple[str, dict]]:
     propshaft = layout_text(20, 1.6, 10, 6, 4)
     orders = ",".join(str(k) for k in range(MAX_ORDER - MAX_ORDERS + 1, MAX_ORDER + 1))
     speeds = [1e-3 * 2.0 ** k for k in range(40)]
-    fastest = max(w for w in speeds if accepted(propshaft, {"omega_max": w}))
-    fastest_orders = max(w for w in speeds if accepted(propshaft, {"omega_max": w, "orders": orders}))
+    fastest = max(w for w in speeds if accepted(propshaft, {"omega_in_max": w}))
+    fastest_orders = max(w for w in speeds if accepted(propshaft, {"omega_in_max": w, "orders": orders}))
     return {
         "most stations": stations(_most(stations, MAX_SEGMENTS)),
         "most segments": segments(_most(segments, MAX_SEGMENTS)),
         "shortest segments (1 mm)": shortest(_most(shortest, MAX_SEGMENTS)),
         "stations between nodes": (layout_text(4, 1.4, 8, 8, 8, between=True), slow),
-        "most orders": (propshaft, {"orders": orders, "omega_max": fastest_orders, "omega": 0.0}),
-        "smallest omega_max": (propshaft, slow),
-        "largest omega_max": (propshaft, {"omega_max": fastest, "omega": 0.0}),
-        "propshaft, 20 segments": (propshaft, {"omega": 0.0}),
+        "most orders": (propshaft, {"orders": orders, "omega_in_max": fastest_orders, "omega_in": 0.0}),
+        "smallest omega_in_max": (propshaft, slow),
+        "largest omega_in_max": (propshaft, {"omega_in_max": fastest, "omega_in": 0.0}),
+        "propshaft, 20 segments": (propshaft, {"omega_in": 0.0}),
         "round-off ripple": (ROUND_OFF_LAYOUT, ROUND_OFF_PARAMETERS),
         "issue's 566 s layout": (layout_text(100, 1.4, 202, 202, 200), slow),
     }
@@ -227,19 +227,19 @@ def python_stages(path: str, parameters: dict) -> dict:
         setattr(core, name, value)
     driveline = model.build_driveline(path, {})
     orders = parse_orders(core.orders)
-    work = estimate(driveline, orders, core.omega_max, CAMPBELL_POINTS, FE_ELEMENTS)
+    work = estimate(driveline, orders, core.omega_in_max, CAMPBELL_POINTS, FE_ELEMENTS)
     result = {"estimate": dict(zip(STAGES, work.seconds)), "refusal": work.refusal(), "stages": {}}
     if result["refusal"] is not None:
         return result
     structure = {}
     steps = {
         "critical speeds": lambda: structure.setdefault("found", driveline.critical_speeds(3)),
-        "order resonances": lambda: model.resonances(driveline, orders, core.omega_max),
+        "order resonances": lambda: model.resonances(driveline, orders, core.omega_in_max),
         "FE check": lambda: structure.setdefault("natural", model.natural_frequencies(driveline)),
         "Campbell table": lambda: model.whirl_table(model.Structure(
-            driveline, (0.0, 0.0, 0.0), 0, structure["natural"]), core.omega_max),
+            driveline, (0.0, 0.0, 0.0), 0, structure["natural"]), core.omega_in_max),
         "unbalance response": lambda: UnbalanceOutputs.build(driveline, driveline.unbalances,
-                                                              core.response_position, core.omega_max),
+                                                              core.response_position, core.omega_in_max),
     }
     for name, step in steps.items():
         started = time.process_time()

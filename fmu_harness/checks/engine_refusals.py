@@ -19,7 +19,6 @@ compares).
 
 from __future__ import annotations
 
-import argparse
 import importlib.metadata
 import importlib.util
 import signal
@@ -29,7 +28,7 @@ from pathlib import Path
 
 from ..doc_pages.sections import replace_section
 from ..packaging import fmu_path, native
-from .worker import answer, answer_in
+from .worker import answer, answer_in, check_parser
 
 RESULT = "engine refusal: "
 MODEL = "TripodCoupling"
@@ -129,11 +128,7 @@ def table(models: Path, natives: Path | None = None) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
-    parser.add_argument("--update", type=Path, metavar="PAGE", help="markdown page whose section to regenerate")
-    parser.add_argument("--worker", nargs=3, metavar=("ENGINE", "FMU", "REFUSAL"), help=argparse.SUPPRESS)
-    args = parser.parse_args(argv)
+    args = check_parser(__doc__.splitlines()[0], "host table", ("ENGINE", "FMU", "REFUSAL")).parse_args(argv)
     if args.worker:
         engine, path, refusal = args.worker
         answer(RESULT, observe(engine, Path(path), *REFUSALS[refusal]))

@@ -25,9 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..runs.libcosim_run import NANOSECONDS
 from ..runs.start_values import check_start_values, engine_instances
-
-NANOSECONDS = 1_000_000_000
 
 
 @dataclass
@@ -160,3 +159,4 @@ def cosim_session(step_size: float, fmus: Mapping[str, Path] | None = None, ssp:
     session = Session(set_values, get_values, step)
     session.resources.callback(slaves.clear)  # the slaves live as long as the session
     return session
+

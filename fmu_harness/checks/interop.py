@@ -17,7 +17,6 @@ crashes fails one cell only.
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import shutil
 import subprocess
@@ -33,14 +32,14 @@ from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
 
-from ..console import CommandParser, Progress
+from ..console import Progress
 from ..doc_pages.sections import replace_section, section
 from ..packaging import fmu_path, native
 from ..runs.runner import FmuInstance
 from ..runs.scenario import scenario, standard_run
 from ..runs.start_values import StartValuesRefused
 from . import importers
-from .worker import answer, answer_in
+from .worker import answer, answer_in, check_parser
 
 TOLERANCE = 1e-9
 #: Model Exchange against co-simulation: CVODE's relative tolerance, and the largest relative deviation
@@ -242,10 +241,7 @@ def markdown(table: Table) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = CommandParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
-    parser.add_argument("--update", type=Path, metavar="PAGE", help="markdown page whose matrix section to regenerate")
-    parser.add_argument("--worker", nargs=3, metavar=("ENGINE", "FMU", "REFERENCE"), help=argparse.SUPPRESS)
+    parser = check_parser(__doc__.splitlines()[0], "matrix section", ("ENGINE", "FMU", "REFERENCE"))
     args = parser.parse_args(argv)
     if args.worker:
         engine, fmu, reference = args.worker

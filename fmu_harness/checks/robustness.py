@@ -179,7 +179,7 @@ LAYOUTS = (
     ("segments.toml", "many segments", "[[segments]] tables are more than the 100 accepted"),
     ("nested.toml", "deep nesting", "brackets nest deeper than 16 levels"),
     ("large.toml", "large file", "is larger than 65536 bytes"),
-    ("stations.toml", "many stations", "the analysis would"),  # with the default omega_max: 875 shaft modes
+    ("stations.toml", "many stations", "the analysis would"),  # with the default omega_in_max: 875 shaft modes
     ("missing.toml", "", "No such file or directory"),
     ("../../../etc/passwd", "", "no shipped example named"),
     ("x" * 300 + ".toml", "", "File name too long"),
@@ -222,7 +222,7 @@ LIMITS = (
     ("density", 1e308, "more than the 250 accepted"),
     ("E", 1e-300, "more than the 250 accepted"),
     ("E", 1e180, "finite-element check"),
-    ("omega_max", 1e300, "more than the 250 accepted"),
+    ("omega_in_max", 1e300, "more than the 250 accepted"),
 )
 
 

@@ -3,8 +3,8 @@
 Usage: ``python -m fmu_harness.checks.work_fuzzer [--cases N] [--seed S] [--python FMU] [--native FMU]``.
 Each case is a random layout of one to four segments with extreme but accepted materials (Young's
 modulus 1e8 to 5e12 Pa, density 0.01 to 20 000 kg/m3, walls down to 1e-4 of the diameter), masses,
-anisotropic and damped bearings, hinges and unbalances, many and high orders and an ``omega_max`` near
-the edge the work estimate accepts, then tunable changes mid-run (``omega_max``, ``orders``, the
+anisotropic and damped bearings, hinges and unbalances, many and high orders and an ``omega_in_max`` near
+the edge the work estimate accepts, then tunable changes mid-run (``omega_in_max``, ``orders``, the
 bearing damping, the response position). Every case runs in a process of its own under a limit of
 CPU time and address space (``resource.setrlimit``): the FMU is initialised, stepped, changed and
 stepped again, and the CPU seconds of each analysis (initialisation or a changed step) are measured,
@@ -89,7 +89,7 @@ def random_orders(rng: np.random.Generator) -> str:
 
 
 def accepted_edge(text: str, orders: str) -> float | None:
-    """The largest ``omega_max`` (a power of two times 1e-3 rad/s) that the work limits accept for
+    """The largest ``omega_in_max`` (a power of two times 1e-3 rad/s) that the work limits accept for
     ``text`` and ``orders``; None if the layout is refused (or accepts none)."""
     try:
         driveline = loads_driveline(text)
@@ -111,7 +111,7 @@ def accepted_edge(text: str, orders: str) -> float | None:
 
 
 def random_case(rng: np.random.Generator) -> dict:
-    """A case: a layout the loader accepts, start values with ``omega_max`` near the estimate's edge, and
+    """A case: a layout the loader accepts, start values with ``omega_in_max`` near the estimate's edge, and
     two tunable changes."""
     while True:
         text, orders = random_layout(rng), random_orders(rng)
@@ -119,10 +119,10 @@ def random_case(rng: np.random.Generator) -> dict:
         if edge is not None:
             break
     omega_max = edge * float(rng.uniform(0.5, 1.0))
-    start = {"omega_max": omega_max, "omega": omega_max * float(rng.uniform(0.0, 1.0)), "orders": orders,
+    start = {"omega_in_max": omega_max, "omega_in": omega_max * float(rng.uniform(0.0, 1.0)), "orders": orders,
              "band": 0.1}
     lower = omega_max * float(rng.uniform(0.3, 1.0))
-    changes = [{"omega_max": lower, "omega": min(start["omega"], lower)},
+    changes = [{"omega_in_max": lower, "omega_in": min(start["omega_in"], lower)},
                {"orders": random_orders(rng), "c_bearing": _log_uniform(rng, 1.0, 1e4),
                 "response_position": float(rng.uniform(0.0, 1.0))}]
     return {"layout": text, "start": start, "changes": changes}
@@ -130,9 +130,9 @@ def random_case(rng: np.random.Generator) -> dict:
 
 def issue_case() -> dict:
     """The layout that once took 12.9 s native and 25.4 s in the Python core (``ROUND_OFF_LAYOUT``), with a
-    change of ``omega_max`` and of ``orders``."""
+    change of ``omega_in_max`` and of ``orders``."""
     return {"layout": ROUND_OFF_LAYOUT, "start": dict(ROUND_OFF_PARAMETERS),
-            "changes": [{"omega_max": 1.5, "omega": 1.5}, {"orders": "1,2,3,89"}]}
+            "changes": [{"omega_in_max": 1.5, "omega_in": 1.5}, {"orders": "1,2,3,89"}]}
 
 
 def _cpu() -> float:

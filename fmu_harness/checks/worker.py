@@ -3,10 +3,25 @@ result line on stdout, found among whatever the engines print, and an exit witho
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import sys
+from pathlib import Path
 from typing import Any
+
+from ..console import CommandParser
+
+
+def check_parser(description: str, section: str, worker: tuple[str, ...]) -> CommandParser:
+    """The command line of a check that regenerates a docs section from worker processes:
+    ``--models``, ``--update PAGE`` (its ``section``) and the hidden ``--worker`` (``worker`` names
+    its arguments)."""
+    parser = CommandParser(description=description)
+    parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
+    parser.add_argument("--update", type=Path, metavar="PAGE", help=f"markdown page whose {section} to regenerate")
+    parser.add_argument("--worker", nargs=len(worker), metavar=worker, help=argparse.SUPPRESS)
+    return parser
 
 
 def answer(prefix: str, result: Any) -> None:

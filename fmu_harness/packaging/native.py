@@ -27,6 +27,7 @@ import hashlib
 import math
 import re
 import tempfile
+import textwrap
 import uuid
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -54,7 +55,7 @@ GENERATION_TOOL = "driveline-fmus native build"
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
 MODEL_SOURCES = NATIVE_SRC
 SHARED_SOURCES = ("fmu_instance.h", "fmu_layer.h", "fmu_instance.c", "fmu_checks.c", "fmu_values.c", "fmu_state.c",
-                  "fmu_model_exchange.c", "python_numbers.h", "python_numbers.c")
+                  "fmu_model_exchange.c", "fmu_derivatives.c", "python_numbers.h", "python_numbers.c")
 LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
@@ -62,6 +63,25 @@ LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
 
 def model_source(name: str) -> Path:
     return MODEL_SOURCES / f"{snake_case(name)}.c"
+
+
+_JACOBIAN_HOOK = re.compile(r"\.jacobian\s*=")
+
+
+def provides_derivatives(name: str) -> bool:
+    """The model's C port gives the ``jacobian`` hook (``.jacobian = ...`` in its ``model_hooks``): its FMU
+    offers directional (and FMI 3.0 adjoint) derivatives and says so in its model description."""
+    return bool(_JACOBIAN_HOOK.search(model_source(name).read_text()))
+
+
+def jacobian_layout(spec: ModelSpec) -> tuple[list[str], list[str]]:
+    """The rows of a model's Jacobian (its Real outputs; the states' derivatives follow them) and its
+    columns (its Real inputs and states), in spec order."""
+    states = {state.name for state in spec.states}
+    rows = [v.name for v in spec.of("output") if v.type == "Real"]
+    columns = [v.name for v in spec.variables
+               if v.type == "Real" and (v.causality == "input" or v.name in states)]
+    return rows, columns
 
 
 def library_folder(name: str) -> Path:
@@ -262,12 +282,22 @@ def _extra_message(model: type[SteppedModel], probe: dict[str, float]) -> str:
     return f"    {{V_{shown}, {_template(errors[0])}}},"
 
 
+def _positions(names: list[str], spec: ModelSpec) -> str:
+    """Each variable's position in ``names`` (-1: not there), as the lines of a C initialiser."""
+    positions = ", ".join(str(names.index(v.name)) if v.name in names else "-1" for v in spec.variables)
+    return "\n    " + "\n    ".join(textwrap.wrap(positions, 100)) + "\n"
+
+
 def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
     """``model_variables.h`` and ``model_variables.c`` of ``model``'s spec and own checks."""
     spec = model.spec
     probes = model.extra_parameter_probes
     names = "\n".join(f"    V_{v.name} = {index}," for index, v in enumerate(spec.variables))
     derivatives = input_derivatives(spec)
+    rows, columns = jacobian_layout(spec)
+    jacobian_enums = "".join(f"enum {{\n{entries}}};\n" for entries in (
+        "".join(f"    ROW_{name} = {k},\n" for k, name in enumerate(rows)),
+        "".join(f"    COLUMN_{name} = {k},\n" for k, name in enumerate(columns))) if entries)
     constants = "".join(f"#define {name} {_c_string(value) if isinstance(value, str) else value}\n"
                         for name, value in model.native_constants.items())
     parts = model.derived_parts
@@ -293,6 +323,11 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_INPUT_DERIVATIVE_COUNT {len(derivatives)}
 /* Model Exchange: continuous states (ModelSpec.states) */
 #define MODEL_STATE_COUNT {len(spec.states)}
+/* Directional derivatives: the Jacobian's rows are the Real outputs (ROW_<name>), then der(<state>), its
+ * columns the Real inputs and the states (COLUMN_<name>) */
+#define MODEL_OUTPUT_ROWS {len(rows)}
+#define MODEL_ROW_COUNT {len(rows) + len(spec.states)}
+#define MODEL_COLUMN_COUNT {len(columns)}
 {constants}
 /* the FMU's token (FMI 2.0 GUID, FMI 3.0 instantiation token): the FMI version's, in model_variables.c */
 extern const char model_token[];
@@ -301,7 +336,7 @@ extern const char model_token[];
 enum {{
 {names}
 }};
-{extra_enum}
+{jacobian_enums}{extra_enum}
 #endif
 """
     entries = "\n".join(_table_entry(v) for v in spec.variables)
@@ -317,6 +352,11 @@ const char model_token[] = {_c_string(token)};
 const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 {entries}
 }};
+"""
+    source += f"""
+/* each variable's row and column of the Jacobian (directional derivatives), -1 for none */
+const int model_jacobian_rows[MODEL_VARIABLE_COUNT] = {{{_positions(rows, spec)}}};
+const int model_jacobian_columns[MODEL_VARIABLE_COUNT] = {{{_positions(columns, spec)}}};
 """
     if spec.relations:
         source += f"""
@@ -385,16 +425,20 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
         "generationTool": GENERATION_TOOL, "variableNamingConvention": "structured",
     })
     state = "State" if fmi3 else "state"
+    derivatives = {} if not provides_derivatives(spec.name) else (
+        {"providesDirectionalDerivatives": "true", "providesAdjointDerivatives": "true"} if fmi3
+        else {"providesDirectionalDerivative": "true"})
     if not MODELS[spec.name].co_simulation_only:
         ET.SubElement(root, "ModelExchange", {  # the same binary: one model identifier for both interfaces
-            "modelIdentifier": spec.name, "needsExecutionTool": "false",
+            "modelIdentifier": spec.name, "needsExecutionTool": "false", **derivatives,
             "canBeInstantiatedOnlyOncePerProcess": "false", f"canGetAndSetFMU{state}": "true",
             f"canSerializeFMU{state}": "true",
             **({"needsCompletedIntegratorStep": "false"} if fmi3 else
                {"completedIntegratorStepNotNeeded": "true", "canNotUseMemoryManagementFunctions": "true"}),
         })
     cosimulation = ET.SubElement(root, "CoSimulation", {
-        "modelIdentifier": spec.name, "needsExecutionTool": "false", "canHandleVariableCommunicationStepSize": "true",
+        "modelIdentifier": spec.name, "needsExecutionTool": "false", **derivatives,
+        "canHandleVariableCommunicationStepSize": "true",
         "canBeInstantiatedOnlyOncePerProcess": "false", f"canGetAndSetFMU{state}": "true",
         f"canSerializeFMU{state}": "true",
         **({} if fmi3 else {"canInterpolateInputs": "true" if input_derivatives(spec) else "false",
@@ -447,6 +491,15 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
 def derivative_reference(spec: ModelSpec, fmi: str, k: int) -> int:
     """Value reference of ``der(<state k>)``: after the spec's variables (FMI 3.0: and ``time``)."""
     return len(spec.variables) + (1 if fmi == "3" else 0) + k
+
+
+def jacobian_references(spec: ModelSpec, fmi: str) -> tuple[list[int], list[int]]:
+    """The value references of the Jacobian's rows (:func:`jacobian_layout`'s, then ``der(<state>)``) and
+    of its columns, in FMI version ``fmi``."""
+    outputs, columns = jacobian_layout(spec)
+    index = [v.name for v in spec.variables].index
+    rows = [index(o) for o in outputs] + [derivative_reference(spec, fmi, k) for k in range(len(spec.states))]
+    return rows, [index(c) for c in columns]
 
 
 def model_description(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> bytes:

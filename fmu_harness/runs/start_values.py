@@ -5,7 +5,8 @@ FMUs return Error there, and libcosim turns that Error into an uncaught C++ exce
 the host process (docs/hosting.md). Every place of the project that starts an engine (the
 importers' sessions, the system master, sweeps) therefore first gives the start values to the
 catalog model of each FMU, whose checks (the spec's bounds and relations, then the model's own,
-``SteppedModel.parameter_errors``) are the code the FMUs run, and stops with the first reason.
+``SteppedModel.parameter_errors`` and ``input_errors``, as ``SteppedModel.initialize``) are the code
+the FMUs run, and stops with the first reason.
 
 Usage: ``driveline-fmus check TARGET [NAME=VALUE ...]``, TARGET an SSP package (its parameter
 bindings) or an FMU (the values given, ``beta=0.3``): prints what would be refused in one line
@@ -27,6 +28,7 @@ from fmpy import read_model_description
 from driveline.catalog import MODELS
 
 from .ssp import bindings
+from .ssp_package import read
 
 _KINDS = {"Real": float, "Integer": int, "Boolean": lambda text: str(text).lower() in ("true", "1"), "String": str}
 
@@ -47,10 +49,12 @@ class Instance:
 
 def refusals(model: str, values: Mapping[str, Any], declared_only: bool = False) -> list[str]:
     """Why the FMU of catalog model ``model`` would refuse the start values ``values`` (parameters
-    and inputs by name) at initialisation, in its own words; [] when it takes them or when the
-    model is not in the catalog (nothing to check it with). ``declared_only``: the spec's bounds
-    and relations alone, not the model's own checks (``CriticalSpeeds`` analyses the structure
-    there, 0.04 to 0.5 s)."""
+    and inputs by name) at initialisation, in its own words: the parameters' checks, then the
+    inputs' (an input's start value beyond its bounds or relations, ``beta`` above ``beta_max``, is
+    refused at ``ExitInitializationMode`` too; an input left out is at its declared start); [] when
+    it takes them or when the model is not in the catalog (nothing to check it with).
+    ``declared_only``: the spec's bounds and relations between parameters alone, not the model's
+    own checks (``CriticalSpeeds`` analyses the structure there, 0.04 to 0.5 s)."""
     model_class = MODELS.get(model)
     if model_class is None:
         return []
@@ -63,7 +67,7 @@ def refusals(model: str, values: Mapping[str, Any], declared_only: bool = False)
             setattr(core, name, _KINDS[variable.type](value))
         except (TypeError, ValueError):
             return [f"{name} = {value!r} is not of type {variable.type}"]
-    return core.declared_parameter_errors() if declared_only else core.parameter_errors()
+    return core.declared_parameter_errors() if declared_only else core.parameter_errors() + core.input_errors()
 
 
 def check_start_values(instances: list[Instance]) -> None:
@@ -87,7 +91,23 @@ def engine_instances(fmus: Mapping[str, Path] | None = None, ssp: Path | None = 
         given.setdefault(instance, {})[name] = value
     found = [Instance(*component) for component in bindings(ssp)] if ssp is not None else [
         Instance(name, read_model_description(str(path)).modelName, {}) for name, path in (fmus or {}).items()]
-    return [Instance(i.name, i.model, {**i.values, **given.get(i.name, {})}) for i in found]
+    fed = _connected_inputs(found, read(ssp).connections) if ssp is not None else {}
+    return [Instance(i.name, i.model, {**fed.get(i.name, {}), **i.values, **given.get(i.name, {})}) for i in found]
+
+
+def _connected_inputs(instances: list[Instance], connections: list[tuple[tuple[str, str], tuple[str, str]]]
+                      ) -> dict[str, dict[str, Any]]:
+    """The inputs a connection feeds, by instance, each at the declared start of the output feeding it:
+    what an engine sets it to before ``ExitInitializationMode`` (not the input's own start); an output
+    of a model outside the catalog is left out."""
+    models = {i.name: MODELS.get(i.model) for i in instances}
+    fed: dict[str, dict[str, Any]] = {}
+    for (source, output), (target, name) in connections:
+        model = models.get(source)
+        variable = next((v for v in model.spec.variables if v.name == output), None) if model else None
+        if variable is not None:
+            fed.setdefault(target, {})[name] = variable.start
+    return fed
 
 
 def main(argv: list[str] | None = None) -> None:

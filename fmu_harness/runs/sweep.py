@@ -1,10 +1,12 @@
-"""Parameter sweeps of one FMU on Dask distributed: one FMU run per point, one tidy table.
+"""Parameter sweeps of one FMU or of an SSP system on Dask distributed: one run per point, one tidy table.
 
 Usage::
 
     python -m fmu_harness.runs.sweep --grid beta=0:0.7:8 omega_in=100,200,300 r=0.02,0.026
     python -m fmu_harness.runs.sweep --model CardanJoint --points points.csv --out cardan.parquet
     python -m fmu_harness.runs.sweep --grid beta=0.1,0.3 --scheduler tcp://host:8786
+    python -m fmu_harness.runs.sweep --system models/native/VehicleLaunch.ssp --step 4e-4 \
+        --grid joint_left.beta+joint_right.beta=0.1,0.2 motor.T_level=100,200
 
 A grid axis is ``name=v1,v2,...`` or ``name=start:stop:count`` (``count`` values, both ends
 included); the grid is the cartesian product of its axes. A points file is CSV (a header of
@@ -12,15 +14,19 @@ names) or JSON (a list of objects). Each name must be a parameter (set as a star
 input (held constant) of the FMU. A run lasts ``--turns`` input turns at the point's
 ``omega_in`` in ``--steps-per-turn`` steps unless ``--duration`` / ``--step`` are given.
 
-Every point is one :func:`fmu_harness.runs.runner.simulate` call on a worker. The FMU's bytes are
+With ``--system`` each point is one run of the whole system, its names ``component.variable``
+(several joined by ``+`` take the same value), by the ``--master`` of
+:mod:`fmu_harness.runs.system_sweep`; the package is shipped and unpacked like an FMU.
+
+Every point of an FMU sweep is one :func:`fmu_harness.runs.runner.simulate` call on a worker. The FMU's bytes are
 scattered to the workers once, extracted and their model description parsed once per worker
 process, so workers need no shared file system. A refused or crashed run becomes a ``failed``
 row with its reason; a point whose parameters break the spec's bounds or relations, which the
 FMU would refuse at initialisation, is not run (:mod:`fmu_harness.runs.start_values`). The command
 ends non-zero when every run failed and names the distinct reasons, before any worker starts when
-every point is refused so. Its arguments, the FMU and the layout are checked before the cluster
-starts; Dask and pyarrow (the ``sweep`` extra) are imported when a sweep runs, so ``--help``
-needs neither.
+every point is refused so. Its arguments, the FMU or package, the layout and the scheduler's
+address are checked before the cluster starts; Dask and pyarrow (the ``sweep`` extra) are imported
+when a sweep runs, so ``--help`` needs neither.
 """
 
 from __future__ import annotations
@@ -33,7 +39,9 @@ import itertools
 import json
 import math
 import os
+import socket
 import sys
+import tempfile
 import threading
 import zipfile
 from collections import Counter
@@ -52,6 +60,15 @@ from driveline.catalog import MODELS
 from ..console import CommandParser, Progress, optional
 from .runner import StepRefused, simulate
 from .start_values import refusals
+from .system_sweep import (
+    MASTERS,
+    STATISTICS,
+    DerivedMetrics,
+    SystemInterface,
+    UnpackedSystem,
+    run_system,
+    stop_and_step,
+)
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -66,13 +83,6 @@ Point = dict[str, Value]
 SPEED = "omega_in"
 """The input whose turns set the default run length."""
 
-STATISTICS: dict[str, Callable[[np.ndarray], Any]] = {
-    "min": np.min,
-    "max": np.max,
-    "mean": np.mean,
-    "p2p": np.ptp,
-    "peak_abs": lambda x: np.max(np.abs(x)),
-}
 GENERIC = ("min", "max", "mean")
 """Statistics of every Real output of any FMU, as columns ``<output>_<statistic>``."""
 SPECIFIC: dict[str, tuple[tuple[str, str], ...]] = {
@@ -90,6 +100,10 @@ SPECIFIC: dict[str, tuple[tuple[str, str], ...]] = {
     ),
 }
 """Further (output, statistic) columns per model name."""
+
+DEFAULT_MODEL = "TripodCoupling"
+DEFAULT_MASTER = "gauss-seidel"
+"""The master of a system sweep: see docs/sweeps.md for the measured choice."""
 
 CRITICAL_SPEEDS_MODEL = "CriticalSpeeds"
 MARGIN = "critical_speed_margin"
@@ -268,6 +282,49 @@ class ShippedFmu:
         data = path.read_bytes()
         return cls(Interface.of(path), hashlib.sha256(data).hexdigest(), data)
 
+    def run(self, point: Point, timing: Timing) -> dict[str, Any]:
+        """On a worker: one run of ``point``."""
+        unpacked = _unpacked(self)
+        return self.interface.run(unpacked.path, point, timing, unpacked.unzipdir, unpacked.description)
+
+
+@dataclass(frozen=True)
+class ShippedSystem:
+    """An SSP package's bytes and interface with the runs' stop time, step and master, scattered once
+    to every worker (:mod:`fmu_harness.runs.system_sweep`)."""
+
+    interface: SystemInterface
+    digest: str
+    data: bytes
+    stop_time: float
+    step_size: float
+    master: str
+
+    @classmethod
+    def read(cls, path: Path, duration: float | None, step_size: float | None, master: str,
+             derived: Sequence[DerivedMetrics] = ()) -> ShippedSystem:
+        """Raises ValueError for a package that cannot be read, a bad timing or an unknown master."""
+        if master not in MASTERS:
+            raise ValueError(f"no master {master!r} (the masters: {', '.join(MASTERS)})")
+        interface = SystemInterface.of(path, derived)
+        data = path.read_bytes()
+        return cls(interface, hashlib.sha256(data).hexdigest(), data, *stop_and_step(interface, duration, step_size),
+                   master)
+
+    def run(self, point: Point, timing: Timing) -> dict[str, Any]:
+        """On a worker: one run of the system at ``point`` (``timing`` is the FMU sweep's, unused)."""
+        try:
+            with _UNPACK_LOCK:
+                if self.digest not in _UNPACKED:
+                    folder = _scratch() / f"ssp-{self.digest[:16]}"
+                    _UNPACKED[self.digest] = UnpackedSystem.write(self.data, folder, self.interface)
+            with tempfile.TemporaryDirectory(dir=_scratch()) as scratch:
+                metrics = run_system(self.interface, _UNPACKED[self.digest], point, self.stop_time, self.step_size,
+                                     self.master, Path(scratch))
+        except Exception as error:  # noqa: BLE001 - any failure of a run is a result of the sweep
+            return failed(error)
+        return {"status": "ok", "reason": None, **metrics}
+
 
 @dataclass(frozen=True)
 class UnpackedFmu:
@@ -278,17 +335,22 @@ class UnpackedFmu:
     description: ModelDescription
 
 
-_UNPACKED: dict[str, UnpackedFmu] = {}
+_UNPACKED: dict[str, UnpackedFmu | UnpackedSystem] = {}
 _UNPACK_LOCK = threading.Lock()
+
+
+def _scratch() -> Path:
+    """The worker's scratch space."""
+    from distributed import get_worker
+
+    return Path(get_worker().local_directory)
 
 
 def _unpacked(fmu: ShippedFmu) -> UnpackedFmu:
     """The FMU written, extracted and parsed once per worker process in the worker's scratch space."""
-    from distributed import get_worker
-
     with _UNPACK_LOCK:
         if fmu.digest not in _UNPACKED:
-            folder = Path(get_worker().local_directory) / f"fmu-{fmu.digest[:16]}"
+            folder = _scratch() / f"fmu-{fmu.digest[:16]}"
             folder.mkdir(parents=True, exist_ok=True)
             path = folder / f"{fmu.interface.model}.fmu"
             path.write_bytes(fmu.data)
@@ -297,10 +359,9 @@ def _unpacked(fmu: ShippedFmu) -> UnpackedFmu:
         return _UNPACKED[fmu.digest]
 
 
-def run_point(fmu: ShippedFmu, point: Point, timing: Timing) -> dict[str, Any]:
+def run_point(shipped: ShippedFmu | ShippedSystem, point: Point, timing: Timing) -> dict[str, Any]:
     """Worker task: run one point of the sweep."""
-    unpacked = _unpacked(fmu)
-    return fmu.interface.run(unpacked.path, point, timing, unpacked.unzipdir, unpacked.description)
+    return shipped.run(point, timing)
 
 
 def _outcome(future: Future) -> dict[str, Any]:
@@ -352,7 +413,7 @@ class Plan:
     timing valid, the points the FMU would refuse (:func:`refused_points`, not run) and the
     critical speeds of the margin (None when there is no margin)."""
 
-    fmu: ShippedFmu
+    fmu: ShippedFmu | ShippedSystem
     points: Sequence[Point]
     timing: Timing
     refused: dict[int, str]
@@ -374,6 +435,22 @@ class Plan:
                                  f"{shipped.interface.model} has none")
             return cls(shipped, points, timing, refused, None)
         return cls(shipped, points, timing, refused, critical_speeds(layout))
+
+    @classmethod
+    def of_system(cls, package: Path, points: Sequence[Point], duration: float | None, step_size: float | None,
+                  master: str, derived: Sequence[DerivedMetrics] = ()) -> Plan:
+        """A sweep of the SSP system ``package`` (:mod:`fmu_harness.runs.system_sweep`): every run lasts
+        ``duration`` (default the package's stop time) in steps of ``step_size`` by ``master``, with the
+        ``derived`` metrics besides the system's own. Raises
+        ValueError for no points, a package that cannot be read, a bad timing or an unknown name; the
+        points a component would refuse or whose step is too long are not run."""
+        if not points:
+            raise ValueError("no points to run")
+        shipped = ShippedSystem.read(package, duration, step_size, master, derived)
+        for point in points:
+            shipped.interface.changes(point)
+        found = {i: shipped.interface.refusal(point, shipped.step_size, master) for i, point in enumerate(points)}
+        return cls(shipped, points, Timing(), {i: reason for i, reason in found.items() if reason}, None)
 
 
 def run(client: Client, plan: Plan, show_progress: bool = False) -> pa.Table:
@@ -453,7 +530,11 @@ def open_client(scheduler: str | None = None, workers: int = 2) -> Iterator[Clie
     single-threaded worker processes (closed on exit)."""
     distributed = optional("distributed", EXTRA, COMMAND)
     if scheduler:
-        with distributed.Client(scheduler) as client:
+        try:
+            client = distributed.Client(scheduler, timeout=CONNECT_SECONDS)
+        except (OSError, TimeoutError) as error:
+            raise SystemExit(f"{COMMAND}: no Dask scheduler answered at {scheduler} ({error})") from None
+        with client:
             yield client
         return
     cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
@@ -461,7 +542,26 @@ def open_client(scheduler: str | None = None, workers: int = 2) -> Iterator[Clie
         yield client
 
 
-def _workers(text: str) -> int:
+CONNECT_SECONDS = 5.0
+"""How long the sweep tries to reach a scheduler."""
+
+
+def check_scheduler(address: str, seconds: float = CONNECT_SECONDS) -> None:
+    """ValueError in one line unless something listens at the TCP scheduler address ``address``
+    (``tcp://host:port``, ``host:port``); another protocol is left to Dask."""
+    scheme, _, location = address.rpartition("://")
+    if scheme not in ("", "tcp", "tls"):
+        return
+    host, colon, port = location.rpartition(":")
+    if not (colon and host and port.isdigit()):
+        raise ValueError(f"--scheduler {address}: expected tcp://host:port")
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=seconds).close()
+    except OSError as error:
+        raise ValueError(f"--scheduler {address}: no scheduler answers there ({error.strerror or error})") from None
+
+
+def workers_count(text: str) -> int:
     """An argparse type: the number of local workers, at least 1."""
     try:
         value = int(text)
@@ -470,6 +570,11 @@ def _workers(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be a whole number of at least 1, got {text}")
     return value
+
+
+def default_workers() -> int:
+    """Local workers by default: one per core."""
+    return os.cpu_count() or 1
 
 
 def _fmu_file(models: Path, model: str) -> Path:
@@ -484,18 +589,46 @@ def _fmu_file(models: Path, model: str) -> Path:
     raise ValueError(f"no FMU {path} ({there}; `driveline-fmus build` builds them)")
 
 
+def run_plan(plan: Plan, scheduler: str | None, workers: int) -> pa.Table:
+    """:func:`run` of a checked plan on the scheduler at ``scheduler`` or a local cluster of ``workers``,
+    with progress; ends the command first when every point is refused (naming the reasons) or an
+    optional package the run needs is missing."""
+    if len(plan.refused) == len(plan.points):
+        print_reasons(Counter(plan.refused.values()))
+        sys.exit(f"{COMMAND}: every point refused, none run")
+    optional("pyarrow", EXTRA, COMMAND)  # before the cluster starts
+    if isinstance(plan.fmu, ShippedSystem) and plan.fmu.master == "libcosim":
+        optional("libcosimpy", "interop", f"{COMMAND} --master libcosim")
+    what = plan.fmu.interface.name if isinstance(plan.fmu, ShippedSystem) else plan.fmu.interface.model
+    with open_client(scheduler, workers) as client:
+        print(f"{len(plan.points)} runs of {what} on {client.scheduler.address}")
+        return run(client, plan, show_progress=True)
+
+
+def read_table(path: Path) -> pa.Table:
+    """A table :func:`write_table` wrote."""
+    if path.suffix.lower() == ".csv":
+        return optional("pyarrow.csv", EXTRA, COMMAND).read_csv(path)
+    return optional("pyarrow.parquet", EXTRA, COMMAND).read_table(path)
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = CommandParser(description=__doc__.splitlines()[0])
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--grid", nargs="+", metavar="AXIS", help="name=v1,v2,... or name=start:stop:count")
     source.add_argument("--points", type=Path, help="CSV or JSON file of points")
-    parser.add_argument("--model", default="TripodCoupling", help="FMU name (default TripodCoupling)")
+    swept = parser.add_mutually_exclusive_group()
+    swept.add_argument("--model", help=f"FMU name (default {DEFAULT_MODEL})")
+    swept.add_argument("--system", type=Path, help="an SSP package: names are component.variable, joined by +")
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--turns", type=int, default=1, help=f"run length in turns of {SPEED} (default 1)")
     parser.add_argument("--steps-per-turn", type=int, default=360)
-    parser.add_argument("--duration", type=float, help="run length [s] instead of whole turns")
-    parser.add_argument("--step", type=float, help="communication step size [s]")
-    parser.add_argument("--workers", type=_workers, default=os.cpu_count() or 1, help="local cluster size")
+    parser.add_argument("--duration", type=float,
+                        help="run length [s] instead of whole turns (of a system: instead of its stop time)")
+    parser.add_argument("--step", type=float, help="communication step size [s] (needed by a system)")
+    parser.add_argument("--master", choices=MASTERS, default=DEFAULT_MASTER,
+                        help=f"the master of a system sweep (default {DEFAULT_MASTER})")
+    parser.add_argument("--workers", type=workers_count, default=default_workers(), help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
     parser.add_argument(
         "--layout", default="", help="driveline of the critical-speed margin: TOML file or shipped name"
@@ -505,17 +638,18 @@ def main(argv: list[str] | None = None) -> None:
 
     try:
         points = grid(dict(map(parse_axis, args.grid))) if args.grid else read_points(args.points)
-        timing = Timing(args.turns, args.steps_per_turn, args.duration, args.step)
-        plan = Plan.of(_fmu_file(args.models, args.model), points, timing, args.layout)
+        if args.system is not None:
+            if args.layout:
+                raise ValueError("--layout sets the critical-speed margin of an FMU sweep, not of a system")
+            plan = Plan.of_system(args.system, points, args.duration, args.step, args.master)
+        else:
+            timing = Timing(args.turns, args.steps_per_turn, args.duration, args.step)
+            plan = Plan.of(_fmu_file(args.models, args.model or DEFAULT_MODEL), points, timing, args.layout)
+        if args.scheduler:
+            check_scheduler(args.scheduler)
     except (ValueError, OSError, zipfile.BadZipFile) as error:
         parser.error(str(error))
-    if len(plan.refused) == len(points):
-        print_reasons(Counter(plan.refused.values()))
-        sys.exit(f"{COMMAND}: every point refused, none run")
-    optional("pyarrow", EXTRA, COMMAND)  # before the cluster starts
-    with open_client(args.scheduler, args.workers) as client:
-        print(f"{len(points)} runs of {args.model} on {client.scheduler.address}")
-        table = run(client, plan, show_progress=True)
+    table = run_plan(plan, args.scheduler, args.workers)
     write_table(table, args.out)
     reasons = failure_reasons(table)
     print(f"{table.num_rows} runs, {reasons.total()} failed -> {args.out}")

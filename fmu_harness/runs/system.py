@@ -30,13 +30,17 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
+from fmpy.model_description import ModelDescription
 
 from driveline.catalog import MODELS
+from driveline.vehicle import dynamics
+from driveline.vehicle.dynamics import Drive
 from driveline.variables import UNITS, ModelSpec, Variable
 
 from ..packaging import fmu_path, native
 from .runner import FmuInstance, StepRefused
 from .ssp import SSC, SSD, SSV
+from .ssp_package import SspSystem
 from .start_values import Instance, StartValuesRefused, check_start_values
 
 for prefix, uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
@@ -81,16 +85,27 @@ class System:
         return [f"{c.name}.{v.name}" for c in self.components for v in c.spec.of("output") if v.type == "Real"]
 
 
-def driveline() -> System:
-    """Speed ramp 500 to 3000 rpm in 1 s with a 50 rpm, 5 Hz sine, into a tripod coupling bent
-    20 degrees under 150 N.m; ``CriticalSpeeds`` on the output shaft when it exists."""
+#: The couplings the driveline system takes and their bindings: bent 20 degrees under 150 N.m (the
+#: tripod with its exact kinematics).
+COUPLINGS = {
+    "TripodCoupling": {"kinematics": 1, "beta": math.radians(20.0), "T_load": 150.0},
+    "CardanJoint": {"beta": math.radians(20.0), "T_load": 150.0},
+}
+#: What the source feeds the coupling's input shaft (every coupling of COUPLINGS has both inputs): its
+#: output shaft's speed and acceleration.
+SOURCE_TO_COUPLING = (("omega_out", "omega_in"), ("alpha_out", "alpha_in"))
+
+
+def driveline(coupling: str = "TripodCoupling") -> System:
+    """Speed ramp 500 to 3000 rpm in 1 s with a 50 rpm, 5 Hz sine, into ``coupling`` (one of
+    :data:`COUPLINGS`) bent 20 degrees under 150 N.m; ``CriticalSpeeds`` on the output shaft when it
+    exists. The source's speed and acceleration feed the coupling's ``omega_in`` and ``alpha_in``."""
     components = [
         Component("source", "SpeedSource", {"omega_out_start": 500.0 * RPM, "ramp_rate": 2500.0 * RPM,
                                             "sine_amplitude": 50.0 * RPM, "sine_frequency": 5.0}),
-        Component("coupling", "TripodCoupling", {"kinematics": 1, "beta": math.radians(20.0), "T_load": 150.0}),
+        Component("coupling", coupling, COUPLINGS[coupling]),
     ]
-    connections = [Connection(("source", "omega_out"), ("coupling", "omega_in")),
-                   Connection(("source", "alpha_out"), ("coupling", "alpha_in"))]
+    connections = [Connection(("source", output), ("coupling", name)) for output, name in SOURCE_TO_COUPLING]
     if WATCHER in MODELS:
         components.append(Component("critical", WATCHER, {}))
         connections += [
@@ -231,62 +246,126 @@ def write_ssp(system: System, models: Path, natives: Path | None = None) -> Path
 Port = tuple[str, str]
 
 
+class Reading:
+    """A batched read of outputs ``(instance, variable)``: one call per instance, with its value
+    references and buffer prepared once (:meth:`FmuInstance.reader`)."""
+
+    def __init__(self, instances: Mapping[str, FmuInstance], ports: Sequence[Port]):
+        names: dict[str, list[str]] = {}
+        for instance, variable in ports:
+            if variable not in names.setdefault(instance, []):
+                names[instance].append(variable)
+        self.position = {port: i for i, port in enumerate((i, v) for i, found in names.items() for v in found)}
+        """Each port's place in the values read."""
+        self._reads = [instances[instance].reader(tuple(found)) for instance, found in names.items()]
+
+    def __call__(self) -> list[float]:
+        return [value for read in self._reads for value in read()]
+
+
+class Transfer:
+    """Connections ``((instance, output), (instance, input))`` carried in batches: one read of the
+    connected outputs per source instance (:class:`Reading`), then one write of the connected inputs
+    per destination instance."""
+
+    def __init__(self, instances: Mapping[str, FmuInstance], connections: Collection[tuple[Port, Port]]):
+        self._read = Reading(instances, [start for start, _ in connections])
+        targets: dict[str, list[tuple[str, int]]] = {}
+        for start, (target, name) in connections:
+            targets.setdefault(target, []).append((name, self._read.position[start]))
+        self._writes = [(instances[target].writer(tuple(name for name, _ in pairs)), [i for _, i in pairs])
+                        for target, pairs in targets.items()]
+
+    def __call__(self) -> None:
+        """Set every connected input from its output as they are now."""
+        values = self._read()
+        for write, positions in self._writes:
+            write([values[i] for i in positions])
+
+
 def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, object]],
                connections: Collection[tuple[Port, Port]], stop_time: float, step_size: float,
                outputs: list[str], on_step: Callable[[int, int], None] | None = None,
-               order: Sequence[str] | None = None) -> np.ndarray:
+               order: Sequence[str] | None = None,
+               unpacked: Mapping[str, tuple[str, ModelDescription]] | None = None) -> np.ndarray:
     """The fixed-step Jacobi master: instances ``{name: FMU}`` with their start values, connections
     ``((instance, output), (instance, input))``; rows of t_k and ``outputs`` (``"instance.variable"``)
-    for t_1 ... t_N. ``on_step(k, N)`` is called after each step. A refused step raises
-    :class:`StepRefused` with the instance's name before its reasons. With ``order`` (every instance's
+    for t_1 ... t_N. ``on_step(k, N)`` is called after each step. A refused step or initialisation
+    raises :class:`StepRefused` with the instance's name before its reasons. With ``order`` (every instance's
     name) it is a Gauss-Seidel master instead: the instances step one after the other in that order,
     each with its inputs set just before from the outputs as they are then (those of the instances
-    already stepped at t_k+1)."""
-    instances = {name: FmuInstance(path, name) for name, path in fmus.items()}
+    already stepped at t_k+1). ``unpacked``: ``{name: (extracted folder, model description)}`` of
+    FMUs already extracted and parsed (kept after the run).
+
+    Values travel in batches (:class:`Transfer`, :class:`Reading`): per step one read per instance feeding others, one
+    write per instance fed, one doStep per instance and one read per instance of ``outputs``."""
+    unpacked = unpacked or {}
+    instances = {name: FmuInstance(path, name, *unpacked.get(name, (None, None))) for name, path in fmus.items()}
     try:
-
-        def value(port: Port) -> float:
-            return instances[port[0]].get([port[1]])[0]
-
         # Like the importers: all instances enter initialisation, each connection carries the
         # start value of its output (outputs are computed on exit), then all exit.
         for name, instance in instances.items():
             instance.enter_initialization(parameters.get(name, {}))
         for start, end in connections:
-            instances[end[0]].set({end[1]: value(start)})
-        for instance in instances.values():
-            instance.exit_initialization()
+            instances[end[0]].set({end[1]: instances[start[0]].get([start[1]])[0]})
+        for name, instance in instances.items():
+            _named(name, instance.exit_initialization)
 
         ports = [tuple(name.split(".", 1)) for name in outputs]
+        record = Reading(instances, ports)
+        columns = [record.position[port] for port in ports]
         steps = int(round(stop_time / step_size))
-        rows = []
         groups = [list(instances)] if order is None else [[name] for name in order]
-        sweeps = [(group, [(start, end) for start, end in connections if end[0] in group]) for group in groups]
+        sweeps = [(group, Transfer(instances, [c for c in connections if c[1][0] in group])) for group in groups]
+        rows = []
         for k in range(steps):
-            for group, into in sweeps:
-                _step(instances, group, into, k, step_size)
-            rows.append([(k + 1) * step_size, *(value(port) for port in ports)])
+            for group, transfer in sweeps:
+                transfer()
+                _step(instances, group, k, step_size)
+            rows.append(record())
             if on_step is not None:
                 on_step(k + 1, steps)
-        return np.array(rows)
+        times = (np.arange(steps) + 1.0) * step_size
+        return np.column_stack([times, np.array(rows, dtype=float).reshape(steps, len(outputs))[:, columns]])
     finally:
         for instance in instances.values():
             instance.close()
 
 
-def _step(instances: Mapping[str, FmuInstance], names: list[str], connections: list[tuple[Port, Port]], k: int,
-          step_size: float) -> None:
-    """Set the inputs of ``connections`` from their outputs as they are, then step ``names`` from t_k."""
-    transfers = [(end, instances[start[0]].get([start[1]])[0]) for start, end in connections]
-    for (name, variable), transferred in transfers:
-        instances[name].set({variable: transferred})
+def _step(instances: Mapping[str, FmuInstance], names: list[str], k: int, step_size: float) -> None:
+    """Step the instances ``names`` from t_k."""
     for name in names:
         instance = instances[name]
         instance.time = k * step_size
-        try:
-            instance.step(step_size)
-        except StepRefused as refused:
-            raise StepRefused(f"{name}: {refused.call}", refused.status, refused.time, refused.messages) from None
+        _named(name, instance.step, step_size)
+
+
+def _named(name: str, call: Callable[..., None], *arguments: object) -> None:
+    """``call(*arguments)`` of the instance ``name``; its :class:`StepRefused` names the instance first."""
+    try:
+        call(*arguments)
+    except StepRefused as refused:
+        raise StepRefused(f"{name}: {refused.call}", refused.status, refused.time, refused.messages) from None
+
+
+def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) -> str | None:
+    """Why ``step`` is too long for a component whose model (``models``: each component's model name)
+    states a limit for a Jacobi coupling (every engine here couples so): a ``VehicleDriveline``'s
+    differential mode; None when no limit is passed."""
+    for component in system.components:
+        if models[component.name] != "VehicleDriveline":
+            continue
+        values = {v.name: v.start for v in MODELS["VehicleDriveline"].spec.variables} | component.parameters
+        drive = Drive(*(float(values[name]) for name in Drive._fields))
+        limit = dynamics.jacobi_step_limit(drive)
+        if step > limit:
+            modes = "; ".join(f"{side} {omega:.4g} rad/s, damping ratio {zeta:.3g}"
+                              for side, (omega, zeta) in zip(("left", "right"), dynamics.internal_modes(drive)))
+            return (f"{component.name} (VehicleDriveline): --step {step!r} s is above {limit:.3g} s, the longest step "
+                    f"at which its differential's internal mode ({modes}) stays stable with the joints' torques "
+                    f"one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, {dynamics.JACOBI_DAMPING_STEP} "
+                    "zeta)): take a shorter step")
+    return None
 
 
 def simulate(system: System, models: Path, outputs: list[str] | None = None, natives: Path | None = None,

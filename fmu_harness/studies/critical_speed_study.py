@@ -62,14 +62,14 @@ def ramp(fmu: Path, speeds: np.ndarray, seconds: float = 1.0) -> np.ndarray:
     names = [v.name for v in SPEC.of("output")]
     times = seconds * speeds / speeds[-1]
     with FmuInstance(fmu) as instance:
-        instance.initialize({"omega_max": float(speeds[-1]), "omega": float(speeds[0])})
-        read, write = instance.reader(names), instance.writer(["omega"])
+        instance.initialize({"omega_in_max": float(speeds[-1]), "omega_in": float(speeds[0])})
+        read, write = instance.reader(names), instance.writer(["omega_in"])
         rows = [(times[0], speeds[0], *read())]
         for k in range(1, len(speeds)):
             write([speeds[k]])
             instance.step(times[k] - times[k - 1])
             rows.append((times[k], speeds[k], *read()))
-    return np.array(rows, dtype=[(n, float) for n in ("time", "omega", *names)])
+    return np.array(rows, dtype=[(n, float) for n in ("time", "omega_in", *names)])
 
 
 def crossings(spins: np.ndarray, whirl: np.ndarray, order: int) -> list[float]:
@@ -87,7 +87,7 @@ def branches(result: np.ndarray) -> dict[tuple[str, int], np.ndarray]:
     mode 3 from the rotor core at the FMU's start values."""
     found = {(sense, mode): result[f"whirl_{sense}_{mode}"] for sense in SENSES for mode in range(1, MODES + 1)}
     shaft = {name: SPEC[name].start for name in SHAFT_PARAMETERS}
-    core = whirl_branches(build_driveline("", shaft), result["omega"], MODES + 1)
+    core = whirl_branches(build_driveline("", shaft), result["omega_in"], MODES + 1)
     found["forward", MODES + 1] = core.forward[:, MODES]
     found["backward", MODES + 1] = core.backward[:, MODES]
     return found
@@ -112,7 +112,7 @@ def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray]
                     criticals: tuple[float, ...]) -> Figure:
     """Whirl branches against shaft speed, the order lines labelled inside the axes, every crossing
     marked with its speed; the 1x forward crossings (the critical speeds) in red."""
-    spins = result["omega"]
+    spins = result["omega_in"]
     x_top = spins[-1] * RPM
     y_top = 1.08 * max(np.nanmax(values) for values in whirl.values()) * RPM
     fig, ax = figure(figsize=(9, 7))

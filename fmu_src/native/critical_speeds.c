@@ -6,8 +6,8 @@
  * parameters are checked, and only in the parts a change affects, each part kept with the
  * parameters it was built for (CriticalSpeedsModel._part): the driveline (structure and damping),
  * the structure (critical speeds, finite-element check), the Campbell table (structure and
- * omega_max), the order resonances (structure, orders, omega_max) and the unbalance outputs
- * (structure, damping, unbalance parameters, omega_max). A step only looks values up.
+ * omega_in_max), the order resonances (structure, orders, omega_in_max) and the unbalance outputs
+ * (structure, damping, unbalance parameters, omega_in_max). A step only looks values up.
  */
 #include <math.h>
 #include <stdio.h>
@@ -647,7 +647,7 @@ static ErrorKind unbalance_outputs(Analysis *analysis, const ModelData *data, ch
         unbalances = &single;
         count = 1;
     }
-    return unbalance_outputs_new(&analysis->driveline, unbalances, count, VALUE(response_position), VALUE(omega_max),
+    return unbalance_outputs_new(&analysis->driveline, unbalances, count, VALUE(response_position), VALUE(omega_in_max),
                                  &analysis->unbalance, error, ERROR_SIZE);
 }
 
@@ -670,13 +670,13 @@ static ErrorKind part(Analysis *analysis, const ModelData *data, Part which, con
         break;
     case PART_WHIRL:
         failed = spend(budget, 2, -1.0, error);
-        failed = failed ? failed : whirl_table_new(analysis->chain, VALUE(omega_max), ROTOR_MODEL_CAMPBELL_POINTS,
+        failed = failed ? failed : whirl_table_new(analysis->chain, VALUE(omega_in_max), ROTOR_MODEL_CAMPBELL_POINTS,
                                                    ROTOR_MODEL_WHIRL_MODES, &analysis->whirl, error, ERROR_SIZE);
         failed = failed ? failed : implausibility(analysis, error);
         break;
     case PART_RESONANCES:
         failed = spend(budget, 1, -1.0, error);
-        failed = failed ? failed : resonances(analysis, orders, n_orders, VALUE(omega_max), error);
+        failed = failed ? failed : resonances(analysis, orders, n_orders, VALUE(omega_in_max), error);
         break;
     default:
         failed = spend(budget, 4, seconds[4], error);
@@ -732,15 +732,17 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
         return;
     }
     failed = failed ? failed : part(analysis, data, PART_DRIVELINE, orders, n_orders, &budget, seconds, error);
-    failed = failed ? failed : searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_max), &work, error);
+    failed = failed ? failed
+                    : searched_modes(&analysis->driveline, orders, n_orders, VALUE(omega_in_max), &work, error);
     if (!failed && !(work <= ROTOR_MODEL_MAX_SEARCHED_MODES)) {
         python_format_g(work, 3, shown, sizeof shown);
         snprintf(error, sizeof error,
                  "the analysis would scan %s shaft modes, more than the %.0f accepted (shorter or stiffer shaft, "
-                 "fewer or lower orders, or a smaller omega_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);
+                 "fewer or lower orders, or a smaller omega_in_max)", shown, ROTOR_MODEL_MAX_SEARCHED_MODES);
         failed = ERROR_VALUE;
     }
-    failed = failed ? failed : work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_max), seconds, error);
+    failed = failed ? failed
+                    : work_refusal(&analysis->driveline, orders, n_orders, VALUE(omega_in_max), seconds, error);
     if (analysis->chain != NULL) {
         chain_set_budget(analysis->chain, &budget);
     }
@@ -763,11 +765,11 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
 
 /* ---- per step ------------------------------------------------------------------------------------ */
 
-/* CriticalSpeedsModel.evaluate: lookups in the analysis at |omega|. */
+/* CriticalSpeedsModel.evaluate: lookups in the analysis at |omega_in|. */
 static Failure evaluate(ModelData *data)
 {
     const Analysis *analysis = data->cache->derived;
-    double speed = fabs(VALUE(omega)), whirl[2 * ROTOR_MODEL_WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
+    double speed = fabs(VALUE(omega_in)), whirl[2 * ROTOR_MODEL_WHIRL_MODES], unbalance[3], margin, smallest = 0.0;
     int closest = 0, count = 0, i;
     if (analysis == NULL || analysis->whirl == NULL || analysis->resonance_count == 0 ||
         analysis->unbalance == NULL) { /* the parameter check builds it before every step */
@@ -819,7 +821,7 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
     return evaluate(data);
 }
 
-/* The outputs at any time: the analysis looked up at |omega| (Model Exchange; no state). */
+/* The outputs at any time: the analysis looked up at |omega_in| (Model Exchange; no state). */
 static Failure evaluate_now(ModelData *data, double time UNUSED)
 {
     return evaluate(data);

@@ -131,11 +131,11 @@ ON_INSTANCE(fmi2, instance_set_string(instance, "SetString", vr, nvr, value))
 
 FMU_STATE_FUNCTIONS(fmi2, fmi2Component, FMUstate, DeSerialize)
 
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[] UNUSED,
-                                        size_t nUnknown UNUSED,
-                                        const fmi2ValueReference vKnown_ref[] UNUSED, size_t nKnown UNUSED,
-                                        const fmi2Real dvKnown[] UNUSED, fmi2Real dvUnknown[] UNUSED)
-ON_INSTANCE(fmi2, instance_unsupported(instance, "GetDirectionalDerivative"))
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
+                                        const fmi2Real dvKnown[], fmi2Real dvUnknown[])
+ON_INSTANCE(fmi2, derivatives_get(instance, "GetDirectionalDerivative", vUnknown_ref, nUnknown, vKnown_ref, nKnown,
+                                  dvKnown, nKnown, dvUnknown, nUnknown, 0))
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[])

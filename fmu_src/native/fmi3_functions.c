@@ -5,9 +5,9 @@
  * state); a refused step returns fmi3Discard with the model unchanged, lastSuccessfulTime =
  * currentCommunicationPoint and terminateSimulation true (the same step would be refused again, so
  * the importer stops; one that corrects its inputs may step again). The independent variable ``time``
- * has the value reference after the spec's variables. Model Exchange: fmu_model_exchange.c. Functions of
- * the scheduled execution interface, clocks and derivatives are exported, as the standard requires, and
- * return fmi3Error (instantiation: NULL).
+ * has the value reference after the spec's variables. Model Exchange: fmu_model_exchange.c; directional and
+ * adjoint derivatives: fmu_derivatives.c. Functions of the scheduled execution interface, clocks and output
+ * derivatives are exported, as the standard requires, and return fmi3Error (instantiation: NULL).
  */
 #include <stddef.h>
 
@@ -221,7 +221,7 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 currentCommunicationPoint, fmi
     return (fmi3Status)status;
 }
 
-/* ---- what a co-simulation FMU without events, clocks or derivatives does not offer ----------- */
+/* ---- derivatives (fmu_derivatives.c); what an FMU without events or clocks does not offer ------ */
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance c, fmi3ValueReference valueReference UNUSED,
                                                size_t *nDependencies UNUSED)
@@ -235,20 +235,17 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference depend
                                        size_t nDependencies UNUSED)
 ON_INSTANCE(fmi3, instance_unsupported(instance, "GetVariableDependencies"))
 
-fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[] UNUSED,
-                                        size_t nUnknowns UNUSED,
-                                        const fmi3ValueReference knowns[] UNUSED, size_t nKnowns UNUSED,
-                                        const fmi3Float64 seed[] UNUSED,
-                                        size_t nSeed UNUSED, fmi3Float64 sensitivity[] UNUSED,
-                                        size_t nSensitivity UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetDirectionalDerivative"))
+fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,
+                                        const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+                                        size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity)
+ON_INSTANCE(fmi3, derivatives_get(instance, "GetDirectionalDerivative", unknowns, nUnknowns, knowns, nKnowns, seed,
+                                  nSeed, sensitivity, nSensitivity, 0))
 
-fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unknowns[] UNUSED,
-                                    size_t nUnknowns UNUSED,
-                                    const fmi3ValueReference knowns[] UNUSED, size_t nKnowns UNUSED,
-                                    const fmi3Float64 seed[] UNUSED,
-                                    size_t nSeed UNUSED, fmi3Float64 sensitivity[] UNUSED, size_t nSensitivity UNUSED)
-ON_INSTANCE(fmi3, instance_unsupported(instance, "GetAdjointDerivative"))
+fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,
+                                    const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+                                    size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity)
+ON_INSTANCE(fmi3, derivatives_get(instance, "GetAdjointDerivative", unknowns, nUnknowns, knowns, nKnowns, seed,
+                                  nSeed, sensitivity, nSensitivity, 1))
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance c)
 ON_INSTANCE(fmi3, instance_unsupported(instance, "EnterConfigurationMode"))

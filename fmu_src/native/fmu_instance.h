@@ -94,6 +94,10 @@ extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
 extern const int model_states[MODEL_STATE_COUNT];
 extern const int model_state_derivatives[MODEL_STATE_COUNT];
 #endif
+/* Directional derivatives: each variable's row of the Jacobian (a Real output; der(<state k>) has row
+ * MODEL_OUTPUT_ROWS + k) and column (a Real input or a state), -1 for none */
+extern const int model_jacobian_rows[MODEL_VARIABLE_COUNT];
+extern const int model_jacobian_columns[MODEL_VARIABLE_COUNT];
 #if MODEL_INPUT_DERIVATIVE_COUNT > 0
 extern const InputDerivative model_input_derivatives[MODEL_INPUT_DERIVATIVE_COUNT];
 #endif
@@ -181,7 +185,11 @@ typedef struct {
  * A NULL ``reset_internal``, ``extra_*_errors`` or ``start_notice`` means none. A model with derived
  * data builds it in ``extra_parameter_errors`` (run before every initialisation and step, once the
  * declared checks pass) into ``data->cache->derived``, keyed by the parameters it was built for, and gives
- * ``free_derived``; NULL: the model has none. */
+ * ``free_derived``; NULL: the model has none. ``jacobian`` gives the exact partial derivatives of the
+ * Real outputs with respect to the Real inputs and the states (PARTIAL) at the point ``data`` holds,
+ * whose outputs ``evaluate`` has just computed with the internal state reset; ``partial`` is zero
+ * and the model writes what is not: the states' own rows and der(<state>)'s are the layer's
+ * (fmu_derivatives.c). NULL: the FMU offers no directional derivatives. */
 typedef struct {
     void (*reset_internal)(ModelData *data);
     Failure (*at_time)(ModelData *data, double time);
@@ -192,12 +200,15 @@ typedef struct {
     void (*extra_input_errors)(const ModelData *data, Messages *out);
     void (*free_derived)(void *derived);
     const char *(*start_notice)(const ModelData *data); /* SteppedModel.start_notice: logged once, a warning */
+    Failure (*jacobian)(const ModelData *data, double partial[]);
 } ModelHooks;
 
 extern const ModelHooks model_hooks;
 
 /* A Real variable of the model by its name, in a hook whose ModelData is ``data`` */
 #define VALUE(name) (data->real_value[V_##name])
+/* d output / d known in a ``jacobian`` hook: a Real output by name, a Real input or state by name */
+#define PARTIAL(output, known) (partial[ROW_##output * MODEL_COLUMN_COUNT + COLUMN_##known])
 
 /* ``start`` and ``advance`` of a model driven by an input shaft (DrivenShaftModel in
  * driveline/model.py): phi_in starts at phi_in_start and integrates the held omega_in exactly;
@@ -303,6 +314,22 @@ Status model_exchange_enter_mode(Instance *instance, const char *function, int e
 int model_exchange_call(Instance *instance, const char *function, int outputs_given);
 /* Error unless the instance is one of the interface's (``model_exchange`` 1: Model Exchange). */
 int instance_is(Instance *instance, int model_exchange, const char *function);
+/* Evaluates the outputs into ``data`` (the instance's values, or a copy of them) at its time, states and
+ * inputs with the internal state reset, checked as a co-simulation step checks them: the reasons of a
+ * refusal in the instance's messages (none: the outputs are in ``data``). */
+void model_exchange_evaluate(Instance *instance, ModelData *data);
+
+/* ---- directional derivatives (fmu_derivatives.c) ------------------------------------------ */
+/* The sensitivities J seed (``adjoint`` 0: FMI's directional derivative, ``n_seed`` = ``n_knowns``,
+ * ``n_sensitivity`` = ``n_unknowns``) or seed^T J (``adjoint`` 1, the sizes the other way round) of the
+ * Jacobian J of the ``unknowns`` (Real outputs, state derivatives) with respect to the ``knowns`` (Real
+ * inputs, states) at the current time, states and inputs, after initialisation. Misuse: Error; a point a
+ * step would refuse or a result that is not finite: Discard, the sensitivities unchanged. */
+Status derivatives_get(Instance *instance, const char *function, const uint32_t unknowns[], size_t n_unknowns,
+                       const uint32_t knowns[], size_t n_knowns, const double seed[], size_t n_seed,
+                       double sensitivity[], size_t n_sensitivity, int adjoint);
+/* The ``jacobian`` hook of a model whose outputs are functions of time and the parameters alone. */
+Failure jacobian_of_time_alone(const ModelData *data, double partial[]);
 
 /* ---- FMU state ------------------------------------------------------------------------ */
 typedef struct StoredState StoredState;

@@ -44,15 +44,43 @@ static int model_exchange_allows(Instance *instance, const char *function)
     return instance_is(instance, 1, function);
 }
 
+void model_exchange_evaluate(Instance *instance, ModelData *data)
+{
+    Messages *out = &instance->messages;
+    double states[STATE_SLOTS];
+    char shown[40];
+    Failure failure;
+    int i;
+    out->count = 0;
+    parameter_errors(data, out);
+    input_errors(data, out);
+    if (out->count) {
+        return;
+    }
+    for (i = 0; i < MODEL_STATE_COUNT; i++) {
+        states[i] = STATE(data, i);
+    }
+    if (model_hooks.reset_internal != NULL) {
+        model_hooks.reset_internal(data);
+    }
+    failure = model_hooks.evaluate(data, data->time);
+    for (i = 0; i < MODEL_STATE_COUNT; i++) { /* a model of time alone computes its state too: the solver's */
+        STATE(data, i) = states[i];
+    }
+    if (failure.kind == ERROR_NONE) {
+        output_errors(data, out, &failure);
+    }
+    if (failure.kind != ERROR_NONE) {
+        python_float_repr(data->time, shown, sizeof shown);
+        messages_add(out, "the outputs at t = ", shown, " s could not be computed (", ERROR_KIND_NAME(failure.kind),
+                     ": ", failure.message, ")", (const char *)NULL);
+    }
+}
+
 /* The outputs and derivatives at the instance's time, states and inputs, if any of them changed. */
 Status model_exchange_update(Instance *instance)
 {
-    Messages *out = &instance->messages;
     ModelData snapshot;
-    double states[STATE_SLOTS];
-    char shown[40];
-    Failure failure = NO_FAILURE;
-    int i;
     if (!instance->model_exchange || !instance->stale || instance->mode != MODE_STEP) {
         return STATUS_OK;
     }
@@ -60,34 +88,12 @@ Status model_exchange_update(Instance *instance)
         return instance_fail(instance, instance->fmi_prefix, ": ", MODEL_NAME, "'s C port gives no evaluate hook, "
                              "which Model Exchange needs", (const char *)NULL);
     }
-    out->count = 0;
-    parameter_errors(&instance->data, out);
-    input_errors(&instance->data, out);
-    if (out->count == 0) {
-        snapshot = instance->data;
-        for (i = 0; i < MODEL_STATE_COUNT; i++) {
-            states[i] = STATE(&instance->data, i);
-        }
-        if (model_hooks.reset_internal != NULL) {
-            model_hooks.reset_internal(&instance->data);
-        }
-        failure = model_hooks.evaluate(&instance->data, instance->data.time);
-        for (i = 0; i < MODEL_STATE_COUNT; i++) { /* a model of time alone computes its state too: the solver's */
-            STATE(&instance->data, i) = states[i];
-        }
-        if (failure.kind == ERROR_NONE) {
-            output_errors(&instance->data, out, &failure);
-        }
-        if (failure.kind != ERROR_NONE) {
-            python_float_repr(instance->data.time, shown, sizeof shown);
-            messages_add(out, "the outputs at t = ", shown, " s could not be computed (", ERROR_KIND_NAME(failure.kind),
-                         ": ", failure.message, ")", (const char *)NULL);
-        }
-        if (out->count) {
-            instance->data = snapshot;
-        }
+    snapshot = instance->data;
+    model_exchange_evaluate(instance, &instance->data);
+    if (instance->messages.count) {
+        instance->data = snapshot;
     }
-    instance->stale = out->count > 0;
+    instance->stale = instance->messages.count > 0;
     return instance_refusal(instance);
 }
 

@@ -349,6 +349,6 @@ Status instance_set_debug_logging(Instance *instance, const char *function, size
 Status instance_unsupported(Instance *instance, const char *function)
 {
     return instance_fail(instance, instance->fmi_prefix, function,
-                         " is not supported by this co-simulation FMU", (const char *)NULL);
+                         " is not supported by this FMU", (const char *)NULL);
 }
 

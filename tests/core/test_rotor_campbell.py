@@ -95,7 +95,7 @@ def test_crossing_branches_keep_their_identity():
 def test_only_what_a_changed_parameter_affects_is_analysed_again():
     model = model_checks.started(CriticalSpeedsModel)
     parts = dict(model._parts)
-    for name, value in (("band", 0.2), ("orders", "1,2"), ("omega_max", 1400.0)):
+    for name, value in (("band", 0.2), ("orders", "1,2"), ("omega_in_max", 1400.0)):
         setattr(model, name, value)
         assert model.step(0.0, 0.01) == []
     assert model._parts["structure"] is parts["structure"]

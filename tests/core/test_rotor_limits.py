@@ -37,7 +37,7 @@ def test_the_limits_still_accept_sixteen_orders_up_to_the_largest():
 
 @pytest.mark.parametrize("parameters", [
     {"L_shaft": 100.0}, {"L_shaft": 1e6}, {"density": 1e308}, {"E": 1e-300},
-    {"omega_max": 1e300}, {"orders": "100,99,98,97,96,95,94,93"},
+    {"omega_in_max": 1e300}, {"orders": "100,99,98,97,96,95,94,93"},
 ])
 def test_analyses_beyond_the_work_limit_are_refused_before_they_start(parameters):
     assert any("shaft modes, more than the 250 accepted" in reason for reason in _refusal(**parameters))

@@ -164,8 +164,8 @@ def test_the_models_declare_their_rules():
     rotor.D_inner = 0.08
     assert rotor.initialize(0.0) == ["parameter D_inner = 80 mm must be below D_outer = 76.2 mm"]
     rotor = CriticalSpeedsModel()
-    rotor.omega = -1600.0
-    assert rotor.input_errors() == ["input omega = -15278.9 rpm must not be below -omega_max = -14323.9 rpm"]
+    rotor.omega_in = -1600.0
+    assert rotor.input_errors() == ["input omega_in = -15278.9 rpm must not be below -omega_in_max = -14323.9 rpm"]
 
 
 @pytest.mark.parametrize("name", MODELS)

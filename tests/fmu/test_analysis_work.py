@@ -34,7 +34,7 @@ def test_the_issues_layout_is_refused_at_initialisation_by_both_cores_alike(nati
     the estimate of every stage in the message, word for word the Python core's."""
     layout = tmp_path / "stations.toml"
     layout.write_text(ISSUE_LAYOUT)
-    values = {"layout": str(layout), "omega_max": 1e-3, "orders": "1", "omega": 0.0}
+    values = {"layout": str(layout), "omega_in_max": 1e-3, "orders": "1", "omega_in": 0.0}
     core = CriticalSpeedsModel()
     for name, value in values.items():
         setattr(core, name, value)
@@ -51,9 +51,9 @@ def test_the_issues_layout_is_refused_at_initialisation_by_both_cores_alike(nati
 def test_the_worst_inputs_the_limits_allow_stay_within_the_budgets(native_dir, tmp_path):
     """Every worst case of fmu_harness.checks.analysis_work (most stations of every kind, most segments,
     shortest segments, stations between nodes, most and highest orders, smallest and largest
-    omega_max): each Python stage within 30 s and 2 GB, the native analysis within 5 s and 500 MB,
+    omega_in_max): each Python stage within 30 s and 2 GB, the native analysis within 5 s and 500 MB,
     each in a process under a limit of time and address space; the issue's layout refused."""
-    assert set(worst_cases()) >= {"most stations", "most orders", "smallest omega_max", "largest omega_max"}
+    assert set(worst_cases()) >= {"most stations", "most orders", "smallest omega_in_max", "largest omega_in_max"}
     results = measure(tmp_path, native.fmu_path(native_dir, "CriticalSpeeds", "2"))
     assert over_budget(results) == []
 

@@ -13,7 +13,7 @@ from driveline.rotor.damped import DampedRotor
 from driveline.rotor.driveline import EXCITED_SHARE
 from driveline.rotor.fem import elements_by_length
 from driveline.rotor.model import CriticalSpeedsModel
-from driveline.rotor.spec import OMEGA_MAX_MIN, SPEC
+from driveline.rotor.spec import OMEGA_IN_MAX_MIN, SPEC
 from driveline.rotor.unbalance_outputs import DAMPED_MODES, DAMPING_POINTS, FE_ELEMENTS, TABLE_ELEMENTS
 from fmu_harness.runs.runner import FmuInstance, StepRefused, simulate
 
@@ -32,7 +32,7 @@ def test_critical_speeds_and_interpolated_whirl_match_the_core(rotor_b):
     model = model_checks.started(CriticalSpeedsModel)
     assert (model.omega_crit_1, model.omega_crit_2, model.omega_crit_3) == tuple(rotor_b.critical_speeds(3))
     for speed in (0.0, 123.4, 777.7, 1499.0):  # off the spline knots
-        model.omega = -speed  # the sign of the speed is ignored
+        model.omega_in = -speed  # the sign of the speed is ignored
         assert model.step(0.0, 0.01) == []
         direct = rotor_b.whirl_frequencies(speed, 2)
         interpolated = [model.whirl_forward_1, model.whirl_forward_2, model.whirl_backward_1, model.whirl_backward_2]
@@ -54,7 +54,7 @@ def test_every_resonance_in_the_band_counts(fmu_path, fmi):
     # Two-piece example (Timoshenko tubes) at 330.5 rad/s with orders 1, 2, 3, 6: the nearest
     # resonance in rad/s (6x forward at 299.2, margin +10.5 %) lies outside the 10 % band, but
     # the 6x backward one at 358.9 (-7.9 %) and the 6x forward one at 363.4 (-9.1 %) lie inside.
-    result = simulate(fmu_path("CriticalSpeeds", fmi), 0.02, 0.01, inputs={"omega": lambda t: 330.5},
+    result = simulate(fmu_path("CriticalSpeeds", fmi), 0.02, 0.01, inputs={"omega_in": lambda t: 330.5},
                       start_values={"layout": "two_piece_propshaft", "orders": "1,2,3,6"})
     last = result[-1]
     assert bool(last["resonance_warning"]) and last["resonance_count"] == 2
@@ -67,7 +67,7 @@ def test_analysis_runs_only_when_the_structure_changes():
     model = model_checks.started(CriticalSpeedsModel)
     analysis = model._analysis
     for k in range(5):
-        model.omega = 100.0 + k
+        model.omega_in = 100.0 + k
         assert model.step(k * 0.01, 0.01) == []
     assert model._analysis is analysis
     model.k_bearing = 2e6  # a softer bearing, mid-run
@@ -90,7 +90,7 @@ def test_shipped_layout_by_name():
         ({"density": 0.0}, "density"),
         ({"orders": "1,two"}, "'two'"),
         ({"layout": "missing.toml"}, "missing.toml"),
-        ({"omega_max": 0.0}, "omega_max"),
+        ({"omega_in_max": 0.0}, "omega_in_max"),
         ({"c_bearing": -1.0}, "c_bearing"),
         ({"unbalance_position": 1.5}, "unbalance_position"),
         ({"response_position": -0.1}, "response_position"),
@@ -116,16 +116,16 @@ def test_malformed_description_file_is_refused(tmp_path):
 
 def test_fmu_follows_a_speed_ramp_and_refuses_overspeed(fmu_path, rotor_b):
     path = fmu_path("CriticalSpeeds")
-    result = simulate(path, 1.0, 0.05, inputs={"omega": lambda t: 1400.0 * t})
+    result = simulate(path, 1.0, 0.05, inputs={"omega_in": lambda t: 1400.0 * t})
     np.testing.assert_allclose(result["omega_crit_1"], rotor_b.critical_speeds(1)[0], rtol=1e-12)
     np.testing.assert_allclose(result["speed_ratio"][1:], 1400.0 * (result["time"][1:] - 0.05) / result["omega_crit_1"][1:], rtol=1e-12)
     with FmuInstance(path) as fmu:
-        fmu.initialize({"omega": 100.0})
+        fmu.initialize({"omega_in": 100.0})
         fmu.step(0.01)
-        fmu.set({"omega": 1600.0})
+        fmu.set({"omega_in": 1600.0})
         with pytest.raises(StepRefused) as refused:
             fmu.step(0.01)
-    assert "omega_max" in refused.value.messages[0]
+    assert "omega_in_max" in refused.value.messages[0]
     with pytest.raises(StepRefused) as refused:
         simulate(path, 0.1, 0.05, start_values={"D_inner": 0.09})
     assert any("D_inner" in message for message in refused.value.messages)
@@ -160,7 +160,7 @@ def test_unbalance_outputs_match_the_damped_model():
     rotor, coarse = DampedRotor(d, elements_by_length(d, FE_ELEMENTS)), DampedRotor(d, elements_by_length(d, TABLE_ELEMENTS))
     speeds = np.linspace(0.0, 1500.0, DAMPING_POINTS)
     for speed in (*speeds, 123.4, 655.0, 1234.5):
-        model.omega = speed
+        model.omega_in = speed
         assert model.step(0.0, 0.01) == []
         response = rotor.unbalance_response([speed], positions=[0.84])
         assert model.unbalance_response == pytest.approx(response.major[0, 0], rel=1e-12, abs=0.0)
@@ -176,7 +176,7 @@ def test_fmu_unbalance_response_peaks_at_the_first_critical_speed(fmu_path, fmi)
     # peaks there (FE_ELEMENTS elements: the peak lies 1.1e-4 above the exact root, measured), and
     # the damping ratio read there is the first forward mode's (2.5e-3 at 800 N s/m; the table's
     # splines are within 1e-4 of the table model's, and that within 0.4 % of a fine mesh's).
-    result = simulate(fmu_path("CriticalSpeeds", fmi), 1.0, 0.001, inputs={"omega": lambda t: 640.0 + 30.0 * t},
+    result = simulate(fmu_path("CriticalSpeeds", fmi), 1.0, 0.001, inputs={"omega_in": lambda t: 640.0 + 30.0 * t},
                       start_values={"c_bearing": 800.0})
     critical = result["omega_crit_1"][-1]
     peak = int(np.argmax(result["unbalance_response"]))
@@ -217,21 +217,21 @@ def test_a_layout_brings_its_own_unbalance_and_damping(tmp_path):
 
 
 #: The edges of every Real parameter that the property tests draw (``support.alongside_the_core``:
-#: +-1e300, one below the minimum, one above the maximum), and omega_max's declared minimum from
+#: +-1e300, one below the minimum, one above the maximum), and omega_in_max's declared minimum from
 #: both sides with the values of issue 34 (1e-300 and 1e-150 rad/s: the Python core's tables
 #: overflowed while the native ones ran).
 EDGES = [(v.name, value) for v in SPEC.of("parameter") if v.type == "Real"
          for value in (1e300, -1e300, *([v.min - 1.0] if v.min is not None else []),
                        *([v.max + 1.0] if v.max is not None else []))] + [
-    ("omega_max", OMEGA_MAX_MIN), ("omega_max", math.nextafter(OMEGA_MAX_MIN, 0.0)), ("omega_max", 1e-150),
-    ("omega_max", 1e-300)]
+    ("omega_in_max", OMEGA_IN_MAX_MIN), ("omega_in_max", math.nextafter(OMEGA_IN_MAX_MIN, 0.0)),
+    ("omega_in_max", 1e-150), ("omega_in_max", 1e-300)]
 
 
 @pytest.mark.parametrize("name, value", EDGES)
 def test_parameter_edges_get_the_cores_answer(family, name, value):
     """At each edge both families give the core's answer: refused with its reason, or run with its
     outputs (the family's tolerance)."""
-    start = {name: value, "omega": 0.0}
+    start = {name: value, "omega_in": 0.0}
     core = CriticalSpeedsModel()
     for variable, start_value in start.items():
         setattr(core, variable, start_value)

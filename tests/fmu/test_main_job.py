@@ -65,10 +65,10 @@ def test_every_csv_starts_with_time_or_the_swept_variable_with_units_and_no_repe
 
 
 def test_ramp_rows_belong_to_their_own_speed_and_pass_every_critical_speed(results):
-    """speed_ratio = omega / omega_crit_1 is computed by the FMU from the speed it stepped with."""
+    """speed_ratio = omega_in / omega_crit_1 is computed by the FMU from the speed it stepped with."""
     ramp = np.genfromtxt(results / "critical_speeds_ramp.csv", delimiter=",", names=True)
-    names = ramp.dtype.names  # genfromtxt drops the brackets: omega_rads, speed_ratio_1, ...
-    omega, ratio, first = (ramp[n] for n in ("omega_rads", "speed_ratio_1", "omega_crit_1_rads"))
+    names = ramp.dtype.names  # genfromtxt drops the brackets: omega_in_rads, speed_ratio_1, ...
+    omega, ratio, first = (ramp[n] for n in ("omega_in_rads", "speed_ratio_1", "omega_crit_1_rads"))
     np.testing.assert_allclose(ratio * first, omega, rtol=1e-14, atol=1e-12)
     criticals = np.genfromtxt(results / "critical_speeds.csv", delimiter=",", skip_header=1)[:, 1]
     # the ramp ends 10 % past the third critical speed, as the README says
@@ -90,11 +90,11 @@ def test_ramp_records_the_unbalance_response_peak(results, models):
     speed within 3 % of where the ramp recorded it (the ramp samples detunings from 1e-5 to 3 %,
     30 % apart, on both sides of each critical speed)."""
     ramp = np.genfromtxt(results / "critical_speeds_ramp.csv", delimiter=",", names=True)
-    omega, response = ramp["omega_rads"], ramp["unbalance_response_m"]
+    omega, response = ramp["omega_in_rads"], ramp["unbalance_response_m"]
     recorded = int(np.argmax(response))
     with FmuInstance(native.fmu_path(models, "CriticalSpeeds")) as instance:
-        instance.initialize({"omega_max": float(omega[-1]), "omega": 0.0})
-        read, write = instance.reader(["unbalance_response"]), instance.writer(["omega"])
+        instance.initialize({"omega_in_max": float(omega[-1]), "omega_in": 0.0})
+        read, write = instance.reader(["unbalance_response"]), instance.writer(["omega_in"])
 
         def at(speed: float) -> float:
             write([speed])

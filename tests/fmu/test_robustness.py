@@ -83,7 +83,7 @@ def test_the_work_fuzzer_finds_no_analysis_beyond_its_budget(paths: robustness.F
                                                              fmi_versions: list[str]):
     """The work fuzzer's short run (fmu_harness.checks.work_fuzzer; benchmarks/work_fuzzer.py runs it long):
     the layout that took 12.9 s native and 25.4 s in the Python core, and two random layouts of extreme
-    materials with omega_max near the estimate's edge, each initialised and changed twice in a process
+    materials with omega_in_max near the estimate's edge, each initialised and changed twice in a process
     under a limit of CPU time and address space: no analysis (accepted or refused) beyond the family's
     budget (5 s and 500 MB native, 30 s and 2 GB Python), and that layout accepted throughout."""
     results = work_fuzzer.fuzz({family: paths("CriticalSpeeds", fmi_versions[0])}, 3, seed=3)

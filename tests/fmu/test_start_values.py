@@ -12,19 +12,26 @@ from fmu_harness.checks import importers
 from fmu_harness.runs import start_values, sweep, system
 from fmu_harness.runs.runner import StepRefused
 
-#: A parameter of each kind of check, and a value the FMUs refuse at initialisation.
+#: A parameter of each kind of check, an input beyond its relation, and a value the FMUs refuse at
+#: initialisation.
 REFUSED = [("TripodCoupling", {"r": -1.0}), ("CardanJoint", {"beta_max": 2.0}),
-           ("CriticalSpeeds", {"omega_max": 1e-300, "omega": 0.0}), ("CriticalSpeeds", {"omega_max": 1e300})]
+           ("CriticalSpeeds", {"omega_in_max": 1e-300, "omega_in": 0.0}), ("CriticalSpeeds", {"omega_in_max": 1e300}),
+           ("TripodCoupling", {"beta": 1.0})]
+
+
+def _changed_system(name: str, component: str, **values: float) -> system.System:
+    """The driveline with ``values`` bound on ``component``, named apart (its package is written next
+    to the driveline's)."""
+    driveline = system.driveline()
+    changed = driveline.component(component)
+    bound = dataclasses.replace(changed, parameters={**changed.parameters, **values})
+    return dataclasses.replace(driveline, name=name,
+                               components=tuple(bound if c is changed else c for c in driveline.components))
 
 
 def _bad_system() -> system.System:
-    """The driveline with a coupling whose groove radius is negative, named apart (its package is
-    written next to the driveline's)."""
-    driveline = system.driveline()
-    coupling = driveline.component("coupling")
-    bad = dataclasses.replace(coupling, parameters={**coupling.parameters, "r": -1.0})
-    return dataclasses.replace(driveline, name="NegativeGrooveRadius",
-                               components=tuple(bad if c is coupling else c for c in driveline.components))
+    """The driveline with a coupling whose groove radius is negative."""
+    return _changed_system("NegativeGrooveRadius", "coupling", r=-1.0)
 
 
 @pytest.mark.parametrize("model, values", REFUSED)
@@ -66,10 +73,10 @@ def test_an_ssp_package_is_checked_by_its_bindings(fmi2_dir, capsys):
 
 def test_an_fmu_is_checked_with_the_values_given(fmi2_dir, capsys):
     with pytest.raises(SystemExit) as exited:
-        start_values.main([str(fmi2_dir / "CriticalSpeeds.fmu"), "omega_max=1e-300", "omega=0"])
+        start_values.main([str(fmi2_dir / "CriticalSpeeds.fmu"), "omega_in_max=1e-300", "omega_in=0"])
     assert exited.value.code == 1
-    assert capsys.readouterr().err == ("refused: CriticalSpeeds (CriticalSpeeds): parameter omega_max = 1e-300 rad/s "
-                                       "is below its minimum 0.001 rad/s\n")
+    assert capsys.readouterr().err == ("refused: CriticalSpeeds (CriticalSpeeds): parameter omega_in_max = 1e-300 "
+                                       "rad/s is below its minimum 0.001 rad/s\n")
 
 
 def test_the_system_master_refuses_before_loading_an_fmu(tmp_path):
@@ -85,3 +92,17 @@ def test_a_sweep_whose_every_point_is_refused_exits_before_any_worker(fmi2_dir, 
     assert exited.value.code == "driveline-fmus sweep: every point refused, none run"  # printed, exit status 1
     assert sweep.refused_points("TripodCoupling", [{"r": 0.03}, {"r": -1.0}]) == {
         1: "parameter r = -1000 mm must be positive"}
+
+
+def test_a_connected_input_is_checked_at_the_start_of_the_output_feeding_it(fmi2_dir, capsys):
+    """An engine sets a connected input to its output's value before ExitInitializationMode: the
+    watcher's omega_in takes the coupling's omega_out start (0), not its own (300 rad/s), so an
+    omega_in_max of 100 rad/s is accepted; an unconnected input's start beyond its relation (the
+    coupling's beta above beta_max, refused by the FMUs at initialisation) is refused naming it."""
+    start_values.main([str(system.write_ssp(_changed_system("SlowShaft", "critical", omega_in_max=100.0), fmi2_dir))])
+    assert "every start value accepted" in capsys.readouterr().out
+    with pytest.raises(SystemExit) as exited:
+        start_values.main([str(system.write_ssp(_changed_system("OverBent", "coupling", beta=1.0), fmi2_dir))])
+    assert exited.value.code == 1
+    assert capsys.readouterr().err == ("refused: coupling (TripodCoupling): input beta = 57.2958 deg must not "
+                                       "exceed beta_max = 45 deg\n")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import importlib.resources
 import importlib.util
 import zipfile
+from dataclasses import replace
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -13,6 +14,7 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
+from driveline.cardan import kinematics
 from driveline.catalog import MODELS
 from fmu_harness.checks import importers
 from fmu_harness.packaging import fmu_path, native
@@ -130,6 +132,25 @@ def test_the_master_feeds_the_coupling_with_the_source_speed_and_acceleration(ma
     acceleration = np.concatenate([[start_acceleration], column["source.alpha_out"][:-1]])
     np.testing.assert_allclose(column["coupling.phi_in"], np.cumsum((speed + 0.5 * acceleration * h) * h), rtol=1e-12)
     assert np.abs(column["coupling.phi_in"] - column["source.phi_out"]).max() < 1e-4
+
+
+def test_a_cardan_joint_coupling_takes_the_source_acceleration_for_the_exact_c4(fmi2_dir, native_dir):
+    """With CardanJoint as the coupling the package connects SpeedSource.alpha_out to its alpha_in,
+    and the master run (the native variant, 0.2 s of the ramp and sine) gives alpha_out as (C4)
+    with a_1 the source's acceleration of t_k at every step, the first included, within 1e-12 of
+    its largest magnitude (the C and numpy sin and cos a few ulps apart)."""
+    driveline = replace(system.driveline("CardanJoint"), stop_time=0.2)
+    assert system.Connection(("source", "alpha_out"), ("coupling", "alpha_in")) in driveline.connections
+    names = ["source.omega_out", "source.alpha_out", "coupling.phi_in", "coupling.alpha_out"]
+    result = system.simulate(driveline, fmi2_dir, names, natives=native_dir)
+    column = dict(zip(names, result[:, 1:].T))
+    source = driveline.component("source").parameters
+    start_acceleration = source["ramp_rate"] + 2 * np.pi * source["sine_frequency"] * source["sine_amplitude"]
+    speed = np.concatenate([[source["omega_out_start"]], column["source.omega_out"][:-1]])
+    acceleration = np.concatenate([[start_acceleration], column["source.alpha_out"][:-1]])
+    beta = driveline.component("coupling").parameters["beta"]
+    exact = kinematics.output_acceleration(column["coupling.phi_in"], beta, speed, acceleration)
+    np.testing.assert_allclose(column["coupling.alpha_out"], exact, rtol=0.0, atol=1e-12 * np.abs(exact).max())
 
 
 @pytest.mark.parametrize("package", PACKAGES)

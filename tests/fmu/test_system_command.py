@@ -110,12 +110,15 @@ def test_a_file_that_is_no_package_is_one_line(package, tmp_path, capsys):
     assert exit_status.value.code == 2 and err.count("\n") == 1 and package in err
 
 
-@pytest.mark.xfail(reason="a start value beyond beta_max is now refused at initialisation, and that stop "
-                          "does not yet name the component", strict=False)
-def test_a_refused_step_stops_the_run_naming_the_component(native_ssp, tmp_path, capsys):
-    """A bend beyond beta_max: the coupling refuses its first step; the run stops with its reason."""
+@pytest.mark.parametrize("engine", system_command.ENGINES)
+def test_a_start_value_the_fmu_refuses_stops_every_engine_naming_the_component(engine, native_ssp, tmp_path,
+                                                                               capsys):
+    """A bend beyond beta_max, which the coupling refuses at ExitInitializationMode (libcosim would
+    abort the process on the native FMU's Error): whatever the engine, the run stops before it
+    starts, in one line naming the component, its model and the FMU's reason, status 2."""
     with pytest.raises(SystemExit) as exit_status:
-        _run(native_ssp, tmp_path / "run.csv", "--set", "coupling.beta=1.0")
-    message = str(exit_status.value.code)
-    assert message.count("\n") == 0 and "the run stopped: coupling: " in message and "beta_max" in message
+        _run(native_ssp, tmp_path / "run.csv", "--engine", engine, "--set", "coupling.beta=1.0")
+    err = capsys.readouterr().err
+    assert exit_status.value.code == 2 and err.count("\n") == 1
+    assert "error: coupling (TripodCoupling): input beta = 57.2958 deg must not exceed beta_max = 45 deg" in err
     assert not (tmp_path / "run.csv").exists()

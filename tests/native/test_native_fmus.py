@@ -447,9 +447,9 @@ def _ramp(t: float) -> float:
 def _critical_run(path: Path, parameters: dict, changes: dict | None = None, ramp: bool = False) -> np.ndarray:
     """The standard scenario (or a speed ramp to 1450 rad/s) with ``parameters``; ``changes`` set half way."""
     case = scenario(MODELS["CriticalSpeeds"].spec)
-    signals = {"omega": _ramp} if ramp else case.signals()
+    signals = {"omega_in": _ramp} if ramp else case.signals()
     with FmuInstance(path) as fmu:
-        fmu.initialize({**parameters, **({"omega": 0.0} if ramp else case.input_values(0.0))})
+        fmu.initialize({**parameters, **({"omega_in": 0.0} if ramp else case.input_values(0.0))})
         first = fmu.run(case.stop_time / 2, case.step_size, signals)
         fmu.set(changes or {})
         second = fmu.run(case.stop_time, case.step_size, signals)
@@ -509,7 +509,7 @@ def test_critical_speeds_refuses_like_the_python_fmu(native_dir, fmu_path, tmp_p
         {"layout": "no_such_example"}, {"layout": "../../../etc/passwd"}, {"layout": "x" * 300 + ".toml"},
         {"layout": str(tmp_path / "missing.toml")}, {"layout": str(tmp_path / "folder.toml")},
         {"layout": str(tmp_path / "garbage.toml")}, {"layout": str(tmp_path / "empty.toml")},
-        {"L_shaft": 100.0}, {"omega_max": 1e300}, {"density": 1e308}, {"E": 1e-300}, {"E": 1e180},
+        {"L_shaft": 100.0}, {"omega_in_max": 1e300}, {"density": 1e308}, {"E": 1e-300}, {"E": 1e180},
         {"D_outer": 1e200, "D_inner": 0.0}, {"orders": "1,2", "D_outer": 1e-100, "D_inner": 0.0},
     ]
     for parameters in cases:

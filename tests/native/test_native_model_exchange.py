@@ -14,16 +14,16 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from ctypes import POINTER, c_double
 
 import numpy as np
 import pytest
-from fmpy import extract, instantiate_fmu, read_model_description, simulate_fmu
+from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
+from support.model_exchange import ModelExchange
 
 NATIVE = [name for name in native.native_models() if not MODELS[name].co_simulation_only]
 ROUNDING = 1e-9  # relative: what two exact integrations of a linear state differ by
@@ -71,55 +71,6 @@ def test_model_exchange_converges_to_co_simulation(native_dir, name, fmi):
     else:
         assert cvode[0] < 100 * 1e-5 and cvode[1] < 100 * 1e-8 and cvode[1] < cvode[0], cvode
         assert euler[1] < euler[0] / 5, euler
-
-
-class ModelExchange:
-    """A Model Exchange instance of a native FMU through FMPy, in continuous-time mode after
-    initialisation with ``start_values``; the messages it logs in ``log``."""
-
-    def __init__(self, path, fmi: str, start_values: dict, unzipdir) -> None:
-        self.description = read_model_description(str(path))
-        self.log: list[str] = []
-        self.fmu = instantiate_fmu(extract(str(path), unzipdir=str(unzipdir)), self.description, "ModelExchange",
-                                   logger=lambda *args: self.log.append(args[-1].decode()))
-        self.references = {v.name: v.valueReference for v in self.description.modelVariables}
-        self.fmi3 = fmi == "3"
-        if self.fmi3:
-            self.fmu.enterInitializationMode(startTime=0.0)
-        else:
-            self.fmu.setupExperiment(startTime=0.0)
-            self.fmu.enterInitializationMode()
-        self.set(start_values)
-        self.fmu.exitInitializationMode()
-        self.fmu.enterContinuousTimeMode()
-        self.states = np.zeros(len(MODELS[self.description.modelName].spec.states))
-
-    def set(self, values: dict) -> None:
-        for name, value in values.items():
-            kind = {float: "Float64" if self.fmi3 else "Real", int: "Int32" if self.fmi3 else "Integer",
-                    bool: "Boolean", str: "String"}[type(value)]
-            getattr(self.fmu, f"set{kind}")([self.references[name]], [value])
-
-    def get(self, names: list[str]) -> list[float]:
-        return (self.fmu.getFloat64 if self.fmi3 else self.fmu.getReal)([self.references[n] for n in names])
-
-    def get_states(self) -> np.ndarray:
-        self.fmu.getContinuousStates(self.states.ctypes.data_as(POINTER(c_double)), self.states.size)
-        return self.states.copy()
-
-    def set_states(self, states: np.ndarray) -> None:
-        values = np.array(states, dtype=float)
-        self.fmu.setContinuousStates(values.ctypes.data_as(POINTER(c_double)), values.size)
-
-    def derivatives(self) -> np.ndarray:
-        values = np.zeros(self.states.size)
-        get = self.fmu.getContinuousStateDerivatives if self.fmi3 else self.fmu.getDerivatives
-        get(values.ctypes.data_as(POINTER(c_double)), values.size)
-        return values
-
-    def close(self) -> None:
-        self.fmu.terminate()
-        self.fmu.freeInstance()
 
 
 WITH_STATES = [name for name in NATIVE if MODELS[name].spec.states]

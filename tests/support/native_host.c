@@ -15,6 +15,8 @@
  * the FMU state half way and replays the second half (bit for bit again), then sets the first
  * input to NaN (or steps by 0 if there is no input) and expects a refused step (Discard, a logged
  * reason, outputs unchanged) that ends fmusim's retry loop (retry_until_stopped) at once, logged once.
+ * Before that it asks the second instance for the directional derivatives of the outputs with respect to
+ * the inputs (a seed of ones): finite numbers, or Error with one logged reason from an FMU without them.
  * It prints the largest deviation from the reference, relative to each output's largest
  * magnitude, and exits 0 when every check held and the deviation is at most the tolerance.
  */
@@ -136,6 +138,9 @@ typedef struct {
     void (*release)(void *instance, void **state);
     void (*finish)(void *instance);
     int (*stops)(void *instance); /* after a Discard: the FMU asks the master to stop */
+    /* the FMI status of the directional derivative of ``n`` unknowns by ``m`` knowns */
+    int (*derivative)(void *instance, const unsigned int unknowns[], size_t n, const unsigned int knowns[], size_t m,
+                      const double seed[], double sensitivity[]);
 } Host;
 
 /* FMI 2.0 */
@@ -151,6 +156,7 @@ static struct {
     fmi2SetStringTYPE *SetString;
     fmi2GetStringTYPE *GetString;
     fmi2GetRealTYPE *GetReal;
+    fmi2GetDirectionalDerivativeTYPE *GetDirectionalDerivative;
     fmi2DoStepTYPE *DoStep;
     fmi2GetBooleanStatusTYPE *GetBooleanStatus;
     fmi2TerminateTYPE *Terminate;
@@ -284,10 +290,16 @@ static int stops2(void *instance)
     return f2.GetBooleanStatus(instance, fmi2Terminated, &terminated) == fmi2OK && terminated;
 }
 
+static int derivative2(void *instance, const unsigned int unknowns[], size_t n, const unsigned int knowns[], size_t m,
+                       const double seed[], double sensitivity[])
+{
+    return (int)f2.GetDirectionalDerivative(instance, unknowns, n, knowns, m, seed, sensitivity);
+}
+
 static int load2(Host *host)
 {
     static const Host fmi2 = {instantiate2, initialize2, set2, set_integer2, set_boolean2, set_string2, get2, step2,
-                              store2, restore2, release2, finish2, stops2};
+                              store2, restore2, release2, finish2, stops2, derivative2};
     *host = fmi2;
     return load("fmi2Instantiate", &f2.Instantiate) && load("fmi2FreeInstance", &f2.FreeInstance) &&
            load("fmi2SetupExperiment", &f2.SetupExperiment) &&
@@ -295,7 +307,8 @@ static int load2(Host *host)
            load("fmi2ExitInitializationMode", &f2.ExitInitializationMode) && load("fmi2SetReal", &f2.SetReal) &&
            load("fmi2SetInteger", &f2.SetInteger) && load("fmi2SetBoolean", &f2.SetBoolean) &&
            load("fmi2SetString", &f2.SetString) && load("fmi2GetString", &f2.GetString) &&
-           load("fmi2GetReal", &f2.GetReal) && load("fmi2DoStep", &f2.DoStep) && load("fmi2Terminate", &f2.Terminate) &&
+           load("fmi2GetReal", &f2.GetReal) && load("fmi2GetDirectionalDerivative", &f2.GetDirectionalDerivative) &&
+           load("fmi2DoStep", &f2.DoStep) && load("fmi2Terminate", &f2.Terminate) &&
            load("fmi2GetBooleanStatus", &f2.GetBooleanStatus) &&
            load("fmi2GetFMUstate", &f2.GetFMUstate) && load("fmi2SetFMUstate", &f2.SetFMUstate) &&
            load("fmi2FreeFMUstate", &f2.FreeFMUstate) &&
@@ -316,6 +329,7 @@ static struct {
     fmi3SetStringTYPE *SetString;
     fmi3GetStringTYPE *GetString;
     fmi3GetFloat64TYPE *GetFloat64;
+    fmi3GetDirectionalDerivativeTYPE *GetDirectionalDerivative;
     fmi3DoStepTYPE *DoStep;
     fmi3TerminateTYPE *Terminate;
     fmi3GetFMUStateTYPE *GetFMUState;
@@ -440,10 +454,16 @@ static int exit_initialization3(void *instance)
     return f3.ExitInitializationMode(instance) == fmi3OK;
 }
 
+static int derivative3(void *instance, const unsigned int unknowns[], size_t n, const unsigned int knowns[], size_t m,
+                       const double seed[], double sensitivity[])
+{
+    return (int)f3.GetDirectionalDerivative(instance, unknowns, n, knowns, m, seed, m, sensitivity, n);
+}
+
 static int load3(Host *host)
 {
     static const Host fmi3 = {instantiate3, initialize3, set3, set_integer3, set_boolean3, set_string3, get3, step3,
-                              store3, restore3, release3, finish3, stops3};
+                              store3, restore3, release3, finish3, stops3, derivative3};
     *host = fmi3;
     return load("fmi3InstantiateCoSimulation", &f3.InstantiateCoSimulation) &&
            load("fmi3FreeInstance", &f3.FreeInstance) &&
@@ -452,6 +472,7 @@ static int load3(Host *host)
            load("fmi3SetInt32", &f3.SetInt32) && load("fmi3SetBoolean", &f3.SetBoolean) &&
            load("fmi3SetString", &f3.SetString) && load("fmi3GetString", &f3.GetString) &&
            load("fmi3GetFloat64", &f3.GetFloat64) && load("fmi3DoStep", &f3.DoStep) &&
+           load("fmi3GetDirectionalDerivative", &f3.GetDirectionalDerivative) &&
            load("fmi3Terminate", &f3.Terminate) && load("fmi3GetFMUState", &f3.GetFMUState) &&
            load("fmi3SetFMUState", &f3.SetFMUState) && load("fmi3FreeFMUState", &f3.FreeFMUState) &&
            load("fmi3SerializedFMUStateSize", &f3.SerializedFMUStateSize) &&
@@ -568,7 +589,8 @@ int main(int argc, char **argv)
     Host host;
     void *a, *b, *state = NULL;
     double *outputs, *replay, deviation = 0.0, before[MAX_SIGNALS], after[MAX_SIGNALS], bad = NAN;
-    int half, i, k, failed = 0, logged;
+    double seed[MAX_SIGNALS], sensitivity[MAX_SIGNALS];
+    int half, i, k, failed = 0, logged, status;
     memset(&s, 0, sizeof s);
     if (argc < 5 || argc > 7 || (strcmp(argv[2], "2") != 0 && strcmp(argv[2], "3") != 0)) {
         return fail("usage: native_host LIBRARY 2|3 TOKEN SCENARIO [RESOURCES [OUTPUTS]]");
@@ -622,6 +644,17 @@ int main(int argc, char **argv)
         }
         deviation = fmax(deviation, largest > 0.0 ? worst / largest : worst);
     }
+    /* the directional derivatives on b: finite, or refused (Error) with one reason logged */
+    for (i = 0; i < s.inputs; i++) {
+        seed[i] = 1.0;
+    }
+    logged = messages_logged;
+    status = failed ? 0 : host.derivative(b, s.output_vr, (size_t)s.outputs, s.input_vr, (size_t)s.inputs, seed,
+                                          sensitivity);
+    for (i = 0; !failed && status == 0 && i < s.outputs; i++) {
+        failed = !isfinite(sensitivity[i]);
+    }
+    failed = failed || !(status == 0 || (status == 3 && messages_logged == logged + 1));
     /* a refused step (a NaN input, or a zero step size where there is no input): Discard, a reason
      * logged, nothing changed */
     logged = messages_logged;

@@ -1,0 +1,141 @@
+"""The launch shudder map: the peak third-order powertrain acceleration of the vehicle launch over the
+joints' bend angle, the launch torque and the joints' friction coefficient, through the sweep layer.
+
+Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
+
+    driveline-fmus map [--package models/native/VehicleLaunch.ssp] [--count 8]
+        [--duration 4] [--step 2e-4] [--master gauss-seidel] [--workers N | --scheduler tcp://host:8786]
+        [--out results/shudder_map.parquet] [--figure results/shudder_map.png]
+    driveline-fmus map --figure-only [--out ...] [--figure ...]
+
+The grid: ``--count`` values each of both joints' ``beta`` (5 to 20 deg), ``motor.T_level`` (20 to
+100 % of the default car's motor peak, :data:`driveline.vehicle.compact_car.MOTOR_PEAK_TORQUE`) and
+both joints' ``mu`` (0.02 to 0.1), the cartesian product (512 launches at the default 8), each one
+launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and :data:`THIRD_ORDER`:
+``mounts.pitch_ddot_order3_peak``, the peak third-order amplitude of the powertrain's pitch
+acceleration over the left joint's turns (:func:`fmu_harness.studies.order_tracking.third_order_peak`;
+the right joint turns negatively in its own frame), and ``mounts.pitch_ddot_order3_speed``, the joint's
+speed there. A launch whose joint turns less than the order tracking's window fails with that reason. The table goes to ``--out``, the figure (a panel per friction
+coefficient: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the
+figure from a table written before.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from driveline.vehicle.compact_car import MOTOR_PEAK_TORQUE
+
+from .console import CommandParser
+from .runs import sweep
+from .runs.system_sweep import DerivedMetrics
+from .studies import figures
+from .studies.order_tracking import third_order_peak
+
+if TYPE_CHECKING:
+    import pyarrow as pa
+
+COMMAND = "driveline-fmus map"
+SHAFT, SIGNAL = "joint_left.phi_in", "mounts.pitch_ddot"
+BETA = "joint_left.beta+joint_right.beta"
+TORQUE = "motor.T_level"
+MU = "joint_left.mu+joint_right.mu"
+PEAK = f"{SIGNAL}_order3_peak"
+BETA_RANGE = (math.radians(5.0), math.radians(20.0))
+TORQUE_RANGE = (0.2 * MOTOR_PEAK_TORQUE, MOTOR_PEAK_TORQUE)
+MU_RANGE = (0.02, 0.1)
+
+
+def pitch_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tuple[float, float]:
+    """The peak third-order pitch acceleration [rad/s2] over the left joint's turns and its speed there [rad/s]."""
+    return third_order_peak(time, outputs[SHAFT], outputs[SIGNAL])
+
+
+THIRD_ORDER = DerivedMetrics((SHAFT, SIGNAL), (PEAK, f"{SIGNAL}_order3_speed"), pitch_third_order)
+
+
+def axes(count: int) -> dict[str, list[float]]:
+    """The map's grid axes, ``count`` values each, both ends included."""
+    return {name: np.linspace(*bounds, count).tolist()
+            for name, bounds in ((BETA, BETA_RANGE), (TORQUE, TORQUE_RANGE), (MU, MU_RANGE))}
+
+
+def draw(table: pa.Table, path: Path) -> Path:
+    """A panel per friction coefficient: the peak third-order pitch acceleration [rad/s2] over the bend
+    angle [deg] and the launch torque [% of the motor's peak], one colour scale for all panels; a
+    failed launch is left blank."""
+    rows = table.to_pylist()
+    betas, torques, mus = (sorted({row[name] for row in rows}) for name in (BETA, TORQUE, MU))
+    peaks = np.full((len(mus), len(torques), len(betas)), np.nan)
+    for row in rows:
+        if row["status"] == "ok":
+            peaks[mus.index(row[MU]), torques.index(row[TORQUE]), betas.index(row[BETA])] = row[PEAK]
+    columns = min(4, len(mus))
+    fig, panels = figures.figure(math.ceil(len(mus) / columns), columns, squeeze=False, sharex=True, sharey=True,
+                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6))
+    top = np.nanmax(peaks) if np.any(np.isfinite(peaks)) else 1.0
+    x, y = np.degrees(betas), 100.0 * np.array(torques) / MOTOR_PEAK_TORQUE
+    for k, panel in enumerate(panels.flat):
+        if k >= len(mus):
+            panel.set_visible(False)
+            continue
+        image = panel.pcolormesh(x, y, peaks[k], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
+        panel.set_title(f"mu = {mus[k]:.3g}", fontsize=9)
+    for panel in panels[-1]:
+        panel.set_xlabel("bend angle beta [deg]")
+    for panel in panels[:, 0]:
+        panel.set_ylabel("launch torque [% of peak]")
+    fig.colorbar(image, ax=panels, label="peak 3rd-order pitch acceleration [rad/s2]")
+    fig.suptitle(f"Launch shudder map: {len(rows)} launches of VehicleLaunch, both joints alike")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return figures.save(fig, path)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = CommandParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp")
+    parser.add_argument("--count", type=int, default=8, help="values per axis (default 8: 512 launches)")
+    parser.add_argument("--duration", type=float, default=4.0, help="launch length [s] (default 4)")
+    parser.add_argument("--step", type=float, default=2e-4, help="communication step [s] (default 2e-4)")
+    parser.add_argument("--master", choices=sweep.MASTERS, default=sweep.DEFAULT_MASTER)
+    parser.add_argument("--workers", type=sweep.workers_count, default=sweep.default_workers(),
+                        help="local cluster size")
+    parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
+    parser.add_argument("--out", type=Path, default=Path("results") / "shudder_map.parquet", help=".parquet or .csv")
+    parser.add_argument("--figure", type=Path, default=Path("results") / "shudder_map.png")
+    parser.add_argument("--figure-only", action="store_true", help="draw the figure from the table at --out")
+    args = parser.parse_args(argv)
+    if args.figure_only:
+        if not args.out.is_file():
+            parser.error(f"--figure-only: no table {args.out} (run the map first)")
+        print(draw(sweep.read_table(args.out), args.figure))
+        return
+    if args.count < 2:
+        parser.error(f"--count must be at least 2, got {args.count}")
+    try:
+        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count)), args.duration, args.step, args.master,
+                                    (THIRD_ORDER,))
+        if args.scheduler:
+            sweep.check_scheduler(args.scheduler)
+    except (ValueError, OSError) as error:
+        parser.error(str(error))
+    table = sweep.run_plan(plan, args.scheduler, args.workers)
+    sweep.write_table(table, args.out)
+    print(draw(table, args.figure))
+    failed = sweep.failure_reasons(table)
+    print(f"{table.num_rows} launches, {failed.total()} failed -> {args.out}")
+    sweep.print_reasons(failed)
+    if failed.total() == table.num_rows:
+        sys.exit(f"{COMMAND}: every launch failed")
+
+
+if __name__ == "__main__":
+    # Dask pickles ``__main__`` functions by value; run the module's own import instead.
+    importlib.import_module(__spec__.name).main()

@@ -1,0 +1,207 @@
+"""Sweeps of the vehicle launch system (``VehicleLaunch.ssp``, native FMUs) through the sweep layer: on a
+Dask scheduler process with one worker process started here, and on a local cluster, against the
+project's master run in this process; refused points and mistakes before any cluster starts."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import json
+import math
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pyarrow.csv
+import pytest
+
+from fmu_harness import shudder_map
+from fmu_harness.runs import system
+from fmu_harness.runs.sweep import Plan, main, run
+from fmu_harness.runs.system_sweep import STATISTICS, SYSTEM_METRICS, DerivedMetrics
+from fmu_harness.studies.order_tracking import third_order_peak
+
+STOP, STEP = 2.0, 8e-4
+"""Short launches: 2 s, in which the left joint turns 2.8 (200 N.m) to 4.0 (280 N.m) revolutions, more than
+the order tracking's window of 2, in 2500 steps of the Gauss-Seidel master at 8e-4 s (its stability limit)."""
+BOTH_BETA = "joint_left.beta+joint_right.beta"
+POINTS = [{BOTH_BETA: 0.1, "motor.T_level": 280.0, "joint_left.mu": 0.08},
+          {BOTH_BETA: 0.3, "motor.T_level": 200.0, "joint_left.mu": 0.02}]
+
+
+@pytest.fixture(scope="module")
+def launch_ssp(fmi2_dir: Path, native_dir: Path) -> Path:
+    return system.write_ssp(system.vehicle_launch(), fmi2_dir, native_dir)
+
+
+@pytest.fixture(scope="module")
+def scheduler(tmp_path_factory) -> str:
+    """The address of a Dask scheduler process with one single-threaded worker process, as on a cluster."""
+    folder = tmp_path_factory.mktemp("dask")
+    address_file = folder / "scheduler.json"
+    started = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+                                 "--port", "0", "--dashboard-address", ":0", "--scheduler-file", str(address_file)],
+                                cwd=folder, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        deadline = time.monotonic() + 60.0
+        while not address_file.is_file() and time.monotonic() < deadline:
+            time.sleep(0.2)
+        address = json.loads(address_file.read_text())["address"]
+        started.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads",
+                                         "1", "--nworkers", "1", "--no-dashboard", "--local-directory", str(folder)],
+                                        cwd=folder, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        yield address
+    finally:
+        for process in reversed(started):
+            process.terminate()
+            process.wait(timeout=30)
+
+
+def master_metrics(fmi2_dir: Path, native_dir: Path, point: dict, order: tuple[str, ...] | None,
+                   step: float = STEP) -> dict[str, float]:
+    """The sweep's metrics of one point from the project's master in this process, the point's values bound
+    to the launch's components (``system.vehicle_launch``, not the package the sweep reads)."""
+    values: dict[str, dict[str, float]] = {}
+    for name, value in point.items():
+        for target in name.split("+"):
+            component, variable = target.split(".")
+            values.setdefault(component, {})[variable] = value
+    launch = system.vehicle_launch()
+    components = tuple(dataclasses.replace(c, parameters={**c.parameters, **values.get(c.name, {})})
+                       for c in launch.components)
+    changed = dataclasses.replace(launch, components=components, stop_time=STOP, step_size=step)
+    metrics = SYSTEM_METRICS["VehicleLaunch"]
+    shaft, signal = shudder_map.SHAFT, shudder_map.SIGNAL
+    outputs = list(dict.fromkeys([*(output for output, _ in metrics), shaft, signal]))
+    rows = system.simulate(changed, fmi2_dir, outputs, natives=native_dir, order=order)
+    found = {f"{output}_{statistic}": float(STATISTICS[statistic](rows[:, 1 + outputs.index(output)]))
+             for output, statistic in metrics}
+    peak, speed = third_order_peak(rows[:, 0], rows[:, 1 + outputs.index(shaft)], rows[:, 1 + outputs.index(signal)])
+    return found | {f"{signal}_order3_peak": peak, f"{signal}_order3_speed": speed}
+
+
+def test_a_system_sweep_on_a_scheduler_gives_the_masters_runs(launch_ssp, scheduler, fmi2_dir, native_dir):
+    """Gauss-Seidel in the package's order (the launch's order) on the scheduler's worker: each row's
+    metrics, the third-order peak of the pitch acceleration among them, are those of the master run here
+    with both joints' beta bound, bit for bit. A bend beyond
+    the joint's beta_max, which the FMU refuses at initialisation, fails its row with the FMU's reason."""
+    from distributed import Client
+
+    plan = Plan.of_system(launch_ssp, [*POINTS, {"joint_right.beta": 1.0}], STOP, STEP, "gauss-seidel",
+                          (shudder_map.THIRD_ORDER,))
+    with Client(scheduler) as client:
+        *rows, beyond = run(client, plan).to_pylist()
+    assert [row["status"] for row in rows] == ["ok", "ok"] and beyond["status"] == "failed"
+    assert beyond["reason"].startswith("joint_right: exitInitializationMode") and "beta_max" in beyond["reason"]
+    for point, row in zip(POINTS, rows):
+        expected = master_metrics(fmi2_dir, native_dir, point, system.LAUNCH_ORDER)
+        assert {name: row[name] for name in expected} == expected
+        assert all(row[name] == value for name, value in point.items())
+    assert rows[0]["joint_right.Rz_in_peak_abs"] != rows[1]["joint_right.Rz_in_peak_abs"]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("libcosimpy") is None, reason="libcosimpy: pip install '.[interop]'")
+def test_the_libcosim_master_gives_the_jacobi_masters_metrics(launch_ssp, scheduler, fmi2_dir, native_dir):
+    """libcosim runs the whole launch in C++ by the same Jacobi scheme: each metric within 1e-9 of the
+    project's Jacobi master's (the engines' agreement in tests/fmu/test_vehicle_launch.py), at 4e-4 s."""
+    from distributed import Client
+
+    plan = Plan.of_system(launch_ssp, POINTS[:1], STOP, 4e-4, "libcosim", (shudder_map.THIRD_ORDER,))
+    with Client(scheduler) as client:
+        row = run(client, plan).to_pylist()[0]
+    assert row["status"] == "ok"
+    expected = master_metrics(fmi2_dir, native_dir, POINTS[0], None, 4e-4)
+    for name, value in expected.items():
+        assert math.isclose(row[name], value, rel_tol=1e-9), name
+
+
+def test_a_tiny_shudder_map_on_a_local_cluster(launch_ssp, tmp_path, capsys):
+    """The map's command with 2 values per axis (8 launches of 2 s) on a local cluster of one worker: a
+    row per launch; at 20 % torque the joint turns less than the order tracking's window, which the
+    row's reason says; at full torque the peak grows with the friction coefficient at either bend angle;
+    a figure with a panel per friction coefficient."""
+    out, figure = tmp_path / "map.csv", tmp_path / "map.png"
+    shudder_map.main(["--package", str(launch_ssp), "--count", "2", "--duration", str(STOP), "--step", str(STEP),
+                      "--workers", "1", "--out", str(out), "--figure", str(figure)])
+    rows = pyarrow.csv.read_csv(out).to_pylist()
+    assert len(rows) == 8 and figure.stat().st_size > 10_000
+    low = [row for row in rows if row[shudder_map.TORQUE] < 100.0]
+    full = {(row[shudder_map.BETA], row[shudder_map.MU]): row[shudder_map.PEAK] for row in rows if row not in low}
+    assert {row["reason"] for row in low} == {
+        "ValueError: the shaft turns less than the 2 revolutions of the order tracking window"}
+    for beta in shudder_map.axes(2)[shudder_map.BETA]:
+        assert full[beta, 0.1] > full[beta, 0.02] > 0.0
+    captured = capsys.readouterr()
+    assert "8 launches, 4 failed" in captured.out and "sweep [8/8]" in captured.err
+
+
+def test_refused_points_are_not_run_and_carry_their_reason(launch_ssp):
+    """A negative roller radius and a step above the drive's Jacobi limit are found before any run: their
+    rows fail with the component's reason; Gauss-Seidel is not held to the Jacobi limit."""
+    points = [{BOTH_BETA: 0.2}, {"joint_right.r": -0.01}]
+    plan = Plan.of_system(launch_ssp, points, 0.01, 5e-4, "jacobi")
+    assert set(plan.refused) == {0, 1}
+    assert plan.refused[0].startswith("drive (VehicleDriveline): --step 0.0005 s is above 0.000415 s")
+    assert plan.refused[1] == "joint_right (TripodCoupling): parameter r = -10 mm must be positive"
+    assert set(Plan.of_system(launch_ssp, points, 0.01, 5e-4, "gauss-seidel").refused) == {1}
+
+
+@pytest.mark.parametrize(("options", "words"), [
+    (["--grid", "wheel.mu=0.1", "--step", "1e-4"], "VehicleLaunch has no component 'wheel'"),
+    (["--grid", "joint_left.nope+joint_right.mu=0.1", "--step", "1e-4"], "joint_left.nope is no parameter"),
+    (["--grid", "joint_left.omega_in=1", "--step", "1e-4"], "joint_left.omega_in is no parameter or unconnected"),
+    (["--grid", "beta=0.1", "--step", "1e-4"], "each name of a system sweep is component.variable"),
+    (["--grid", "joint_left.mu=0.1"], "a system sweep needs --step"),
+    (["--grid", "joint_left.mu=0.1", "--step", "3e-4", "--duration", "0.001"], "no whole number of steps"),
+    (["--grid", "joint_left.mu=0.1", "--step", "1e-4", "--layout", "x.toml"], "--layout sets the critical-speed"),
+    (["--grid", "joint_left.mu=0.1", "--step", "1e-4", "--master", "fast"], "invalid choice: 'fast'"),
+    (["--grid", "joint_left.mu=0.1", "--step", "1e-4", "--model", "TripodCoupling"], "not allowed with argument"),
+    (["--grid", "joint_left.mu=0.1", "--step", "1e-4", "--scheduler", "tcp://127.0.0.1:1"],
+     "--scheduler tcp://127.0.0.1:1: no scheduler answers there"),
+    (["--grid", "joint_left.mu=0.1", "--step", "1e-4", "--scheduler", "nowhere"], "expected tcp://host:port"),
+])
+def test_a_mistake_is_one_line_before_the_cluster_starts(options, words, launch_ssp, tmp_path, capsys):
+    """Status 2, one line, within a few seconds (a bad scheduler address too: refused at once), no table."""
+    out = tmp_path / "map.csv"
+    start = time.monotonic()
+    with pytest.raises(SystemExit) as stopped:
+        main(["--system", str(launch_ssp), *options, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert stopped.value.code == 2 and err.count("\n") == 1 and words in err, err
+    assert time.monotonic() - start < 5.0 and not out.exists()
+
+
+def test_every_point_refused_ends_non_zero_with_the_reasons(launch_ssp, tmp_path, capsys):
+    with pytest.raises(SystemExit) as stopped:
+        main(["--system", str(launch_ssp), "--grid", "joint_left.r=-0.01,-0.02", "--step", "1e-4",
+              "--out", str(tmp_path / "map.csv")])
+    assert "every point refused, none run" in str(stopped.value.code)
+    assert "1 failed: joint_left (TripodCoupling): parameter r = -20 mm must be positive" in capsys.readouterr().err
+
+
+def test_the_libcosim_master_without_its_extra_is_one_line(launch_ssp, tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "libcosimpy", None)
+    with pytest.raises(SystemExit) as stopped:
+        main(["--system", str(launch_ssp), "--grid", "joint_left.mu=0.1", "--step", "1e-4", "--master", "libcosim",
+              "--out", str(tmp_path / "map.csv")])
+    message = str(stopped.value.code)
+    assert message.count("\n") == 0 and "libcosimpy" in message and "[interop]" in message
+    assert not (tmp_path / "map.csv").exists()
+
+
+def test_grid_values_reach_every_joined_target(launch_ssp):
+    """One value of a joined name binds each of its targets; the others keep the package's bindings."""
+    plan = Plan.of_system(launch_ssp, [{BOTH_BETA: 0.25}], STOP, STEP, "gauss-seidel")
+    bound = {c.name: c.parameters for c in plan.fmu.interface.system({BOTH_BETA: 0.25}).components}
+    assert bound["joint_left"]["beta"] == bound["joint_right"]["beta"] == 0.25
+    assert bound["joint_left"]["l"] == 0.45 and bound["joint_right"]["l"] == 0.70
+    assert np.isclose(bound["motor"]["T_level"], 140.0)
+
+
+def test_a_derived_metric_needs_outputs_the_system_has(launch_ssp):
+    """A study's metric naming an output the package has not is refused before anything runs."""
+    nowhere = DerivedMetrics(("mounts.nope",), ("nope_peak",), shudder_map.pitch_third_order)
+    with pytest.raises(ValueError, match="mounts.nope: no Real output of VehicleLaunch"):
+        Plan.of_system(launch_ssp, POINTS, STOP, STEP, "gauss-seidel", (nowhere,))

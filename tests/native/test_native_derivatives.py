@@ -1,0 +1,257 @@
+"""Directional and adjoint derivatives of the native FMUs (``fmu_src/native/fmu_derivatives.c``), both FMI
+versions, both interfaces: declared in the model description exactly for the models whose C port gives
+the ``jacobian`` hook, equal to central differences of the same FMU and to Richardson-extrapolated
+differences of the Python core, the adjoint the transpose of the directional derivative, and every
+hostile call refused with a defined status and a logged reason.
+
+Tolerances (``support.derivatives``): the central difference through the FMU with a relative step of
+1e-6 errs by h^2 |f'''| / 6 + eps |f| / h, about 2e-10 of the outputs' scale (measured up to 2.1e-10):
+the exact derivative must agree within 1e-7 of the row's largest scaled entry, plus 10 eps |f| / h for
+an output much larger than what it moves by. The Python core, differenced with steps 2e-3, 1e-3, 5e-4
+and extrapolated twice (error O(h^6), rounding about 1e-12; measured up to 1.4e-12), within 1e-10: an
+independent derivative, as the Python cores convert their inputs to float (``np.asarray(dtype=float)``)
+and cannot take the complex step. The adjoint identity v^T (J w) = (J^T v)^T w holds to rounding (1e-13 of
+|v|^T |J| |w|).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+import zipfile
+from ctypes import c_double, c_uint
+
+import numpy as np
+import pytest
+from fmpy import extract, instantiate_fmu, read_model_description
+from fmpy.fmi1 import FMICallException
+
+from driveline.catalog import MODELS
+from fmu_harness.packaging import native
+from support import derivatives
+from support.model_exchange import ModelExchange
+
+PROVIDING = [name for name in native.native_models() if native.provides_derivatives(name)]
+INTERFACES = ("ModelExchange", "CoSimulation")
+FMU_TOLERANCE = 1e-7
+CORE_TOLERANCE = 1e-10
+TIME = 0.05  # s: a point of a source away from t = 0
+SHIFT = 0.4  # rad: the states moved from their start, away from the joints' symmetric positions
+
+
+def _points(name: str) -> list[dict]:
+    return [{}, *MODELS[name].dependency_points]
+
+
+def _at_point(path, fmi: str, point: dict, folder) -> ModelExchange:
+    """A Model Exchange instance at ``point``, time TIME and its states moved by SHIFT."""
+    model = ModelExchange(path, fmi, point, folder)
+    model.fmu.setTime(TIME)
+    model.set_states(model.get_states() + SHIFT)
+    return model
+
+
+def _description_flags(path, fmi: str) -> dict[str, dict[str, str]]:
+    with zipfile.ZipFile(path) as archive:
+        root = ET.fromstring(archive.read("modelDescription.xml"))
+    names = ("providesDirectionalDerivatives", "providesAdjointDerivatives") if fmi == "3" else (
+        "providesDirectionalDerivative",)
+    return {interface.tag: {n: interface.get(n, "false") for n in names}
+            for interface in root if interface.tag in INTERFACES}
+
+
+@pytest.mark.parametrize("name", [n for n in native.native_models() if not MODELS[n].co_simulation_only])
+def test_the_description_declares_the_derivatives_the_binary_gives(native_dir, tmp_path, name, fmi):
+    """Every interface of the FMU declares them exactly when the C port gives the hook; a model
+    without it refuses the call with Error and a reason, one with it answers."""
+    path = native.fmu_path(native_dir, name, fmi)
+    provides = "true" if name in PROVIDING else "false"
+    assert all(set(flags.values()) == {provides} for flags in _description_flags(path, fmi).values())
+    assert set(_description_flags(path, fmi)) == set(INTERFACES)
+    model = ModelExchange(path, fmi, {}, tmp_path)
+    rows, columns = derivatives.references(name, fmi)
+    if name in PROVIDING:
+        assert len(model.fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))) == len(rows)
+    else:
+        with pytest.raises(FMICallException) as refused:
+            model.fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))
+        assert refused.value.status == 3
+        assert model.log[-1] == f"fmi{fmi}GetDirectionalDerivative is not supported by this FMU"
+
+
+@pytest.mark.parametrize("name", PROVIDING)
+def test_directional_derivatives_equal_central_differences_of_the_fmu(native_dir, tmp_path, name, fmi):
+    """Model Exchange, at the start values and the model's dependency points, the states moved: the
+    exact Jacobian against central differences of the same instance (within the differences' own
+    error), its zeros where the model description declares no dependency."""
+    path = native.fmu_path(native_dir, name, fmi)
+    rows, columns = derivatives.layout(name)
+    for n, point in enumerate(_points(name)):
+        model = _at_point(path, fmi, point, tmp_path / str(n))
+        jacobian = derivatives.exact(model.fmu, name, fmi)
+        differences, values = derivatives.fmu_differences(model, name)
+        at = np.array(model.get(columns), dtype=float)
+        rounding = 10 * np.finfo(float).eps * np.abs(values) / derivatives.FMU_STEP  # the difference's, scaled
+        allowed = FMU_TOLERANCE + (rounding / derivatives.row_scales(jacobian, at))[:, None]
+        assert np.all(derivatives.scaled_error(jacobian, differences, at) <= allowed), point
+        declared = {u.variable.name: {k.name for k in u.dependencies}
+                    for u in (*model.description.outputs, *model.description.derivatives)}
+        for i, row in enumerate(rows):
+            moved = {columns[j] for j in np.flatnonzero(jacobian[i])}
+            assert moved <= declared.get(row, set(columns)), (row, moved)
+        model.close()
+
+
+@pytest.mark.parametrize("name", PROVIDING)
+def test_directional_derivatives_equal_the_python_cores_extrapolated_differences(native_dir, tmp_path, name, fmi):
+    path = native.fmu_path(native_dir, name, fmi)
+    spec = MODELS[name].spec
+    _, columns = derivatives.layout(name)
+    for n, point in enumerate(_points(name)):
+        model = _at_point(path, fmi, point, tmp_path / str(n))
+        jacobian = derivatives.exact(model.fmu, name, fmi)
+        values = {v.name: v.start for v in spec.variables} | point
+        values |= dict(zip(columns, model.get(columns)))
+        reference = derivatives.core_differences(name, values, TIME)
+        error = derivatives.scaled_error(jacobian, reference, np.array([values[c] for c in columns], dtype=float))
+        assert error.max(initial=0.0) <= CORE_TOLERANCE, (point, error)
+        model.close()
+
+
+@pytest.mark.parametrize("name", PROVIDING)
+def test_co_simulation_gives_the_model_exchange_derivatives(native_dir, tmp_path, name, fmi):
+    """At the start and after a step the co-simulation instance's Jacobian is the Model Exchange
+    instance's at the same time, states and inputs, bit for bit (the same map of one instant)."""
+    path = native.fmu_path(native_dir, name, fmi)
+    spec = MODELS[name].spec
+    states = [state.name for state in spec.states]
+    cs = ModelExchange(path, fmi, {}, tmp_path / "cs", interface="CoSimulation")
+    for time in (0.0, 0.01):
+        if time:
+            cs.fmu.doStep(0.0, time)
+        me = ModelExchange(path, fmi, {}, tmp_path / f"me{time}")
+        me.fmu.setTime(time)
+        me.set_states(np.array(cs.get(states), dtype=float))
+        assert np.array_equal(derivatives.exact(cs.fmu, name, fmi), derivatives.exact(me.fmu, name, fmi))
+        me.close()
+    cs.close()
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+@pytest.mark.parametrize("name", PROVIDING)
+def test_the_adjoint_is_the_transpose(native_dir, tmp_path, name, interface):
+    """FMI 3.0: unit seeds give the directional derivatives' Jacobian exactly, and random seeds
+    v^T (J w) = (J^T v)^T w to rounding."""
+    path = native.fmu_path(native_dir, name, "3")
+    model = ModelExchange(path, "3", {}, tmp_path, interface=interface)
+    rows, columns = derivatives.references(name, "3")
+    jacobian = derivatives.exact(model.fmu, name, "3")
+    assert np.array_equal(derivatives.exact(model.fmu, name, "3", adjoint=True), jacobian)
+    generator = np.random.default_rng(30)
+    for _ in range(3):
+        v, w = generator.normal(size=len(rows)), generator.normal(size=len(columns))
+        forward = v @ np.array(model.fmu.getDirectionalDerivative(rows, columns, list(w)))
+        backward = np.array(model.fmu.getAdjointDerivative(rows, columns, list(v), len(columns))) @ w
+        assert abs(forward - backward) <= 1e-13 * (np.abs(v) @ np.abs(jacobian) @ np.abs(w)) + 1e-300
+    model.close()
+
+
+def _refusal(path, fmi: str, folder, interface: str, call, point: dict | None = None) -> tuple[int, str]:
+    """The status and the last message of ``call(fmu, rows, columns)`` on a fresh instance after initialisation."""
+    model = ModelExchange(path, fmi, point or {}, folder, interface=interface)
+    rows, columns = derivatives.references("CardanJoint", fmi)
+    with pytest.raises(FMICallException) as refused:
+        call(model.fmu, rows, columns)
+    return refused.value.status, model.log[-1]
+
+
+HOSTILE = {
+    "an unknown reference": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([9999], columns, [1.0] * len(columns)),
+                             3, "value reference 9999 is no unknown (a Real output or a state derivative)"),
+    "an input as unknown": (lambda fmu, rows, columns: fmu.getDirectionalDerivative([columns[1]], columns,
+                                                                                    [1.0] * len(columns)),
+                            3, "value reference 4 (beta) is no unknown (a Real output or a state derivative)"),
+    "an output as known": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, [rows[1]], [1.0]),
+                           3, "value reference 7 (phi_out) is no known (a Real input or a continuous state)"),
+    "a parameter as known": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, [0], [1.0]),
+                             3, "value reference 0 (beta_max) is no known (a Real input or a continuous state)"),
+    "a NaN seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1.0, np.nan] + [0.0] * (len(columns) - 2)),
+                   3, "seed[1] = nan is not finite"),
+    "an overflowing seed": (lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1e308] * len(columns)),
+                            2, "the directional derivative at t = 0.0 s overflows: the seed is too large"),
+}
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+@pytest.mark.parametrize("case", HOSTILE)
+def test_a_hostile_call_gets_a_status_and_a_reason(native_dir, tmp_path, case, interface, fmi):
+    call, status, message = HOSTILE[case]
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    got = _refusal(path, fmi, tmp_path, interface, call)
+    assert got == (status, f"fmi{fmi}GetDirectionalDerivative: {message}" if status == 3 else message)
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+def test_fmi3_sizes_that_do_not_match_are_refused(native_dir, tmp_path, interface):
+    path = native.fmu_path(native_dir, "CardanJoint", "3")
+    directional = _refusal(path, "3", tmp_path / "d", interface,
+                           lambda fmu, rows, columns: fmu.getDirectionalDerivative(rows, columns, [1.0] * 4, 3))
+    adjoint = _refusal(path, "3", tmp_path / "a", interface,
+                       lambda fmu, rows, columns: fmu.getAdjointDerivative(rows, columns, [1.0] * 3, 4))
+    rows, columns = derivatives.references("CardanJoint", "3")
+    assert directional == (3, "fmi3GetDirectionalDerivative: nSeed, nSensitivity = 4, 3 where the knowns and "
+                              f"unknowns give {len(columns)}, {len(rows)} (scalar variables only)")
+    assert adjoint == (3, "fmi3GetAdjointDerivative: nSeed, nSensitivity = 3, 4 where the unknowns and knowns "
+                          f"give {len(rows)}, {len(columns)} (scalar variables only)")
+
+
+def test_a_point_a_step_would_refuse_is_discarded_with_its_reason(native_dir, tmp_path, fmi):
+    """beta beyond beta_max, set after initialisation: Discard with the co-simulation step's words,
+    in both interfaces; corrected, the derivatives are given again."""
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    for interface in INTERFACES:
+        model = ModelExchange(path, fmi, {}, tmp_path / interface, interface=interface)
+        rows, columns = derivatives.references("CardanJoint", fmi)
+        model.set({"beta": 1.0})
+        with pytest.raises(FMICallException) as refused:
+            model.fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))
+        assert refused.value.status == 2
+        assert model.log[-1] == "input beta = 57.2958 deg must not exceed beta_max = 45 deg"
+        model.set({"beta": 0.5})
+        assert len(model.fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))) == len(rows)
+        model.close()
+
+
+def test_outside_step_mode_the_call_is_an_error(native_dir, tmp_path, fmi):
+    """Before and during initialisation (the initial unknowns' derivatives are not offered): Error."""
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    description = read_model_description(str(path))
+    log: list[str] = []
+    fmu = instantiate_fmu(extract(str(path), unzipdir=str(tmp_path)), description, "ModelExchange",
+                          logger=lambda *args: log.append(args[-1].decode()))
+    rows, columns = derivatives.references("CardanJoint", fmi)
+    for mode in ("Instantiated", "InitializationMode"):
+        if mode == "InitializationMode":
+            fmu.reset()
+            if fmi == "3":
+                fmu.enterInitializationMode(startTime=0.0)
+            else:
+                fmu.setupExperiment(startTime=0.0)
+                fmu.enterInitializationMode()
+        with pytest.raises(FMICallException) as refused:
+            fmu.getDirectionalDerivative(rows, columns, [1.0] * len(columns))
+        assert refused.value.status == 3
+        assert log[-1] == f"fmi{fmi}GetDirectionalDerivative is not allowed in {mode}"
+    fmu.freeInstance()
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+def test_a_null_array_is_an_error(native_dir, tmp_path, interface, fmi):
+    """The C call with the unknowns' references missing (NULL, one unknown named): Error, logged."""
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    model = ModelExchange(path, fmi, {}, tmp_path, interface=interface)
+    knowns, seed, sensitivity = (c_uint * 1)(3), (c_double * 1)(1.0), (c_double * 1)()
+    arguments = (None, 1, knowns, 1, seed, 1, sensitivity, 1) if fmi == "3" else (None, 1, knowns, 1, seed, sensitivity)
+    with pytest.raises(FMICallException) as refused:
+        getattr(model.fmu, f"fmi{fmi}GetDirectionalDerivative")(model.fmu.component, *arguments)
+    assert refused.value.status == 3
+    assert model.log[-1] == f"fmi{fmi}GetDirectionalDerivative: null array"

@@ -1,0 +1,130 @@
+"""Jacobians of a native FMU: exact through its directional (or adjoint) derivatives, by central
+differences of the same FMU (Model Exchange) and by Richardson-extrapolated central differences of the
+Python core, for the tests and the benchmark of directional derivatives.
+
+The rows are the Real outputs, then der(<state>); the columns the Real inputs and the states
+(:func:`fmu_harness.packaging.native.jacobian_layout`). Column j is perturbed by ``h * scale_j`` with
+``scale_j = max(1, |x_j|)``: angles in rad and speeds of 100 rad/s alike.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from driveline.catalog import MODELS
+from driveline.model import TimeSourceModel
+from fmu_harness.packaging import native
+
+#: Relative step of the central differences through the FMU: rounding eps |f| / h near 2e-10 of the
+#: outputs' scale, truncation h^2 |f'''| / 6 below it (the reducer's stresses near 160 deg vary fast with
+#: the angle: 7e-9 with a step of 1e-5, 8e-11 with 1e-6, measured 2026-11-27).
+FMU_STEP = 1e-6
+#: Relative step of the Python core's differences, halved twice and extrapolated (error O(h^6): 4e-9
+#: with 1e-2, 4e-13 with 2e-3 for the reducer's stresses; rounding about 1e-12).
+CORE_STEP = 2e-3
+
+
+def layout(name: str) -> tuple[list[str], list[str]]:
+    rows, columns = native.jacobian_layout(MODELS[name].spec)
+    return rows + [state.derivative_name for state in MODELS[name].spec.states], columns
+
+
+def references(name: str, fmi: str) -> tuple[list[int], list[int]]:
+    """The value references of the rows and of the columns."""
+    return native.jacobian_references(MODELS[name].spec, fmi)
+
+
+def exact(fmu, name: str, fmi: str, adjoint: bool = False) -> np.ndarray:
+    """The Jacobian from unit seeds: a column per directional derivative, or a row per adjoint one."""
+    rows, columns = references(name, fmi)
+    if adjoint:
+        return np.array([fmu.getAdjointDerivative(rows, columns, list(np.eye(len(rows))[i]), len(columns))
+                         for i in range(len(rows))]).reshape(len(rows), len(columns))
+    return np.array([fmu.getDirectionalDerivative(rows, columns, list(np.eye(len(columns))[j]))
+                     for j in range(len(columns))]).reshape(len(columns), len(rows)).T
+
+
+def scales(values: np.ndarray) -> np.ndarray:
+    return np.maximum(1.0, np.abs(values))
+
+
+def fmu_differences(model, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Central differences through a Model Exchange instance (``support.model_exchange``) and the
+    row values at its point; the point restored after."""
+    spec = MODELS[name].spec
+    outputs, columns = native.jacobian_layout(spec)
+    states = [state.name for state in spec.states]
+
+    def rows() -> np.ndarray:
+        return np.concatenate([model.get(outputs), model.derivatives()])
+
+    def put(column: str, value: float) -> None:
+        if column in states:
+            x = model.get_states()
+            x[states.index(column)] = value
+            model.set_states(x)
+        else:
+            model.set({column: float(value)})
+
+    point = np.array(model.get(columns), dtype=float)
+    base = rows()
+    differences = np.zeros((base.size, len(columns)))
+    for j, column in enumerate(columns):
+        h = FMU_STEP * scales(point)[j]
+        put(column, point[j] + h)
+        above = rows()
+        put(column, point[j] - h)
+        differences[:, j] = (above - rows()) / (2.0 * h)
+        put(column, point[j])
+    return differences, base
+
+
+def core_rows(name: str, values: dict, time: float) -> np.ndarray:
+    """The rows from the Python core at ``values`` (parameters, inputs, states) and ``time``, evaluated as
+    Model Exchange evaluates (internal state reset; a source's state is the solver's)."""
+    model = MODELS[name]()
+    spec = model.spec
+    for key, value in values.items():
+        setattr(model, key, value)
+    model.reset_internal_state()
+    states = {state.name: getattr(model, state.name) for state in spec.states}
+    if isinstance(model, TimeSourceModel):
+        model.at_time(time)
+    else:
+        model.evaluate(time)
+    for state, value in states.items():
+        setattr(model, state, value)
+    outputs, _ = native.jacobian_layout(spec)
+    return np.array([getattr(model, o) for o in outputs] + [getattr(model, s.derivative) for s in spec.states],
+                    dtype=float)
+
+
+def core_differences(name: str, values: dict, time: float) -> np.ndarray:
+    """Richardson-extrapolated central differences of the Python core: D(h), D(h/2), D(h/4) combined
+    to cancel the h^2 and h^4 terms of the truncation error."""
+    _, columns = native.jacobian_layout(MODELS[name].spec)
+    point = np.array([values[c] for c in columns], dtype=float)
+    size = core_rows(name, values, time).size
+    jacobian = np.zeros((size, len(columns)))
+    for j, column in enumerate(columns):
+        def central(h: float) -> np.ndarray:
+            return (core_rows(name, {**values, column: point[j] + h}, time)
+                    - core_rows(name, {**values, column: point[j] - h}, time)) / (2.0 * h)
+        h = CORE_STEP * scales(point)[j]
+        d1, d2, d4 = central(h), central(h / 2), central(h / 4)
+        r1, r2 = (4.0 * d2 - d1) / 3.0, (4.0 * d4 - d2) / 3.0
+        jacobian[:, j] = (16.0 * r2 - r1) / 15.0
+    return jacobian
+
+
+def row_scales(jacobian: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """Each row's largest entry times its column's scale (1 for a row of zeros): what the row's output
+    moves by when a known moves by its scale."""
+    row_scale = np.max(np.abs(jacobian) * scales(point), axis=1, initial=0.0)
+    row_scale[row_scale == 0.0] = 1.0
+    return row_scale
+
+
+def scaled_error(jacobian: np.ndarray, other: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """|other - jacobian| of each entry times its column's scale, over its row's scale."""
+    return np.abs(other - jacobian) * scales(point) / row_scales(jacobian, point)[:, None]
