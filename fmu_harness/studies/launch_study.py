@@ -6,7 +6,7 @@ mount modes; the run (``vehicle_launch.csv``), the third-order peaks against the
 The launch: the package's joints and mounts, the motor's torque ramped to ``TORQUE`` (a gentle
 take-off: the shaft accelerates by about 0.7 rad/s2, so that each resonance is passed slowly enough
 for its peak to stay near its crossing; docs/vehicle_launch.md, "Shudder"), run by the project's
-master in Gauss-Seidel order at 0.8 ms, its stable limit, where a 40 s launch costs about 10 s of CPU.
+master in Gauss-Seidel order at 0.8 ms, its stable limit, where a 40 s launch costs about 4 s of CPU.
 
 The powertrain's response is split into its modes with the core's mass-normalised mode shapes of the
 default layout (``driveline.mounts``): mode j's share of the accelerations at the centre of gravity,
@@ -202,7 +202,7 @@ def axial_force_figure(launch: Launch) -> Figure:
                      "its third order is 4/pi of its peak)", fontsize=9)
         ax.legend(loc="upper center", ncols=2, fontsize=8)
         ax.grid(alpha=0.3)
-    axes[-1].set_xlabel("halfshaft speed [rad/s]")
+    axes[-1].set_xlabel("left halfshaft speed [rad/s] (the right one turns as fast, negatively)")
     fig.tight_layout()
     return fig
 
@@ -252,7 +252,7 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
                     **(ring | {"mec": color, "ms": 10}), label=f"_crossing {peak.mode}")
         bottom.plot(peak.measured[1], 1.0, **(dot | {"color": color}), label=f"_peak {peak.mode}")
     bottom.set_ylim(0.0, 1.1)
-    bottom.set_xlabel("halfshaft speed [rad/s]")
+    bottom.set_xlabel("left halfshaft speed [rad/s]")
     bottom.set_ylabel("third-order amplitude / its peak [1]")
     bottom.set_title("Each mount mode's share of the powertrain's acceleration, third order: crossing (ring), "
                      "peak (dot),\nthe peak's speed against the crossing's", fontsize=10)
