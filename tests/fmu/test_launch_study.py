@@ -1,5 +1,5 @@
 """The launch study's runs without friction (``fmu_harness.studies.launch_study``): a quick launch of
-the native ``VehicleLaunch.ssp``, 140 N.m for 4 s (Gauss-Seidel at 0.8 ms, about 1 s of CPU each), with
+the native ``VehicleLaunch.ssp``, 140 N.m for 4 s (Gauss-Seidel at 0.8 ms, 1 s of CPU for the three), with
 the package's joints (``mu`` = 0.05), without friction, and without friction or bend."""
 
 from __future__ import annotations

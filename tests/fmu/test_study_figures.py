@@ -115,7 +115,7 @@ def test_campbell_diagram_nests_the_backward_crossings_inside_the_critical_speed
 
 @pytest.fixture(scope="module")
 def launch_figures(fmi2_dir, native_dir):
-    """The launch study's figures on a quick launch: 140 N.m for 4 s (1 s of CPU), through three mount
+    """The launch study's figures on a quick launch: 140 N.m for 4 s (0.3 s of CPU), through three mount
     modes' crossings."""
     package = system.write_ssp(system.vehicle_launch(), fmi2_dir, native_dir)
     launch = launch_study.run(package, torque=140.0, stop_time=4.0)
