@@ -155,6 +155,7 @@ def test_the_launchs_third_order_peaks_lie_at_the_mount_modes_crossings_delayed_
             continue
         (peak,) = order_tracking.peaks_near(speeds, amplitude, crossings[j:j + 1], launch_study.WINDOW_MARGIN)
         swept = launch_study.swept_peak(time, angle, found.frequencies[j], damping[j])
+        assert peak is not None, f"mode {j + 1}: no third-order peak near its crossing"
         assert peak[1] == pytest.approx(swept, rel=1e-2), f"mode {j + 1}"
         if swept < 1.03 * crossings[j]:
             assert peak[1] == pytest.approx(crossings[j], rel=3e-2), f"mode {j + 1}"
