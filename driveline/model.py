@@ -73,6 +73,9 @@ class SteppedModel(ABC):
         if errors:
             return errors
         self._valid_parameters = parameters  # NaN never compares equal, so it is always re-checked
+        errors = self._guarded(lambda: self.step_size_errors(step_size), "the step size")
+        if errors:
+            return errors
         errors = self._undoable(lambda: self.advance(current_time, step_size), f"the step from t = {current_time!r} s")
         if not errors:
             self.time = current_time + step_size
@@ -129,6 +132,10 @@ class SteppedModel(ABC):
     #: step and to the value it has at each other point.
     dependency_points: ClassVar[tuple[dict[str, Any], ...]] = ()
 
+    #: The stop time of the model's standard run (``fmu_harness/runs/scenario.py``: 100 steps), where
+    #: the default experiment's would make a step the model refuses (None: the default experiment's).
+    scenario_stop_time: ClassVar[float | None] = None
+
     #: Why the model's native FMU offers co-simulation only ("": Model Exchange beside it, its states
     #: the spec's ``states``): a state the spec cannot name as an output.
     co_simulation_only: ClassVar[str] = ""
@@ -147,6 +154,16 @@ class SteppedModel(ABC):
     def start_notice(self) -> str | None:
         """What the log says once, at initialisation, of how the model reads inputs the host left at
         their start values (a default it may not expect), or None; a warning, not a refusal."""
+        return None
+
+    def step_size_errors(self, step_size: float) -> list[str]:
+        """Why a positive, finite communication step is too long for the model (checked once the
+        parameters and inputs are valid), or []."""
+        return []
+
+    def step_notice(self, step_size: float) -> str | None:
+        """What the log says of a step the model took but that a host should not take (a warning; the
+        adapters log one text once), or None."""
         return None
 
     def extra_input_errors(self) -> list[str]:

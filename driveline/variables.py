@@ -49,6 +49,7 @@ UNITS: dict[str, Unit] = {
     for u in (
         Unit("s", {"s": 1}),
         Unit("Hz", {"s": -1}),
+        Unit("1/s", {"s": -1}),
         Unit("m", {"m": 1}, (DisplayUnit("mm", 1e3),)),
         Unit("kg", {"kg": 1}),
         Unit("rad", {"rad": 1}, (DisplayUnit("deg", 180.0 / math.pi),)),

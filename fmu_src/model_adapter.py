@@ -105,6 +105,7 @@ class ModelAdapter:
         self.phase = Phase.INSTANTIATED
         self.fault: str | None = None
         self._refusal: str | None = None  # the first reason of the last refused step
+        self._notice: str | None = None  # the model's last step notice: a repeat is not logged
         self._log_texts: dict[str, str] = {}
         self._spec_of_reference: dict[int, Any] = {}
         for variable in spec.variables:
@@ -233,6 +234,10 @@ class ModelAdapter:
         self.stepped = self.stepped or not errors
         if not errors:
             self._refusal = None
+            notice = self.model.step_notice(step_size)
+            if notice is not None and notice != self._notice:
+                self._notice = notice
+                self.log(self.log_text(notice), self.warning_status, _WARNING_CATEGORY)
             return StepOutcome.OK
         if errors[0] != self._refusal:  # the same step is refused again: its reasons are logged once
             self._refusal = errors[0]

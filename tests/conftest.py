@@ -19,6 +19,9 @@ test uses, so that test files carry none:
   runs and writes their times into the file (the others' stay); without ``-n`` and without
   ``TESTS`` (``--collect-only`` will do) it also drops the tests no longer collected.
 
+``--cpu-total`` prints the CPU seconds the file holds for the selected tests (with ``--collect-only``, what
+a run of them costs without running it).
+
 ``--fmi 2`` (or ``3``) builds and tests one FMI version only. ``--quick`` is the core and the
 FMI 2.0 FMUs without the slow and importer tests (``-m "not slow and not importers" --fmi 2``),
 and does not even import the modules that hold slow tests only (ROSS takes seconds to import):

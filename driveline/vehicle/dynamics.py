@@ -38,6 +38,12 @@ TOO_LONG = f"the communication step needs more than {MAX_SUBSTEPS} internal step
 #: 0.31 to 0.34 from zeta = 0.23 on; the constants keep below every one (docs/vehicle_launch.md).
 JACOBI_OMEGA_STEP = 0.28
 JACOBI_DAMPING_STEP = 1.5
+#: Above ``omega h = DIVERGENCE_OMEGA_STEP`` on either side the loop diverges whatever the master's order:
+#: measured in the launch over 0.6 s (the parameter changes above), a Gauss-Seidel master stepping the drive
+#: before its joints (the joints take the drive's outputs of the same step, the drive their torques one
+#: step late) diverged from omega h = 0.53 (damping doubled) to 0.65 to 0.7 (stiffness doubled), Jacobi
+#: from 0.25: the FMU refuses such a step rather than diverge (docs/vehicle_driveline.md).
+DIVERGENCE_OMEGA_STEP = 0.7
 
 #: Positions in the state tuple.
 CASE, DIFF, PHI_WHEEL_LEFT, WHEEL_LEFT, PHI_WHEEL_RIGHT, WHEEL_RIGHT, SPEED, TRAVEL, SLIP_LEFT, SLIP_RIGHT = range(10)
@@ -200,11 +206,48 @@ def reaction_torque(drive: Drive, joints: Joints, case_acceleration: float) -> f
 
 def internal_modes(drive: Drive) -> tuple[tuple[float, float], tuple[float, float]]:
     """Angular frequency [rad/s] and damping ratio of the differential's internal mode on each side with the
-    joints outside: a side gear (``J_side``) against its halfshaft (the wheel held)."""
-    return tuple((math.sqrt(k / drive.J_side), c / (2.0 * math.sqrt(k * drive.J_side)))
+    joints outside: a side gear (``J_side``) against its halfshaft (the wheel held); a side without
+    stiffness has no oscillation (0 rad/s, damping ratio inf)."""
+    return tuple((math.sqrt(k / drive.J_side), c / (2.0 * math.sqrt(k * drive.J_side)) if k > 0.0 else math.inf)
                  for k, c in ((drive.k_left, drive.c_left), (drive.k_right, drive.c_right)))
 
 
 def jacobi_step_limit(drive: Drive) -> float:
-    """The longest communication step of a Jacobi master coupling the drive with its joints [s]."""
-    return min(min(JACOBI_OMEGA_STEP, JACOBI_DAMPING_STEP * zeta) / omega for omega, zeta in internal_modes(drive))
+    """The longest communication step of a Jacobi master coupling the drive with its joints [s] (inf
+    without stiffness on either side)."""
+    return min((min(JACOBI_OMEGA_STEP, JACOBI_DAMPING_STEP * zeta) / omega
+                for omega, zeta in internal_modes(drive) if omega > 0.0), default=math.inf)
+
+
+def modes_text(drive: Drive) -> str:
+    """The differential's internal modes as a message shows them."""
+    (omega_left, zeta_left), (omega_right, zeta_right) = internal_modes(drive)
+    return (f"left {omega_left:.4g} rad/s, damping ratio {zeta_left:.3g}; "
+            f"right {omega_right:.4g} rad/s, damping ratio {zeta_right:.3g}")
+
+
+def divergence_step_limit(drive: Drive) -> float:
+    """The step above which the drive coupled to its joints diverges in any master's order [s]."""
+    return min((DIVERGENCE_OMEGA_STEP / omega for omega, _ in internal_modes(drive) if omega > 0.0), default=math.inf)
+
+
+def step_limit_notice(drive: Drive, step_size: float) -> str | None:
+    """What the log says once of a communication step above the Jacobi limit, or None."""
+    limit = jacobi_step_limit(drive)
+    if not step_size > limit:
+        return None
+    return (f"communication steps above {limit:.3g} s let the differential's internal mode ({modes_text(drive)}) "
+            f"diverge in a Jacobi master, the joints' torques one step late (omega h <= min({JACOBI_OMEGA_STEP}, "
+            f"{JACOBI_DAMPING_STEP} zeta)); a Gauss-Seidel master stepping the drive before its joints may hold "
+            f"longer, never beyond {divergence_step_limit(drive):.3g} s (omega h = {DIVERGENCE_OMEGA_STEP})")
+
+
+def step_limit_errors(drive: Drive, step_size: float) -> list[str]:
+    """A communication step at which the drive coupled to its joints diverges in any master's order: refused."""
+    limit = divergence_step_limit(drive)
+    if not step_size > limit:
+        return []
+    return [f"communication step {step_size!r} s is above {limit:.3g} s, where the differential's internal mode "
+            f"({modes_text(drive)}) diverges coupled to the joints in any master's order (omega h > "
+            f"{DIVERGENCE_OMEGA_STEP}; a Jacobi master needs {jacobi_step_limit(drive):.3g} s or less): take a "
+            "shorter step"]

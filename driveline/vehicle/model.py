@@ -15,8 +15,6 @@ class VehicleDrivelineModel(SteppedModel):
     left joint turns positively and the right one negatively (ISO 8855, y to the left)."""
 
     spec = SPEC
-    co_simulation_only = ("co-simulation only: VehicleDriveline's state holds the wheels' angles, which are no "
-                          "outputs (a Model Exchange state is an output of the spec)")
     # rolling slowly on a grade with every input set: the road load (rolling resistance within its
     # regularisation, v_low) and the halfshafts act
     dependency_points = ({"v_start": 0.05, "grade": 0.05, "T_motor": 120.0, "T_in_left": 300.0, "T_in_right": -280.0,
@@ -24,6 +22,8 @@ class VehicleDrivelineModel(SteppedModel):
                           "omega_out_right": -27.0},)
 
     native_constants = {"TOO_LONG": dynamics.TOO_LONG}
+    # 100 steps of 1 ms, within the step limit (1.04 ms with the defaults: dynamics.divergence_step_limit)
+    scenario_stop_time = 0.1
 
     def reset_internal_state(self) -> None:
         self._state: tuple[float, ...] = (0.0,) * dynamics.STATE_SIZE
@@ -44,6 +44,12 @@ class VehicleDrivelineModel(SteppedModel):
         return Joints(self.T_in_left, -self.T_in_right, self.phi_out_left, -self.phi_out_right,
                       self.omega_out_left, -self.omega_out_right)
 
+    def step_size_errors(self, step_size: float) -> list[str]:
+        return dynamics.step_limit_errors(self._drive(), step_size)
+
+    def step_notice(self, step_size: float) -> str | None:
+        return dynamics.step_limit_notice(self._drive(), step_size)
+
     def start(self, start_time: float) -> None:
         drive, joints = self._drive(), self._joints()
         self._state = dynamics.start_state(drive, self.v_start, joints)
@@ -53,6 +59,15 @@ class VehicleDrivelineModel(SteppedModel):
         drive, joints = self._drive(), self._joints()
         self._state = dynamics.advance(drive, self._state, self.T_motor, joints, step_size)
         self._evaluate(drive, joints, step_size)
+
+    def evaluate(self) -> None:
+        """Model Exchange (the native FMU's ``evaluate_now``): the outputs, the states' derivatives among
+        them, at the states the solver holds in the outputs that are states (the case's and the
+        differential's speeds from the side gears') and this instant's inputs."""
+        left, right = self.omega_in_left, self.omega_in_right
+        self._state = ((left - right) / 2.0, (left + right) / 2.0, self.phi_wheel_left, self.omega_wheel_left,
+                       self.phi_wheel_right, self.omega_wheel_right, self.v_x, self.x, self.slip_left, self.slip_right)
+        self._evaluate(self._drive(), self._joints(), 0.0)
 
     def _evaluate(self, drive: Drive, joints: Joints, elapsed: float) -> None:
         """Outputs at the state reached ``elapsed`` after the inputs' communication point."""
@@ -71,3 +86,11 @@ class VehicleDrivelineModel(SteppedModel):
         self.F_x_left = dynamics.tyre_force(drive, self.slip_left, drive.mu_road_left)
         self.F_x_right = dynamics.tyre_force(drive, self.slip_right, drive.mu_road_right)
         self.v_x, self.a_x, self.x = state[dynamics.SPEED], rate[dynamics.SPEED], state[dynamics.TRAVEL]
+        self.phi_wheel_left, self.phi_wheel_right = state[dynamics.PHI_WHEEL_LEFT], state[dynamics.PHI_WHEEL_RIGHT]
+        self.alpha_wheel_left, self.alpha_wheel_right = rate[dynamics.WHEEL_LEFT], rate[dynamics.WHEEL_RIGHT]
+        self.slip_dot_left, self.slip_dot_right = rate[dynamics.SLIP_LEFT], rate[dynamics.SLIP_RIGHT]
+
+    def rounding_scales(self) -> dict[str, float]:
+        """The slips' rates start as r_wheel (v_start / r_wheel) - v_start, zero but for rounding (eq V6)."""
+        scale = 2.0 * abs(self.v_start) / self.sigma_slip
+        return {"slip_dot_left": scale, "slip_dot_right": scale}

@@ -4,17 +4,19 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Variable
+from ..variables import DefaultExperiment, ModelSpec, State, Variable
 from . import compact_car as car
 
 POSITIVE = {"min": 0.0, "min_exclusive": True}
 SIDES = ("left", "right")
-# What the outputs are computed from (``depends_on``; the state, wheel angles among it, is internal):
-# the case's and side gears' accelerations (eqs V1, V2), a tyre's force (eq V5), the car's (V7, V8)
+# What the outputs are computed from (``depends_on``, the states among it): the case's and side gears'
+# accelerations (eqs V1, V2), a halfshaft's torque (V3), a tyre's force (V5), the car's (V7, V8)
 GEARS = ("ratio", "J_motor", "J_diff", "J_side", "T_motor", "T_in_left", "T_in_right")
+HALFSHAFT = ("k_{side}", "c_{side}", "phi_out_{side}", "omega_out_{side}", "phi_wheel_{side}", "omega_wheel_{side}")
 TYRE = ("m_vehicle", "grade", "front_share", "C_slip")
-CAR = ("m_vehicle", "J_wheel", "r_wheel", "f_roll", "rho_air", "c_drag", "A_front", "grade", "v_low")
+CAR = ("m_vehicle", "J_wheel", "r_wheel", "f_roll", "rho_air", "c_drag", "A_front", "grade", "v_low", "v_x")
 ROLLING = ("v_start", "r_wheel")  # the start: rolling at v_start without slip
+V_MAX = 150.0  # m/s, the fastest start: 540 km/h
 
 
 def _side(names: tuple[str, ...], side: str) -> tuple[str, ...]:
@@ -77,7 +79,9 @@ SPEC = ModelSpec(
         Variable("v_low", "parameter", 0.1,
                  "Low-speed regularisation: the slip's speed |v| + v_low, rolling resistance's sign tanh(v / v_low)",
                  "m/s", "km/h", **POSITIVE),
-        Variable("v_start", "parameter", 0.0, "Car speed at the start time (rolling without slip)", "m/s", "km/h"),
+        Variable("v_start", "parameter", 0.0, "Car speed at the start time (rolling without slip), within 540 km/h "
+                 "either way: beyond any road car (the drag's v |v| overflows from 1e154 m/s on)", "m/s", "km/h",
+                 min=-V_MAX, max=V_MAX),
         Variable("T_motor", "input", 0.0, "Motor torque on its rotor, forward positive", "N.m"),
         *_per_side("T_in", "input", 0.0,
                    "Torque the {side} joint takes from its input shaft, the side gear (the joint's T_in)", "N.m"),
@@ -87,28 +91,41 @@ SPEC = ModelSpec(
         *_per_side("omega_out", "input", 0.0, "Output shaft speed of the {side} joint (the joint's omega_out)",
                    "rad/s", "rpm"),
         *_per_side("omega_in", "output", 0.0, "Speed of the {side} side gear, the joint's input shaft",
-                   "rad/s", "rpm", depends_on=(), initial_depends_on=ROLLING),
+                   "rad/s", "rpm"),
         *_per_side("alpha_in", "output", 0.0, "Angular acceleration of the {side} side gear", "rad/s2",
                    depends_on=GEARS),
         *_per_side("T_load", "output", 0.0, "Torque in the {side} halfshaft, the joint's load torque", "N.m",
-                   depends_on=("k_{side}", "c_{side}", "phi_out_{side}", "omega_out_{side}"),
-                   initial_depends_on=("c_{side}", "omega_out_{side}", *ROLLING)),
+                   depends_on=HALFSHAFT, initial_depends_on=("c_{side}", "omega_out_{side}", "omega_wheel_{side}")),
         Variable("T_reaction", "output", 0.0,
                  "Torque of the drive's rotating parts on the powertrain housing about the axle direction "
                  "(y): minus both joints' T_in, minus the rate of the parts' angular momentum", "N.m",
                  depends_on=GEARS),
-        Variable("omega_motor", "output", 0.0, "Motor speed", "rad/s", "rpm", depends_on=("ratio",),
-                 initial_depends_on=("ratio", *ROLLING)),
-        *_per_side("omega_wheel", "output", 0.0, "Speed of the {side} front wheel", "rad/s", "rpm", depends_on=(),
-                   initial_depends_on=ROLLING),
+        Variable("omega_motor", "output", 0.0, "Motor speed", "rad/s", "rpm",
+                 depends_on=("ratio", "omega_in_left", "omega_in_right")),
+        *_per_side("omega_wheel", "output", 0.0, "Speed of the {side} front wheel", "rad/s", "rpm"),
         *_per_side("F_x", "output", 0.0, "Longitudinal force of the road on the {side} front tyre", "N",
-                   depends_on=(*TYRE, "mu_road_{side}"), initial_depends_on=()),
-        *_per_side("slip", "output", 0.0, "Transient longitudinal slip of the {side} front tyre", "1",
-                   depends_on=(), initial_depends_on=()),
-        Variable("v_x", "output", 0.0, "Car speed", "m/s", "km/h", depends_on=(), initial_depends_on=("v_start",)),
+                   depends_on=(*TYRE, "mu_road_{side}", "slip_{side}"), initial_depends_on=()),
+        *_per_side("slip", "output", 0.0, "Transient longitudinal slip of the {side} front tyre", "1"),
+        Variable("v_x", "output", 0.0, "Car speed", "m/s", "km/h"),
         Variable("a_x", "output", 0.0, "Car acceleration", "m/s2", depends_on=(*CAR, *TYRE[2:], "mu_road_left",
-                 "mu_road_right"), initial_depends_on=(*CAR, "v_start")),
-        Variable("x", "output", 0.0, "Distance travelled from the start", "m", depends_on=(), initial_depends_on=()),
+                 "mu_road_right", "slip_left", "slip_right"), initial_depends_on=CAR),
+        Variable("x", "output", 0.0, "Distance travelled from the start", "m"),
+        *_per_side("phi_wheel", "output", 0.0, "Angle of the {side} front wheel (from the joint's phi_out at the "
+                   "start: the halfshaft untwisted)", "rad", "deg"),
+        *_per_side("alpha_wheel", "output", 0.0, "Angular acceleration of the {side} front wheel", "rad/s2",
+                   depends_on=(*HALFSHAFT, "J_wheel", "r_wheel", *TYRE, "mu_road_{side}", "slip_{side}"),
+                   initial_depends_on=("c_{side}", "omega_out_{side}", "omega_wheel_{side}", "J_wheel")),
+        *_per_side("slip_dot", "output", 0.0, "Rate of the {side} front tyre's transient slip (eq V6)", "1/s",
+                   depends_on=("r_wheel", "v_low", "sigma_slip", "omega_wheel_{side}", "v_x", "slip_{side}"),
+                   initial_depends_on=()),
     ),
+    # the Model Exchange states: dynamics.py's state, the case's and the differential's speeds as the side
+    # gears' (omega_in_left = case + diff, omega_in_right = -(case - diff))
+    states=(*(State(f"omega_in_{side}", ROLLING, f"alpha_in_{side}") for side in SIDES),
+            *(state for side in SIDES for state in (State(f"phi_wheel_{side}", (f"phi_out_{side}",),
+                                                          f"omega_wheel_{side}"),
+                                                    State(f"omega_wheel_{side}", ROLLING, f"alpha_wheel_{side}"))),
+            State("v_x", ("v_start",), "a_x"), State("x", (), "v_x"),
+            *(State(f"slip_{side}", (), f"slip_dot_{side}") for side in SIDES)),
     default_experiment=DefaultExperiment(0.0, 4.0, 1e-4),
 )

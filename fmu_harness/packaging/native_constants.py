@@ -44,7 +44,8 @@ SHARED = {
     "driveline.tripod.closed_form": ("PAPER_PHASE",),
     "driveline.tripod.plane_solver": ("LAST_UPDATE", "MAX_ITERATIONS"),
     "driveline.tripod.reactions": ("FRICTION_TOLERANCE", "MAX_FRICTION_ITERATIONS"),
-    "driveline.vehicle.dynamics": ("GRAVITY", "RATE_STEP", "MAX_SUBSTEPS", "STATE_SIZE"),
+    "driveline.vehicle.dynamics": ("GRAVITY", "RATE_STEP", "MAX_SUBSTEPS", "STATE_SIZE", "JACOBI_OMEGA_STEP",
+                                   "JACOBI_DAMPING_STEP", "DIVERGENCE_OMEGA_STEP"),
 }
 
 #: The kinds of failure the C port tells apart: the exceptions the Python core raises. ``ErrorKind``

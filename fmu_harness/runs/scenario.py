@@ -52,8 +52,9 @@ class Scenario:
 
 
 def scenario(spec: ModelSpec) -> Scenario:
-    """The standard run of ``spec``: its default stop time in :data:`STEPS` steps."""
-    stop = spec.default_experiment.stop_time
+    """The standard run of ``spec``: its default stop time (or its model's ``scenario_stop_time``) in
+    :data:`STEPS` steps."""
+    stop = MODELS[spec.name].scenario_stop_time or spec.default_experiment.stop_time
     breakpoints = np.array([0.0, 0.5 * stop, stop])
     inputs = {v.name: v.start * np.array(INPUT_FACTORS) for v in spec.of("input") if v.type == "Real"}
     return Scenario(spec, stop, stop / STEPS, breakpoints, inputs)

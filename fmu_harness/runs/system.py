@@ -359,12 +359,10 @@ def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) 
         drive = Drive(*(float(values[name]) for name in Drive._fields))
         limit = dynamics.jacobi_step_limit(drive)
         if step > limit:
-            modes = "; ".join(f"{side} {omega:.4g} rad/s, damping ratio {zeta:.3g}"
-                              for side, (omega, zeta) in zip(("left", "right"), dynamics.internal_modes(drive)))
             return (f"{component.name} (VehicleDriveline): --step {step!r} s is above {limit:.3g} s, the longest step "
-                    f"at which its differential's internal mode ({modes}) stays stable with the joints' torques "
-                    f"one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, {dynamics.JACOBI_DAMPING_STEP} "
-                    "zeta)): take a shorter step")
+                    f"at which its differential's internal mode ({dynamics.modes_text(drive)}) stays stable with the "
+                    f"joints' torques one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, "
+                    f"{dynamics.JACOBI_DAMPING_STEP} zeta)): take a shorter step")
     return None
 
 

@@ -80,6 +80,9 @@ static void step(Instance *instance, double current_time, double step_size)
     }
     parameter_errors(&instance->data, out);
     input_errors(&instance->data, out);
+    if (out->count == 0 && model_hooks.step_size_errors != NULL) {
+        model_hooks.step_size_errors(&instance->data, step_size, out);
+    }
     if (out->count) {
         return;
     }
@@ -87,6 +90,21 @@ static void step(Instance *instance, double current_time, double step_size)
     if (out->count == 0) {
         instance->data.time = current_time + step_size;
     }
+}
+
+/* The model's notice of a step it took, logged as a warning when it differs from the last one. */
+static void step_notice(Instance *instance, double step_size)
+{
+    Messages *out = &instance->messages;
+    if (model_hooks.step_notice == NULL || out->count) {
+        return;
+    }
+    model_hooks.step_notice(&instance->data, step_size, out);
+    if (out->count && strcmp(instance->notice, out->text[0]) != 0) {
+        instance_log(instance, STATUS_WARNING, out->text[0], (const char *)NULL);
+        strcpy(instance->notice, out->text[0]);
+    }
+    out->count = 0;
 }
 
 /* ---- logging ------------------------------------------------------------------------------ */
@@ -223,6 +241,7 @@ Status instance_reset(Instance *instance)
     instance->start_time = 0.0;
     instance->terminated = 0;
     instance->refusal[0] = '\0';
+    instance->notice[0] = '\0';
     instance->mode = MODE_INSTANTIATED;
     return STATUS_OK;
 }
@@ -297,6 +316,7 @@ Status instance_do_step(Instance *instance, double current_time, double step_siz
     instance->messages.count = 0;
     step(instance, current_time, step_size);
     instance->terminated = instance->messages.count > 0;
+    step_notice(instance, step_size);
     return instance_refusal(instance);
 }
 

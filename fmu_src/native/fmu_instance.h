@@ -160,6 +160,7 @@ struct Instance {
     ModelCache cache;
     char *resources; /* owned; cache.resources points at it */
     char refusal[FMU_MESSAGE_SIZE]; /* the first reason of the last refusal or misuse: a repeat is not logged */
+    char notice[FMU_MESSAGE_SIZE];  /* the model's last step notice (ModelHooks.step_notice): a repeat is not logged */
     int model_exchange; /* instantiated for Model Exchange (fmu_model_exchange.c) */
     int event_mode;     /* Model Exchange after initialisation: event mode, else continuous-time mode */
     int stale;          /* Model Exchange: a time, state or input was set since the outputs were evaluated */
@@ -200,6 +201,10 @@ typedef struct {
     void (*extra_input_errors)(const ModelData *data, Messages *out);
     void (*free_derived)(void *derived);
     const char *(*start_notice)(const ModelData *data); /* SteppedModel.start_notice: logged once, a warning */
+    /* SteppedModel.step_size_errors and step_notice: reasons to refuse a step of ``step_size`` (checked once the
+     * parameters and inputs are valid), and after a step taken at most one warning, logged when it differs */
+    void (*step_size_errors)(const ModelData *data, double step_size, Messages *out);
+    void (*step_notice)(const ModelData *data, double step_size, Messages *out);
     Failure (*jacobian)(const ModelData *data, double partial[]);
 } ModelHooks;
 

@@ -173,7 +173,7 @@ Status model_exchange_get_derivatives(Instance *instance, const char *function, 
     return status;
 }
 
-/* Nominal values: 1 (the states are angles in rad). */
+/* Nominal values: 1 (the specs declare none). */
 Status model_exchange_get_nominals(Instance *instance, const char *function, double nominals[], size_t n)
 {
     int i;

@@ -7,6 +7,7 @@
  * Python's words.
  */
 #include <math.h>
+#include <stdio.h>
 
 #include "driveline_constants.h"
 #include "fmu_instance.h"
@@ -215,6 +216,12 @@ static Failure evaluate(ModelData *data, const Joints *joints, double elapsed)
     VALUE(v_x) = STATE[SPEED];
     VALUE(a_x) = rate[SPEED];
     VALUE(x) = STATE[TRAVEL];
+    VALUE(phi_wheel_left) = STATE[PHI_WHEEL_LEFT];
+    VALUE(phi_wheel_right) = STATE[PHI_WHEEL_RIGHT];
+    VALUE(alpha_wheel_left) = rate[WHEEL_LEFT];
+    VALUE(alpha_wheel_right) = rate[WHEEL_RIGHT];
+    VALUE(slip_dot_left) = rate[SLIP_LEFT];
+    VALUE(slip_dot_right) = rate[SLIP_RIGHT];
     return failure;
 }
 
@@ -256,4 +263,105 @@ static Failure advance(ModelData *data, double UNUSED current_time, double step_
     return failure.kind != ERROR_NONE ? failure : evaluate(data, &joints, step_size);
 }
 
-const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance};
+/* internal_modes, one side: a side gear against its halfshaft; without stiffness no oscillation */
+static void internal_mode(const ModelData *data, double k, double c, double *omega, double *zeta)
+{
+    *omega = sqrt(k / VALUE(J_side));
+    *zeta = k > 0.0 ? c / (2.0 * sqrt(k * VALUE(J_side))) : HUGE_VAL;
+}
+
+/* jacobi_step_limit (``jacobi``: omega h <= min(JACOBI_OMEGA_STEP, JACOBI_DAMPING_STEP zeta)) or
+ * divergence_step_limit (omega h <= DIVERGENCE_OMEGA_STEP): the shorter side's; inf without stiffness */
+static double step_limit(const ModelData *data, int jacobi)
+{
+    double omega[2], zeta[2], limit = HUGE_VAL, side_limit, damped;
+    int i;
+    internal_mode(data, VALUE(k_left), VALUE(c_left), &omega[0], &zeta[0]);
+    internal_mode(data, VALUE(k_right), VALUE(c_right), &omega[1], &zeta[1]);
+    for (i = 0; i < 2; i++) {
+        if (omega[i] > 0.0) {
+            damped = VEHICLE_DYNAMICS_JACOBI_DAMPING_STEP * zeta[i];
+            side_limit = jacobi ? fmin(VEHICLE_DYNAMICS_JACOBI_OMEGA_STEP, damped)
+                                : VEHICLE_DYNAMICS_DIVERGENCE_OMEGA_STEP;
+            side_limit = side_limit / omega[i];
+            limit = side_limit < limit ? side_limit : limit;
+        }
+    }
+    return limit;
+}
+
+/* modes_text, in ``text`` (at least 160 characters) */
+static void modes_text(const ModelData *data, char *text, size_t size)
+{
+    char shown[4][40];
+    double omega, zeta;
+    internal_mode(data, VALUE(k_left), VALUE(c_left), &omega, &zeta);
+    python_format_g(omega, 4, shown[0], sizeof shown[0]);
+    python_format_g(zeta, 3, shown[1], sizeof shown[1]);
+    internal_mode(data, VALUE(k_right), VALUE(c_right), &omega, &zeta);
+    python_format_g(omega, 4, shown[2], sizeof shown[2]);
+    python_format_g(zeta, 3, shown[3], sizeof shown[3]);
+    snprintf(text, size, "left %s rad/s, damping ratio %s; right %s rad/s, damping ratio %s", shown[0], shown[1],
+             shown[2], shown[3]);
+}
+
+/* step_limit_notice: a step above the Jacobi limit */
+static void step_notice(const ModelData *data, double step_size, Messages *out)
+{
+    char modes[200], limit[40], omega_step[40], damping_step[40], divergence[40], divergence_step[40];
+    double jacobi = step_limit(data, 1);
+    if (!(step_size > jacobi)) {
+        return;
+    }
+    modes_text(data, modes, sizeof modes);
+    python_format_g(jacobi, 3, limit, sizeof limit);
+    python_float_repr(VEHICLE_DYNAMICS_JACOBI_OMEGA_STEP, omega_step, sizeof omega_step);
+    python_float_repr(VEHICLE_DYNAMICS_JACOBI_DAMPING_STEP, damping_step, sizeof damping_step);
+    python_format_g(step_limit(data, 0), 3, divergence, sizeof divergence);
+    python_float_repr(VEHICLE_DYNAMICS_DIVERGENCE_OMEGA_STEP, divergence_step, sizeof divergence_step);
+    messages_add(out, "communication steps above ", limit, " s let the differential's internal mode (", modes,
+                 ") diverge in a Jacobi master, the joints' torques one step late (omega h <= min(", omega_step, ", ",
+                 damping_step, " zeta)); a Gauss-Seidel master stepping the drive before its joints may hold longer, "
+                 "never beyond ", divergence, " s (omega h = ", divergence_step, ")", (const char *)NULL);
+}
+
+/* step_limit_errors: a step at which the coupled drive diverges in any master's order */
+static void step_size_errors(const ModelData *data, double step_size, Messages *out)
+{
+    char modes[200], step[40], limit[40], divergence_step[40], jacobi[40];
+    double longest = step_limit(data, 0);
+    if (!(step_size > longest)) {
+        return;
+    }
+    modes_text(data, modes, sizeof modes);
+    python_float_repr(step_size, step, sizeof step);
+    python_format_g(longest, 3, limit, sizeof limit);
+    python_float_repr(VEHICLE_DYNAMICS_DIVERGENCE_OMEGA_STEP, divergence_step, sizeof divergence_step);
+    python_format_g(step_limit(data, 1), 3, jacobi, sizeof jacobi);
+    messages_add(out, "communication step ", step, " s is above ", limit, " s, where the differential's internal "
+                 "mode (", modes, ") diverges coupled to the joints in any master's order (omega h > ",
+                 divergence_step, "; a Jacobi master needs ", jacobi, " s or less): take a shorter step",
+                 (const char *)NULL);
+}
+
+/* Model Exchange: the state from the spec's states, the solver's (the side gears' speeds give the case's
+ * and the differential's), the outputs and the derivatives at the inputs of this instant */
+static Failure evaluate_now(ModelData *data, double UNUSED time)
+{
+    Joints joints = joints_of(data);
+    STATE[CASE] = (VALUE(omega_in_left) - VALUE(omega_in_right)) / 2.0;
+    STATE[DIFF] = (VALUE(omega_in_left) + VALUE(omega_in_right)) / 2.0;
+    STATE[PHI_WHEEL_LEFT] = VALUE(phi_wheel_left);
+    STATE[WHEEL_LEFT] = VALUE(omega_wheel_left);
+    STATE[PHI_WHEEL_RIGHT] = VALUE(phi_wheel_right);
+    STATE[WHEEL_RIGHT] = VALUE(omega_wheel_right);
+    STATE[SPEED] = VALUE(v_x);
+    STATE[TRAVEL] = VALUE(x);
+    STATE[SLIP_LEFT] = VALUE(slip_left);
+    STATE[SLIP_RIGHT] = VALUE(slip_right);
+    return evaluate(data, &joints, 0.0);
+}
+
+const ModelHooks model_hooks = {
+    .reset_internal = reset_internal, .start = start, .advance = advance, .evaluate = evaluate_now,
+    .step_size_errors = step_size_errors, .step_notice = step_notice};

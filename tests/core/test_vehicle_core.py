@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from driveline.vehicle import compact_car as car
 from driveline.vehicle import dynamics
 from driveline.vehicle.dynamics import Drive, Joints
 from driveline.vehicle.model import VehicleDrivelineModel
@@ -201,10 +202,12 @@ def test_stepping_against_solve_ivp_of_the_equations_written_again(step):
     on a 3 deg grade at mu 0.6: the model's Runge-Kutta steps against DOP853 (rtol 1e-12) of the
     equations written here independently, the whole state over 150 steps. Tolerance: 5e-5 of each
     variable's largest magnitude, the Runge-Kutta error at lambda h_int <= 0.25 (measured 2.6e-5 at
-    2 ms, in the slip, the fastest variable)."""
+    2 ms, in the slip, the fastest variable). The side gears four times the default's inertia lower
+    the differential's internal mode to 337 rad/s, where 2 ms is a step the drive takes (below
+    dynamics.divergence_step_limit, 2.08 ms)."""
     rng = np.random.default_rng(29)
     model = model_checks.started(VehicleDrivelineModel, grade=math.radians(3.0), mu_road_left=0.6,
-                                 mu_road_right=0.6, v_start=4.0)
+                                 mu_road_right=0.6, v_start=4.0, J_side=4 * car.SIDE_INERTIA)
     p = {name: getattr(model, name) for name in Drive._fields}
     y = np.array(model._state)
     t, rows, reference = 0.0, [], []
@@ -241,7 +244,41 @@ def test_reaction_torque_is_the_momentum_balance():
 
 
 def test_a_step_needing_unbounded_work_is_refused():
-    model = model_checks.started(VehicleDrivelineModel)
+    """Halfshafts without stiffness (no differential mode, no step limit): the tyres' modes bound the work."""
+    model = model_checks.started(VehicleDrivelineModel, k_left=0.0, k_right=0.0)
     errors = model.step(0.0, 1e4)
     assert len(errors) == 1 and "more than 10000 internal steps" in errors[0]
     assert model.step(0.0, 1e-3) == []
+
+
+def test_the_step_limits_follow_the_differential_mode():
+    """omega h <= min(0.28, 1.5 zeta) (Jacobi) and omega h <= 0.7 (any order) on the faster side: at the
+    defaults left 674.2 rad/s, zeta 0.232 (sqrt(k_left / J_side), c_left / (2 sqrt(k_left J_side))); a step
+    between the two is taken with a notice, a longer one refused; halfshafts without stiffness have no limit."""
+    model = model_checks.started(VehicleDrivelineModel)
+    drive = model._drive()
+    omega = math.sqrt(car.TORSIONAL_STIFFNESS_LEFT / car.SIDE_INERTIA)
+    zeta = car.TORSIONAL_DAMPING / (2.0 * math.sqrt(car.TORSIONAL_STIFFNESS_LEFT * car.SIDE_INERTIA))
+    assert dynamics.jacobi_step_limit(drive) == pytest.approx(min(0.28, 1.5 * zeta) / omega, rel=1e-14)
+    assert dynamics.divergence_step_limit(drive) == pytest.approx(0.7 / omega, rel=1e-14)
+    assert model.step_notice(4e-4) is None and model.step_size_errors(1.03e-3) == []
+    assert "communication steps above 0.000415 s" in model.step_notice(5e-4)
+    errors = model.step(0.0, 1.05e-3)
+    assert errors == ["communication step 0.00105 s is above 0.00104 s, where the differential's internal mode "
+                      "(left 674.2 rad/s, damping ratio 0.232; right 540.5 rad/s, damping ratio 0.29) diverges "
+                      "coupled to the joints in any master's order (omega h > 0.7; a Jacobi master needs 0.000415 s "
+                      "or less): take a shorter step"]
+    assert model.step(0.0, 1.03e-3) == []
+    free = model_checks.started(VehicleDrivelineModel, k_left=0.0, k_right=0.0)._drive()
+    assert dynamics.jacobi_step_limit(free) == dynamics.divergence_step_limit(free) == math.inf
+
+
+def test_a_start_speed_beyond_any_road_car_is_refused_as_a_parameter():
+    """1e300 m/s made the drag v |v| and a_x -inf at initialisation (found by the random runs): the bound
+    of v_start refuses it, and the fastest start allowed gives finite outputs."""
+    fast = VehicleDrivelineModel()
+    fast.v_start = 1e300
+    assert fast.initialize(0.0) == ["parameter v_start = 1e+300 m/s is above its maximum 150.0 m/s"]
+    fastest = VehicleDrivelineModel()
+    fastest.v_start = -150.0
+    assert fastest.initialize(0.0) == [] and math.isfinite(fastest.a_x) and fastest.a_x > 0.0

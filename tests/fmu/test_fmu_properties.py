@@ -23,9 +23,7 @@ EXAMPLES = {"python": 40, "native": 60}
 
 #: Models whose random runs found a defect not yet fixed (each named in the open issue's note).
 DEFECTS_FOUND = {
-    "VehicleDriveline": "drawn parameters make a_x -inf at initialisation, refused as a non-finite output",
     "PowertrainMounts": "a drawn case of the Python FMUs departs from the core (not yet traced)",
-    "UniversalReducer": "a drawn case of the Python FMI 3.0 FMU departs from the core (not yet traced)",
 }
 
 

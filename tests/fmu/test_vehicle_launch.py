@@ -6,14 +6,18 @@ from __future__ import annotations
 import csv
 import importlib.util
 import math
+import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from driveline.catalog import MODELS
+from driveline.vehicle.model import VehicleDrivelineModel
 from fmu_harness import system_command
-from fmu_harness.runs import launch_energy, launch_reference, system
+from fmu_harness.runs import launch_energy, launch_reference, ssp_package, system
+from fmu_harness.runs.runner import StepRefused
+from support import model_checks
 
 STEP, STOP = 1e-4, 0.05
 
@@ -162,3 +166,40 @@ def test_the_gauss_seidel_master_converges_beyond_the_jacobi_limit(fmi2_dir, nat
     for name, bound in bounds.items():
         assert found[0][name] <= bound
         assert 0.8 <= math.log2(found[0][name] / found[1][name]) <= 1.2
+
+
+def test_the_drive_notes_a_step_above_the_jacobi_limit_once_and_refuses_a_diverging_one(family, fmi):
+    """Both families and FMI versions, the drive alone: steps of 5e-4 s, above the Jacobi limit
+    (4.15e-4 s), are taken and the reason logged once as a warning; 1.2e-3 s, above the step where the
+    launch diverged in either master's order (1.04e-3 s, omega h = 0.7), is refused with the core's words."""
+    core = model_checks.started(VehicleDrivelineModel)
+    notice, (reason,) = core.step_notice(5e-4), core.step_size_errors(1.2e-3)
+    with family.open("VehicleDriveline", fmi) as fmu:
+        fmu.initialize()
+        first = len(fmu.log)
+        for _ in range(3):
+            fmu.step(5e-4)
+        assert [(r.status, family.reason(r.message)) for r in fmu.log[first:]] == [("Warning", notice)]
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1.2e-3)
+        assert refused.value.status == "Discard" and [family.reason(m) for m in refused.value.messages] == [reason]
+
+
+def test_a_diverging_step_stops_the_launch_naming_the_drive(launch_ssp, tmp_path, capfd):
+    """The launch at 1.2e-3 s (the command's own check left out): the project's master stops at the first
+    step with the drive's reason; libcosim's step fails and the drive's reason is in its log."""
+    package = ssp_package.read(launch_ssp)
+    with zipfile.ZipFile(launch_ssp) as archive:
+        archive.extractall(tmp_path)
+    fmus = {c.name: tmp_path / c.source for c in package.components}
+    outputs = ["drive.T_load_left"]
+    with pytest.raises(StepRefused) as refused:
+        system_command.run_engine("master", launch_ssp, package, fmus, outputs, 0.012, 1.2e-3, lambda k, n: None)
+    assert str(refused.value).startswith("drive: doStep at t = 0 s returned Discard: communication step 0.0012 s")
+    if importlib.util.find_spec("libcosimpy") is None:
+        pytest.skip("libcosimpy is not installed on this platform (pip install '.[interop]')")
+    capfd.readouterr()
+    with pytest.raises(StepRefused):
+        system_command.run_engine("libcosim", launch_ssp, package, fmus, outputs, 0.012, 1.2e-3, lambda k, n: None)
+    said = capfd.readouterr()
+    assert "communication step 0.0012 s is above 0.00104 s" in said.out + said.err

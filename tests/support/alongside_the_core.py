@@ -102,11 +102,13 @@ def run_alongside_the_core(fmu: FmuInstance, model_class: type[SteppedModel], ru
     core = model_class()
     for name, value in parameters.items():
         setattr(core, name, value)
-    if core.parameter_errors():
-        expect_refused_parameters(fmu, parameters, core.parameter_errors(), reason)
+    # the parameters, or the start values with them (outputs the core cannot compute: L1 = 1e300 m puts the
+    # reducer's stresses beyond their bounds), refused at initialisation
+    errors = core.parameter_errors() or core.initialize(0.0)
+    if errors:
+        expect_refused_parameters(fmu, parameters, errors, reason)
         return [], []
     fmu.initialize(parameters)
-    core.initialize(0.0)
     fmu_rows, core_rows = [], []
     repeated = None  # the first reason of the last refusal: the same refusal again is not logged again
     for inputs, step_size in steps:
