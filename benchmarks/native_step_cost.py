@@ -37,15 +37,19 @@ def compile_timer(folder: Path) -> Path:
     return executable
 
 
-def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path, integers: dict[str, int]) -> float:
-    """Nanoseconds per step of ``fmu`` from the C timer, with the Integer parameters ``integers``."""
+def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path, integers: dict[str, int],
+                inputs_set: list[str] | None = None, outputs_read: list[str] | None = None) -> float:
+    """Nanoseconds per step of ``fmu`` from the C timer, with the Integer parameters ``integers``,
+    setting the inputs ``inputs_set`` and reading the outputs ``outputs_read`` (None: all Real ones)."""
     unzipdir = Path(extract(str(fmu), unzipdir=str(work)))
     description = read_model_description(str(fmu))
     token = description.instantiationToken if fmi == "3" else description.guid
     real = ("Real", "Float64")
-    inputs = [v.valueReference for v in description.modelVariables if v.causality == "input" and v.type in real]
-    outputs = [v.valueReference for v in description.modelVariables if v.causality == "output" and v.type in real]
     references = {v.name: v.valueReference for v in description.modelVariables}
+    inputs = [v.valueReference for v in description.modelVariables if v.causality == "input" and v.type in real] \
+        if inputs_set is None else [references[name] for name in inputs_set]
+    outputs = [v.valueReference for v in description.modelVariables if v.causality == "output" and v.type in real] \
+        if outputs_read is None else [references[name] for name in outputs_read]
     library = native.host_library(unzipdir, description.coSimulation.modelIdentifier, fmi)
     done = subprocess.run([str(timer), str(library), fmi, token, description.defaultExperiment.stepSize,
                            str(C_STEPS), str(C_ROUNDS), " ".join(map(str, inputs)), " ".join(map(str, outputs)),

@@ -12,6 +12,8 @@ which the housing passes to the powertrain, is the opposite: ``-(Rx_in, Ry_in, R
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 #: The shortest accepted shaft direction and the smallest sine between shaft and bend directions.
@@ -20,14 +22,18 @@ MIN_DIRECTION = 1e-6
 
 def joint_frame(shaft: np.ndarray, bend: np.ndarray, name: str) -> np.ndarray:
     """Columns X', Y', Z' in vehicle axes: Z' along ``shaft``, X' the part of ``bend`` normal to
-    it, Y' = Z' x X'. ValueError naming the joint ``name`` when the directions do not span a plane."""
-    length = float(np.linalg.norm(shaft))
+    it, Y' = Z' x X'. ValueError naming the joint ``name`` when the directions do not span a plane or
+    a length overflows (a direction of finite components that would otherwise turn into zeros)."""
+    length, bend_length = float(np.linalg.norm(shaft)), float(np.linalg.norm(bend))
+    for what, size in (("halfshaft", length), ("bend-plane", bend_length)):
+        if math.isinf(size):
+            raise ValueError(f"the {what} direction of the {name} joint is too long (its length overflows)")
     if not length >= MIN_DIRECTION:
         raise ValueError(f"the halfshaft direction of the {name} joint has no length ({length:.3g})")
     z_axis = shaft / length
     normal = bend - (bend @ z_axis) * z_axis
     sine = float(np.linalg.norm(normal))
-    if not sine >= MIN_DIRECTION * max(float(np.linalg.norm(bend)), 1.0):
+    if not sine >= MIN_DIRECTION * max(bend_length, 1.0):
         raise ValueError(f"the bend-plane direction of the {name} joint is parallel to its halfshaft "
                          "direction or zero: it must point across the shaft")
     x_axis = normal / sine

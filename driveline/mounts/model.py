@@ -33,8 +33,6 @@ class PowertrainMountsModel(SteppedModel):
     """The ``PowertrainMounts`` co-simulation model."""
 
     spec = SPEC
-    co_simulation_only = ("co-simulation only: PowertrainMounts' C port gives no Model Exchange evaluate hook yet "
-                          "(its 12 states are declared in the spec)")
     # every input loaded, the joints' and motor's directions off the axes (a direction's part along
     # itself or along the shaft is dropped), a mean torque (the sag's motor axis)
     dependency_points = ({**{name: 100.0 * (-1) ** k * (1 + k % 5) for k, name in enumerate(INPUTS)},
@@ -99,6 +97,14 @@ class PowertrainMountsModel(SteppedModel):
         state = propagator.step(self._values(COORDINATES + VELOCITIES), held, rates)
         self._propagator = propagator
         self._show(state, held + rates * step_size)
+
+    def evaluate(self, time: float) -> None:
+        """Model Exchange (the native FMUs): accelerations and mount forces at the current state
+        under the inputs now (their rates are co-simulation's alone), the system built if needed."""
+        errors = self.extra_parameter_errors()
+        if errors:
+            raise ValueError(errors[0])
+        self._show(self._values(COORDINATES + VELOCITIES), self._system.inputs @ self._values(INPUTS))
 
     def _show(self, state: np.ndarray, force: np.ndarray) -> None:
         """Motion and mount-force outputs of ``state`` under the generalised ``force``."""

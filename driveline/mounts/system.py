@@ -8,6 +8,7 @@ measured from the static equilibrium under the weight, whose mount forces are th
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,9 @@ class Placement:
         """ValueError naming the direction that does not give a frame or an axis."""
         frames = {side: joint_frame(shafts[side], bends[side], side) for side in SIDES}
         length = float(np.linalg.norm(motor_axis))
+        if math.isinf(length):
+            raise ValueError("the motor axis (motor_axis_x, motor_axis_y, motor_axis_z) is too long (its length "
+                             "overflows)")
         if not length > 0.0:
             raise ValueError("the motor axis (motor_axis_x, motor_axis_y, motor_axis_z) has no length")
         return cls(centres, frames, motor_axis / length)

@@ -282,6 +282,12 @@ def _extra_message(model: type[SteppedModel], probe: dict[str, float]) -> str:
     return f"    {{V_{shown}, {_template(errors[0])}}},"
 
 
+def _references(variables: list[Variable]) -> str:
+    """The variables' value references, -1 after them, as the lines of a C initialiser."""
+    references = ", ".join([*(f"V_{v.name}" for v in variables), "-1"])
+    return "\n    " + "\n    ".join(textwrap.wrap(references, 100)) + "\n"
+
+
 def _positions(names: list[str], spec: ModelSpec) -> str:
     """Each variable's position in ``names`` (-1: not there), as the lines of a C initialiser."""
     positions = ", ".join(str(names.index(v.name)) if v.name in names else "-1" for v in spec.variables)
@@ -308,6 +314,12 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
         + f"    PARTS\n}};\n#define PART_MOST_VALUES {most}\nextern const int model_part_values[PARTS][PART_MOST_VALUES + 1];\n")
     extra_enum = part_enum + "" if not probes else part_enum + "\n/* messages of the model's own checks */\nenum {\n" + "".join(
         f"    MESSAGE_{name} = {index},\n" for index, name in enumerate(probes)) + "};\n"
+    by_causality = [[v for v in spec.variables if v.causality == causality
+                     and (v.type == "Real" and causality != "output" or v.min is not None or v.max is not None)]
+                    for causality in ("parameter", "input", "output")]
+    checked = [v for variables in by_causality for v in variables]
+    starts = [sum(len(variables) for variables in by_causality[:k]) for k in range(4)]
+    real_outputs = [v for v in spec.of("output") if v.type == "Real"]
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
 #ifndef MODEL_VARIABLES_H
 #define MODEL_VARIABLES_H
@@ -323,6 +335,14 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_INPUT_DERIVATIVE_COUNT {len(derivatives)}
 /* Model Exchange: continuous states (ModelSpec.states) */
 #define MODEL_STATE_COUNT {len(spec.states)}
+/* the variables the range checks read, by causality (model_checked_from), in the table's order: the bounded
+ * ones and the Real parameters and inputs (finite; the Real outputs' sum shows that they are before their bounds
+ * are checked: model_real_outputs) */
+#define MODEL_CHECKED_COUNT {len(checked)}
+#define MODEL_REAL_OUTPUT_COUNT {len(real_outputs)}
+extern const int model_checked[MODEL_CHECKED_COUNT + 1];
+extern const int model_checked_from[4];
+extern const int model_real_outputs[MODEL_REAL_OUTPUT_COUNT + 1];
 /* Directional derivatives: the Jacobian's rows are the Real outputs (ROW_<name>), then der(<state>), its
  * columns the Real inputs and the states (COLUMN_<name>) */
 #define MODEL_OUTPUT_ROWS {len(rows)}
@@ -352,6 +372,11 @@ const char model_token[] = {_c_string(token)};
 const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 {entries}
 }};
+
+/* -1 ends each list */
+const int model_checked[MODEL_CHECKED_COUNT + 1] = {{{_references(checked)}}};
+const int model_checked_from[4] = {{{", ".join(map(str, starts))}}};
+const int model_real_outputs[MODEL_REAL_OUTPUT_COUNT + 1] = {{{_references(real_outputs)}}};
 """
     source += f"""
 /* each variable's row and column of the Jacobian (directional derivatives), -1 for none */

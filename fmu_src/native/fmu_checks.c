@@ -94,17 +94,15 @@ void messages_add_extra(Messages *out, const ModelData *data, int message)
 
 /* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
 
-/* SteppedModel._range_error for every variable of ``causality``: finite, then the declared bounds. */
+/* SteppedModel._range_error for every variable of ``causality``: finite, then the declared bounds (the
+ * generated list of the variables that have a check of these; the outputs' finiteness: output_errors). */
 static void range_errors(const ModelData *data, Causality causality, Messages *out)
 {
-    int i;
-    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
-        const VariableInfo *v = &model_variables[i];
+    int k;
+    for (k = model_checked_from[causality]; k < model_checked_from[causality + 1]; k++) {
+        const VariableInfo *v = &model_variables[model_checked[k]];
         const MessageTemplate *message = NULL;
-        double value = value_of(data, i);
-        if (v->causality != causality) {
-            continue;
-        }
+        double value = value_of(data, model_checked[k]);
         if (v->type == VAR_REAL && !isfinite(value)) {
             message = &v->not_finite;
         } else if (v->has_min && (v->min_exclusive ? !(value > v->min) : value < v->min)) {
@@ -194,15 +192,13 @@ static SumOutcome fsum_outcome(const double values[], int count, Failure *failur
  * of the sum itself becomes ``failure``. */
 void output_errors(const ModelData *data, Messages *out, Failure *failure)
 {
-    double values[MODEL_VARIABLE_COUNT];
-    int names[MODEL_VARIABLE_COUNT], count = 0, i;
+    double values[MODEL_REAL_OUTPUT_COUNT + 1];
+    const int *names = model_real_outputs;
+    int count = MODEL_REAL_OUTPUT_COUNT, i;
     char shown[40];
     SumOutcome outcome;
-    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
-        if (model_variables[i].causality == CAUSALITY_OUTPUT && model_variables[i].type == VAR_REAL) {
-            names[count] = i;
-            values[count++] = data->real_value[i];
-        }
+    for (i = 0; i < count; i++) {
+        values[i] = data->real_value[names[i]];
     }
     outcome = fsum_outcome(values, count, failure);
     if (outcome == SUM_FINITE) {

@@ -45,6 +45,9 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
     const VariableInfo *v = reference < MODEL_VARIABLE_COUNT ? &model_variables[reference] : NULL;
     const char *problem = NULL;
     char number[24];
+    if (v != NULL && v->type == type && !setting) { /* a variable of the spec to get: the common case */
+        return 1;
+    }
     if (is_time(instance, reference)) {
         problem = type == VAR_REAL && !setting ? NULL : " is the independent variable time, a Real that cannot be set";
     } else if (derivative_of(instance, reference) >= 0) {
@@ -168,10 +171,10 @@ Status instance_get_real(Instance *instance, const char *function, const uint32_
     }
     status = model_exchange_update(instance);
     for (i = 0; i < n; i++) {
-        k = derivative_of(instance, vr[i]);
-        value[i] = is_time(instance, vr[i]) ? instance->data.time
-                   : k >= 0                ? DERIVATIVE_VALUE(k)
-                                           : instance->data.real_value[vr[i]];
+        k = vr[i] < MODEL_VARIABLE_COUNT ? -1 : derivative_of(instance, vr[i]);
+        value[i] = vr[i] < MODEL_VARIABLE_COUNT ? instance->data.real_value[vr[i]]
+                   : k >= 0                     ? DERIVATIVE_VALUE(k)
+                                                : instance->data.time;
     }
     return status;
 }

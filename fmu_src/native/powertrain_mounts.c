@@ -5,7 +5,8 @@
  * driveline/layout_files.py). The system (matrices, modes, input map, the weight's sag) is the model's
  * derived data, built when the parameters change; the propagator of a step size (Phi, Gamma0, Gamma1, one
  * exponential of the augmented matrix: Pade 13 with scaling and squaring, exact_step.squarings' count) is
- * built again only when the step size changes. The state (q, q') is the outputs x ... yaw_dot.
+ * built again only when the step size changes. The state (q, q') is the outputs x ... yaw_dot, Model Exchange's
+ * continuous states (spec._states).
  */
 #include <math.h>
 #include <stdio.h>
@@ -20,18 +21,12 @@
 
 /* ---- the system (rigid_body.py, joints.py, system.py) --------------------------------------------- */
 
-/* spec.INPUTS and their rates (spec.derivative_name), in the order of the input map */
-static const int INPUT_VARIABLES[] = {
-    V_F_x, V_F_y, V_F_z, V_M_x, V_M_y, V_M_z, V_Rx_in_left, V_Ry_in_left, V_Rz_in_left, V_Mx_in_left, V_My_in_left,
-    V_T_in_left, V_Rx_in_right, V_Ry_in_right, V_Rz_in_right, V_Mx_in_right, V_My_in_right, V_T_in_right, V_T_motor};
-#define N_INPUTS (int)(sizeof INPUT_VARIABLES / sizeof INPUT_VARIABLES[0])
-static const int RATE_VARIABLES[N_INPUTS] = {
-    V_F_x_dot, V_F_y_dot, V_F_z_dot, V_M_x_dot, V_M_y_dot, V_M_z_dot, V_Rx_in_dot_left, V_Ry_in_dot_left,
-    V_Rz_in_dot_left, V_Mx_in_dot_left, V_My_in_dot_left, V_T_in_dot_left, V_Rx_in_dot_right, V_Ry_in_dot_right,
-    V_Rz_in_dot_right, V_Mx_in_dot_right, V_My_in_dot_right, V_T_in_dot_right, V_T_motor_dot};
-static const int STATE_VARIABLES[12] = {V_x,     V_y,     V_z,     V_roll,     V_pitch,     V_yaw,
-                                        V_x_dot, V_y_dot, V_z_dot, V_roll_dot, V_pitch_dot, V_yaw_dot};
-static const int ACCELERATION_VARIABLES[6] = {V_x_ddot, V_y_ddot, V_z_ddot, V_roll_ddot, V_pitch_ddot, V_yaw_ddot};
+/* The loads in the order of the input map (spec.INPUTS) are the inputs whose rates the spec declares, in that
+ * order: model_input_derivatives[k].input, its rate .target. The states (x ... yaw, then their velocities) and
+ * their derivatives: model_states, model_state_derivatives (the accelerations from the seventh on). */
+#define N_INPUTS MODEL_INPUT_DERIVATIVE_COUNT
+#define STATE_VARIABLES model_states
+#define ACCELERATION_VARIABLES (model_state_derivatives + 6)
 static const int STATIC_VARIABLES[6] = {V_x_static,    V_y_static,     V_z_static,
                                         V_roll_static, V_pitch_static, V_yaw_static};
 static const char *const COORDINATES[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
@@ -42,7 +37,8 @@ typedef struct {
 
 typedef struct {
     int held;
-    double parameters[MODEL_VARIABLE_COUNT]; /* the Real parameters it was built for */
+    int parameter_count, parameter[MODEL_VARIABLE_COUNT]; /* the Real parameters it was built for */
+    double parameters[MODEL_VARIABLE_COUNT];               /* and their values */
     char *layout_name;                      /* owned */
     Layout layout;
     double mass[6][6], stiffness[6][6], damping[6][6], a[12][12], b[12][6], inputs[6][N_INPUTS];
@@ -83,12 +79,17 @@ static void mount_map(const Mount *m, const double centre[3], double out[3][6])
     dense_multiply(&m->axes[0][0], &t[0][0], &out[0][0], 3, 3, 6);
 }
 
-/* joints.joint_frame: columns X', Y', Z'; 0 with the message */
+/* joints.joint_frame: columns X', Y', Z'; 0 with the message (also for a length that overflows) */
 static int joint_frame(const double shaft[3], const double bend[3], const char *side, double frame[3][3], char *error)
 {
-    double length = norm3(shaft), z[3], x[3], y[3], along, sine, shown;
+    double length = norm3(shaft), bend_length = norm3(bend), z[3], x[3], y[3], along, sine, shown;
     char text[40];
     int k;
+    if (isinf(length) || isinf(bend_length)) {
+        snprintf(error, ERROR_SIZE, "the %s direction of the %s joint is too long (its length overflows)",
+                 isinf(length) ? "halfshaft" : "bend-plane", side);
+        return 0;
+    }
     if (!(length >= MOUNTS_JOINTS_MIN_DIRECTION)) {
         python_format_g(length, 3, text, sizeof text);
         snprintf(error, ERROR_SIZE, "the halfshaft direction of the %s joint has no length (%s)", side, text);
@@ -102,7 +103,7 @@ static int joint_frame(const double shaft[3], const double bend[3], const char *
         x[k] = bend[k] - along * z[k];
     }
     sine = norm3(x);
-    shown = fmax(norm3(bend), 1.0);
+    shown = fmax(bend_length, 1.0);
     if (!(sine >= MOUNTS_JOINTS_MIN_DIRECTION * shown)) {
         snprintf(error, ERROR_SIZE,
                  "the bend-plane direction of the %s joint is parallel to its halfshaft direction or zero: it must "
@@ -368,6 +369,11 @@ static int build(System *s, const ModelData *data, char *error)
     }
     vector_of(data, motor, axis);
     length = norm3(axis);
+    if (isinf(length)) {
+        snprintf(error, ERROR_SIZE, "the motor axis (motor_axis_x, motor_axis_y, motor_axis_z) is too long (its "
+                 "length overflows)");
+        return 0;
+    }
     if (!(length > 0.0)) {
         snprintf(error, ERROR_SIZE, "the motor axis (motor_axis_x, motor_axis_y, motor_axis_z) has no length");
         return 0;
@@ -399,13 +405,25 @@ static int built_for(const System *s, const ModelData *data)
     if (!s->held || strcmp(s->layout_name, data->string_value[V_layout]) != 0) {
         return 0;
     }
-    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
-        if (model_variables[i].causality == CAUSALITY_PARAMETER && model_variables[i].type == VAR_REAL &&
-            !(s->parameters[i] == data->real_value[i])) {
+    for (i = 0; i < s->parameter_count; i++) {
+        if (!(s->parameters[i] == data->real_value[s->parameter[i]])) {
             return 0;
         }
     }
     return 1;
+}
+
+/* Keeps the Real parameters' values ``s`` was built for */
+static void keep_parameters(System *s, const ModelData *data)
+{
+    int i;
+    s->parameter_count = 0;
+    for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
+        if (model_variables[i].causality == CAUSALITY_PARAMETER && model_variables[i].type == VAR_REAL) {
+            s->parameter[s->parameter_count] = i;
+            s->parameters[s->parameter_count++] = data->real_value[i];
+        }
+    }
 }
 
 /* PowertrainMountsModel.extra_parameter_errors */
@@ -430,7 +448,7 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
         return;
     }
     memcpy(built->layout_name, data->string_value[V_layout], length + 1);
-    memcpy(built->parameters, data->real_value, sizeof built->parameters);
+    keep_parameters(built, data);
     built->held = 1;
     free_system(s);
     cache->derived = built;
@@ -513,14 +531,19 @@ static int propagator(System *s, double h)
 
 /* ---- per step (model.py) ---------------------------------------------------------------------------- */
 
-/* G u of the inputs ``variables`` */
-static void generalised(const System *s, const ModelData *data, const int variables[N_INPUTS], double out[6])
+/* G u of the loads (``rates`` 0) or of their rates (1) */
+static void generalised(const System *s, const ModelData *data, int rates, double out[6])
 {
+    double u[N_INPUTS];
     int i, k;
+    for (k = 0; k < N_INPUTS; k++) {
+        const InputDerivative *load = &model_input_derivatives[k];
+        u[k] = data->real_value[rates ? load->target : load->input];
+    }
     for (i = 0; i < 6; i++) {
         out[i] = 0.0;
         for (k = 0; k < N_INPUTS; k++) {
-            out[i] += s->inputs[i][k] * data->real_value[variables[k]];
+            out[i] += s->inputs[i][k] * u[k];
         }
     }
 }
@@ -607,7 +630,7 @@ static Failure start(ModelData *data, double start_time UNUSED)
     if (s == NULL) { /* the parameter check builds it before every initialisation */
         return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
     }
-    generalised(s, data, INPUT_VARIABLES, force);
+    generalised(s, data, 0, force);
     if (!static_displacement(s, force, state)) {
         return FAILURE(ERROR_VALUE, "Singular matrix");
     }
@@ -626,8 +649,8 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
     if ((!s->has_propagator || s->propagator.h != step_size) && !propagator(s, step_size)) {
         return FAILURE(ERROR_VALUE, s->failure);
     }
-    generalised(s, data, INPUT_VARIABLES, held);
-    generalised(s, data, RATE_VARIABLES, rates);
+    generalised(s, data, 0, held);
+    generalised(s, data, 1, rates);
     for (i = 0; i < 12; i++) {
         state[i] = data->real_value[STATE_VARIABLES[i]];
     }
@@ -648,5 +671,66 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
     return NO_FAILURE;
 }
 
-const ModelHooks model_hooks = {.start = start, .advance = advance, .extra_parameter_errors = extra_parameter_errors,
-                                .free_derived = free_system};
+/* Model Exchange: the accelerations (the velocities' derivatives) and mount forces at the solver's state
+ * (q, q') under the inputs now, M q'' + C q' + K q = G u; the static sag and modal table stay as the
+ * initialisation left them (functions of the parameters alone). */
+static Failure evaluate(ModelData *data, double time UNUSED)
+{
+    System *s = data->cache->derived;
+    double force[6], state[12];
+    int i;
+    if (s == NULL) {
+        return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
+    }
+    generalised(s, data, 0, force);
+    for (i = 0; i < 12; i++) {
+        state[i] = data->real_value[STATE_VARIABLES[i]];
+    }
+    show(s, data, state, force);
+    return NO_FAILURE;
+}
+
+/* Directional derivatives: the model is linear, its partials constant. The accelerations (A s + B G u)[6:]
+ * by the states and the loads (their rates: none, as in evaluate), each mount's force by the states
+ * (show's mount forces); the states' own rows and der(<state>)'s are the layer's. */
+static Failure jacobian(const ModelData *data, double partial[])
+{
+    const System *s = data->cache->derived;
+    int i, j, k, n;
+    if (s == NULL) {
+        return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
+    }
+    for (i = 0; i < 6; i++) {
+        double *row = partial + model_jacobian_rows[ACCELERATION_VARIABLES[i]] * MODEL_COLUMN_COUNT;
+        for (k = 0; k < 12; k++) {
+            row[model_jacobian_columns[STATE_VARIABLES[k]]] = s->a[6 + i][k];
+        }
+        for (k = 0; k < N_INPUTS; k++) {
+            double sum = 0.0;
+            for (j = 0; j < 6; j++) {
+                sum += s->b[6 + i][j] * s->inputs[j][k];
+            }
+            row[model_jacobian_columns[model_input_derivatives[k].input]] = sum;
+        }
+    }
+    for (n = 0; n < s->layout.count; n++) {
+        const Mount *m = &s->layout.mounts[n];
+        for (i = 0; i < 3; i++) {
+            double *row = partial + model_jacobian_rows[V_F_x_mount1 + 3 * n + i] * MODEL_COLUMN_COUNT;
+            for (j = 0; j < 6; j++) {
+                double moved = 0.0, speed = 0.0;
+                for (k = 0; k < 3; k++) {
+                    moved -= m->axes[k][i] * m->stiffness[k] * s->maps[n][k][j];
+                    speed -= m->axes[k][i] * m->damping[k] * s->maps[n][k][j];
+                }
+                row[model_jacobian_columns[STATE_VARIABLES[j]]] = moved;
+                row[model_jacobian_columns[STATE_VARIABLES[6 + j]]] = speed;
+            }
+        }
+    }
+    return NO_FAILURE;
+}
+
+const ModelHooks model_hooks = {.start = start, .advance = advance, .evaluate = evaluate,
+                                .extra_parameter_errors = extra_parameter_errors, .free_derived = free_system,
+                                .jacobian = jacobian};

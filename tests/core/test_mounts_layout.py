@@ -72,4 +72,9 @@ def test_the_model_refuses_what_the_layout_or_the_placement_cannot_give(tmp_path
     assert "bend-plane direction of the left joint is parallel" in _initialize(bend_z_left=0.0, bend_y_left=1.0)[0]
     assert "halfshaft direction of the right joint has no length" in _initialize(shaft_y_right=0.0)[0]
     assert "motor axis" in _initialize(motor_axis_y=0.0)[0]
+    # finite components whose squared length overflows: refused, not turned into a zero direction
+    assert "the motor axis (motor_axis_x, motor_axis_y, motor_axis_z) is too long (its length overflows)" in \
+        _initialize(motor_axis_x=1e300)[0]
+    assert "halfshaft direction of the left joint is too long" in _initialize(shaft_z_left=1e300)[0]
+    assert "bend-plane direction of the right joint is too long" in _initialize(bend_x_right=1e300)[0]
     assert _initialize() == []

@@ -21,7 +21,6 @@ where a perturbation crosses a threshold, so for those an undeclared change alon
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any
 
 from fmpy import read_model_description
@@ -29,6 +28,7 @@ from fmpy import read_model_description
 from driveline.catalog import MODELS
 from driveline.model import SteppedModel
 from driveline.variables import Variable
+from support.dependency_points import points
 
 START_TIME = 0.0123  # s: sin and cos of the source's 5 Hz sine are far from 0 and 1 here
 STEP = 1e-4  # s
@@ -40,14 +40,6 @@ RELATIVE_STEP = 1e-3  # the small perturbation of a Real value, relative (absolu
 # so rounding stays below 3e-13 of that scale (measured: 6e-17); a model that failed to start in
 # its equilibrium would be off by the scale times the input's relative step, 1e-3
 ROUNDING = 1e-12
-#: Points of the tests' own, besides each model's start values and dependency_points: a layout
-#: with the most mounts, where the forces of PowertrainMounts' mounts 4 to 8 are not zero
-TEST_POINTS = {"PowertrainMounts": ({**MODELS["PowertrainMounts"].dependency_points[0],
-                                     "layout": str(Path(__file__).parents[1] / "support" / "eight_mounts.toml")},)}
-
-
-def points(model: str) -> list[dict[str, Any]]:
-    return [{}, *MODELS[model].dependency_points, *TEST_POINTS.get(model, ())]
 
 
 def small_step(variable: Variable, value: Any) -> Any:
@@ -90,7 +82,10 @@ def rounding(model: str, values: dict[str, Any]) -> dict[str, float]:
         return {}
     core = core_at(model, values)
     assert not core.initialize(START_TIME)
-    return {name: ROUNDING * scale for name, scale in core.rounding_scales().items()}
+    found = {name: ROUNDING * scale for name, scale in core.rounding_scales().items()}
+    # a state's der() is its derivative's value (Model Exchange: the accelerations are der(<velocity>))
+    states = MODELS[model].spec.states
+    return {**found, **{s.derivative_name: found[s.derivative] for s in states if s.derivative in found}}
 
 
 def declared(path, initial: bool) -> dict[str, set[str]]:

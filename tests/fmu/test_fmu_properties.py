@@ -23,7 +23,6 @@ EXAMPLES = {"python": 40, "native": 60}
 
 #: Models whose random runs found a defect not yet fixed (each named in the open issue's note).
 DEFECTS_FOUND = {
-    "PowertrainMounts": "a drawn case of the Python FMUs departs from the core (not yet traced)",
 }
 
 

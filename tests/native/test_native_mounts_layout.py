@@ -62,6 +62,7 @@ def _cases(folder: Path) -> list[dict]:
         {"shaft_x_left": 0.0, "shaft_y_left": 0.0, "shaft_z_left": 0.0},
         {"bend_x_right": 0.0, "bend_y_right": 2.0, "bend_z_right": 0.0},
         {"motor_axis_x": 0.0, "motor_axis_y": 0.0, "motor_axis_z": 0.0},
+        {"motor_axis_x": 1e300}, {"shaft_z_left": 1e300}, {"bend_x_right": 1e300, "bend_z_right": 1e300},
     ]
 
 
