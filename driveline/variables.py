@@ -170,17 +170,34 @@ class Relation:
         return f"{self.lhs} {self.op} {self.right_side()}"
 
 
+def decade(value: float) -> float:
+    """The power of ten at or below ``value`` (> 0): the order of magnitude a nominal is given."""
+    return 10.0 ** math.floor(math.log10(value))
+
+
+#: The nominal of a shaft's angle (State.nominal): a radian, the angle's own scale; a shaft that turns
+#: winds it past that at once, where the solver's relative tolerance governs.
+SHAFT_ANGLE_NOMINAL = 1.0  # rad
+
+
 @dataclass(frozen=True)
 class State:
     """An output the model integrates over time (an input shaft's angle): its value at one instant
     is its own, ``initial`` names the parameters and inputs its value at initialisation is computed
     from (inputs: a start in the equilibrium under the start inputs) and ``derivative`` the input
     or output that is its time derivative (a Model Exchange FMU's continuous state, whose
-    derivative is the variable ``der(<name>)``)."""
+    derivative is the variable ``der(<name>)``). ``nominal`` is its typical magnitude in SI units
+    (the model description's ``nominal`` attribute and ``GetNominalsOfContinuousStates``), declared
+    by every state: a host's solver scales its absolute tolerance by it."""
 
     name: str
     initial: tuple[str, ...]
     derivative: str
+    nominal: float
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.nominal) and self.nominal > 0.0):
+            raise ValueError(f"state {self.name}: the nominal must be finite and positive, got {self.nominal!r}")
 
     @property
     def derivative_name(self) -> str:

@@ -13,14 +13,16 @@ from pathlib import Path
 from .checks import python_fmu_check
 from .console import CommandParser, Progress
 from .packaging import native
-from .studies import coupling_comparison, critical_speed_study, mounts_study, tripod_study
+from .runs import system
+from .studies import coupling_comparison, critical_speed_study, launch_study, mounts_study, tripod_study
 
 
 def simulate(models: Path, out: Path) -> list[Path]:
     """Run every study on the native FMUs below ``models``, then the Python FMUs' check; the files written."""
     fmus = {name: native.fmu_path(models, name) for name in ("TripodCoupling", "CardanJoint", "UniversalReducer",
                                                              "CriticalSpeeds", "PowertrainMounts")}
-    missing = [str(path) for path in fmus.values() if not path.exists()]
+    launch = system.ssp_path(system.vehicle_launch(), models, models)  # native/VehicleLaunch.ssp
+    missing = [str(path) for path in (*fmus.values(), launch) if not path.exists()]
     if missing:
         raise SystemExit(f"driveline-fmus run: no native FMU {', '.join(missing)}: build the FMUs first with "
                          f"`driveline-fmus build{'' if models == Path('models') else f' --dest {models}'}` "
@@ -30,6 +32,7 @@ def simulate(models: Path, out: Path) -> list[Path]:
         "coupling comparison": lambda: coupling_comparison.write(fmus["CardanJoint"].parent, out),
         "critical speeds": lambda: critical_speed_study.write(fmus["CriticalSpeeds"], out),
         "powertrain mounts": lambda: mounts_study.write(fmus["PowertrainMounts"], out),
+        "launch shudder": lambda: launch_study.write(launch, out),
         "Python FMUs against native": lambda: python_fmu_check.run(models, models, out),
     }
     written = []

@@ -1,5 +1,7 @@
-"""The launch shudder map: the peak third-order powertrain acceleration of the vehicle launch over the
-joints' bend angle, the launch torque and the joints' friction coefficient, through the sweep layer.
+"""The launch shudder map: peak third-order powertrain acceleration over bend angle, torque and friction.
+
+The peak third-order powertrain acceleration of the vehicle launch over the joints' bend angle, the
+launch torque and the joints' friction coefficient, each launch a run of the sweep layer.
 
 Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
 
@@ -15,9 +17,9 @@ launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and :da
 ``mounts.pitch_ddot_order3_peak``, the peak third-order amplitude of the powertrain's pitch
 acceleration over the left joint's turns (:func:`fmu_harness.studies.order_tracking.third_order_peak`;
 the right joint turns negatively in its own frame), and ``mounts.pitch_ddot_order3_speed``, the joint's
-speed there. A launch whose joint turns less than the order tracking's window fails with that reason. The table goes to ``--out``, the figure (a panel per friction
-coefficient: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the
-figure from a table written before.
+speed there. A launch whose joint turns less than the order tracking's window fails with that
+reason. The table goes to ``--out``, the figure (a panel per friction coefficient: the peak over bend
+angle and torque) to ``--figure``; ``--figure-only`` draws the figure from a table written before.
 """
 
 from __future__ import annotations
@@ -100,16 +102,18 @@ def draw(table: pa.Table, path: Path) -> Path:
 
 def main(argv: Sequence[str] | None = None) -> None:
     parser = CommandParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp")
+    parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp",
+                        help="the launch's SSP package (default models/native/VehicleLaunch.ssp)")
     parser.add_argument("--count", type=int, default=8, help="values per axis (default 8: 512 launches)")
     parser.add_argument("--duration", type=float, default=4.0, help="launch length [s] (default 4)")
     parser.add_argument("--step", type=float, default=2e-4, help="communication step [s] (default 2e-4)")
-    parser.add_argument("--master", choices=sweep.MASTERS, default=sweep.DEFAULT_MASTER)
+    parser.add_argument("--master", choices=sweep.MASTERS, default=sweep.DEFAULT_MASTER,
+                        help=f"default {sweep.DEFAULT_MASTER} (docs/vehicle_launch.md, 'Throughput')")
     parser.add_argument("--workers", type=sweep.workers_count, default=sweep.default_workers(),
                         help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
     parser.add_argument("--out", type=Path, default=Path("results") / "shudder_map.parquet", help=".parquet or .csv")
-    parser.add_argument("--figure", type=Path, default=Path("results") / "shudder_map.png")
+    parser.add_argument("--figure", type=Path, default=Path("results") / "shudder_map.png", help="PNG file to write")
     parser.add_argument("--figure-only", action="store_true", help="draw the figure from the table at --out")
     args = parser.parse_args(argv)
     if args.figure_only:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
+from ..variables import SHAFT_ANGLE_NOMINAL, DefaultExperiment, ModelSpec, Relation, State, Variable
 
 JOINT = ("phi_in", "beta", "phase")  # the joint's position
 
@@ -53,5 +53,5 @@ SPEC = ModelSpec(
     ),
     default_experiment=DefaultExperiment(0.0, 0.12, 1e-4),
     relations=(Relation("beta", "<=", "beta_max"),),
-    states=(State("phi_in", ("phi_in_start",), derivative="omega_in"),),
+    states=(State("phi_in", ("phi_in_start",), derivative="omega_in", nominal=SHAFT_ANGLE_NOMINAL),),
 )

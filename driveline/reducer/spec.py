@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
+from ..variables import SHAFT_ANGLE_NOMINAL, DefaultExperiment, ModelSpec, Relation, State, Variable
 
 SINGULAR = "eq 21 is singular at 0 and 180 deg"
 #: Largest stress [Pa] of the connecting shaft an output may report: ten times the tensile strength of
@@ -94,5 +94,5 @@ SPEC = ModelSpec(
         Relation("intersection_angle", ">=", "intersection_angle_min", reason=SINGULAR),
         Relation("intersection_angle", "<=", "intersection_angle_max", reason=SINGULAR),
     ),
-    states=(State("phi_in", ("phi_in_start",), derivative="omega_in"),),
+    states=(State("phi_in", ("phi_in_start",), derivative="omega_in", nominal=SHAFT_ANGLE_NOMINAL),),
 )

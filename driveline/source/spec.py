@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, State, Variable
+from ..variables import SHAFT_ANGLE_NOMINAL, DefaultExperiment, ModelSpec, State, Variable
 
 RPM = math.pi / 30.0
 SPEED = ("omega_out_start", "ramp_rate", "sine_amplitude", "sine_frequency")
@@ -27,5 +27,6 @@ SPEC = ModelSpec(
         Variable("alpha_out", "output", 0.0, "Shaft acceleration d(omega_out)/dt", "rad/s2", depends_on=SPEED[1:]),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-3),
-    states=(State("phi_out", ("phi_out_start", *SPEED), derivative="omega_out"),),
+    states=(State("phi_out", ("phi_out_start", *SPEED), derivative="omega_out",
+                  nominal=SHAFT_ANGLE_NOMINAL),),
 )

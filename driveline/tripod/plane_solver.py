@@ -22,22 +22,30 @@ import numpy as np
 
 from ..scalar import Real, arcsin, lib
 
-FD_STEP = 1e-7  # on the axis components (~rho/l); F is ~l-scaled, so round-off ~1e-10 relative
-# Newton's method with a Jacobian good to ~1e-9 shrinks the update by ~1e-9 per iteration,
-# so after an update below 1e-9 the remaining error of the axis is below 1e-17.
+# Newton's method with the analytic Jacobian converges quadratically: after an update below 1e-9
+# the remaining error of the axis is of order 1e-18, below the float64 resolution.
 LAST_UPDATE = 1e-9
 MAX_ITERATIONS = 20
+#: Unit tangents of the closure's arguments (x, y, beta, phi_in), for :func:`_star_centre`.
+ALONG_X, ALONG_Y, ALONG_BETA, ALONG_PHI = (1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), (
+    0.0, 0.0, 0.0, 1.0)
 
 
 def _star_centre(
-    x: Real, y: Real, turn3: tuple[Real, Real], cb: Real, sb: Real, r: float, l: float, xp: Any
-) -> tuple[Real, Real, Real, Real, Real]:
+    x: Real, y: Real, turn3: tuple[Real, Real], cb: Real, sb: Real, r: float, l: float, xp: Any,
+    tangents: tuple[tuple[float, float, float, float], ...] = (),
+) -> tuple[tuple[Real, Real, Real, Real, Real], list[tuple[Real, Real, Real]]]:
     """Star centre relative to P in tripod-plane coordinates (two components) [m], arg(alpha)
     [rad], and the centre's term in ``turn3 = exp(3i chi)`` (two components; its derivative in
     chi is ``-3i`` times that term). Written in real arithmetic, which numpy runs faster.
 
     With the frame vectors mapped to the input frame by eq 2 (rotations keep dot products):
     ``P.E1 = -l x``, ``P.E2 = -l y``, ``P.U = l (z - 1)``, so ``c = l ((z - 1) f + (x, y))``.
+
+    Second, for each tangent ``(dx, dy, dbeta, dphi_in)`` the directional derivative of the first
+    three, exact: the frame's columns turn with beta as ``d(E_x, E_z)/d beta = (-E_z, E_x)``,
+    ``arg alpha`` moves by ``Im(d alpha / alpha)``, ``exp(2i arg alpha)`` by ``2i`` times that and
+    ``turn3`` by ``3i turn3 dphi_in``.
     """
     z = xp.sqrt(1.0 - x * x - y * y)
     k = 1.0 / (1.0 + z)
@@ -59,7 +67,28 @@ def _star_centre(
     tr, ti = (ar * ar - ai * ai) / norm, 2.0 * ar * ai / norm  # exp(2i arg alpha)
     qr, qi = tr * br + ti * bi, ti * br - tr * bi  # times conj(beta)
     orbit_r, orbit_i = qr * turn3[0] - qi * turn3[1], qr * turn3[1] + qi * turn3[0]
-    return c1 - orbit_r, c2 - orbit_i, xp.atan2(ai, ar) if xp is math else np.arctan2(ai, ar), orbit_r, orbit_i
+    values = (c1 - orbit_r, c2 - orbit_i, xp.atan2(ai, ar) if xp is math else np.arctan2(ai, ar), orbit_r, orbit_i)
+    derivatives = []
+    for dx, dy, dbeta, dphi in tangents:
+        dz = -(x * dx + y * dy) / z
+        dk = -k * k * dz
+        dxyk = (dx * y + x * dy) * k + x * y * dk
+        de1x, de2y = -(2.0 * x * dx * k + x * x * dk), -(2.0 * y * dy * k + y * y * dk)
+        dE1x, dE1z = cb * de1x + sb * dx - E1z * dbeta, sb * de1x - cb * dx + E1x * dbeta
+        dE2x, dE2z = sb * dy - cb * dxyk - E2z * dbeta, -sb * dxyk - cb * dy + E2x * dbeta
+        dUx, dUz = cb * dx - sb * dz - Uz * dbeta, sb * dx + cb * dz + Ux * dbeta
+        df1, df2 = (dE1z - f1 * dUz) / Uz, (dE2z - f2 * dUz) / Uz
+        da11, da12 = r * (dE1x - dUx * f1 - Ux * df1), r * (-dxyk - dy * f1 - y * df1)
+        da21, da22 = r * (dE2x - dUx * f2 - Ux * df2), r * (de2y - dy * f2 - y * df2)
+        dc1, dc2 = l * (dz * f1 + (z - 1.0) * df1 + dx), l * (dz * f2 + (z - 1.0) * df2 + dy)
+        dar, dai = 0.5 * (da11 + da22), 0.5 * (da21 - da12)
+        dbr, dbi = 0.5 * (da11 - da22), 0.5 * (da21 + da12)
+        dtwist = (ar * dai - ai * dar) / norm  # Im(d alpha / alpha)
+        dqr, dqi = tr * dbr + ti * dbi - 2.0 * dtwist * qi, ti * dbr - tr * dbi + 2.0 * dtwist * qr
+        dorbit_r = dqr * turn3[0] - dqi * turn3[1] - 3.0 * dphi * orbit_i
+        dorbit_i = dqr * turn3[1] + dqi * turn3[0] + 3.0 * dphi * orbit_r
+        derivatives.append((dc1 - dorbit_r, dc2 - dorbit_i, dtwist))
+    return values, derivatives
 
 
 class Solution(NamedTuple):
@@ -99,11 +128,8 @@ def solve(phi_in: Real, beta: Real, r: float, l: float, start: Solution | None =
         x, y = start.predict(phi_in)
     turn3 = (xp.cos(3.0 * phi_in), xp.sin(3.0 * phi_in))
     for _ in range(MAX_ITERATIONS):
-        fx, fy, twist, orbit_r, orbit_i = _star_centre(x, y, turn3, cb, sb, r, l, xp)
-        fx_x, fy_x, twist_x, _, _ = _star_centre(x + FD_STEP, y, turn3, cb, sb, r, l, xp)
-        fx_y, fy_y, twist_y, _, _ = _star_centre(x, y + FD_STEP, turn3, cb, sb, r, l, xp)
-        jxx, jyx = (fx_x - fx) / FD_STEP, (fy_x - fy) / FD_STEP
-        jxy, jyy = (fx_y - fx) / FD_STEP, (fy_y - fy) / FD_STEP
+        (fx, fy, twist, orbit_r, orbit_i), ((jxx, jyx, gradient_x), (jxy, jyy, gradient_y)) = _star_centre(
+            x, y, turn3, cb, sb, r, l, xp, (ALONG_X, ALONG_Y))
         det = jxx * jyy - jxy * jyx
         dx = (jyy * fx - jxy * fy) / det
         dy = (jxx * fy - jyx * fx) / det
@@ -113,7 +139,6 @@ def solve(phi_in: Real, beta: Real, r: float, l: float, start: Solution | None =
     else:
         raise ArithmeticError("tripod closure: plane iteration did not converge")
     # The last update moved (x, y) by (-dx, -dy): carry arg(alpha) along to first order.
-    gradient_x, gradient_y = (twist_x - twist) / FD_STEP, (twist_y - twist) / FD_STEP
     twist = twist - (gradient_x * dx + gradient_y * dy)
     # Implicit function theorem: d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit.
     d_chi_x, d_chi_y = 3.0 * orbit_i, -3.0 * orbit_r

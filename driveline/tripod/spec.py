@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
+from ..variables import SHAFT_ANGLE_NOMINAL, DefaultExperiment, ModelSpec, Relation, State, Variable
 
 CLOSED_FORM, EXACT = 0, 1
 #: The largest bend angle the model accepts with any beta_max: the declared max of beta and of beta_max.
@@ -141,5 +141,5 @@ SPEC = ModelSpec(
         Relation("l", ">", "r", reason="the bearing centre lies beyond the grooves"),
         Relation("beta", "<=", "beta_max"),
     ),
-    states=(State("phi_in", ("phi_in_start",), derivative="omega_in"),),
+    states=(State("phi_in", ("phi_in_start",), derivative="omega_in", nominal=SHAFT_ANGLE_NOMINAL),),
 )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from ..variables import DefaultExperiment, ModelSpec, State, Variable
+from ..variables import DefaultExperiment, ModelSpec, State, Variable, decade
 from . import compact_car as car
 
 POSITIVE = {"min": 0.0, "min_exclusive": True}
@@ -17,6 +17,24 @@ TYRE = ("m_vehicle", "grade", "front_share", "C_slip")
 CAR = ("m_vehicle", "J_wheel", "r_wheel", "f_roll", "rho_air", "c_drag", "A_front", "grade", "v_low", "v_x")
 ROLLING = ("v_start", "r_wheel")  # the start: rolling at v_start without slip
 V_MAX = 150.0  # m/s, the fastest start: 540 km/h
+
+
+EXPERIMENT = DefaultExperiment(0.0, 4.0, 1e-4)
+URBAN_SPEED = 50.0 / 3.6  # m/s, the car's typical speed
+DRIVE_TORQUE = car.MOTOR_PEAK_TORQUE * car.RATIO / 2.0  # N.m, one halfshaft's share of the motor's peak
+#: The states' nominals (State.nominal), the decade of their typical magnitudes in the default car: the
+#: speeds at URBAN_SPEED (the car's 13.9 m/s, the wheels' and side gears' 45 rad/s), the distance
+#: travelled over the default experiment at that speed (56 m), the wheel's angle as the halfshaft's twist
+#: under DRIVE_TORQUE (what the wheel's motion against the joint's output is made of: 0.16 rad left,
+#: 0.25 rad right; a wheel that rolls winds it past that, where the relative tolerance governs), the
+#: slip that carries DRIVE_TORQUE (0.044)
+NOMINALS = {
+    "v_x": decade(URBAN_SPEED),
+    "omega": decade(URBAN_SPEED / car.WHEEL_RADIUS),
+    "x": decade(URBAN_SPEED * (EXPERIMENT.stop_time - EXPERIMENT.start_time)),
+    "phi_wheel": decade(DRIVE_TORQUE / max(car.TORSIONAL_STIFFNESS_LEFT, car.TORSIONAL_STIFFNESS_RIGHT)),
+    "slip": decade(DRIVE_TORQUE / (car.WHEEL_RADIUS * car.SLIP_STIFFNESS)),
+}
 
 
 def _side(names: tuple[str, ...], side: str) -> tuple[str, ...]:
@@ -120,12 +138,13 @@ SPEC = ModelSpec(
                    initial_depends_on=()),
     ),
     # the Model Exchange states: dynamics.py's state, the case's and the differential's speeds as the side
-    # gears' (omega_in_left = case + diff, omega_in_right = -(case - diff))
-    states=(*(State(f"omega_in_{side}", ROLLING, f"alpha_in_{side}") for side in SIDES),
+    # gears' (omega_in_left = case + diff, omega_in_right = -(case - diff)), with their nominals (NOMINALS)
+    states=(*(State(f"omega_in_{side}", ROLLING, f"alpha_in_{side}", NOMINALS["omega"]) for side in SIDES),
             *(state for side in SIDES for state in (State(f"phi_wheel_{side}", (f"phi_out_{side}",),
-                                                          f"omega_wheel_{side}"),
-                                                    State(f"omega_wheel_{side}", ROLLING, f"alpha_wheel_{side}"))),
-            State("v_x", ("v_start",), "a_x"), State("x", (), "v_x"),
-            *(State(f"slip_{side}", (), f"slip_dot_{side}") for side in SIDES)),
-    default_experiment=DefaultExperiment(0.0, 4.0, 1e-4),
+                                                          f"omega_wheel_{side}", NOMINALS["phi_wheel"]),
+                                                    State(f"omega_wheel_{side}", ROLLING, f"alpha_wheel_{side}",
+                                                          NOMINALS["omega"]))),
+            State("v_x", ("v_start",), "a_x", NOMINALS["v_x"]), State("x", (), "v_x", NOMINALS["x"]),
+            *(State(f"slip_{side}", (), f"slip_dot_{side}", NOMINALS["slip"]) for side in SIDES)),
+    default_experiment=EXPERIMENT,
 )

@@ -8,7 +8,8 @@ one) in each engine, each run a process of its own so that an engine aborting is
   ``ExitInitializationMode`` (native: Error; Python: OK, every step refused);
 * **step**: the input ``beta = 1.2 rad`` (above its maximum) set once initialisation is over (as a
   start value the FMU refuses it at ``ExitInitializationMode`` already), refused at every step
-  (Discard).
+  (Discard): by fmpy, libcosim and Ecos after a first step at the start values (libcosim
+  initialises at its first step), by the project's master before its first step.
 
 The engines: fmpy's ``simulate_fmu``, libcosim and Ecos (:mod:`.importers`, their start-value
 check switched off to observe the engine itself) and the project's master
@@ -84,8 +85,12 @@ def observe(engine: str, path: Path, values: dict[str, float], inputs: dict[str,
     session_of = importers.cosim_session if engine.startswith("libcosim") else importers.ecos_session
     try:
         session = session_of(STEP_SIZE, {"m": path}, start_values=start, checked=engine.endswith("checked"))
+        # libcosim initialises the FMUs at its first step and passes a value set before it as a
+        # start value (refused at ExitInitializationMode): an input refused during the run is set
+        # after a first step at the start values
+        answers = [session.step()] if inputs else []
         session.set({f"m.{name}": value for name, value in inputs.items()})
-        answers = [session.step() for _ in range(STEPS)]
+        answers += [session.step() for _ in range(STEPS - len(answers))]
         session.close()
     except StartValuesRefused as refused:
         return f"raises StartValuesRefused before the engine starts: {refused}"
@@ -105,7 +110,8 @@ def measure(engine: str, path: Path, refusal: str) -> str:
     if result is not None:
         return result
     if done.returncode < 0:
-        said = next((line.strip() for line in done.stderr.splitlines() if "terminate called" in line), "")
+        said = "; ".join(" ".join(line.split()) for line in done.stderr.splitlines()
+                         if "terminate called" in line or line.strip().startswith("what():"))
         return f"the process dies of {signal.Signals(-done.returncode).name}" + (f' ("{said}")' if said else "")
     return f"the process exits with {done.returncode}: {(done.stderr.strip().splitlines() or [''])[-1]}"
 

@@ -58,8 +58,8 @@ def _complete(
     and the element that carries unit, min and max, in document order) and rebuild the model
     structure with ``structure`` from the outputs' and state derivatives' 1-based indices,
     elements and dependencies. A description with a ``<ModelExchange>`` element has the states'
-    derivatives ``der(<state>)`` among its variables (written complete), and its outputs depend
-    on the states too."""
+    derivatives ``der(<state>)`` among its variables (written complete), its states their
+    ``nominal``, and its outputs depend on the states too."""
     if spec.units:
         unit_definitions = ET.Element("UnitDefinitions")
         unit_definitions.extend(_unit_element("Unit", unit) for unit in spec.units)
@@ -73,6 +73,7 @@ def _complete(
     def known(names: tuple[str, ...]) -> list[tuple[int, str]]:
         return [(indices[name], references[name]) for name in names]
 
+    nominals = {state.name: state.nominal for state in spec.states if states}
     derivatives = [Unknown(indices[state.derivative_name], variables[indices[state.derivative_name] - 1][0],
                            known(spec.derivative_dependencies(state)),
                            known(spec.derivative_dependencies(state, initial=True)))
@@ -83,6 +84,8 @@ def _complete(
         variable = spec[element.get("name")]
         element.set("description", variable.description)
         typed.attrib.update(_type_attributes(variable))
+        if variable.name in nominals:  # a continuous state: its typical magnitude, the solver's scale
+            typed.set("nominal", number_text(nominals[variable.name]))
         if variable.causality != "output" and variable.type != "String":  # pythonfmu writes 16 digits
             typed.set("start", number_text(variable.start))
         if fmi3 and variable.derivative is not None:  # FMI 3.0: an input's derivative is an input too

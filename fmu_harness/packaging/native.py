@@ -406,10 +406,12 @@ const int model_part_values[PARTS][PART_MOST_VALUES + 1] = {{
     if spec.states:
         states = ", ".join(f"V_{state.name}" for state in spec.states)
         sources = ", ".join(f"V_{state.derivative}" for state in spec.states)
+        nominals = ", ".join(_c_double(state.nominal) for state in spec.states)
         source += f"""
-/* the continuous states and the variables that are their time derivatives */
+/* the continuous states, the variables that are their time derivatives and their nominal values */
 const int model_states[MODEL_STATE_COUNT] = {{{states}}};
 const int model_state_derivatives[MODEL_STATE_COUNT] = {{{sources}}};
+const double model_state_nominals[MODEL_STATE_COUNT] = {{{nominals}}};
 """
     if derivatives:
         table = "\n".join(f"    {{V_{of}, {order}, V_{target}}}," for of, order, target in derivatives)

@@ -42,7 +42,7 @@ SHARED = {
     "driveline.tripod.spec": ("EXACT",),
     "driveline.tripod.geometry": ("THIRD_TURN",),
     "driveline.tripod.closed_form": ("PAPER_PHASE",),
-    "driveline.tripod.plane_solver": ("FD_STEP", "LAST_UPDATE", "MAX_ITERATIONS"),
+    "driveline.tripod.plane_solver": ("LAST_UPDATE", "MAX_ITERATIONS"),
     "driveline.tripod.reactions": ("FRICTION_TOLERANCE", "MAX_FRICTION_ITERATIONS"),
     "driveline.vehicle.dynamics": ("GRAVITY", "RATE_STEP", "MAX_SUBSTEPS", "STATE_SIZE", "JACOBI_OMEGA_STEP",
                                    "JACOBI_DAMPING_STEP", "DIVERGENCE_OMEGA_STEP"),

@@ -17,6 +17,7 @@ limit for a Jacobi coupling (``jacobi`` and ``libcosim``), is not run: its row f
 
 from __future__ import annotations
 
+import functools
 import math
 import tempfile
 import zipfile
@@ -54,7 +55,8 @@ SYSTEM_METRICS: dict[str, tuple[tuple[str, str], ...]] = {
     ),
 }
 """(output, statistic) metric columns of the systems the project packages; any other system gets
-``min``, ``max`` and ``mean`` of every Real output of every component."""
+the :data:`GENERIC` statistics of every Real output of every component."""
+GENERIC = ("min", "max", "mean")
 
 
 @dataclass(frozen=True)
@@ -67,7 +69,6 @@ class DerivedMetrics:
     outputs: tuple[str, ...]
     columns: tuple[str, ...]
     compute: Callable[[np.ndarray, dict[str, np.ndarray]], Sequence[float]]
-GENERIC = ("min", "max", "mean")
 
 
 def targets(name: str) -> list[Target]:
@@ -152,16 +153,24 @@ class SystemInterface:
         return list(dict.fromkeys([*(output for output, _ in self.statistics()), *derived]))
 
     def refusal(self, point: Point, step_size: float, master: str) -> str | None:
-        """Why the point is not run: the first start value a component would refuse (the spec's bounds
-        and relations), or its step above a drive's limit for a Jacobi coupling; None to run it."""
+        """Why the point is not run: the first start value a component would refuse at initialisation
+        (the model's own checks, as ``driveline-fmus system`` makes them), or its step above a drive's
+        limit for a Jacobi coupling; None to run it."""
         system = self.system(point)
         for component in system.components:
-            reasons = refusals(self.models[component.name], component.parameters, declared_only=True)
+            reasons = _refusals(self.models[component.name], tuple(sorted(component.parameters.items())))
             if reasons:
                 return f"{component.name} ({self.models[component.name]}): {reasons[0]}"
         if master != "gauss-seidel":
             return step_limit_error(system, self.models, step_size)
         return None
+
+
+@functools.lru_cache(maxsize=4096)
+def _refusals(model: str, values: tuple[tuple[str, Value], ...]) -> list[str]:
+    """:func:`refusals` of a component's start values, each distinct set checked once (a grid repeats
+    them, and ``CriticalSpeeds`` analyses its structure there, 0.04 to 0.5 s)."""
+    return refusals(model, dict(values))
 
 
 def _descriptions(path: Path, package: SspSystem) -> dict[str, ModelDescription]:

@@ -90,9 +90,10 @@ typedef struct {
 
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
 #if MODEL_STATE_COUNT > 0
-/* Model Exchange: the continuous states and the variables their time derivatives are */
+/* Model Exchange: the continuous states, the variables their time derivatives are, their nominal values */
 extern const int model_states[MODEL_STATE_COUNT];
 extern const int model_state_derivatives[MODEL_STATE_COUNT];
+extern const double model_state_nominals[MODEL_STATE_COUNT];
 #endif
 /* Directional derivatives: each variable's row of the Jacobian (a Real output; der(<state k>) has row
  * MODEL_OUTPUT_ROWS + k) and column (a Real input or a state), -1 for none */

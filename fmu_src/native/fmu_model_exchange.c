@@ -22,10 +22,12 @@
 #define STATE_SLOTS MODEL_STATE_COUNT
 #define STATE(data, k) ((data)->real_value[model_states[k]])
 #define DERIVATIVE(data, k) ((data)->real_value[model_state_derivatives[k]])
+#define NOMINAL(k) (model_state_nominals[k])
 #else /* no state: the loops over them run zero times */
 #define STATE_SLOTS 1
 #define STATE(data, k) ((data)->real_value[0])
 #define DERIVATIVE(data, k) ((data)->real_value[0])
+#define NOMINAL(k) 1.0
 #endif
 
 int instance_is(Instance *instance, int model_exchange, const char *function)
@@ -173,7 +175,7 @@ Status model_exchange_get_derivatives(Instance *instance, const char *function, 
     return status;
 }
 
-/* Nominal values: 1 (the specs declare none). */
+/* Nominal values: State.nominal of the spec, the states' typical magnitudes (model_state_nominals). */
 Status model_exchange_get_nominals(Instance *instance, const char *function, double nominals[], size_t n)
 {
     int i;
@@ -181,7 +183,7 @@ Status model_exchange_get_nominals(Instance *instance, const char *function, dou
         return STATUS_ERROR;
     }
     for (i = 0; i < MODEL_STATE_COUNT; i++) {
-        nominals[i] = 1.0;
+        nominals[i] = NOMINAL(i);
     }
     return STATUS_OK;
 }

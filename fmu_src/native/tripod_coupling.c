@@ -70,9 +70,16 @@ static double arcsine(Guard *guard, double a)
 
 /* ---- exact kinematics, tripod-plane formulation (plane_solver.py) ------------------------- */
 
+/* The star centre at one axis (x, y) and the terms its directional derivatives reuse. */
 typedef struct {
     double fx, fy, twist, orbit_r, orbit_i;
+    double x, y, z, k, cb, sb, E1x, E1z, E2x, E2z, Ux, Uz, f1, f2, ar, ai, norm, tr, ti, qr, qi, turn3[2], r, l;
 } StarCentre;
+
+/* Directional derivative of the star centre (two components) and of arg(alpha). */
+typedef struct {
+    double fx, fy, twist;
+} StarTangent;
 
 /* Star centre relative to P in tripod-plane coordinates, arg(alpha) and the centre's term in
  * turn3 = exp(3i chi); frame vectors mapped to the input frame by eq 2. */
@@ -99,7 +106,61 @@ static StarCentre star_centre(Guard *guard, double x, double y, const double tur
     s.fx = c1 - s.orbit_r;
     s.fy = c2 - s.orbit_i;
     s.twist = atan2(ai, ar);
+    s.x = x;
+    s.y = y;
+    s.z = z;
+    s.k = k;
+    s.cb = cb;
+    s.sb = sb;
+    s.E1x = E1x;
+    s.E1z = E1z;
+    s.E2x = E2x;
+    s.E2z = E2z;
+    s.Ux = Ux;
+    s.Uz = Uz;
+    s.f1 = f1;
+    s.f2 = f2;
+    s.ar = ar;
+    s.ai = ai;
+    s.norm = norm;
+    s.tr = tr;
+    s.ti = ti;
+    s.qr = qr;
+    s.qi = qi;
+    s.turn3[0] = turn3[0];
+    s.turn3[1] = turn3[1];
+    s.r = r;
+    s.l = l;
     return s;
+}
+
+/* The star centre's exact derivative along (dx, dy, dbeta, dphi_in): the frame's columns turn with
+ * beta as d(E_x, E_z)/d beta = (-E_z, E_x), arg alpha moves by Im(d alpha / alpha), exp(2i arg alpha)
+ * by 2i times that and turn3 by 3i turn3 dphi_in (plane_solver._star_centre's tangents). */
+static StarTangent star_tangent(Guard *guard, const StarCentre *s, double dx, double dy, double dbeta, double dphi)
+{
+    StarTangent t;
+    double x = s->x, y = s->y, z = s->z, k = s->k, cb = s->cb, sb = s->sb, r = s->r, l = s->l;
+    double dz = divide(guard, -(x * dx + y * dy), z), dk = -k * k * dz, dxyk = (dx * y + x * dy) * k + x * y * dk;
+    double de1x = -(2.0 * x * dx * k + x * x * dk), de2y = -(2.0 * y * dy * k + y * y * dk);
+    double dE1x = cb * de1x + sb * dx - s->E1z * dbeta, dE1z = sb * de1x - cb * dx + s->E1x * dbeta;
+    double dE2x = sb * dy - cb * dxyk - s->E2z * dbeta, dE2z = -sb * dxyk - cb * dy + s->E2x * dbeta;
+    double dUx = cb * dx - sb * dz - s->Uz * dbeta, dUz = sb * dx + cb * dz + s->Ux * dbeta;
+    double df1 = divide(guard, dE1z - s->f1 * dUz, s->Uz), df2 = divide(guard, dE2z - s->f2 * dUz, s->Uz);
+    double da11 = r * (dE1x - dUx * s->f1 - s->Ux * df1), da12 = r * (-dxyk - dy * s->f1 - y * df1);
+    double da21 = r * (dE2x - dUx * s->f2 - s->Ux * df2), da22 = r * (de2y - dy * s->f2 - y * df2);
+    double dc1 = l * (dz * s->f1 + (z - 1.0) * df1 + dx), dc2 = l * (dz * s->f2 + (z - 1.0) * df2 + dy);
+    double dar = 0.5 * (da11 + da22), dai = 0.5 * (da21 - da12);
+    double dbr = 0.5 * (da11 - da22), dbi = 0.5 * (da21 + da12);
+    double dtwist = divide(guard, s->ar * dai - s->ai * dar, s->norm); /* Im(d alpha / alpha) */
+    double dqr = s->tr * dbr + s->ti * dbi - 2.0 * dtwist * s->qi;
+    double dqi = s->ti * dbr - s->tr * dbi + 2.0 * dtwist * s->qr;
+    double dorbit_r = dqr * s->turn3[0] - dqi * s->turn3[1] - 3.0 * dphi * s->orbit_i;
+    double dorbit_i = dqr * s->turn3[1] + dqi * s->turn3[0] + 3.0 * dphi * s->orbit_r;
+    t.fx = dc1 - dorbit_r;
+    t.fy = dc2 - dorbit_i;
+    t.twist = dtwist;
+    return t;
 }
 
 /* Newton's method on "star centre = tripod centre" for the axis (x, y), from the warm start
@@ -110,9 +171,11 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
                         double solution[5], double *phi_out, double *ratio)
 {
     double x, y, turn3[2], jxx = 0.0, jyx = 0.0, jxy = 0.0, jyy = 0.0;
-    double det = 0.0, dx = 0.0, dy = 0.0, gradient_x, gradient_y, twist, dx_dphi, dy_dphi;
-    StarCentre f = {0.0, 0.0, 0.0, 0.0, 0.0}, fx = f, fy = f;
+    double det = 0.0, dx = 0.0, dy = 0.0, twist, dx_dphi, dy_dphi;
+    StarCentre f;
+    StarTangent along_x = {0.0, 0.0, 0.0}, along_y = along_x;
     int i;
+    f.twist = f.orbit_r = f.orbit_i = 0.0;
     if (!warm) {
         double rho_over_l = divide(guard, r * (1.0 - cb), 2.0 * cb * l);
         x = rho_over_l * cosine(guard, 3.0 * phi_in);
@@ -126,12 +189,12 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
     turn3[1] = sine(guard, 3.0 * phi_in);
     for (i = 0; i < TRIPOD_PLANE_SOLVER_MAX_ITERATIONS && guard->failure.kind == ERROR_NONE; i++) {
         f = star_centre(guard, x, y, turn3, cb, sb, r, l);
-        fx = star_centre(guard, x + TRIPOD_PLANE_SOLVER_FD_STEP, y, turn3, cb, sb, r, l);
-        fy = star_centre(guard, x, y + TRIPOD_PLANE_SOLVER_FD_STEP, turn3, cb, sb, r, l);
-        jxx = (fx.fx - f.fx) / TRIPOD_PLANE_SOLVER_FD_STEP;
-        jyx = (fx.fy - f.fy) / TRIPOD_PLANE_SOLVER_FD_STEP;
-        jxy = (fy.fx - f.fx) / TRIPOD_PLANE_SOLVER_FD_STEP;
-        jyy = (fy.fy - f.fy) / TRIPOD_PLANE_SOLVER_FD_STEP;
+        along_x = star_tangent(guard, &f, 1.0, 0.0, 0.0, 0.0);
+        along_y = star_tangent(guard, &f, 0.0, 1.0, 0.0, 0.0);
+        jxx = along_x.fx;
+        jyx = along_x.fy;
+        jxy = along_y.fx;
+        jyy = along_y.fy;
         det = jxx * jyy - jxy * jyx;
         dx = divide(guard, jyy * f.fx - jxy * f.fy, det);
         dy = divide(guard, jxx * f.fy - jyx * f.fx, det);
@@ -148,13 +211,11 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
         return;
     }
     /* the last update moved (x, y) by (-dx, -dy): carry arg(alpha) along to first order */
-    gradient_x = (fx.twist - f.twist) / TRIPOD_PLANE_SOLVER_FD_STEP;
-    gradient_y = (fy.twist - f.twist) / TRIPOD_PLANE_SOLVER_FD_STEP;
-    twist = f.twist - (gradient_x * dx + gradient_y * dy);
+    twist = f.twist - (along_x.twist * dx + along_y.twist * dy);
     /* d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit */
     dx_dphi = -(jyy * (3.0 * f.orbit_i) - jxy * (-3.0 * f.orbit_r)) / det;
     dy_dphi = -(jxx * (-3.0 * f.orbit_r) - jyx * (3.0 * f.orbit_i)) / det;
-    *ratio = 1.0 + gradient_x * dx_dphi + gradient_y * dy_dphi;
+    *ratio = 1.0 + along_x.twist * dx_dphi + along_y.twist * dy_dphi;
     *phi_out = phi_in + twist;
     solution[0] = phi_in;
     solution[1] = x;

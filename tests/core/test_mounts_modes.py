@@ -19,6 +19,7 @@ from scipy.linalg import eigh
 from driveline.mounts.layout import loads_layout
 from driveline.mounts.model import PowertrainMountsModel
 from driveline.mounts.rigid_body import COORDINATES, RigidBody, modes, torque_roll_axis, unrestrained_error
+from driveline.variables import decade
 from support.mount_layouts import random_layout, reference_matrices
 
 
@@ -106,3 +107,18 @@ def test_static_sag_of_a_symmetric_layout_is_the_springs_own(tmp_path):
     assert model.F_z_mount1 + model.F_z_mount2 + model.F_z_mount3 + model.F_z_mount4 == pytest.approx(200.0 * 9.81,
                                                                                                      rel=1e-13)
 
+
+
+def test_the_states_nominals_are_the_decades_of_the_default_layouts_sag_and_lowest_mode():
+    """The spec's nominals (Model Exchange's absolute tolerance scale) against the default layout: a
+    translation's the power of ten at or below its largest static sag along an axis, a rotation's about
+    one, a velocity's that times the power of ten at or below the lowest mode's angular frequency."""
+    model = PowertrainMountsModel()
+    assert model.initialize(0.0) == []
+    sag = {name: abs(getattr(model, f"{name}_static")) for name in COORDINATES}
+    rate = 2.0 * math.pi * model.f_mode_1
+    nominals = {state.name: state.nominal for state in PowertrainMountsModel.spec.states}
+    translations, rotations = COORDINATES[:3], COORDINATES[3:]
+    for names in (translations, rotations):
+        assert {nominals[name] for name in names} == {decade(max(sag[name] for name in names))}
+        assert {nominals[f"{name}_dot"] for name in names} == {decade(max(sag[name] for name in names)) * decade(rate)}

@@ -113,7 +113,7 @@ def test_a_spec_refuses_relations_it_cannot_enforce(relation, fragment):
         (Variable("y", "output", 0.0, "undeclared"), (), r"output y declares no dependencies: give its Variable "
                                                         r"depends_on=\(...\).*docs/development.md, Add a model"),
         (Variable("y", "output", 0.0, "declared", depends_on=("nowhere",)), (), "no input, parameter or state"),
-        (Variable("y", "output", 0.0, "a state"), (State("y", ("y",), "x"),),
+        (Variable("y", "output", 0.0, "a state"), (State("y", ("y",), "x", 1.0),),
          "initial values must name parameters or inputs"),
         (Variable("y", "output", 0.0, "at start", depends_on=(), initial_depends_on=("y",)), (), "no input"),
     ],
@@ -133,7 +133,7 @@ def test_the_dependencies_at_initialisation_follow_a_state_to_its_initial_values
                  Variable("z", "output", 0.0, "from p alone, zero at the start", depends_on=("p",),
                           initial_depends_on=()))
     spec = ModelSpec("Probe", "a state and two outputs", variables, DefaultExperiment(0.0, 1.0, 0.1),
-                     states=(State("s", ("x0",), "x"),))
+                     states=(State("s", ("x0",), "x", 1.0),))
     assert [spec.output_dependencies(name) for name in ("s", "y", "z")] == [(), ("x",), ()]
     assert [spec.initial_dependencies(name) for name in ("s", "y", "z")] == [("x0",), ("x", "x0"), ()]
 
@@ -145,7 +145,7 @@ def test_a_state_starting_in_an_equilibrium_depends_at_initialisation_on_the_inp
                  Variable("a", "output", 0.0, "the acceleration, 0 at the start",
                           depends_on=("F", "k", "q"), initial_depends_on=()))
     spec = ModelSpec("Probe", "a spring starting at rest", variables, DefaultExperiment(0.0, 1.0, 0.1),
-                     states=(State("q", ("F", "k"), "v"), State("v", (), "a")))
+                     states=(State("q", ("F", "k"), "v", 1.0), State("v", (), "a", 1.0)))
     assert [spec.initial_dependencies(name) for name in ("q", "v", "a")] == [("F", "k"), (), ()]
     assert [spec.output_dependencies(name) for name in ("q", "v", "a")] == [(), (), ("F",)]
 

@@ -19,7 +19,8 @@ from driveline.mounts.layout import load_layout, shipped_layout
 from driveline.mounts.rigid_body import RigidBody, modes
 from fmu_harness.checks import python_fmu_check
 from fmu_harness.runs.runner import FmuInstance
-from fmu_harness.studies import critical_speed_study
+from fmu_harness.runs import system
+from fmu_harness.studies import critical_speed_study, launch_study, order_tracking
 from fmu_harness.packaging import native
 
 FIRST_COLUMNS = {"time [s]", "beta [deg]", "mode [1]"}  # time, the swept bend angle, the mode number
@@ -28,8 +29,10 @@ RUNS = 20
 
 
 @pytest.fixture(scope="module")
-def models(fmu_path, native_dir, tmp_path_factory) -> Path:
-    """A models folder as the build leaves it: the FMI 2.0 Python FMUs, the native ones in native/."""
+def models(fmu_path, fmi2_dir, native_dir, tmp_path_factory) -> Path:
+    """A models folder as the build leaves it: the FMI 2.0 Python FMUs, the native ones and the native
+    launch package in native/."""
+    system.write_ssp(system.vehicle_launch(), fmi2_dir, native_dir)
     folder = tmp_path_factory.mktemp("main_job_models")
     for name in MODELS:
         (folder / f"{name}.fmu").symlink_to(fmu_path(name))
@@ -50,7 +53,8 @@ def results(models, tmp_path_factory) -> Path:
 def test_every_csv_starts_with_time_or_the_swept_variable_with_units_and_no_repeated_row(results):
     tables = sorted(results.glob("*.csv"))
     assert [t.name for t in tables] == ["coupling_comparison.csv", "critical_speeds.csv", "critical_speeds_ramp.csv",
-                                        "powertrain_modes.csv", "tripod_coupling.csv"]
+                                        "launch_shudder_peaks.csv", "powertrain_modes.csv", "tripod_coupling.csv",
+                                        "vehicle_launch.csv"]
     for table in tables:
         header, *rows = list(csv.reader(table.open()))
         assert header[0] in FIRST_COLUMNS, table.name
@@ -125,3 +129,39 @@ def test_the_modal_table_is_the_cores_for_the_default_layout(results):
     np.testing.assert_allclose(table[:, 0], found.frequencies, rtol=1e-9)
     np.testing.assert_allclose(table[:, 1:], found.shares, rtol=0.0, atol=1e-9)
     assert (results / "powertrain_decoupling.png").stat().st_size > 30_000
+
+
+def test_the_launchs_third_order_peaks_lie_at_the_mount_modes_crossings_delayed_by_the_sweep(results):
+    """vehicle_launch.csv (every 3.2 ms of the main job's 40 s launch at 20 N.m): each mount mode's share
+    of the powertrain's acceleration (the core's mode shapes), its third order over the left halfshaft's
+    speed. Every mode whose crossing 3 x f_shaft = f_mode the launch passes (1-5) peaks within 1 % of
+    where a single mode of its frequency and damping, forced over the launch's own angle history,
+    peaks (measured at most 0.6 %, mode 2); that reference lies above the crossing by the sweep (7.0 %
+    for mode 1, 3.7 % for mode 2, 2.8, 2.5, 1.6 % for modes 3-5), and where it is below 3 % the
+    measured peak lies within 3 % of the crossing speed, the issue's check (measured 2.7, 2.7, 1.5 %).
+    The study's peak table holds the FMU's mode frequencies; its figures are written."""
+    run = np.genfromtxt(results / "vehicle_launch.csv", delimiter=",", names=True)
+    body, found = launch_study.powertrain_modes()
+    accelerations = np.column_stack([run[f"{name}_ddot_{'rads2' if name in ('roll', 'pitch', 'yaw') else 'ms2'}"]
+                                     for name in ("x", "y", "z", "roll", "pitch", "yaw")])
+    time, angle = run["time_s"], run["phi_out_left_rad"]
+    shares = launch_study.modal_accelerations(body, found, accelerations)
+    damping = launch_study.modal_damping(body, found)
+    crossings = launch_study.crossing_speeds(found.frequencies)
+    checked = []
+    for j in range(6):
+        speeds, amplitude = order_tracking.order_track(time, angle, shares[:, j], 3)
+        if crossings[j] > speeds[-1]:
+            continue
+        (peak,) = order_tracking.peaks_near(speeds, amplitude, crossings[j:j + 1], launch_study.WINDOW_MARGIN)
+        swept = launch_study.swept_peak(time, angle, found.frequencies[j], damping[j])
+        assert peak is not None, f"mode {j + 1}: no third-order peak near its crossing"
+        assert peak[1] == pytest.approx(swept, rel=1e-2), f"mode {j + 1}"
+        if swept < 1.03 * crossings[j]:
+            assert peak[1] == pytest.approx(crossings[j], rel=3e-2), f"mode {j + 1}"
+            checked.append(j + 1)
+    assert checked == [3, 4, 5]
+    table = np.genfromtxt(results / "launch_shudder_peaks.csv", delimiter=",", skip_header=1, usecols=(1, 4, 5))
+    np.testing.assert_allclose(table[:, 0], found.frequencies, rtol=1e-9)
+    for name in ("launch_speed_torque.png", "launch_axial_force.png", "launch_shudder_orders.png"):
+        assert (results / name).stat().st_size > 30_000

@@ -14,7 +14,8 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from fmu_harness.packaging import native  # noqa: E402
-from fmu_harness.studies import coupling_comparison, critical_speed_study, tripod_study  # noqa: E402
+from fmu_harness.runs import system  # noqa: E402
+from fmu_harness.studies import coupling_comparison, critical_speed_study, launch_study, tripod_study  # noqa: E402
 from fmu_harness.studies.figures import by_scale  # noqa: E402
 from support import figure_checks  # noqa: E402
 
@@ -110,6 +111,43 @@ def test_campbell_diagram_nests_the_backward_crossings_inside_the_critical_speed
         assert square.get_xdata()[0] == pytest.approx(ring.get_xdata()[0], rel=0.03)
         assert square.get_zorder() > ring.get_zorder()
     plt.close(fig)
+
+
+@pytest.fixture(scope="module")
+def launch_figures(fmi2_dir, native_dir):
+    """The launch study's figures on a quick launch: 140 N.m for 4 s (0.3 s of CPU), through three mount
+    modes' crossings."""
+    package = system.write_ssp(system.vehicle_launch(), fmi2_dir, native_dir)
+    launch = launch_study.run(package, torque=140.0, stop_time=4.0)
+    peaks, speeds, amplitudes = launch_study.third_order_peaks(launch)
+    figures = {"speed_torque": launch_study.speed_torque_figure(launch),
+               "axial_force": launch_study.axial_force_figure(launch),
+               "orders": launch_study.orders_figure(launch, peaks, speeds, amplitudes)}
+    yield figures, peaks
+    for fig in figures.values():
+        plt.close(fig)
+
+
+def test_the_launch_figures_show_each_curve_and_what_their_titles_name(launch_figures):
+    """Speed and both halfshaft torques; both joints' axial force with its third order; the
+    spectrogram with orders 1 and 3, every mode's line, each crossing ring with its peak inside or
+    beside it, each crossed mode's normalised third order."""
+    figures, peaks = launch_figures
+    for name, fig in figures.items():
+        assert_clean(fig, name)
+    assert drawn_labels(figures["speed_torque"]) == ["vehicle speed", "left halfshaft", "right halfshaft"]
+    assert drawn_labels(figures["axial_force"]) == [f"{label}" for side in ("left", "right") for label in
+                                                   (f"-Rz_in, {side} joint", "its third-order amplitude")]
+    top, bottom = figures["orders"].axes[:2]
+    labels = [line.get_label() for line in top.get_lines()]
+    assert labels[:2] == ["order 1", "order 3"] and labels.count("_mode 1") == 1
+    assert sum(label.startswith("_mode ") for label in labels) == 6
+    reached = [p for p in peaks if p.measured is not None]
+    assert len(reached) >= 3
+    rings = top.get_lines()[labels.index("3 x f_shaft = f_mode")]
+    np.testing.assert_allclose(rings.get_xdata(), [p.crossing for p in reached])
+    assert [line.get_label().split(":")[0] for line in bottom.get_lines() if not line.get_label().startswith("_")] == [
+        f"mode {p.mode} ({p.coordinate})" for p in reached]
 
 
 def deviations(*panels: tuple[float, ...]) -> plt.Figure:

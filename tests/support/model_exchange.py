@@ -57,6 +57,11 @@ class ModelExchange:
         get(values.ctypes.data_as(POINTER(c_double)), values.size)
         return values
 
+    def nominals(self) -> np.ndarray:
+        values = np.zeros(self.states.size)
+        self.fmu.getNominalsOfContinuousStates(values.ctypes.data_as(POINTER(c_double)), values.size)
+        return values
+
     def close(self) -> None:
         self.fmu.terminate()
         self.fmu.freeInstance()

@@ -1,0 +1,292 @@
+"""Main-job study of launch shudder on the native ``VehicleLaunch.ssp``: a slow launch from standstill to
+30 km/h, over which three times the halfshaft frequency sweeps through five of the powertrain's six
+mount modes; the run (``vehicle_launch.csv``), the third-order peaks against the mode crossings
+(``launch_shudder_peaks.csv``) and three figures.
+
+The launch: the package's joints and mounts, the motor's torque ramped to ``TORQUE`` (a gentle
+take-off: the shaft accelerates by about 0.7 rad/s2, so that each resonance is passed slowly enough
+for its peak to stay near its crossing; docs/vehicle_launch.md, "Shudder"), run by the project's
+master in Gauss-Seidel order at 0.8 ms, its stable limit, where a 40 s launch costs about 4 s of CPU.
+
+The powertrain's response is split into its modes with the core's mass-normalised mode shapes of the
+default layout (``driveline.mounts``): mode j's share of the accelerations at the centre of gravity,
+``phi_j phi_j^T M q''``, read in its dominant coordinate. Each mode's third order over the halfshaft
+speed (:mod:`.order_tracking`) peaks near its crossing, later by the sweep: the single-mode reference
+(:func:`swept_peak`) gives where a mode of that frequency and damping passed at the launch's own speed
+history peaks.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from scipy.signal import lsim
+
+from driveline.catalog import MODELS
+from driveline.mounts.layout import load_layout, shipped_layout
+from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody, modes
+
+from ..runs import ssp_package
+from ..runs.system import LAUNCH_ORDER, run_jacobi
+from . import order_tracking
+from .figures import figure, save
+from .result_table import write_csv
+
+TORQUE = 20.0  # motor torque after the ramp [N.m]
+STOP_TIME = 40.0  # [s]
+STEP = 8e-4  # Gauss-Seidel's longest stable step (docs/vehicle_launch.md) [s]
+EVERY = 4  # the CSV file holds every 4th communication point (3.2 ms)
+LAYOUT = "transverse_fwd_powertrain"  # PowertrainMounts' default layout
+KMH = 3.6
+SHAFT = "joint_left.phi_out"  # the left halfshaft's angle, whose orders the study tracks
+RESPONSE = "mounts.pitch_ddot"  # the spectrogram's signal: the coordinate that responds most
+#: (component.variable, CSV name) of vehicle_launch.csv, after the time.
+COLUMNS = (("drive.v_x", "v_x"), ("motor.T_motor", "T_motor"),
+           ("drive.T_load_left", "T_load_left"), ("drive.T_load_right", "T_load_right"),
+           ("drive.omega_in_left", "omega_in_left"), ("drive.omega_in_right", "omega_in_right"),
+           ("joint_left.phi_out", "phi_out_left"), ("joint_right.phi_out", "phi_out_right"),
+           ("joint_left.Rz_in", "Rz_in_left"), ("joint_right.Rz_in", "Rz_in_right"),
+           *((f"mounts.{name}_ddot", f"{name}_ddot") for name in COORDINATES))
+FREQUENCIES = tuple(f"mounts.f_mode_{j}" for j in range(1, 7))
+WINDOW_MARGIN = 0.25  # a peak belongs to a crossing within this fraction of its speed (a fast sweep: 22 %)
+SPECTRUM_TOP = 25.0  # the spectrogram's highest frequency [Hz]
+
+
+@dataclass(frozen=True)
+class Launch:
+    """The run: times [s] and each output of :data:`COLUMNS` and :data:`FREQUENCIES` by its name."""
+
+    time: np.ndarray
+    values: dict[str, np.ndarray]
+
+    @property
+    def shaft_angle(self) -> np.ndarray:
+        return self.values[SHAFT]
+
+    @property
+    def mode_frequencies(self) -> np.ndarray:
+        """The FMU's natural frequencies [Hz] (constant over the run)."""
+        return np.array([self.values[name][-1] for name in FREQUENCIES])
+
+    def accelerations(self) -> np.ndarray:
+        """The powertrain's accelerations at its centre of gravity (samples x 6, COORDINATES)."""
+        return np.column_stack([self.values[f"mounts.{name}_ddot"] for name in COORDINATES])
+
+
+def run(package: Path, torque: float = TORQUE, stop_time: float = STOP_TIME, step: float = STEP,
+        changes: dict[str, dict[str, float]] | None = None) -> Launch:
+    """The package's launch with the motor's torque ``torque`` and the parameters ``changes``
+    ({component: {name: value}}), in the project's master in :data:`LAUNCH_ORDER`."""
+    system = ssp_package.read(package)
+    extra = {"motor": {"T_level": torque}} | (changes or {})
+    parameters = {c.name: {**c.parameters, **extra.get(c.name, {})} for c in system.components}
+    outputs = [name for name, _ in COLUMNS] + list(FREQUENCIES)
+    with tempfile.TemporaryDirectory(prefix="driveline-launch-") as scratch:
+        with zipfile.ZipFile(package) as archive:
+            archive.extractall(scratch)
+        fmus = {c.name: Path(scratch) / c.source for c in system.components}
+        rows = run_jacobi(fmus, parameters, system.connections, stop_time, step, outputs, order=LAUNCH_ORDER)
+    return Launch(rows[:, 0], {name: rows[:, k + 1] for k, name in enumerate(outputs)})
+
+
+def powertrain_modes() -> tuple[RigidBody, Modes]:
+    body = RigidBody.of(load_layout(shipped_layout(LAYOUT)))
+    return body, modes(body)
+
+
+def modal_damping(body: RigidBody, found: Modes) -> np.ndarray:
+    """Each mode's damping ratio, the diagonal of ``Phi^T C Phi`` over ``2 omega_j``."""
+    return np.diag(found.shapes.T @ body.damping @ found.shapes) / (4.0 * np.pi * found.frequencies)
+
+
+def modal_accelerations(body: RigidBody, found: Modes, accelerations: np.ndarray) -> np.ndarray:
+    """Mode j's share of ``accelerations`` (samples x 6) in its dominant coordinate (samples x 6):
+    ``phi_dj (phi_j^T M q'')``; the six shares of a coordinate sum to its acceleration."""
+    participation = accelerations @ (body.mass @ found.shapes)
+    return participation * found.shapes[found.dominant, np.arange(6)]
+
+
+def crossing_speeds(frequencies: np.ndarray, order: int = order_tracking.SHUDDER_ORDER) -> np.ndarray:
+    """Halfshaft speeds [rad/s] at which ``order`` times the shaft's frequency meets each frequency [Hz]."""
+    return 2.0 * np.pi * np.asarray(frequencies) / order
+
+
+def swept_peak(time: np.ndarray, shaft_angle: np.ndarray, frequency: float, damping: float) -> float:
+    """Halfshaft speed [rad/s] at which the third order of the acceleration of one mode (natural
+    ``frequency`` [Hz], damping ratio ``damping``) forced by ``cos 3 phi(t)`` over the launch's own
+    angle history peaks: the crossing delayed by the sweep, the reference for the peaks."""
+    omega = 2.0 * np.pi * frequency
+    force = np.cos(order_tracking.SHUDDER_ORDER * shaft_angle)
+    system = (np.array([[0.0, 1.0], [-omega**2, -2.0 * damping * omega]]), np.array([[0.0], [1.0]]),
+              np.array([[-omega**2, -2.0 * damping * omega]]), np.array([[1.0]]))
+    _, response, _ = lsim(system, force, time, interp=True)
+    speeds, amplitude = order_tracking.order_track(time, shaft_angle, response, order_tracking.SHUDDER_ORDER)
+    (found,) = order_tracking.peaks_near(speeds, amplitude, crossing_speeds([frequency]), WINDOW_MARGIN)
+    return np.nan if found is None else found[1]
+
+
+@dataclass(frozen=True)
+class Peak:
+    """One mode's crossing and its measured third-order peak (None if the launch does not reach it)."""
+
+    mode: int
+    frequency: float  # [Hz]
+    coordinate: str
+    damping: float
+    crossing: float  # [rad/s]
+    measured: tuple[float, float] | None  # (amplitude, speed [rad/s])
+    swept: float  # the single-mode reference's peak speed [rad/s], nan without a peak
+
+    @property
+    def difference(self) -> float:
+        """Measured peak speed against the crossing [%]."""
+        return np.nan if self.measured is None else 100.0 * (self.measured[1] / self.crossing - 1.0)
+
+
+def third_order_peaks(launch: Launch) -> tuple[list[Peak], np.ndarray, np.ndarray]:
+    """Each mode's peak, the order tracking's speeds [rad/s] and each mode's third-order amplitude
+    there (modes x speeds, the unit of its dominant coordinate's acceleration)."""
+    body, found = powertrain_modes()
+    damping = modal_damping(body, found)
+    shares = modal_accelerations(body, found, launch.accelerations())
+    tracks = [order_tracking.order_track(launch.time, launch.shaft_angle, shares[:, j], 3) for j in range(6)]
+    speeds = tracks[0][0]
+    amplitudes = np.array([amplitude for _, amplitude in tracks])
+    frequencies = launch.mode_frequencies
+    crossings = crossing_speeds(frequencies)
+    peaks = []
+    for j in range(6):
+        reached = speeds.size > 0 and crossings[j] < speeds[-1]
+        (measured,) = order_tracking.peaks_near(speeds, amplitudes[j], crossings[j:j + 1], WINDOW_MARGIN)
+        swept = swept_peak(launch.time, launch.shaft_angle, frequencies[j], damping[j]) if reached else np.nan
+        peaks.append(Peak(j + 1, float(frequencies[j]), COORDINATES[found.dominant[j]], float(damping[j]),
+                          float(crossings[j]), measured if reached else None, swept))
+    return peaks, speeds, amplitudes
+
+
+def speed_torque_figure(launch: Launch) -> Figure:
+    """Vehicle speed and both halfshaft torques over time."""
+    fig, (speed, torque) = figure(2, 1, figsize=(8, 6), sharex=True)
+    speed.plot(launch.time, launch.values["drive.v_x"] * KMH, color="tab:blue", label="vehicle speed")
+    speed.set_ylabel("vehicle speed [km/h]")
+    speed.set_title(f"Launch from standstill, motor torque ramped to {TORQUE:g} N.m: vehicle speed", fontsize=10)
+    for side, color in (("left", "tab:red"), ("right", "tab:green")):
+        torque.plot(launch.time, launch.values[f"drive.T_load_{side}"], color=color, lw=0.8, label=f"{side} halfshaft")
+    torque.set_title("Halfshaft torques, each in its joint's frame (the right one turns negatively)", fontsize=10)
+    torque.set_ylabel("T_load [N.m]")
+    torque.set_xlabel("time [s]")
+    torque.legend(loc="center right")
+    for ax in (speed, torque):
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def axial_force_figure(launch: Launch) -> Figure:
+    """Both joints' generated axial force -Rz_in over the halfshaft speed, with its third-order amplitude."""
+    fig, axes = figure(2, 1, figsize=(8, 6), sharex=True)
+    omega = order_tracking.shaft_speed(launch.time, launch.shaft_angle)
+    for ax, side, color in zip(axes, ("left", "right"), ("tab:red", "tab:green")):
+        force = -launch.values[f"joint_{side}.Rz_in"]
+        ax.plot(omega, force, color=color, lw=0.4, label=f"-Rz_in, {side} joint")
+        speeds, amplitude = order_tracking.order_track(launch.time, launch.shaft_angle, force, 3)
+        ax.plot(speeds, amplitude, color="black", lw=1.6, label="its third-order amplitude")
+        ax.set_ylim(-1.5 * amplitude.max(), 1.6 * amplitude.max())
+        ax.set_ylabel("generated axial force [N]")
+        ax.set_title(f"Generated axial force of the {side} joint (friction's sign follows the sliding: "
+                     "its third order is 4/pi of its peak)", fontsize=9)
+        ax.legend(loc="upper center", ncols=2, fontsize=8)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("left halfshaft speed [rad/s] (the right one turns as fast, negatively)")
+    fig.tight_layout()
+    return fig
+
+
+def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitudes: np.ndarray) -> Figure:
+    """The powertrain's pitch acceleration as a spectrogram over the halfshaft speed with the 1st and
+    3rd order lines, the mount modes and the crossings and peaks marked; below, each mode's share's
+    third-order amplitude over the same speeds, scaled to its peak."""
+    fig, (top, bottom) = figure(2, 1, figsize=(9, 9), sharex=True, height_ratios=(3, 2), layout="constrained")
+    shaft, frequencies, spectrum = order_tracking.spectrogram(launch.time, launch.shaft_angle, launch.values[RESPONSE],
+                                                              window=2.0, hop=0.2)
+    shown = frequencies <= SPECTRUM_TOP
+    mesh = top.pcolormesh(shaft, frequencies[shown], spectrum[shown], shading="nearest", cmap="magma")
+    fig.colorbar(mesh, ax=(top, bottom), label="pitch acceleration amplitude [rad/s2] (spectrogram)", pad=0.01,
+                 shrink=0.6, anchor=(0.0, 1.0))
+    left, right = speeds[0], speeds[-1]
+    line = np.array([left, right])
+    for order, style in ((1, ":"), (3, "--")):
+        top.plot(line, order * line / (2.0 * np.pi), style, color="white", lw=1.2, label=f"order {order}")
+    for peak in peaks:
+        top.plot(line, [peak.frequency] * 2, color="cyan", lw=0.7, ls="-.", label=f"_mode {peak.mode}")
+        top.annotate(f"mode {peak.mode} ({peak.coordinate}) {peak.frequency:.2f} Hz", (left, peak.frequency),
+                     xytext=(3, 2), textcoords="offset points", color="cyan", fontsize=7)
+    reached = [peak for peak in peaks if peak.measured is not None]
+    ring = {"ls": "none", "marker": "o", "ms": 13, "mfc": "none", "mec": "cyan", "mew": 1.6}
+    dot = {"ls": "none", "marker": "o", "ms": 5, "color": "lime", "zorder": 4}
+    top.plot([p.crossing for p in reached], [p.frequency for p in reached], **ring, label="3 x f_shaft = f_mode")
+    top.plot([p.measured[1] for p in reached], [3.0 * p.measured[1] / (2.0 * np.pi) for p in reached], **dot,
+             label="measured third-order peak")
+    top.set_facecolor("black")  # where no window is centred, as where the spectrum is 0
+    top.set_xlim(left, right)
+    top.set_ylim(0.0, SPECTRUM_TOP)
+    top.set_ylabel("frequency [Hz]")
+    top.set_title("Powertrain pitch acceleration at its centre of gravity over the halfshaft speed:\n"
+                  "orders 1 and 3, mount modes, their crossings with the 3rd order and the measured peaks",
+                  fontsize=10)
+    top.legend(loc="upper left", fontsize=8)
+    inside = (speeds >= left) & (speeds <= right)
+    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    for peak, amplitude in zip(peaks, amplitudes):
+        if peak.measured is None:
+            continue
+        color = colors[peak.mode - 1]
+        bottom.plot(speeds[inside], amplitude[inside] / peak.measured[0], color=color, lw=1.2,
+                    label=f"mode {peak.mode} ({peak.coordinate}): {peak.difference:+.1f} %")
+        bottom.plot(peak.crossing, np.interp(peak.crossing, speeds, amplitude) / peak.measured[0],
+                    **(ring | {"mec": color, "ms": 10}), label=f"_crossing {peak.mode}")
+        bottom.plot(peak.measured[1], 1.0, **(dot | {"color": color}), label=f"_peak {peak.mode}")
+    bottom.set_ylim(0.0, 1.1)
+    bottom.set_xlabel("left halfshaft speed [rad/s]")
+    bottom.set_ylabel("third-order amplitude / its peak [1]")
+    bottom.set_title("Each mount mode's share of the powertrain's acceleration, third order: crossing (ring), "
+                     "peak (dot),\nthe peak's speed against the crossing's", fontsize=10)
+    bottom.legend(loc="upper left", fontsize=8)
+    bottom.grid(alpha=0.3)
+    return fig
+
+
+def write(package: Path, out: Path) -> list[Path]:
+    """Run the launch, write ``vehicle_launch.csv``, ``launch_shudder_peaks.csv`` and the three
+    figures into ``out``; return the files written."""
+    out.mkdir(parents=True, exist_ok=True)
+    launch = run(package)
+    units = {name: MODELS[model].spec[variable].unit
+             for name, model, variable in _column_models(package)}
+    header = ["time [s]", *(f"{csv_name} [{units[name]}]" for name, csv_name in COLUMNS)]
+    kept = slice(EVERY - 1, None, EVERY)
+    table = np.column_stack([launch.time[kept], *(launch.values[name][kept] for name, _ in COLUMNS)])
+    run_csv = write_csv(out / "vehicle_launch.csv", header, table.tolist())
+    peaks, speeds, amplitudes = third_order_peaks(launch)
+    peaks_csv = write_csv(out / "launch_shudder_peaks.csv",
+                          ("mode [1]", "f_mode [Hz]", "dominant [1]", "damping_ratio [1]", "crossing_speed [rad/s]",
+                           "peak_speed [rad/s]", "difference [%]", "swept_peak_speed [rad/s]",
+                           "peak_amplitude [m/s2 or rad/s2]"),
+                          ((p.mode, p.frequency, p.coordinate, p.damping, p.crossing,
+                            np.nan if p.measured is None else p.measured[1], p.difference, p.swept,
+                            np.nan if p.measured is None else p.measured[0]) for p in peaks))
+    return [run_csv, peaks_csv,
+            save(speed_torque_figure(launch), out / "launch_speed_torque.png"),
+            save(axial_force_figure(launch), out / "launch_axial_force.png"),
+            save(orders_figure(launch, peaks, speeds, amplitudes), out / "launch_shudder_orders.png")]
+
+
+def _column_models(package: Path) -> list[tuple[str, str, str]]:
+    """(component.variable, model, variable) of each column of :data:`COLUMNS`."""
+    models = {c.name: Path(c.source).stem for c in ssp_package.read(package).components}
+    return [(name, models[name.split(".")[0]], name.split(".")[1]) for name, _ in COLUMNS]
