@@ -1,5 +1,6 @@
-"""``driveline-fmus system PACKAGE.ssp``: run an SSP package of FMUs and write every output of every
-component to a CSV file, the time first, each column headed ``Component.variable [unit]``.
+"""Run an SSP package of FMUs and write every output of every component to a CSV file.
+
+``driveline-fmus system PACKAGE.ssp`` writes the time first, each column headed ``Component.variable [unit]``.
 
 The engine is the project's fixed-step Jacobi master (``master``, :func:`fmu_harness.runs.system.run_jacobi`,
 FMI 2.0 and 3.0 FMUs through fmpy), libcosim (``libcosim``, FMI 2.0) or Ecos (``ecos``), the engines
@@ -149,7 +150,7 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
 
 
 def _arguments(argv: list[str] | None) -> argparse.Namespace:
-    parser = OneLineParser(description=__doc__.splitlines()[0].strip("`"))
+    parser = OneLineParser(description=__doc__.splitlines()[0])
     parser.add_argument("package", type=Path, help="the SSP package (.ssp)")
     parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
     parser.add_argument("--step", type=float, default=1e-3, help="communication step [s] (default 1e-3)")
