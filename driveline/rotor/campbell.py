@@ -211,6 +211,11 @@ class WhirlTable:
         self._forward = senses[0].shape[1]
         self._n = n_modes
 
+    @property
+    def knots(self) -> FloatArray:
+        """The speeds the splines pass through (the branches' speeds)."""
+        return self._spline.x
+
     def __call__(self, speed: float) -> FloatArray:
         values = self._spline(speed)
         k, n = self._forward, self._n

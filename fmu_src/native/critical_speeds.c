@@ -811,6 +811,32 @@ static Failure evaluate(ModelData *data)
     return NO_FAILURE;
 }
 
+/* The exact derivatives of the outputs in omega_in at the point evaluate has just computed, each that of
+ * the lookup that gives the output, times d|omega_in| / d omega_in (1 at omega_in = 0: for a growing
+ * omega_in). The critical speeds are the structure's (no row); the whirl frequencies are the Campbell
+ * table's cubic splines, the derivative of the branch each sorted value comes from; the nearest order
+ * resonance keeps its speed (the branch the point is on), its margin moves as 1 / resonance_speed;
+ * the response and the bearing force by the response's linear solve differentiated, the damping
+ * ratio by the mode table's spline of the nearest mode (unbalance_outputs_slopes). */
+static Failure jacobian(const ModelData *data, double partial[])
+{
+    const Analysis *analysis = data->cache->derived;
+    double omega = VALUE(omega_in), sign = omega < 0.0 ? -1.0 : 1.0, speed = fabs(omega);
+    double whirl[2 * ROTOR_MODEL_WHIRL_MODES], whirl_slopes[2 * ROTOR_MODEL_WHIRL_MODES], unbalance[3];
+    whirl_table_slopes(analysis->whirl, speed, whirl, whirl_slopes);
+    PARTIAL(whirl_forward_1, omega_in) = sign * whirl_slopes[0];
+    PARTIAL(whirl_forward_2, omega_in) = sign * whirl_slopes[1];
+    PARTIAL(whirl_backward_1, omega_in) = sign * whirl_slopes[2];
+    PARTIAL(whirl_backward_2, omega_in) = sign * whirl_slopes[3];
+    PARTIAL(speed_ratio, omega_in) = sign / VALUE(omega_crit_1);
+    PARTIAL(resonance_margin, omega_in) = sign / VALUE(resonance_speed);
+    unbalance_outputs_slopes(analysis->unbalance, speed, unbalance);
+    PARTIAL(unbalance_response, omega_in) = sign * unbalance[0];
+    PARTIAL(bearing_force_max, omega_in) = sign * unbalance[1];
+    PARTIAL(damping_ratio, omega_in) = sign * unbalance[2];
+    return NO_FAILURE;
+}
+
 static Failure start(ModelData *data, double start_time UNUSED)
 {
     return evaluate(data);
@@ -828,4 +854,5 @@ static Failure evaluate_now(ModelData *data, double time UNUSED)
 }
 
 const ModelHooks model_hooks = {.start = start, .advance = advance, .evaluate = evaluate_now,
-                                .extra_parameter_errors = extra_parameter_errors, .free_derived = free_analysis};
+                                .extra_parameter_errors = extra_parameter_errors, .free_derived = free_analysis,
+                                .jacobian = jacobian};

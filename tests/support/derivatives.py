@@ -9,10 +9,13 @@ The rows are the Real outputs, then der(<state>); the columns the Real inputs an
 
 from __future__ import annotations
 
+import functools
+from typing import Any
+
 import numpy as np
 
 from driveline.catalog import MODELS
-from driveline.model import TimeSourceModel
+from driveline.model import SteppedModel, TimeSourceModel
 from fmu_harness.packaging import native
 
 #: Relative step of the central differences through the FMU: rounding eps |f| / h near 2e-10 of the
@@ -79,6 +82,24 @@ def fmu_differences(model, name: str) -> tuple[np.ndarray, np.ndarray]:
     return differences, base
 
 
+def analysed(name: str, values: dict) -> SteppedModel:
+    """A model of ``name`` at the parameters of ``values`` with the data derived from them built."""
+    spec = MODELS[name].spec
+    return _analysed(name, tuple((v.name, values.get(v.name, v.start)) for v in spec.of("parameter")))
+
+
+@functools.lru_cache(maxsize=4)
+def _analysed(name: str, parameters: tuple[tuple[str, Any], ...]) -> SteppedModel:
+    """A model of ``name`` whose data derived from ``parameters`` (its ``derived_state``: CriticalSpeeds'
+    analysis) is built: the differences perturb inputs and states only, so one point's rows share it."""
+    model = MODELS[name]()
+    for key, value in parameters:
+        setattr(model, key, value)
+    errors = model.extra_parameter_errors()
+    assert not errors, errors
+    return model
+
+
 def core_rows(name: str, values: dict, time: float) -> np.ndarray:
     """The rows from the Python core at ``values`` (parameters, inputs, states) and ``time``, evaluated as
     Model Exchange evaluates (internal state reset; a source's state is the solver's)."""
@@ -87,11 +108,18 @@ def core_rows(name: str, values: dict, time: float) -> np.ndarray:
     for key, value in values.items():
         setattr(model, key, value)
     model.reset_internal_state()
+    built = analysed(name, values)
+    for attribute in model.derived_state:
+        setattr(model, attribute, getattr(built, attribute))
+    errors = model.extra_parameter_errors()  # nothing left to build: the parameters are those analysed
+    assert not errors, errors
     states = {state.name: getattr(model, state.name) for state in spec.states}
     if isinstance(model, TimeSourceModel):
         model.at_time(time)
-    else:
+    elif spec.states:
         model.evaluate(time)
+    else:
+        model.start(time)  # no state: the outputs of the inputs, at any time
     for state, value in states.items():
         setattr(model, state, value)
     outputs, _ = native.jacobian_layout(spec)

@@ -730,8 +730,9 @@ ErrorKind whirl_table_new(const Chain *chain, double omega_max, int points, int 
     return ERROR_NONE;
 }
 
-/* The first ``n`` of columns [first, end) at ``speed``, ascending (np.sort(...)[:n], NaN last). */
-static void smallest(const CubicSpline *spline, double speed, int first, int end, int n, double *out)
+/* The first ``n`` of columns [first, end) at ``speed``, ascending (np.sort(...)[:n], NaN last); with
+ * ``slopes`` (NULL: none) the derivative in the speed of the column each value comes from. */
+static void smallest(const CubicSpline *spline, double speed, int first, int end, int n, double *out, double *slopes)
 {
     int filled = 0;
     for (int c = first; c < end; ++c) {
@@ -740,11 +741,17 @@ static void smallest(const CubicSpline *spline, double speed, int first, int end
         while (k > 0 && before(v, out[k - 1])) {
             if (k < n) {
                 out[k] = out[k - 1];
+                if (slopes) {
+                    slopes[k] = slopes[k - 1];
+                }
             }
             --k;
         }
         if (k < n) {
             out[k] = v;
+            if (slopes) {
+                slopes[k] = cubic_spline_slope(spline, speed, c);
+            }
         }
     }
 }
@@ -752,8 +759,15 @@ static void smallest(const CubicSpline *spline, double speed, int first, int end
 /* WhirlTable.__call__ */
 void whirl_table_evaluate(const WhirlTable *table, double speed, double *out)
 {
-    smallest(&table->spline, speed, 0, table->forward, table->n_modes, out);
-    smallest(&table->spline, speed, table->forward, table->spline.m, table->n_modes, out + table->n_modes);
+    smallest(&table->spline, speed, 0, table->forward, table->n_modes, out, NULL);
+    smallest(&table->spline, speed, table->forward, table->spline.m, table->n_modes, out + table->n_modes, NULL);
+}
+
+void whirl_table_slopes(const WhirlTable *table, double speed, double *out, double *slopes)
+{
+    int n = table->n_modes;
+    smallest(&table->spline, speed, 0, table->forward, n, out, slopes);
+    smallest(&table->spline, speed, table->forward, table->spline.m, n, out + n, slopes + n);
 }
 
 int whirl_table_knots(const WhirlTable *table)

@@ -659,8 +659,9 @@ struct UnbalanceOutputs {
     cplx *load;         /* DampedRotor.load per unit Omega^2, rotor.size */
     cplx *row;          /* DampedRotor.shape_rows at the response position, rotor.n */
     CubicSpline modes;  /* DAMPED_MODES damped frequencies, then their damping ratios */
-    cplx *ab, *x;       /* evaluate's work: one object is evaluated by one caller at a time */
+    cplx *ab, *x, *dx;  /* evaluate's work: one object is evaluated by one caller at a time */
     int *pivots;
+    int *place;         /* place[order[i]] = i: the row of each unknown [p, q] in the interleaved order */
 };
 
 /* DampedRotor.shape_rows for one position: ``row`` (rotor.n); ERROR_NONE, or ERROR_VALUE with the
@@ -709,7 +710,9 @@ void unbalance_outputs_free(UnbalanceOutputs *outputs)
     cubic_spline_free(&outputs->modes);
     free(outputs->ab);
     free(outputs->x);
+    free(outputs->dx);
     free(outputs->pivots);
+    free(outputs->place);
     free(outputs);
 }
 
@@ -798,13 +801,19 @@ ErrorKind unbalance_outputs_new(const Driveline *d, const RotorUnbalance *unbala
     outputs->row = calloc((size_t)rotor->n + 1, sizeof *outputs->row);
     outputs->ab = malloc((size_t)rotor->band.rows * (size_t)m * sizeof *outputs->ab);
     outputs->x = malloc((size_t)m * sizeof *outputs->x);
+    outputs->dx = malloc((size_t)m * sizeof *outputs->dx);
     outputs->pivots = malloc((size_t)m * sizeof *outputs->pivots);
+    outputs->place = malloc((size_t)m * sizeof *outputs->place);
     cplx *rows = malloc(((size_t)rotor->n + 1) * sizeof *rows);
-    if (!outputs->load || !outputs->row || !outputs->ab || !outputs->x || !outputs->pivots || !rows) {
+    if (!outputs->load || !outputs->row || !outputs->ab || !outputs->x || !outputs->dx || !outputs->pivots ||
+        !outputs->place || !rows) {
         free(rows);
         unbalance_outputs_free(outputs);
         ROTOR_ERROR(error, size, ROTOR_OUT_OF_MEMORY);
         return ERROR_VALUE;
+    }
+    for (int i = 0; i < m; i++) {
+        outputs->place[rotor->order[i]] = i;
     }
     /* DampedRotor.load: the unbalances' phasors times their shape rows */
     double length = driveline_length(d);
@@ -851,76 +860,167 @@ void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed,
     cubic_spline_evaluate(&outputs->modes, speed, out);
 }
 
-/* UnbalanceOutputs.evaluate (DampedRotor.solve, components and bearing_forces at one speed) */
-void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3])
+/* The tabulated mode nearest ``speed``: numpy.argmin of |frequency - speed|, the first of equal ones, the first NaN */
+static int nearest_mode(const double *table, double speed)
 {
-    double table[2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
-    cubic_spline_evaluate(&outputs->modes, speed, table);
-    int nearest = 0; /* numpy.argmin: the first of equal ones, the first nan */
+    int nearest = 0;
     for (int k = 0; k < ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES; k++) {
         double distance = fabs(table[k] - speed);
         if (isnan(distance)) {
-            nearest = k;
-            break;
+            return k;
         }
         if (distance < fabs(table[nearest] - speed)) {
             nearest = k;
         }
     }
-    out[2] = table[ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES + nearest];
-    if (speed == 0.0) {
-        out[0] = out[1] = 0.0;
-        return;
-    }
+    return nearest;
+}
+
+/* DampedRotor.solve at ``speed``: K2 + i Omega (C2 + Omega Gv) - Omega^2 M2 factorised into ``ab``, the
+ * response to Omega^2 [F, 0] into ``x`` (interleaved order); -1 if it is exactly singular */
+static int dynamic_solve(const UnbalanceOutputs *outputs, double speed)
+{
     const Rotor *rotor = &outputs->rotor;
-    Band band = rotor->band;
-    int m = rotor->size, n = rotor->n;
-    /* K2 + i Omega (C2 + Omega Gv) - Omega^2 M2 */
     cplx spin_c = cplx_make(0.0, speed), spin_g = cplx_make(0.0, speed * speed);
     double squared = speed * speed;
-    size_t cells = (size_t)band.rows * (size_t)m;
+    size_t cells = (size_t)rotor->band.rows * (size_t)rotor->size;
     for (size_t i = 0; i < cells; i++) {
         outputs->ab[i] = cplx_sub(cplx_add(cplx_add(rotor->banded[0][i], cplx_mul(spin_c, rotor->banded[1][i])),
                                             cplx_mul(spin_g, rotor->banded[2][i])),
                                    cplx_scale(squared, rotor->banded[3][i]));
     }
-    for (int i = 0; i < m; i++) {
+    for (int i = 0; i < rotor->size; i++) {
         outputs->x[i] = cplx_scale(squared, outputs->load[rotor->order[i]]);
     }
-    if (band_solve(band, outputs->ab, outputs->pivots, outputs->x)) { /* an undamped resonance hit exactly */
-        out[0] = out[1] = INFINITY;
-        return;
+    return band_solve(rotor->band, outputs->ab, outputs->pivots, outputs->x);
+}
+
+/* The response's derivative in the speed into ``dx``, ``ab`` and ``x`` being dynamic_solve's: with
+ * A = K2 + i Omega (C2 + Omega Gv) - Omega^2 M2 and b = Omega^2 [F, 0], x' = A^-1 (b' - A' x),
+ * A' = i (C2 + 2 Omega Gv) - 2 Omega M2, b' = 2 Omega [F, 0]. */
+static void response_slope(const UnbalanceOutputs *outputs, double speed)
+{
+    const Rotor *rotor = &outputs->rotor;
+    Band band = rotor->band;
+    cplx spin_c = cplx_make(0.0, 1.0), spin_g = cplx_make(0.0, 2.0 * speed);
+    for (int i = 0; i < band.n; i++) {
+        outputs->dx[i] = cplx_scale(2.0 * speed, outputs->load[rotor->order[i]]);
     }
-    /* the solution back in the order [p, q]: x[i] is unknown order[i] */
-    cplx forward = cplx_real(0.0), backward = cplx_real(0.0);
-    const cplx *x = outputs->x;
-    int *place = outputs->pivots; /* free again after the solve */
-    for (int i = 0; i < m; i++) {
-        place[rotor->order[i]] = i;
+    for (int j = 0; j < band.n; j++) {
+        int first = j - band.ku > 0 ? j - band.ku : 0, last = j + band.kl < band.n ? j + band.kl : band.n - 1;
+        for (int i = first; i <= last; i++) {
+            cplx slope = cplx_sub(cplx_add(cplx_mul(spin_c, AB(band, rotor->banded[1], i, j)),
+                                           cplx_mul(spin_g, AB(band, rotor->banded[2], i, j))),
+                                  cplx_scale(2.0 * speed, AB(band, rotor->banded[3], i, j)));
+            outputs->dx[i] = cplx_sub(outputs->dx[i], cplx_mul(slope, outputs->x[j]));
+        }
     }
+    band_substitute(band, outputs->ab, outputs->pivots, outputs->dx);
+}
+
+/* d|z| = Re(conj(z) dz) / |z|; 0 at z = 0 (|B| of an axisymmetric rotor, identically 0) */
+static double modulus_slope(cplx z, cplx dz)
+{
+    double size = cplx_abs(z);
+    return size > 0.0 ? (z.re * dz.re + z.im * dz.im) / size : 0.0;
+}
+
+/* (k + i Omega c) a: a bearing's force from the response ``a`` of one circle */
+static cplx bearing_term(cplx k, cplx c, cplx spin_c, cplx a)
+{
+    return cplx_mul(cplx_add(k, cplx_mul(spin_c, c)), a);
+}
+
+/* its derivative in the speed: (k + i Omega c) a' + i c a */
+static cplx bearing_slope(cplx k, cplx c, cplx spin_c, cplx a, cplx da)
+{
+    return cplx_add(bearing_term(k, c, spin_c, da), cplx_mul(cplx_make(0.0, 1.0), cplx_mul(c, a)));
+}
+
+/* The orbit's major semi-axis at the response row and the largest bearing force of the response in ``x``
+ * at ``speed`` (components, bearing_forces) into out[0], out[1]; with ``slopes`` (NULL: none) their
+ * derivatives in the speed from x' in ``dx``, the largest force's that of the bearing it is at. */
+static void orbit_and_forces(const UnbalanceOutputs *outputs, double speed, double out[2], double slopes[2])
+{
+    const Rotor *rotor = &outputs->rotor;
+    int n = rotor->n;
+    cplx spin_c = cplx_make(0.0, speed), zero = cplx_real(0.0);
+    cplx forward = zero, backward = zero, d_forward = zero, d_backward = zero;
+    const cplx *x = outputs->x, *dx = outputs->dx;
+    const int *place = outputs->place;
     for (int j = 0; j < n; j++) {
         forward = cplx_add(forward, cplx_mul(x[place[j]], outputs->row[j]));
         if (rotor->doubled) {
             backward = cplx_add(backward, cplx_mul(x[place[n + j]], outputs->row[j]));
         }
+        if (slopes) {
+            d_forward = cplx_add(d_forward, cplx_mul(dx[place[j]], outputs->row[j]));
+            d_backward = rotor->doubled ? cplx_add(d_backward, cplx_mul(dx[place[n + j]], outputs->row[j])) : zero;
+        }
     }
     out[0] = cplx_abs(forward) + cplx_abs(cplx_conj(backward));
-    double largest = 0.0; /* np.max(forces, initial=0.0), nan propagated */
+    double largest = 0.0, d_largest = 0.0; /* np.max(forces, initial=0.0), nan propagated */
     for (int b = 0; b < rotor->n_bearings; b++) {
         int row = rotor->bearing_rows[b];
-        double force = 0.0;
+        double force = 0.0, d_force = 0.0;
         if (row >= 0) {
             const cplx *c = rotor->coefficients + 4 * b;
-            cplx a = x[place[row]], q = rotor->doubled ? x[place[n + row]] : cplx_real(0.0);
-            cplx fa = cplx_add(cplx_mul(cplx_add(c[0], cplx_mul(spin_c, c[2])), a),
-                               cplx_mul(cplx_add(c[1], cplx_mul(spin_c, c[3])), q));
-            cplx fq = cplx_add(cplx_mul(cplx_add(cplx_conj(c[1]), cplx_mul(spin_c, cplx_conj(c[3]))), a),
-                               cplx_mul(cplx_add(cplx_conj(c[0]), cplx_mul(spin_c, cplx_conj(c[2]))), q));
+            cplx a = x[place[row]], q = rotor->doubled ? x[place[n + row]] : zero;
+            cplx fa = cplx_add(bearing_term(c[0], c[2], spin_c, a), bearing_term(c[1], c[3], spin_c, q));
+            cplx fq = cplx_add(bearing_term(cplx_conj(c[1]), cplx_conj(c[3]), spin_c, a),
+                               bearing_term(cplx_conj(c[0]), cplx_conj(c[2]), spin_c, q));
             force = cplx_abs(fa) + cplx_abs(fq);
+            if (slopes) {
+                cplx da = dx[place[row]], dq = rotor->doubled ? dx[place[n + row]] : zero;
+                cplx dfa = cplx_add(bearing_slope(c[0], c[2], spin_c, a, da), bearing_slope(c[1], c[3], spin_c, q, dq));
+                cplx dfq = cplx_add(bearing_slope(cplx_conj(c[1]), cplx_conj(c[3]), spin_c, a, da),
+                                    bearing_slope(cplx_conj(c[0]), cplx_conj(c[2]), spin_c, q, dq));
+                d_force = modulus_slope(fa, dfa) + modulus_slope(fq, dfq);
+            }
         }
         if (isnan(force) || force > largest) {
+            d_largest = isnan(largest) ? d_largest : d_force;
             largest = isnan(largest) ? largest : force;
         }
     }
     out[1] = largest;
+    if (slopes) {
+        slopes[0] = modulus_slope(forward, d_forward) + modulus_slope(cplx_conj(backward), cplx_conj(d_backward));
+        slopes[1] = d_largest;
+    }
+}
+
+/* UnbalanceOutputs.evaluate (DampedRotor.solve, components and bearing_forces at one speed) */
+void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3])
+{
+    double table[2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES];
+    cubic_spline_evaluate(&outputs->modes, speed, table);
+    out[2] = table[ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES + nearest_mode(table, speed)];
+    if (speed == 0.0) {
+        out[0] = out[1] = 0.0;
+        return;
+    }
+    if (dynamic_solve(outputs, speed)) { /* an undamped resonance hit exactly */
+        out[0] = out[1] = INFINITY;
+        return;
+    }
+    orbit_and_forces(outputs, speed, out, NULL);
+}
+
+void unbalance_outputs_slopes(const UnbalanceOutputs *outputs, double speed, double slopes[3])
+{
+    double table[2 * ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES], out[2];
+    cubic_spline_evaluate(&outputs->modes, speed, table);
+    slopes[2] = cubic_spline_slope(&outputs->modes, speed,
+                                   ROTOR_UNBALANCE_OUTPUTS_DAMPED_MODES + nearest_mode(table, speed));
+    if (speed == 0.0) { /* the response grows as Omega^2 */
+        slopes[0] = slopes[1] = 0.0;
+        return;
+    }
+    if (dynamic_solve(outputs, speed)) { /* the infinite response, which a step refuses */
+        slopes[0] = slopes[1] = NAN;
+        return;
+    }
+    response_slope(outputs, speed);
+    orbit_and_forces(outputs, speed, out, slopes);
 }

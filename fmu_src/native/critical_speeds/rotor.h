@@ -201,6 +201,9 @@ int cubic_spline_build(CubicSpline *spline, int n, const double *x, int m, const
 void cubic_spline_evaluate(const CubicSpline *spline, double x, double *out);
 /* Column ``column`` alone of cubic_spline_evaluate. */
 double cubic_spline_value(const CubicSpline *spline, double x, int column);
+/* The first derivative of column ``column`` at ``x`` (scipy's ``spline(x, 1)``; at a knot the interval on its
+ * right, as the evaluation: the slope is continuous there). */
+double cubic_spline_slope(const CubicSpline *spline, double x, int column);
 void cubic_spline_free(CubicSpline *spline);
 
 /* ---- campbell.c: model.whirl_table (campbell.whirl_branches + WhirlTable) ------------------ */
@@ -212,6 +215,10 @@ ErrorKind whirl_table_new(const Chain *chain, double omega_max, int points, int 
                           char *error, size_t size);
 /* WhirlTable.__call__: forward_1..n, backward_1..n at ``speed`` */
 void whirl_table_evaluate(const WhirlTable *table, double speed, double *out);
+/* whirl_table_evaluate into ``out`` and into ``slopes`` the derivatives in the speed of the branches'
+ * splines the sorted values come from (the exact derivatives of the table; where two branches of a
+ * sense cross, that of the branch the sort puts first, the one found first of two equal values). */
+void whirl_table_slopes(const WhirlTable *table, double speed, double *out, double *slopes);
 /* The speeds the splines pass through (whirl_branches' knots: ``points`` and those added). */
 int whirl_table_knots(const WhirlTable *table);
 void whirl_table_free(WhirlTable *table);
@@ -256,6 +263,11 @@ ErrorKind unbalance_outputs_new(const Driveline *driveline, const RotorUnbalance
  * dynamic stiffness: infinite response and force). It allocates nothing: the object holds the
  * solve's work arrays, so one object is evaluated by one caller at a time. */
 void unbalance_outputs_evaluate(const UnbalanceOutputs *outputs, double speed, double out[3]);
+/* The derivatives in the speed of unbalance_outputs_evaluate's three: the response's by its linear solve
+ * differentiated (x' = A^-1 (b' - A' x), one more banded factorisation and two substitutions), the largest
+ * force's that of the bearing it is at, the damping ratio's that of the mode table's spline of the mode
+ * nearest ``speed``; at speed 0 the response's and force's are 0 (both grow as speed^2). Same work arrays. */
+void unbalance_outputs_slopes(const UnbalanceOutputs *outputs, double speed, double slopes[3]);
 /* UnbalanceOutputs.modes(speed): the tabulated damped frequencies of the DAMPED_MODES (4) modes, then
  * their damping ratios (out has 8 places) */
 void unbalance_outputs_modes(const UnbalanceOutputs *outputs, double speed, double out[8]);

@@ -270,6 +270,17 @@ double cubic_spline_value(const CubicSpline *spline, double x, int column)
     return polynomial(spline, i, column, x - spline->x[i]);
 }
 
+double cubic_spline_slope(const CubicSpline *spline, double x, int column)
+{
+    if (isnan(x)) {
+        return x;
+    }
+    int i = interval_of(spline, x);
+    const double *c = spline->c + (size_t)4 * i * spline->m + column;
+    double t = x - spline->x[i];
+    return c[spline->m] + t * (2.0 * c[2 * (size_t)spline->m] + t * 3.0 * c[3 * (size_t)spline->m]);
+}
+
 void cubic_spline_free(CubicSpline *spline)
 {
     free(spline->x);
