@@ -1,5 +1,5 @@
-"""The native rotor library's finite elements (``fem.c``, ``damped.c``) against the Python core:
-the plausibility check's natural frequencies (model.natural_frequencies, scipy's eigh) and the
+"""The native rotor library's finite elements (``fem.c``, ``damped.c``, ``unbalance_outputs.c``) against the
+Python core: the plausibility check's natural frequencies (model.natural_frequencies, scipy's eigh) and the
 FMU's unbalance outputs (UnbalanceOutputs.build and evaluate: numpy's eig, ARPACK above
 DENSE_SIZE, LAPACK's banded solve; in C the dense solver, shift-invert Arnoldi above DENSE_SIZE).
 
@@ -85,7 +85,7 @@ OMEGA_MAX = 1500.0
 
 @pytest.fixture(scope="module")
 def library(tmp_path_factory):
-    lib = compile_rotor(tmp_path_factory.mktemp("damped"), ["fem", "damped", "spline", "layout", "pyrepr"])
+    lib = compile_rotor(tmp_path_factory.mktemp("damped"), ["fem", "unbalance_outputs", "spline", "layout", "pyrepr"])
     driveline_p, outputs_p, error, size = P(CDriveline), ctypes.c_void_p, ctypes.c_char_p, ctypes.c_size_t
     declare(lib, {
         "fe_natural_frequencies": (ErrorKind, [driveline_p, ctypes.c_int, P(DOUBLE_P), P(ctypes.c_int), error,

@@ -45,6 +45,7 @@ def raised(kind: int, message: str) -> Exception:
 #: The modules a module calls into besides itself (the layout reader's parts and the elements' checks
 #: with the loader, the linear algebra with the damped model, the shaft elements with both models).
 NEEDS = {"layout": ("layout_file", "toml", "messages", "arena", "elements"), "damped": ("linalg",),
+         "unbalance_outputs": ("damped", "linalg"),
          "transfer": ("elements",), "fem": ("elements",)}
 
 

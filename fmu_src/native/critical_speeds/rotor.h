@@ -11,7 +11,8 @@
  *   spline.c     not-a-knot cubic splines (scipy's CubicSpline default)
  *   campbell.c   whirl branches over the speed and the Campbell table
  *   fem.c        finite-element model: the plausibility check's natural frequencies
- *   damped.c     damped finite-element model: damped modes, unbalance response, bearing forces
+ *   damped.c     damped finite-element model: damped modes and their table over the speed (damped.h)
+ *   unbalance_outputs.c  the FMU's unbalance outputs: response, bearing forces, damping ratio, their slopes
  * Every function that fails with a message returns ErrorKind (driveline_constants.h): ERROR_NONE on
  * success, else the kind of the failure, the exception the Python core raises there (ERROR_VALUE for
  * its ValueErrors, and for out of memory), with the message in ``error`` (``size`` bytes, always
