@@ -41,10 +41,12 @@ TIME = 0.05  # s: a point of a source away from t = 0
 SHIFT = 0.4  # rad: the states moved from their start, away from the joints' symmetric positions
 
 
-#: Points of a model's derivatives beyond its dependency points: CriticalSpeeds on anisotropic damped
-#: bearings with two unbalances (the doubled response system, the sorted Campbell table), below zero
-DERIVATIVE_POINTS = {"CriticalSpeeds": ({"layout": str(Path(__file__).parents[1] / "support" / "anisotropic_tube.toml"),
-                                         "omega_in": -700.0},)}
+#: Points of a model's derivatives beyond its dependency points (which the dependency tests pay for at every
+#: parameter): CriticalSpeeds below zero with heavy damping, the unbalance and the response off the middle, and
+#: on anisotropic damped bearings with two unbalances (the doubled response system, the sorted Campbell table)
+DERIVATIVE_POINTS = {"CriticalSpeeds": (
+    {"omega_in": -500.0, "c_bearing": 5000.0, "unbalance_position": 0.3, "response_position": 0.8},
+    {"layout": str(Path(__file__).parents[1] / "support" / "anisotropic_tube.toml"), "omega_in": -700.0})}
 
 
 #: Rows whose values round above eps, with their relative rounding: CriticalSpeeds' unbalance response and

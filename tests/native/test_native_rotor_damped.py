@@ -93,6 +93,7 @@ def library(tmp_path_factory):
         "unbalance_outputs_new": (ErrorKind, [driveline_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_double,
                                               ctypes.c_double, P(outputs_p), error, size]),
         "unbalance_outputs_evaluate": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
+        "unbalance_outputs_slopes": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
         "unbalance_outputs_modes": (None, [outputs_p, ctypes.c_double, DOUBLE_P]),
         "unbalance_outputs_free": (None, [outputs_p]),
     })
@@ -110,9 +111,11 @@ def natural_frequencies(lib, d: Driveline, elements: int = model.FE_ELEMENTS) ->
     return out
 
 
-def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds, table: bool = False) -> np.ndarray:
+def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds, table: bool = False,
+            slopes: bool = False) -> np.ndarray:
     """The C UnbalanceOutputs' evaluate at ``speeds`` (rows: response, force, damping ratio), with ``table``
-    also its mode table (the damped frequencies, then the damping ratios)."""
+    also its mode table (the damped frequencies, then the damping ratios), with ``slopes`` instead their
+    derivatives in the speed."""
     c = c_driveline(d)
     excited = unbalances(items)
     error, made = ctypes.create_string_buffer(512), ctypes.c_void_p()
@@ -124,7 +127,7 @@ def outputs(lib, d: Driveline, items, fraction: float, omega_max: float, speeds,
         out, modes = (ctypes.c_double * 3)(), (ctypes.c_double * (2 * DAMPED_MODES))()
         rows = []
         for speed in speeds:
-            lib.unbalance_outputs_evaluate(handle, speed, out)
+            (lib.unbalance_outputs_slopes if slopes else lib.unbalance_outputs_evaluate)(handle, speed, out)
             lib.unbalance_outputs_modes(handle, speed, modes)
             rows.append(list(out) + (list(modes) if table else []))
     finally:
@@ -197,6 +200,34 @@ def test_unbalance_outputs_match_the_python_model(library, name):
     assert frequencies <= bound, f"damped frequencies differ by {frequencies:.3g}"
     zeta = np.max(np.abs(got[:, 3 + DAMPED_MODES:] - table[:, DAMPED_MODES:]))
     assert zeta <= bound, f"tabulated damping ratios differ by {zeta:.3g}"
+
+
+#: Relative rounding of the response and the bearing force: the banded solve's, about cond eps (measured at
+#: most 9.8e-12 on the FMU's points, test_native_derivatives.ROUNDING)
+SOLVE_ROUNDING = 3e-11
+#: Slopes at speeds off the mode table's knots and away from resonances and from where the nearest mode changes
+SLOPE_SPEEDS = (37.0, 310.0, 790.0, 1220.0)
+
+
+@pytest.mark.parametrize("name", ["default", "ends", "anisotropic", "cross_coupled", "own_unbalances"])
+def test_the_slopes_are_the_derivatives_of_the_outputs(library, name):
+    """unbalance_outputs_slopes against Richardson-extrapolated central differences of the outputs (steps 2e-3,
+    1e-3, 5e-4 of the speed: error O(h^6)): on the fixed ends' bearings (no row), the doubled system of
+    anisotropic and cross-coupled bearings (elliptic orbits: |B| > 0, complex k_b), a layout's own unbalances
+    with a phase. Within 1e-9 of the slope, plus the values' rounding, which the extrapolation multiplies by
+    6.6 / h (its weights 1/45, 20/45, 64/45 on the steps h, h/2, h/4)."""
+    d = OUTPUTS[name]
+    items = excitation(d)
+    got = outputs(library, d, items, 0.3, OMEGA_MAX, SLOPE_SPEEDS, slopes=True)
+    for speed, slope in zip(SLOPE_SPEEDS, got):
+        h = 2e-3 * speed
+        steps = [h, h / 2, h / 4]
+        values = outputs(library, d, items, 0.3, OMEGA_MAX, [speed + sign * k for k in steps for sign in (1, -1)])
+        d1, d2, d4 = ((values[2 * i] - values[2 * i + 1]) / (2 * k) for i, k in enumerate(steps))
+        reference = (16.0 * (4.0 * d4 - d2) / 3.0 - (4.0 * d2 - d1) / 3.0) / 15.0
+        rounding = np.array([SOLVE_ROUNDING, SOLVE_ROUNDING, EPS]) * np.abs(values).max(axis=0) * 6.6 / h
+        assert np.all(np.abs(slope - reference) <= 1e-9 * np.abs(reference) + rounding), (speed, slope, reference)
+        assert slope[0] != 0.0 and (slope[1] != 0.0 or name == "ends"), (speed, slope)  # ends: bearings held
 
 
 def test_the_mode_table_above_the_dense_size_is_arpacks_selection(library):
