@@ -350,7 +350,7 @@ def _named(name: str, call: Callable[..., None], *arguments: object) -> None:
 
 def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) -> str | None:
     """Why ``step`` is too long for a component whose model (``models``: each component's model name)
-    states a limit for a Jacobi coupling (every engine here couples so): a ``VehicleDriveline``'s
+    states a limit for a Jacobi coupling (the Jacobi master, libcosim, Ecos): a ``VehicleDriveline``'s
     differential mode; None when no limit is passed."""
     for component in system.components:
         if models[component.name] != "VehicleDriveline":
@@ -362,7 +362,7 @@ def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) 
             return (f"{component.name} (VehicleDriveline): --step {step!r} s is above {limit:.3g} s, the longest step "
                     f"at which its differential's internal mode ({dynamics.modes_text(drive)}) stays stable with the "
                     f"joints' torques one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, "
-                    f"{dynamics.JACOBI_DAMPING_STEP} zeta)): take a shorter step")
+                    f"{dynamics.JACOBI_DAMPING_STEP} zeta)): take a shorter step, or the Gauss-Seidel master")
     return None
 
 
