@@ -22,6 +22,7 @@ from benchmarks import report
 from benchmarks.model_exchange_cost import ROUNDS, ContinuousTime, best_microseconds, instances
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
+from fmu_harness.console import summary
 
 CALLS = 1000
 
@@ -47,7 +48,7 @@ def costs(model: ContinuousTime, name: str, fmi: str) -> list[float]:
 
 def main() -> None:
     providing = [name for name in native.native_models() if native.provides_derivatives(name)]
-    parser = report.parser(__doc__.splitlines()[0])
+    parser = report.parser(summary(__doc__))
     parser.add_argument("names", nargs="*", metavar="NAME",
                         help=f"the models to measure (default: all that give the hook: {', '.join(providing)})")
     args = parser.parse_args()
