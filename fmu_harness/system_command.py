@@ -26,6 +26,7 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .checks import importers
+from .console import summary
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
@@ -160,7 +161,7 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
 
 
 def _arguments(argv: list[str] | None) -> argparse.Namespace:
-    parser = OneLineParser(description=__doc__.splitlines()[0])
+    parser = OneLineParser(description=summary(__doc__))
     parser.add_argument("package", type=Path, help="the SSP package (.ssp)")
     parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
     parser.add_argument("--step", type=float, default=1e-3,

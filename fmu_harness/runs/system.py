@@ -42,6 +42,7 @@ from .runner import FmuInstance, StepRefused
 from .ssp import SSC, SSD, SSV
 from .ssp_package import SspSystem
 from .start_values import Instance, StartValuesRefused, check_start_values
+from ..console import summary
 
 for prefix, uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
     ET.register_namespace(prefix, uri)
@@ -380,7 +381,7 @@ def simulate(system: System, models: Path, outputs: list[str] | None = None, nat
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--native", action="store_true", help="the native FMUs where a model has one")
     args = parser.parse_args(argv)
