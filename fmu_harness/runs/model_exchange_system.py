@@ -209,7 +209,8 @@ def strongly_connected(nodes: int, after: Mapping[int, Collection[int]]) -> list
 class ModelExchangeSystem:
     """Instances ``{name: FMU}`` with their start values and ``connections`` ``((instance, output),
     (instance, input))`` as one ODE: :meth:`rates` of the stacked states; :attr:`blocks`, the
-    connections' order (each a list of connection numbers; more than one, or one feeding itself, a loop)."""
+    connections' order (each a list of connection numbers), :attr:`loops` which of them are algebraic loops
+    (more than one connection, or one feeding itself)."""
 
     def __init__(self, fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, object]],
                  connections: Sequence[tuple[Port, Port]], scratch: Path) -> None:
@@ -227,13 +228,17 @@ class ModelExchangeSystem:
         except BaseException:
             self.close()
             raise
-        self.blocks = strongly_connected(len(self.connections), self._order())
-        for block in filter(self.is_loop, self.blocks):
+        after = self._order()
+        self.blocks = strongly_connected(len(self.connections), after)
+        self.loops = [len(block) > 1 or block[0] in after[block[0]] for block in self.blocks]
+        for block in (b for b, loop in zip(self.blocks, self.loops) if loop):
             for (_, _), (target, _) in (self.connections[k] for k in block):
                 if not self.instances[target].gives_derivatives:
                     self.close()
                     raise NotRunnable(f"{target}: the algebraic loop of {self.loop_name(block)} goes through it, and "
                                       "it gives no directional derivatives to solve it with")
+        self._reads = {id(block): self._grouped(block, 0) for block in self.blocks}
+        self._writes = {id(block): self._grouped(block, 1) for block in self.blocks}
         sizes = [instance.size for instance in self.instances.values()]
         self.slices = dict(zip(self.instances, (slice(a, b) for a, b in zip(np.cumsum([0, *sizes]), np.cumsum(sizes)))))
 
@@ -248,20 +253,29 @@ class ModelExchangeSystem:
     def loop_name(self, block: list[int]) -> str:
         return ", ".join(f"{s}.{o}" for (s, o), _ in (self.connections[k] for k in block))
 
-    def is_loop(self, block: list[int]) -> bool:
-        return len(block) > 1 or block[0] in self._order()[block[0]]
-
     def start(self) -> np.ndarray:
         """The stacked states the instances hold after initialisation."""
         return np.concatenate([instance.states() for instance in self.instances.values()])
 
+    def _grouped(self, block: list[int], end: int) -> list[tuple[ModelExchangeInstance, list[str], list[int]]]:
+        """The block's connections by instance of their source (``end`` 0) or target (1): (instance,
+        variables, positions in the block), so that each instance is called once."""
+        groups: dict[str, tuple[list[str], list[int]]] = {}
+        for position, k in enumerate(block):
+            name, variable = self.connections[k][end]
+            groups.setdefault(name, ([], []))[0].append(variable)
+            groups[name][1].append(position)
+        return [(self.instances[name], variables, positions) for name, (variables, positions) in groups.items()]
+
     def _carry(self, block: list[int], values: Sequence[float]) -> None:
-        for k, value in zip(block, values):
-            (_, _), (target, input_) = self.connections[k]
-            self.instances[target].set([input_], [value])
+        for instance, inputs, positions in self._writes[id(block)]:
+            instance.set(inputs, [values[p] for p in positions])
 
     def _outputs(self, block: list[int]) -> np.ndarray:
-        return np.array([self.instances[s].get([o])[0] for (s, o), _ in (self.connections[k] for k in block)])
+        values = np.zeros(len(block))
+        for instance, outputs, positions in self._reads[id(block)]:
+            values[positions] = instance.get(outputs)
+        return values
 
     def _solve_loop(self, block: list[int]) -> None:
         """The loop's values v = y(v) by Newton's method, (I - dy/dv) dv = y(v) - v, the Jacobian from the
@@ -288,8 +302,8 @@ class ModelExchangeSystem:
         """Every instance at ``time`` and its share of ``states``, every connection's input set."""
         for name, instance in self.instances.items():
             instance.set_point(time, states[self.slices[name]])
-        for block in self.blocks:
-            if self.is_loop(block):
+        for block, loop in zip(self.blocks, self.loops):
+            if loop:
                 self._solve_loop(block)
             else:
                 self._carry(block, self._outputs(block))
