@@ -1,8 +1,8 @@
 """Cost of the native FMUs' exact derivatives: one directional derivative and one Jacobian, against the
 Jacobian a host forms by forward differences without them.
 
-``python -m benchmarks.derivative_cost``: for each model whose C port gives the ``jacobian`` hook and each
-FMI version, builds the native FMU and runs it through fmpy's low-level API in continuous-time mode (the
+``python -m benchmarks.derivative_cost [NAME ...]``: for each model whose C port gives the ``jacobian`` hook
+(or those named) and each FMI version, builds the native FMU and runs it through fmpy's low-level API in continuous-time mode (the
 instance of :mod:`benchmarks.model_exchange_cost`). One directional derivative: every unknown (Real
 outputs and state derivatives) for one seed on every known (Real inputs and states), one call; one exact
 Jacobian: a directional derivative per known with a unit seed (FMI 3.0 also: an adjoint derivative per
@@ -22,6 +22,7 @@ from benchmarks import report
 from benchmarks.model_exchange_cost import ROUNDS, ContinuousTime, best_microseconds, instances
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
+from fmu_harness.console import summary
 
 CALLS = 1000
 
@@ -46,13 +47,21 @@ def costs(model: ContinuousTime, name: str, fmi: str) -> list[float]:
 
 
 def main() -> None:
-    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    providing = [name for name in native.native_models() if native.provides_derivatives(name)]
+    parser = report.parser(summary(__doc__))
+    parser.add_argument("names", nargs="*", metavar="NAME",
+                        help=f"the models to measure (default: all that give the hook: {', '.join(providing)})")
+    args = parser.parse_args()
+    unknown = [name for name in args.names if name not in providing]
+    if unknown:
+        parser.error(f"{', '.join(unknown)}: not a model whose native FMU gives derivatives ({', '.join(providing)})")
+    if args.names and args.update_docs:
+        parser.error("--update-docs writes the table of every model: name none with it")
     measurement = report.Measurement()
     lines = ["| FMU | FMI | unknowns x knowns | one directional derivative µs | one Jacobian, directional µs "
              "| one Jacobian, adjoint µs | one Jacobian, forward differences µs |", "|---|---|---|---|---|---|---|"]
     with tempfile.TemporaryDirectory() as folder:
-        providing = [name for name in native.native_models() if native.provides_derivatives(name)]
-        for name, fmi, model in instances(Path(folder), providing):
+        for name, fmi, model in instances(Path(folder), args.names or providing):
             outputs, columns = native.jacobian_layout(MODELS[name].spec)
             one, directional, adjoint, differences = costs(model, name, fmi)
             shown = "" if np.isnan(adjoint) else f"{adjoint:.2f}"

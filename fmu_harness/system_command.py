@@ -3,7 +3,8 @@
 ``driveline-fmus system PACKAGE.ssp`` writes the time first, each column headed ``Component.variable [unit]``.
 
 The engine is the project's fixed-step Jacobi master (``master``, :func:`fmu_harness.runs.system.run_jacobi`,
-FMI 2.0 and 3.0 FMUs through fmpy), libcosim (``libcosim``, FMI 2.0) or Ecos (``ecos``), the engines
+FMI 2.0 and 3.0 FMUs through fmpy), the same master stepping the components one after the other in the
+package's order (``gauss-seidel``), libcosim (``libcosim``, FMI 2.0) or Ecos (``ecos``), the engines
 of the importer matrix. ``--set Component.name=value`` binds a parameter (or an unconnected input's
 start value) in a copy of the package, so every engine runs the same bindings.
 """
@@ -23,6 +24,7 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .checks import importers
+from .console import summary
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
@@ -30,7 +32,8 @@ from .runs.start_values import StartValuesRefused, check_start_values, engine_in
 from .runs.system import run_jacobi, step_limit_error
 from .studies.result_table import write_csv
 
-ENGINES = ("master", "libcosim", "ecos")
+ENGINES = ("master", "gauss-seidel", "libcosim", "ecos")
+JACOBI_ENGINES = ("master", "libcosim", "ecos")  # each couples by Jacobi: the inputs of a step are all one step late
 PROGRESS_SHARE = 0.1  # a progress line every tenth of the run when stderr is no terminal
 
 
@@ -130,9 +133,10 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
                stop_time: float, step_size: float, on_step: Callable[[int, int], None]) -> np.ndarray:
     """Rows of time and ``outputs`` for t_1 ... t_N from ``engine``."""
     steps = int(round(stop_time / step_size))
-    if engine == "master":
+    if engine in ("master", "gauss-seidel"):
+        order = [c.name for c in system.components] if engine == "gauss-seidel" else None
         return run_jacobi(fmus, {c.name: c.parameters for c in system.components}, system.connections,
-                          stop_time, step_size, outputs, on_step)
+                          stop_time, step_size, outputs, on_step, order=order)
     if engine == "libcosim":
         session = importers.cosim_session(step_size, ssp=package)
     else:
@@ -150,7 +154,7 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
 
 
 def _arguments(argv: list[str] | None) -> argparse.Namespace:
-    parser = OneLineParser(description=__doc__.splitlines()[0])
+    parser = OneLineParser(description=summary(__doc__))
     parser.add_argument("package", type=Path, help="the SSP package (.ssp)")
     parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
     parser.add_argument("--step", type=float, default=1e-3, help="communication step [s] (default 1e-3)")
@@ -158,7 +162,8 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--set", action="append", default=[], metavar="Component.name=value",
                         help="bind a parameter or an unconnected input's start value; repeatable")
     parser.add_argument("--engine", choices=ENGINES, default="master",
-                        help="master: the project's Jacobi master (fmpy); libcosim; ecos (default master)")
+                        help="master: the project's Jacobi master (fmpy); gauss-seidel: the same master stepping the "
+                             "components in the package's order; libcosim; ecos (default master)")
     return parser.parse_args(argv)
 
 
@@ -184,7 +189,8 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
         package = ssp_package.with_parameters(args.package, changes, scratch / args.package.name)
         system = ssp_package.read(package)
     check_start_values(engine_instances(ssp=package))
-    reason = step_limit_error(system, {name: d.modelName for name, d in descriptions.items()}, args.step)
+    models = {name: d.modelName for name, d in descriptions.items()}
+    reason = step_limit_error(system, models, args.step) if args.engine in JACOBI_ENGINES else None
     if reason is not None:
         raise UsageError(reason)
     outputs, headers = output_columns(system, descriptions)
