@@ -51,7 +51,8 @@ static DualReactions leading_order(const DualLoad *load, Dual ratio, Dual pin)
     return out;
 }
 
-/* outputs.efficiency's partial derivatives on the step's branch (its values: output_power, total) */
+/* outputs.efficiency's partial derivatives on the step's branch (its values: output_power, total); where no
+ * power flows (total 0 in drive) it is 1, a peak between drive and coast: derivatives 0 */
 static Dual efficiency(Dual output_power, Dual total, double output_value, double total_value)
 {
     if (output_value >= 0.0) {
