@@ -6,15 +6,9 @@ from the samples). Here each mode on its own: closed form with the rates from th
 eqs, exact without friction, exact with friction (drive and coast: the efficiency's two branches), the
 automatic rates while both are 0, against central differences of the same FMU and the Python core's
 extrapolated differences, with the tolerances of the generic test (``support.derivatives``) but for two
-rows where large terms cancel:
-
-* ``a_plunger_sum`` (exact reactions) sums three plunger accelerations built from terms of |Omega|^2 l,
-  about 3e4 m/s^2, to about 0.04 m/s^2: the differences' rounding, eps 3e4 / h over the row's scale of
-  0.5, is 1e-5 with the FMU's step 1e-6 (measured 1.9e-5) and 3e-8 with the core's 5e-4 (measured
-  7.0e-8): bounds 1e-4 and 5e-7; its exact value is checked to 1e-10 in the columns where the outputs are
-  polynomials (below);
-* ``Rz_out`` (exact reactions, the axial part of three arm forces of some 1e3 N): the core's rounding
-  measured 2.6e-10: bound 1e-9.
+rows where large terms cancel (``a_plunger_sum`` and ``Rz_out`` of the exact reactions, held to the
+differences' own rounding: ``support.derivatives.ROUNDING_ROWS``); their exact values are checked to 1e-10
+in the columns where the outputs are polynomials (below).
 
 Without friction every output is a polynomial of degree at most 2 in omega_in, alpha_in, T_load, beta_dot
 and beta_ddot (velocities linear in omega_in and beta_dot, accelerations and forces quadratic in them,
@@ -49,7 +43,6 @@ POINTS = {
 }
 POLYNOMIAL = ("omega_in", "alpha_in", "T_load", "beta_dot", "beta_ddot")
 FMU_TOLERANCE, CORE_TOLERANCE = 1e-7, 1e-10
-CANCELLING = {"a_plunger_sum": (1e-4, 5e-7), "Rz_out": (FMU_TOLERANCE, 1e-9)}  # (FMU, core) bounds: see above
 
 
 def _at_point(native_dir, fmi: str, point: dict, folder) -> ModelExchange:
@@ -61,8 +54,7 @@ def _at_point(native_dir, fmi: str, point: dict, folder) -> ModelExchange:
 
 def _bounds(index: int) -> np.ndarray:
     """The (FMU, core) bound of each row."""
-    rows, _ = derivatives.layout(NAME)
-    return np.array([CANCELLING.get(row, (FMU_TOLERANCE, CORE_TOLERANCE))[index] for row in rows])
+    return derivatives.row_bounds(NAME, FMU_TOLERANCE, CORE_TOLERANCE)[index]
 
 
 def _core_values(model: ModelExchange, point: dict) -> dict:
