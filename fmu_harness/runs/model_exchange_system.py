@@ -125,7 +125,7 @@ class ModelExchangeInstance:
         self.call("exitInitializationMode")
         while True:
             if self.fmi3:
-                needed, _, _, _, _, time_defined, _ = self.call("updateDiscreteStates")
+                needed, _, _, _, time_defined, _ = self.call("updateDiscreteStates")
             else:
                 needed, _, _, _, time_defined, _ = self.call("newDiscreteStates")
             if time_defined:
