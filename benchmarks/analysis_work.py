@@ -15,6 +15,7 @@ from pathlib import Path
 
 from benchmarks import report
 from fmu_harness.checks.analysis_work import NATIVE_BUDGET, PYTHON_BUDGET, measure, table
+from fmu_harness.console import summary
 
 
 def over_budget(results: dict[str, dict]) -> list[str]:
@@ -36,7 +37,7 @@ def over_budget(results: dict[str, dict]) -> list[str]:
 
 
 def main() -> None:
-    arguments = report.parser(__doc__.splitlines()[0])
+    arguments = report.parser(summary(__doc__))
     arguments.add_argument("fmu", nargs="?", type=Path, default=Path("models/native/CriticalSpeeds.fmu"),
                            help="the native CriticalSpeeds FMU")
     args = arguments.parse_args()

@@ -36,6 +36,7 @@ from driveline.rotor.model import analyse, analyse_structure, resonances, whirl_
 from fmu_harness.packaging import build as build_fmu
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance
+from fmu_harness.console import summary
 
 ORDERS, OMEGA_MAX = (1, 2, 3), 1500.0
 MODEL = "CriticalSpeeds"
@@ -137,7 +138,7 @@ def fmu_table(update_docs: bool) -> None:
 
 
 if __name__ == "__main__":
-    update_docs = report.parser(__doc__.splitlines()[0]).parse_args().update_docs
+    update_docs = report.parser(summary(__doc__)).parse_args().update_docs
     analysis_table(update_docs)
     print()
     fmu_table(update_docs)

@@ -15,6 +15,7 @@ from benchmarks import report
 from benchmarks.timing import best_of
 from driveline.rotor import Driveline, one_piece_shaft
 from tests.support.ross_reference import E, RHO, ross_forward_critical_speeds
+from fmu_harness.console import summary
 
 AGREEMENT = 5e-3
 
@@ -33,7 +34,7 @@ def ross() -> np.ndarray:
 
 
 def main() -> None:
-    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    args = report.parser(summary(__doc__)).parse_args()
     measurement = report.Measurement()
     reference, result = ross(), ours()  # warm-up, and the agreement check
     difference = np.abs(result - reference) / reference

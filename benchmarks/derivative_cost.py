@@ -2,9 +2,8 @@
 Jacobian a host forms by forward differences without them.
 
 ``python -m benchmarks.derivative_cost [NAME ...]``: for each model whose C port gives the ``jacobian`` hook
-(or those named of them; the docs' table is written only for all) and each FMI version, builds the native
-FMU and runs it through fmpy's low-level API in continuous-time mode (the instance of
-:mod:`benchmarks.model_exchange_cost`). One directional derivative: every unknown (Real
+(or those named) and each FMI version, builds the native FMU and runs it through fmpy's low-level API in continuous-time mode (the
+instance of :mod:`benchmarks.model_exchange_cost`). One directional derivative: every unknown (Real
 outputs and state derivatives) for one seed on every known (Real inputs and states), one call; one exact
 Jacobian: a directional derivative per known with a unit seed (FMI 3.0 also: an adjoint derivative per
 unknown); one Jacobian by forward differences: the evaluation at the point and one per state and input
@@ -23,6 +22,7 @@ from benchmarks import report
 from benchmarks.model_exchange_cost import ROUNDS, ContinuousTime, best_microseconds, instances
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
+from fmu_harness.console import summary
 
 CALLS = 1000
 
@@ -47,21 +47,21 @@ def costs(model: ContinuousTime, name: str, fmi: str) -> list[float]:
 
 
 def main() -> None:
-    parser = report.parser(__doc__.splitlines()[0])
     providing = [name for name in native.native_models() if native.provides_derivatives(name)]
+    parser = report.parser(summary(__doc__))
     parser.add_argument("names", nargs="*", metavar="NAME",
-                        help=f"models to measure (default: all of {', '.join(providing)})")
+                        help=f"the models to measure (default: all that give the hook: {', '.join(providing)})")
     args = parser.parse_args()
-    unknown = sorted(set(args.names) - set(providing))
+    unknown = [name for name in args.names if name not in providing]
     if unknown:
-        parser.error(f"no exact derivatives to measure for {', '.join(unknown)} (models: {', '.join(providing)})")
+        parser.error(f"{', '.join(unknown)}: not a model whose native FMU gives derivatives ({', '.join(providing)})")
     if args.names and args.update_docs:
-        parser.error("--update-docs writes the table of every model: name none")
+        parser.error("--update-docs writes the table of every model: name none with it")
     measurement = report.Measurement()
     lines = ["| FMU | FMI | unknowns x knowns | one directional derivative µs | one Jacobian, directional µs "
              "| one Jacobian, adjoint µs | one Jacobian, forward differences µs |", "|---|---|---|---|---|---|---|"]
     with tempfile.TemporaryDirectory() as folder:
-        for name, fmi, model in instances(Path(folder), [n for n in providing if not args.names or n in args.names]):
+        for name, fmi, model in instances(Path(folder), args.names or providing):
             outputs, columns = native.jacobian_layout(MODELS[name].spec)
             one, directional, adjoint, differences = costs(model, name, fmi)
             shown = "" if np.isnan(adjoint) else f"{adjoint:.2f}"

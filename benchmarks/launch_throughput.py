@@ -18,6 +18,7 @@ from pathlib import Path
 
 from benchmarks import report
 from fmu_harness.runs.system_sweep import SystemInterface, UnpackedSystem, run_system
+from fmu_harness.console import summary
 
 GOAL = 2.0 / 4.0
 """CPU seconds per simulated second of launch: at most 2 s of CPU per 4 s launch (issue 29)."""
@@ -36,7 +37,7 @@ def cpu_seconds(interface: SystemInterface, unpacked: UnpackedSystem, master: st
 
 
 def main() -> None:
-    parser = report.parser(__doc__.splitlines()[0])
+    parser = report.parser(summary(__doc__))
     parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp")
     parser.add_argument("--stop-time", type=float, default=4.0, help="launch length [s] (default 4)")
     parser.add_argument("--repeat", type=int, default=3, help="measurements per master (default 3)")

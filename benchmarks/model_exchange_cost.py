@@ -23,6 +23,7 @@ from fmpy import extract, instantiate_fmu, read_model_description
 from benchmarks import report
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
+from fmu_harness.console import summary
 
 CALLS, ROUNDS = 2000, 7
 
@@ -101,7 +102,7 @@ def instances(dest: Path, names: list[str]) -> Iterator[tuple[str, str, Continuo
 
 
 def main() -> None:
-    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    args = report.parser(summary(__doc__)).parse_args()
     measurement = report.Measurement()
     lines = ["| FMU | FMI | states | Real inputs | one evaluation µs | one Jacobian (forward differences) µs |",
              "|---|---|---|---|---|---|"]

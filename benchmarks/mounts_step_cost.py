@@ -22,6 +22,7 @@ from driveline.mounts.layout import load_layout, shipped_layout
 from driveline.mounts.rigid_body import COORDINATES
 from driveline.mounts.spec import AXES, SHARED_LAYOUT
 from fmu_harness.packaging import native
+from fmu_harness.console import summary
 
 NAME = "PowertrainMounts"
 TARGET_NS = 1000.0
@@ -41,7 +42,7 @@ def loops() -> list[tuple[str, list[str], list[str] | None]]:
 
 
 def main() -> None:
-    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    args = report.parser(summary(__doc__)).parse_args()
     measurement = report.Measurement()
     lines = ["| FMI | loop | ns per step |", "|---|---|---|"]
     typical = []

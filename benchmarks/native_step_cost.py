@@ -23,6 +23,7 @@ from benchmarks import report
 from benchmarks.step_cost import ROUNDS, STEPS, VARIANTS, Stepper, best_alternating
 from driveline.catalog import MODELS
 from fmu_harness.packaging import build, native, toolchain
+from fmu_harness.console import summary
 
 HERE = Path(__file__).resolve().parent
 C_STEPS, C_ROUNDS = 200_000, 7
@@ -60,7 +61,7 @@ def c_host_cost(timer: Path, fmu: Path, fmi: str, work: Path, integers: dict[str
 
 
 def main() -> None:
-    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    args = report.parser(summary(__doc__)).parse_args()
     measurement = report.Measurement()
     lines = ["| FMU | FMI | variant | native via fmpy µs | no-physics twin via fmpy µs | ratio | Python FMU via fmpy µs "
              "| Python / native | native from C ns | no-physics twin from C ns |",

@@ -13,6 +13,7 @@ from pathlib import Path
 from benchmarks import report
 from benchmarks.timing import resident_set_bytes
 from fmu_harness.runs.runner import FmuInstance
+from fmu_harness.console import summary
 
 WARM_UP = 10_000
 
@@ -36,7 +37,7 @@ def soak(path: Path, steps: int) -> tuple[float, int, int]:
 
 
 def main() -> None:
-    arguments = report.parser(__doc__.splitlines()[0])
+    arguments = report.parser(summary(__doc__))
     arguments.add_argument("steps", nargs="?", type=int, default=1_000_000, help="steps per FMU")
     arguments.add_argument("models", nargs="?", type=Path, default=Path("models"), help="folder of the FMUs")
     args = arguments.parse_args()

@@ -22,6 +22,7 @@ from benchmarks import minimal_models, report
 from driveline.catalog import MODELS
 from fmu_harness.packaging import build
 from fmu_harness.runs.runner import Fmi3Instance, FmuInstance
+from fmu_harness.console import summary
 
 STEPS, ROUNDS = 2000, 7
 VARIANTS = {"TripodCoupling": {"closed form": {"kinematics": 0}, "exact": {"kinematics": 1}}}
@@ -103,7 +104,7 @@ def best_alternating(steppers: list[Stepper | HarnessStepper]) -> list[float]:
 
 
 def main() -> None:
-    args = report.parser(__doc__.splitlines()[0]).parse_args()
+    args = report.parser(summary(__doc__)).parse_args()
     measurement = report.Measurement()
     lines = ["| FMU | FMI | variant | fmpy batched µs/step | minimal twin µs/step | model/twin | "
              "harness, constant inputs µs/step | harness/fmpy | harness, inputs f(t) µs/step | harness/fmpy |",

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from benchmarks import report
 from fmu_harness.runs.sweep import Timing, grid, open_client, sweep
+from fmu_harness.console import summary
 
 AXES = {
     "beta": [0.05 * k for k in range(1, 13)],
@@ -39,7 +40,7 @@ def wall_time(fmu: Path, workers: int) -> float:
 
 
 def main() -> None:
-    parser = report.parser(__doc__.splitlines()[0])
+    parser = report.parser(summary(__doc__))
     parser.add_argument("--fmu", type=Path, default=Path("models") / "TripodCoupling.fmu")
     parser.add_argument("--repeat", type=int, default=3, help="measurements per cluster size")
     args = parser.parse_args()

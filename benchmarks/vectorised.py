@@ -17,6 +17,7 @@ from benchmarks import report
 from benchmarks.timing import best_of
 from driveline.tripod.outputs import coupling_outputs
 from fmu_harness.runs.runner import FmuInstance
+from fmu_harness.console import summary
 
 OMEGA, T_LOAD, R, L, M = 2000 * math.pi / 30, 100.0, 0.026, 0.700, 0.2
 BETAS = np.radians(np.linspace(1.0, 45.0, 10))
@@ -49,7 +50,7 @@ def vectorised(kinematics: int) -> np.ndarray:
 
 
 def main() -> None:
-    arguments = report.parser(__doc__.splitlines()[0])
+    arguments = report.parser(summary(__doc__))
     arguments.add_argument("models", nargs="?", type=Path, default=Path("models"), help="folder of the FMI 2.0 FMUs")
     args = arguments.parse_args()
     measurement = report.Measurement()

@@ -16,12 +16,13 @@ from pathlib import Path
 
 from benchmarks import report
 from fmu_harness.checks.work_fuzzer import exit_over_budget, fuzz, summary
+from fmu_harness.console import summary
 
 FMUS = {"python": Path("models/CriticalSpeeds.fmu"), "native": Path("models/native/CriticalSpeeds.fmu")}
 
 
 def main() -> None:
-    arguments = report.parser(__doc__.splitlines()[0])
+    arguments = report.parser(summary(__doc__))
     arguments.add_argument("--cases", type=int, default=200, help="cases per family (default 200)")
     arguments.add_argument("--seed", type=int, default=1, help="seed of the random cases (default 1)")
     args = arguments.parse_args()

@@ -28,6 +28,11 @@ class CommandParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def summary(doc: str | None) -> str:
+    """A command's description for ``--help``: its module docstring's first paragraph on one line."""
+    return " ".join((doc or "").strip().split("\n\n", 1)[0].split())
+
+
 def optional(module: str, extra: str, command: str) -> ModuleType:
     """Import ``module`` of the optional dependencies ``extra``; without it, end ``command`` in one
     line that names what to install."""

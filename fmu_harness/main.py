@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .checks import python_fmu_check
-from .console import CommandParser, Progress
+from .console import CommandParser, Progress, summary
 from .packaging import native
 from .runs import system
 from .studies import coupling_comparison, critical_speed_study, launch_study, mounts_study, tripod_study
@@ -44,7 +44,7 @@ def simulate(models: Path, out: Path) -> list[Path]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = CommandParser(description=__doc__.splitlines()[0])
+    parser = CommandParser(description=summary(__doc__))
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--out", type=Path, default=Path("results"), help="folder for CSV files and figures")
     args = parser.parse_args(argv)

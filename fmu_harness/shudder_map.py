@@ -35,7 +35,7 @@ import numpy as np
 
 from driveline.vehicle.compact_car import MOTOR_PEAK_TORQUE
 
-from .console import CommandParser
+from .console import CommandParser, summary
 from .runs import sweep
 from .runs.system_sweep import DerivedMetrics
 from .studies import figures
@@ -101,7 +101,7 @@ def draw(table: pa.Table, path: Path) -> Path:
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    parser = CommandParser(description=__doc__.splitlines()[0])
+    parser = CommandParser(description=summary(__doc__))
     parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp",
                         help="the launch's SSP package (default models/native/VehicleLaunch.ssp)")
     parser.add_argument("--count", type=int, default=8, help="values per axis (default 8: 512 launches)")

@@ -3,8 +3,11 @@
 ``driveline-fmus system PACKAGE.ssp`` writes the time first, each column headed ``Component.variable [unit]``.
 
 The engine is the project's fixed-step Jacobi master (``master``, :func:`fmu_harness.runs.system.run_jacobi`,
-FMI 2.0 and 3.0 FMUs through fmpy), libcosim (``libcosim``, FMI 2.0) or Ecos (``ecos``), the engines
-of the importer matrix. ``--set Component.name=value`` binds a parameter (or an unconnected input's
+FMI 2.0 and 3.0 FMUs through fmpy), the same master stepping the components one after the other in the
+package's order (``gauss-seidel``), libcosim (``libcosim``, FMI 2.0) or Ecos (``ecos``), the engines
+of the importer matrix, or the FMUs' Model Exchange interfaces as one ODE (``model-exchange``,
+:func:`fmu_harness.runs.model_exchange_system.run_model_exchange`; ``--step`` is then the output interval,
+``--rtol`` the integrator's tolerance). ``--set Component.name=value`` binds a parameter (or an unconnected input's
 start value) in a copy of the package, so every engine runs the same bindings.
 """
 
@@ -23,14 +26,17 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .checks import importers
+from .console import summary
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
 from .runs.start_values import StartValuesRefused, check_start_values, engine_instances
+from .runs.model_exchange_system import NotRunnable, run_model_exchange
 from .runs.system import run_jacobi, step_limit_error
 from .studies.result_table import write_csv
 
-ENGINES = ("master", "libcosim", "ecos")
+ENGINES = ("master", "gauss-seidel", "libcosim", "ecos", "model-exchange")
+JACOBI_ENGINES = ("master", "libcosim", "ecos")  # each couples by Jacobi: the inputs of a step are all one step late
 PROGRESS_SHARE = 0.1  # a progress line every tenth of the run when stderr is no terminal
 
 
@@ -127,12 +133,17 @@ def progress_printer(stop_time: float, stream=sys.stderr) -> Callable[[int, int]
 
 
 def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Path], outputs: list[str],
-               stop_time: float, step_size: float, on_step: Callable[[int, int], None]) -> np.ndarray:
-    """Rows of time and ``outputs`` for t_1 ... t_N from ``engine``."""
+               stop_time: float, step_size: float, on_step: Callable[[int, int], None], rtol: float) -> np.ndarray:
+    """Rows of time and ``outputs`` for t_1 ... t_N from ``engine`` (``rtol``: Model Exchange's tolerance)."""
     steps = int(round(stop_time / step_size))
-    if engine == "master":
+    if engine == "model-exchange":
+        with tempfile.TemporaryDirectory(prefix="driveline-model-exchange-") as scratch:
+            return run_model_exchange(fmus, {c.name: c.parameters for c in system.components}, system.connections,
+                                      stop_time, step_size, outputs, Path(scratch), rtol, on_step)
+    if engine in ("master", "gauss-seidel"):
+        order = [c.name for c in system.components] if engine == "gauss-seidel" else None
         return run_jacobi(fmus, {c.name: c.parameters for c in system.components}, system.connections,
-                          stop_time, step_size, outputs, on_step)
+                          stop_time, step_size, outputs, on_step, order=order)
     if engine == "libcosim":
         session = importers.cosim_session(step_size, ssp=package)
     else:
@@ -150,15 +161,20 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
 
 
 def _arguments(argv: list[str] | None) -> argparse.Namespace:
-    parser = OneLineParser(description=__doc__.splitlines()[0])
+    parser = OneLineParser(description=summary(__doc__))
     parser.add_argument("package", type=Path, help="the SSP package (.ssp)")
     parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
-    parser.add_argument("--step", type=float, default=1e-3, help="communication step [s] (default 1e-3)")
+    parser.add_argument("--step", type=float, default=1e-3,
+                        help="communication step [s], with model-exchange the output interval (default 1e-3)")
+    parser.add_argument("--rtol", type=float, default=1e-8,
+                        help="model-exchange: the integrator's relative tolerance (default 1e-8)")
     parser.add_argument("--out", type=Path, help="CSV file to write (default: the package's name with .csv)")
     parser.add_argument("--set", action="append", default=[], metavar="Component.name=value",
                         help="bind a parameter or an unconnected input's start value; repeatable")
     parser.add_argument("--engine", choices=ENGINES, default="master",
-                        help="master: the project's Jacobi master (fmpy); libcosim; ecos (default master)")
+                        help="master: the project's Jacobi master (fmpy); gauss-seidel: the same master stepping the "
+                             "components in the package's order; libcosim; ecos; model-exchange: the FMUs' Model "
+                             "Exchange interfaces as one ODE (default master)")
     return parser.parse_args(argv)
 
 
@@ -170,6 +186,10 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
         raise UsageError("the package has no DefaultExperiment stop time: give --stop-time")
     if not (math.isfinite(args.step) and args.step > 0.0 and math.isfinite(stop_time) and stop_time >= args.step):
         raise UsageError(f"--step {args.step!r} and --stop-time {stop_time!r}: need 0 < step <= stop time, finite")
+    if not (math.isfinite(args.rtol) and 1e-13 <= args.rtol <= 1e-2):
+        raise UsageError(f"--rtol {args.rtol!r}: need 1e-13 <= rtol <= 1e-2")
+    if args.rtol != 1e-8 and args.engine != "model-exchange":
+        raise UsageError(f"--rtol is the model-exchange engine's; --engine {args.engine} steps at --step")
     if abs(stop_time / args.step - round(stop_time / args.step)) > 1e-9 * stop_time / args.step:
         raise UsageError(f"--stop-time {stop_time!r} is no whole number of steps of {args.step!r} s")
     with zipfile.ZipFile(args.package) as archive:
@@ -178,20 +198,28 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
     descriptions = {name: _description(path) for name, path in fmus.items()}
     if args.engine == "libcosim" and any(d.fmiVersion != "2.0" for d in descriptions.values()):
         raise UsageError("libcosim runs FMI 2.0 FMUs only; this package holds others")
+    if args.engine == "model-exchange":
+        lacking = [f"{name} ({fmus[name].name})" for name, d in descriptions.items() if d.modelExchange is None]
+        if lacking:
+            raise UsageError(f"model-exchange needs every FMU's Model Exchange interface; {', '.join(lacking)} "
+                             f"{'has' if len(lacking) == 1 else 'have'} none (the Python FMUs are co-simulation "
+                             "only: take the native package)")
     changes = parameter_changes(args.set, system, descriptions)
     package = args.package
     if changes:
         package = ssp_package.with_parameters(args.package, changes, scratch / args.package.name)
         system = ssp_package.read(package)
     check_start_values(engine_instances(ssp=package))
-    reason = step_limit_error(system, {name: d.modelName for name, d in descriptions.items()}, args.step)
+    models = {name: d.modelName for name, d in descriptions.items()}
+    reason = step_limit_error(system, models, args.step) if args.engine in JACOBI_ENGINES else None
     if reason is not None:
         raise UsageError(reason)
     outputs, headers = output_columns(system, descriptions)
     out = args.out or Path(args.package.name).with_suffix(".csv")
     if not out.parent.is_dir():
         raise UsageError(f"--out {out}: no folder {out.parent}")
-    rows = run_engine(args.engine, package, system, fmus, outputs, stop_time, args.step, progress_printer(stop_time))
+    rows = run_engine(args.engine, package, system, fmus, outputs, stop_time, args.step, progress_printer(stop_time),
+                      args.rtol)
     return write_csv(out, ["time [s]", *headers], rows.tolist())
 
 
@@ -200,7 +228,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         with tempfile.TemporaryDirectory(prefix="driveline-system-") as scratch:
             out = run(args, Path(scratch))
-    except (UsageError, PackageError, StartValuesRefused) as error:
+    except (UsageError, PackageError, StartValuesRefused, NotRunnable) as error:
         print(f"{sys.argv[0]}: error: {error}", file=sys.stderr)
         sys.exit(2)
     except StepRefused as error:

@@ -37,6 +37,7 @@ class TripodCouplingModel(DrivenShaftModel):
         {"kinematics": EXACT, "mu": 0.05, "seed_reactions": 1, "alpha_in": 30.0, "beta_dot": 0.5, "beta_ddot": 3.0,
          "phi_in_start": 0.4},
         {"beta_rate": RATES_FROM_SAMPLES, "beta_dot": 0.5, "phi_in_start": 0.4},
+        {"kinematics": EXACT, "mu": 0.05, "alpha_in": 30.0, "beta_dot": 0.5, "beta_ddot": 3.0, "phi_in_start": 0.4},
     )
 
     def reset_internal_state(self) -> None:

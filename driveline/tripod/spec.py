@@ -11,9 +11,10 @@ CLOSED_FORM, EXACT = 0, 1
 BETA_LIMIT = math.radians(60.0)
 RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 # What the outputs are computed from (``depends_on``): the joint's position, the plungers' inertia,
-# the rates of speed and bend, the plungers' forces and the forces with friction
+# the rates of speed and bend, the plungers' forces and the forces with friction. An output's list is
+# the union over the modes: the seed's eqs 20, 30, 33, 34 and the leading order need fewer, the exact
+# reactions (a_plunger_sum, Rz_out, Rx_in, Ry_in with the bend's rates, the load and friction) more.
 POSITION = ("phi_in", "beta", "r", "l", "kinematics")
-INERTIA = (*POSITION, "omega_in", "m_plunger", "seed_reactions")
 PLUNGERS = (*POSITION, "omega_in", "m_plunger", "alpha_in", "beta_dot", "beta_ddot", "beta_rate")
 FORCES = (*PLUNGERS, "T_load", "mu", "v_slip")
 FRICTION = tuple(name for name in FORCES if name != "kinematics")  # zero without friction, which needs the exact
@@ -92,19 +93,20 @@ SPEC = ModelSpec(
         Variable("theta", "output", 0.0, "Cone angle theta of the output shaft about the bearing centre", "rad", "deg",
                  depends_on=POSITION),
         Variable("a_plunger_sum", "output", 0.0, "Sum a1 + a2 + a3 of the plungers' axial accelerations (eq 20)",
-                 "m/s2", depends_on=("phi_in", "beta", "r", "kinematics", "omega_in", "seed_reactions")),
+                 "m/s2", depends_on=(*POSITION, "omega_in", "alpha_in", "beta_dot", "beta_ddot", "beta_rate",
+                                     "seed_reactions")),
         Variable("Rz_out", "output", 0.0,
                  "Output self-aligning bearing on the output shaft: axial force R_z'' along the shaft (eq 30)", "N",
-                 depends_on=INERTIA),
+                 depends_on=(*FORCES, "seed_reactions")),
         Variable("Rx_out", "output", 0.0,
                  "Output bearing on the output shaft: radial force along E1 (bend-plane side, normal to the shaft)",
                  "N", depends_on=FORCES),
         Variable("Ry_out", "output", 0.0, "Output bearing on the output shaft: radial force along E2 = Y' swung", "N",
                  depends_on=FORCES),
         Variable("Rx_in", "output", 0.0, "Input bearing on the input shaft: force R_x' along X' (eq 33)", "N",
-                 depends_on=INERTIA),
+                 depends_on=(*FORCES, "seed_reactions")),
         Variable("Ry_in", "output", 0.0, "Input bearing on the input shaft: force R_y' along Y' (eq 34)", "N",
-                 depends_on=(*INERTIA, "T_load", "alpha_in")),
+                 depends_on=(*FORCES, "seed_reactions")),
         Variable("Mx_in", "output", 0.0, "Input bearing on the input shaft: moment about X' through the joint centre O",
                  "N.m", depends_on=FORCES),
         Variable("My_in", "output", 0.0, "Input bearing on the input shaft: moment about Y' through the joint centre O",

@@ -60,10 +60,10 @@ class VehicleDrivelineModel(SteppedModel):
         self._state = dynamics.advance(drive, self._state, self.T_motor, joints, step_size)
         self._evaluate(drive, joints, step_size)
 
-    def evaluate(self) -> None:
+    def evaluate(self, time: float) -> None:
         """Model Exchange (the native FMU's ``evaluate_now``): the outputs, the states' derivatives among
         them, at the states the solver holds in the outputs that are states (the case's and the
-        differential's speeds from the side gears') and this instant's inputs."""
+        differential's speeds from the side gears') and this instant's inputs; autonomous, whatever ``time``."""
         left, right = self.omega_in_left, self.omega_in_right
         self._state = ((left - right) / 2.0, (left + right) / 2.0, self.phi_wheel_left, self.omega_wheel_left,
                        self.phi_wheel_right, self.omega_wheel_right, self.v_x, self.x, self.slip_left, self.slip_right)

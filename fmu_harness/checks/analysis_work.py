@@ -23,6 +23,7 @@ from driveline.rotor.model import (CAMPBELL_POINTS, FE_ELEMENTS, MAX_ORDER, MAX_
                                    CriticalSpeedsModel, parse_orders, searched_modes)
 from driveline.rotor.spec import OMEGA_IN_MAX_MIN
 from driveline.rotor.work import MAX_ANALYSIS_SECONDS, STAGES, estimate
+from ..console import summary
 
 #: The budgets of one analysis on the project's two-core machine: (seconds, bytes of memory).
 PYTHON_BUDGET = (30.0, 2 * 1024**3)
@@ -334,7 +335,7 @@ def table(results: dict[str, dict]) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--native", type=Path, help="a native CriticalSpeeds FMU (FMI 2.0) to measure too")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as folder:

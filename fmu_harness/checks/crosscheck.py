@@ -25,6 +25,7 @@ from driveline.catalog import MODELS
 
 from ..runs.runner import FmuInstance
 from ..runs.scenario import scenario, standard_run
+from ..console import summary
 
 REL_TOL = 1e-9
 
@@ -79,7 +80,7 @@ def rerun(fmu: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     args = parser.parse_args(argv)
     for pattern in ("*.fmu", "fmi3/*.fmu", "native/*.fmu", "native/fmi3/*.fmu"):

@@ -30,6 +30,7 @@ from pathlib import Path
 from ..doc_pages.sections import replace_section
 from ..packaging import fmu_path, native
 from .worker import answer, answer_in, check_parser
+from ..console import summary
 
 RESULT = "engine refusal: "
 MODEL = "TripodCoupling"
@@ -134,7 +135,7 @@ def table(models: Path, natives: Path | None = None) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = check_parser(__doc__.splitlines()[0], "host table", ("ENGINE", "FMU", "REFUSAL")).parse_args(argv)
+    args = check_parser(summary(__doc__), "host table", ("ENGINE", "FMU", "REFUSAL")).parse_args(argv)
     if args.worker:
         engine, path, refusal = args.worker
         answer(RESULT, observe(engine, Path(path), *REFUSALS[refusal]))

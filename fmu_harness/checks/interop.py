@@ -32,7 +32,7 @@ from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
 
-from ..console import Progress
+from ..console import Progress, summary
 from ..doc_pages.sections import replace_section, section
 from ..packaging import fmu_path, native
 from ..runs.runner import FmuInstance
@@ -241,7 +241,7 @@ def markdown(table: Table) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = check_parser(__doc__.splitlines()[0], "matrix section", ("ENGINE", "FMU", "REFERENCE"))
+    parser = check_parser(summary(__doc__), "matrix section", ("ENGINE", "FMU", "REFERENCE"))
     args = parser.parse_args(argv)
     if args.worker:
         engine, fmu, reference = args.worker

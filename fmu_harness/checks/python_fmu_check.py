@@ -31,6 +31,7 @@ from driveline.catalog import MODELS
 from ..packaging import native
 from ..runs.runner import FmuInstance
 from ..runs.scenario import standard_run
+from ..console import summary
 
 REPORT = "python_fmus.md"
 
@@ -77,7 +78,7 @@ def run(models: Path, natives: Path, out: Path, names: Sequence[str] = ()) -> li
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("names", nargs="*", help="models to compare (default: all)")
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of the FMI 2.0 Python FMUs")
     parser.add_argument("--native", type=Path, help="folder whose native/ holds the native FMUs (default: --models)")

@@ -39,6 +39,7 @@ from driveline.catalog import MODELS
 from .failing_model import FAILURES, FailingModel, build_failing_fmus
 from .robustness_probe import (DISTINCT_TEXTS_LEAK, ECOS_IGNORES_DISCARD, FMI2_DISCARD, NO_GUID_CHECK,
                                 STATUS_OK_LOGGED, VERDICT, WRAPPER_DEPARTURES)
+from ..console import summary
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Seconds a case may take; every case needs a few seconds at most (a host process start included).
@@ -420,7 +421,7 @@ def skipped(results: list[Result]) -> str:
 def main(argv: list[str] | None = None) -> None:
     from ..packaging import fmu_path, native
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--models", type=Path, default=Path("models"),
                         help="folder of the built FMUs (the native ones in its native/; default: models)")
     parser.add_argument("--family", action="append", choices=FAMILIES,

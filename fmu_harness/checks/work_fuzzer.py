@@ -32,6 +32,7 @@ from driveline.rotor.model import (CAMPBELL_POINTS, FE_ELEMENTS, MAX_ORDER, MAX_
 from driveline.rotor.work import estimate
 from fmu_harness.checks.analysis_work import (NATIVE_BUDGET, PYTHON_BUDGET, ROUND_OFF_LAYOUT, ROUND_OFF_PARAMETERS,
                                               peak_resident)
+from ..console import summary
 
 BUDGETS = {"python": PYTHON_BUDGET, "native": NATIVE_BUDGET}
 #: Communication step of a run [s]; each analysis is followed by one step.
@@ -271,7 +272,7 @@ def summary(results: list[dict]) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--cases", type=int, default=20,
                         help="cases per family (default 20; the first is the issue's layout)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the random cases (default 0)")

@@ -14,6 +14,7 @@ from driveline.catalog import MODELS
 from driveline.variables import ModelSpec
 
 from .sections import DOCS, model_page, replace_section
+from ..console import summary
 
 
 def _escaped(text: str) -> str:
@@ -66,7 +67,7 @@ def update(docs: Path = DOCS) -> None:
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--update", type=Path, metavar="DOCS", help="docs folder whose model pages to rewrite")
     args = parser.parse_args()
     if args.update:

@@ -41,6 +41,7 @@ from driveline.vehicle.dynamics import Joints
 from driveline.vehicle.model import VehicleDrivelineModel
 
 from . import system
+from ..console import summary
 
 #: The compared signals: co-simulation column and its meaning.
 SIGNALS = {
@@ -231,7 +232,7 @@ def convergence_table(models: Path, stop_time: float, steps: tuple[float, ...] =
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs (native/ below)")
     parser.add_argument("--stop-time", type=float, default=0.5, help="length of the compared launch [s]")
     parser.add_argument("--gauss-seidel", action="store_true",

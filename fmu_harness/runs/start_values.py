@@ -29,6 +29,7 @@ from driveline.catalog import MODELS
 
 from .ssp import bindings
 from .ssp_package import read
+from ..console import summary
 
 _KINDS = {"Real": float, "Integer": int, "Boolean": lambda text: str(text).lower() in ("true", "1"), "String": str}
 
@@ -111,7 +112,7 @@ def _connected_inputs(instances: list[Instance], connections: list[tuple[tuple[s
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("target", type=Path, help="an SSP package or an FMU")
     parser.add_argument("values", nargs="*", metavar="NAME=VALUE", help="start values of an FMU")
     args = parser.parse_args(argv)

@@ -57,7 +57,7 @@ from fmpy.model_description import ModelDescription
 
 from driveline.catalog import MODELS
 
-from ..console import CommandParser, Progress, optional
+from ..console import CommandParser, Progress, optional, summary
 from .runner import StepRefused, simulate
 from .start_values import refusals
 from .system_sweep import (
@@ -613,7 +613,7 @@ def read_table(path: Path) -> pa.Table:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = CommandParser(description=__doc__.splitlines()[0])
+    parser = CommandParser(description=summary(__doc__))
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--grid", nargs="+", metavar="AXIS", help="name=v1,v2,... or name=start:stop:count")
     source.add_argument("--points", type=Path, help="CSV or JSON file of points")

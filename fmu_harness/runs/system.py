@@ -42,6 +42,7 @@ from .runner import FmuInstance, StepRefused
 from .ssp import SSC, SSD, SSV
 from .ssp_package import SspSystem
 from .start_values import Instance, StartValuesRefused, check_start_values
+from ..console import summary
 
 for prefix, uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV)):
     ET.register_namespace(prefix, uri)
@@ -350,7 +351,7 @@ def _named(name: str, call: Callable[..., None], *arguments: object) -> None:
 
 def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) -> str | None:
     """Why ``step`` is too long for a component whose model (``models``: each component's model name)
-    states a limit for a Jacobi coupling (every engine here couples so): a ``VehicleDriveline``'s
+    states a limit for a Jacobi coupling (the Jacobi master, libcosim, Ecos): a ``VehicleDriveline``'s
     differential mode; None when no limit is passed."""
     for component in system.components:
         if models[component.name] != "VehicleDriveline":
@@ -362,7 +363,7 @@ def step_limit_error(system: SspSystem, models: Mapping[str, str], step: float) 
             return (f"{component.name} (VehicleDriveline): --step {step!r} s is above {limit:.3g} s, the longest step "
                     f"at which its differential's internal mode ({dynamics.modes_text(drive)}) stays stable with the "
                     f"joints' torques one step late (omega h <= min({dynamics.JACOBI_OMEGA_STEP}, "
-                    f"{dynamics.JACOBI_DAMPING_STEP} zeta)): take a shorter step")
+                    f"{dynamics.JACOBI_DAMPING_STEP} zeta)): take a shorter step, or the Gauss-Seidel master")
     return None
 
 
@@ -380,7 +381,7 @@ def simulate(system: System, models: Path, outputs: list[str] | None = None, nat
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--native", action="store_true", help="the native FMUs where a model has one")
     args = parser.parse_args(argv)

@@ -7,12 +7,14 @@
  * by successive substitution), its leading order in r/l (reactions_closed_form.py), or the seed's
  * eqs 20, 30, 33, 34 as printed (dynamics.py). Every expression keeps the Python core's order of
  * operations; where Python's math module or float division raises, the step is refused with
- * Python's words.
+ * Python's words. The exact partial derivatives of the outputs (the ``jacobian`` hook) are in the
+ * folder tripod_coupling/ (derivatives.h).
  */
 #include <math.h>
 
 #include "driveline_constants.h"
 #include "fmu_instance.h"
+#include "tripod_coupling/derivatives.h"
 
 #define INTEGER(name) (data->int_value[V_##name])
 /* the exact solver's warm start (plane_solver.Solution): a flag, then phi_in, x, y, dx/dphi, dy/dphi */
@@ -674,6 +676,13 @@ static const char *start_notice(const ModelData *data)
     return INTEGER(beta_rate) == RATES_AUTOMATIC && RATES_SET == 0.0 ? RATES_ESTIMATED : NULL;
 }
 
+/* The outputs' partial derivatives at the point the step has just computed (tripod_coupling/derivatives.h),
+ * the exact closure's at the solution the step found there. */
+static Failure jacobian(const ModelData *data, double partial[])
+{
+    return tripod_jacobian(data, INTEGER(kinematics) == TRIPOD_SPEC_EXACT ? SOLUTION + 1 : NULL, partial);
+}
+
 const ModelHooks model_hooks = {.reset_internal = reset_internal, .start = start, .advance = advance,
                                 .evaluate = evaluate_now, .extra_parameter_errors = extra_parameter_errors,
-                                .start_notice = start_notice};
+                                .start_notice = start_notice, .jacobian = jacobian};

@@ -56,11 +56,16 @@ static double equivalent_mass(const ModelData *data, Failure *failure)
     return VALUE(m_vehicle) + divide(failure, 2.0 * VALUE(J_wheel), VALUE(r_wheel) * VALUE(r_wheel));
 }
 
+/* wheel_load */
+static double wheel_load(const ModelData *data)
+{
+    return VALUE(m_vehicle) * VEHICLE_DYNAMICS_GRAVITY * cos(VALUE(grade)) * VALUE(front_share) / 2.0;
+}
+
 /* (V5) tyre_force */
 static double tyre_force(const ModelData *data, Failure *failure, double slip, double mu)
 {
-    double load = VALUE(m_vehicle) * VEHICLE_DYNAMICS_GRAVITY * cos(VALUE(grade)) * VALUE(front_share) / 2.0;
-    double limit = mu * load;
+    double limit = mu * wheel_load(data);
     return limit * tanh(divide(failure, VALUE(C_slip) * slip, limit));
 }
 
@@ -185,11 +190,16 @@ static Failure integrate(ModelData *data, const Joints *joints, double step_size
     return NO_FAILURE;
 }
 
+/* (V9) the inertia of the rotating parts' angular momentum at the case's speed (reaction_torque) */
+static double momentum_inertia(const ModelData *data)
+{
+    return VALUE(ratio) * VALUE(J_motor) + VALUE(J_diff) + 2.0 * VALUE(J_side);
+}
+
 /* (V9) reaction_torque */
 static double reaction_torque(const ModelData *data, const Joints *joints, double case_acceleration)
 {
-    double momentum_inertia = VALUE(ratio) * VALUE(J_motor) + VALUE(J_diff) + 2.0 * VALUE(J_side);
-    return -(joints->T_in_left + joints->T_in_right) - momentum_inertia * case_acceleration;
+    return -(joints->T_in_left + joints->T_in_right) - momentum_inertia(data) * case_acceleration;
 }
 
 /* VehicleDrivelineModel._evaluate: outputs at the state reached ``elapsed`` after the inputs' time */
@@ -362,6 +372,96 @@ static Failure evaluate_now(ModelData *data, double UNUSED time)
     return evaluate(data, &joints, 0.0);
 }
 
+/* (V5) differentiated: dF_x / d slip = C_slip / cosh^2(C_slip slip / (mu F_z)), smooth, falling to 0 where
+ * the force saturates */
+static double tyre_slope(const ModelData *data, double slip, double mu)
+{
+    double growth = cosh(VALUE(C_slip) * slip / (mu * wheel_load(data)));
+    return VALUE(C_slip) / (growth * growth);
+}
+
+/* (V8) differentiated: rolling resistance's f_roll m g cos(grade) / (v_low cosh^2(v / v_low)) and the drag's
+ * rho_air c_drag A_front |v| (v |v| has the slope 2 |v|: continuous, no kink); the grade's term is constant */
+static double road_load_slope(const ModelData *data, double v)
+{
+    double growth = cosh(v / VALUE(v_low));
+    return VALUE(f_roll) * VALUE(m_vehicle) * VEHICLE_DYNAMICS_GRAVITY * cos(VALUE(grade)) /
+               (VALUE(v_low) * growth * growth) +
+           VALUE(rho_air) * VALUE(c_drag) * VALUE(A_front) * fabs(v);
+}
+
+/* One side's places in the Jacobian: the rows of its outputs, the columns of its joint's inputs and its
+ * states, and the sign of its joint's frame in the drive's sense (joints_of: +1 left, -1 right). */
+typedef struct {
+    int T_load, alpha_wheel, F_x, slip_dot;
+    int phi_out, omega_out, phi_wheel, omega_wheel, slip;
+    double frame;
+} Side;
+
+static const Side LEFT = {ROW_T_load_left, ROW_alpha_wheel_left, ROW_F_x_left, ROW_slip_dot_left,
+                          COLUMN_phi_out_left, COLUMN_omega_out_left, COLUMN_phi_wheel_left, COLUMN_omega_wheel_left,
+                          COLUMN_slip_left, 1.0};
+static const Side RIGHT = {ROW_T_load_right, ROW_alpha_wheel_right, ROW_F_x_right, ROW_slip_dot_right,
+                           COLUMN_phi_out_right, COLUMN_omega_out_right, COLUMN_phi_wheel_right,
+                           COLUMN_omega_wheel_right, COLUMN_slip_right, -1.0};
+
+#define AT(row, column) (partial[(row) * MODEL_COLUMN_COUNT + (column)])
+
+/* A side's halfshaft (V3, T_load in its joint's frame: frame times the drive's), wheel (V4), tyre (V5) and
+ * slip (V6; d|v|/dv = sign_v) rows, with its tyre's share of a_x (V7: ``mass`` the equivalent mass) */
+static void side_partials(const ModelData *data, double partial[], const Side *side, double k, double c, double mu,
+                          double slip, double sign_v, double mass)
+{
+    double J = VALUE(J_wheel), r = VALUE(r_wheel), sigma = VALUE(sigma_slip);
+    double slope = tyre_slope(data, slip, mu);
+    AT(side->T_load, side->phi_out) = k;
+    AT(side->T_load, side->phi_wheel) = -side->frame * k;
+    AT(side->T_load, side->omega_out) = c;
+    AT(side->T_load, side->omega_wheel) = -side->frame * c;
+    AT(side->alpha_wheel, side->phi_out) = side->frame * k / J;
+    AT(side->alpha_wheel, side->phi_wheel) = -k / J;
+    AT(side->alpha_wheel, side->omega_out) = side->frame * c / J;
+    AT(side->alpha_wheel, side->omega_wheel) = -c / J;
+    AT(side->alpha_wheel, side->slip) = -r * slope / J;
+    AT(side->F_x, side->slip) = slope;
+    AT(ROW_a_x, side->slip) = slope / mass;
+    AT(side->slip_dot, side->omega_wheel) = r / sigma;
+    AT(side->slip_dot, COLUMN_v_x) = (-1.0 - sign_v * slip) / sigma;
+    AT(side->slip_dot, side->slip) = -(fabs(VALUE(v_x)) + VALUE(v_low)) / sigma;
+}
+
+/* The exact partial derivatives of the outputs with respect to the inputs and the states, (V1)-(V9)
+ * differentiated at the point evaluate_now has just evaluated (no internal step: the state is the solver's).
+ * The case's and the differential's accelerations (V1, V2) and T_reaction (V9) are linear in the torques,
+ * omega_motor in the side gears' speeds (case = (omega_in_left - omega_in_right) / 2), the halfshafts (V3) in
+ * the angles and speeds; the tyre forces (V5) and the rolling resistance (V8) are smooth (tanh), the drag
+ * v |v| has the continuous slope 2 |v|. The one kink is the slip speed |v| + v_low of (V6) at v_x = 0, where
+ * the derivative with respect to v_x is the one for a growing v_x (d|v|/dv = 1). */
+static Failure jacobian(const ModelData *data, double partial[])
+{
+    Failure failure = NO_FAILURE;
+    double v = VALUE(v_x), sign_v = v >= 0.0 ? 1.0 : -1.0, mass = equivalent_mass(data, &failure);
+    double case_inertia_inverse = 1.0 / case_inertia(data), diff_inverse = 1.0 / (2.0 * VALUE(J_side));
+    double case_motor = VALUE(ratio) * case_inertia_inverse, momentum = momentum_inertia(data);
+    PARTIAL(alpha_in_left, T_motor) = case_motor;
+    PARTIAL(alpha_in_left, T_in_left) = -case_inertia_inverse - diff_inverse;
+    PARTIAL(alpha_in_left, T_in_right) = case_inertia_inverse - diff_inverse;
+    PARTIAL(alpha_in_right, T_motor) = -case_motor;
+    PARTIAL(alpha_in_right, T_in_left) = case_inertia_inverse - diff_inverse;
+    PARTIAL(alpha_in_right, T_in_right) = -case_inertia_inverse - diff_inverse;
+    PARTIAL(T_reaction, T_motor) = -momentum * case_motor;
+    PARTIAL(T_reaction, T_in_left) = -1.0 + momentum * case_inertia_inverse;
+    PARTIAL(T_reaction, T_in_right) = 1.0 - momentum * case_inertia_inverse;
+    PARTIAL(omega_motor, omega_in_left) = 0.5 * VALUE(ratio);
+    PARTIAL(omega_motor, omega_in_right) = -0.5 * VALUE(ratio);
+    side_partials(data, partial, &LEFT, VALUE(k_left), VALUE(c_left), VALUE(mu_road_left), VALUE(slip_left), sign_v,
+                  mass);
+    side_partials(data, partial, &RIGHT, VALUE(k_right), VALUE(c_right), VALUE(mu_road_right), VALUE(slip_right),
+                  sign_v, mass);
+    PARTIAL(a_x, v_x) = -road_load_slope(data, v) / mass;
+    return failure;
+}
+
 const ModelHooks model_hooks = {
     .reset_internal = reset_internal, .start = start, .advance = advance, .evaluate = evaluate_now,
-    .step_size_errors = step_size_errors, .step_notice = step_notice};
+    .step_size_errors = step_size_errors, .step_notice = step_notice, .jacobian = jacobian};

@@ -1,5 +1,6 @@
-"""``driveline-fmus system``: any SSP package run to a CSV file by the project's master, libcosim or Ecos,
-with parameters set from the command line, and every mistake one line before any work."""
+"""``driveline-fmus system``: any SSP package run to a CSV file by the project's master (Jacobi or
+Gauss-Seidel), libcosim or Ecos, with parameters set from the command line, and every mistake one line
+before any work."""
 
 from __future__ import annotations
 
@@ -76,6 +77,27 @@ def test_the_engines_give_the_masters_results(engine, native_ssp, tmp_path, fmi2
     scale[header.index("coupling.a_plunger_sum [m/s2]")] = np.abs(
         reference[:, header.index("coupling.F_plunger1 [N]")]).max() / mass
     assert (np.abs(values - reference).max(axis=0) / scale).max() <= 1e-9
+
+
+def test_gauss_seidel_runs_the_launch_in_the_packages_order_at_a_step_jacobi_refuses(fmi2_dir, native_dir, tmp_path,
+                                                                                      capsys):
+    """``VehicleLaunch.ssp`` at 8e-4 s, above the drive's Jacobi limit (4.15e-4 s): the Jacobi master
+    refuses it in one line naming the way out; ``--engine gauss-seidel`` runs it, every column bit for
+    bit the master's in the package's order (:data:`system.LAUNCH_ORDER`)."""
+    package = system.write_ssp(system.vehicle_launch(), fmi2_dir, native_dir)
+    step, stop = 8e-4, 0.04
+    arguments = [str(package), "--stop-time", str(stop), "--step", str(step), "--out", str(tmp_path / "run.csv")]
+    with pytest.raises(SystemExit) as exit_status:
+        system_command.main(arguments)
+    err = capsys.readouterr().err
+    assert exit_status.value.code == 2 and err.count("\n") == 1 and err.rstrip().endswith("or the Gauss-Seidel master")
+    system_command.main([*arguments, "--engine", "gauss-seidel"])
+    with (tmp_path / "run.csv").open() as handle:
+        header, *rows = list(csv.reader(handle))
+    launch = dataclasses.replace(system.vehicle_launch(), stop_time=stop, step_size=step)
+    outputs = [column.split(" [")[0] for column in header[1:]]
+    expected = system.simulate(launch, fmi2_dir, outputs, natives=native_dir, order=system.LAUNCH_ORDER)
+    np.testing.assert_array_equal(np.array(rows, dtype=float), expected)
 
 
 @pytest.mark.parametrize(("options", "words"), [

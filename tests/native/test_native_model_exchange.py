@@ -186,7 +186,7 @@ def test_vehicle_driveline_derivatives_are_the_cores(native_dir, tmp_path, fmi):
         core = MODELS["VehicleDriveline"]()
         for name, value in {**inputs, **dict(zip([s.name for s in spec.states], states))}.items():
             setattr(core, name, float(value))
-        core.evaluate()
+        core.evaluate(0.0)
         expected = [getattr(core, name) for name in outputs]
         assert model.get(outputs) == pytest.approx(expected, rel=1e-13, abs=1e-13)
         assert list(model.derivatives()) == pytest.approx([getattr(core, s.derivative) for s in spec.states],

@@ -3,11 +3,13 @@ a missing optional package named with its extra."""
 
 from __future__ import annotations
 
+import importlib
 import io
+from pathlib import Path
 
 import pytest
 
-from fmu_harness.console import Progress, optional
+from fmu_harness.console import Progress, optional, summary
 
 
 class Terminal(io.StringIO):
@@ -51,3 +53,18 @@ def test_a_missing_optional_package_ends_the_command_naming_its_extra():
     assert exited.value.code == ("driveline-fmus sweep needs a_package_that_is_not_there, which is not installed: "
                                  "pip install 'driveline-fmus[sweep]'")
     assert optional("json", "sweep", "driveline-fmus sweep").__name__ == "json"
+
+
+def _commands() -> list[str]:
+    """The modules whose ``--help`` describes them by :func:`summary` of their docstring."""
+    root = Path(__file__).resolve().parents[2]
+    return sorted(str(path.relative_to(root).with_suffix("")).replace("/", ".")
+                  for folder in ("benchmarks", "fmu_harness") for path in (root / folder).rglob("*.py")
+                  if "summary(__doc__)" in path.read_text())
+
+
+@pytest.mark.parametrize("module", _commands())
+def test_a_commands_help_opens_with_a_whole_sentence(module):
+    """Its docstring's first paragraph on one line, a sentence ending with a period, short enough to read."""
+    described = summary(importlib.import_module(module).__doc__)
+    assert described.endswith(".") and "\n" not in described and 20 <= len(described) <= 200, described
