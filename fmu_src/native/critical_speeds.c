@@ -813,7 +813,7 @@ static Failure evaluate(ModelData *data)
 
 /* The exact derivatives of the outputs in omega_in at the point evaluate has just computed, each that of
  * the lookup that gives the output, times d|omega_in| / d omega_in (1 at omega_in = 0: for a growing
- * omega_in). The critical speeds are the structure's (no row); the whirl frequencies are the Campbell
+ * omega_in). The critical speeds are the structure's (0); the whirl frequencies are the Campbell
  * table's cubic splines, the derivative of the branch each sorted value comes from; the nearest order
  * resonance keeps its speed (the branch the point is on), its margin moves as 1 / resonance_speed;
  * the response and the bearing force by the response's linear solve differentiated, the damping

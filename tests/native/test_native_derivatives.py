@@ -193,6 +193,29 @@ def test_directional_derivatives_equal_the_python_cores_extrapolated_differences
         model.close()
 
 
+def test_critical_speeds_at_standstill_gives_the_derivative_for_a_growing_speed(native_dir, tmp_path, fmi):
+    """At omega_in = 0, where the outputs of |omega_in| have a kink (the whirl frequencies part there), the
+    derivatives for a growing omega_in: forward differences of the FMU, steps 1e-2 and 5e-3 rad/s
+    extrapolated (error O(h^2), rounding 2 eps |f| / h: 5e-11 of the whirl rows' scale), within 1e-7 of the
+    row's scale; the response's and the bearing force's 0 (they grow as omega_in^2)."""
+    path = native.fmu_path(native_dir, "CriticalSpeeds", fmi)
+    rows, columns = derivatives.layout("CriticalSpeeds")
+    model = _at_point(path, fmi, ({"omega_in": 0.0}, {}), tmp_path)
+    jacobian = derivatives.exact(model.fmu, "CriticalSpeeds", fmi)
+
+    def forward(h: float) -> np.ndarray:
+        model.set({"omega_in": h})
+        above = np.array(model.get(rows))
+        model.set({"omega_in": 0.0})
+        return (above - np.array(model.get(rows))) / h
+
+    reference = 2.0 * forward(5e-3) - forward(1e-2)
+    assert np.all(derivatives.scaled_error(jacobian, reference[:, None], np.zeros(1)) <= FMU_TOLERANCE)
+    assert jacobian[rows.index("whirl_forward_1"), 0] > 0.0 > jacobian[rows.index("whirl_backward_1"), 0]
+    assert jacobian[rows.index("unbalance_response"), 0] == jacobian[rows.index("bearing_force_max"), 0] == 0.0
+    model.close()
+
+
 @pytest.mark.parametrize("name", PROVIDING)
 def test_co_simulation_gives_the_model_exchange_derivatives(native_dir, tmp_path, name, fmi):
     """At the start and after 0.01 s the co-simulation instance's Jacobian is the Model Exchange
