@@ -33,6 +33,7 @@ from driveline.catalog import MODELS
 from fmu_harness.packaging import native
 from support import derivatives
 from support.model_exchange import ModelExchange
+from support.native_rotor import SOLVE_ROUNDING
 
 PROVIDING = [name for name in native.native_models() if native.provides_derivatives(name)]
 INTERFACES = ("ModelExchange", "CoSimulation")
@@ -60,12 +61,9 @@ DERIVATIVE_POINTS = {"CriticalSpeeds": (
 
 
 #: Rows whose values round above eps, with their relative rounding: CriticalSpeeds' unbalance response and
-#: bearing force come from a banded solve of the dynamic stiffness, which rounds at about cond eps (largest
-#: deviation from a cubic through 41 speeds 1e-5 |omega_in| apart, both cores, measured 2026-11-27: 5.2e-13 at
-#: the start values to 9.8e-12 on the anisotropic layout). A difference with step h errs by up to it |f| / h,
-#: the extrapolated one by 6.6 times that (its weights 1/45, 20/45, 64/45 on steps h, h/2, h/4).
-ROUNDING = {"CriticalSpeeds": {"unbalance_response": 3e-11, "bearing_force_max": 3e-11}}
-EXTRAPOLATION_ROUNDING = (1.0 + 20.0 * 2.0 + 64.0 * 4.0) / 45.0
+#: bearing force come from a banded solve of the dynamic stiffness (support.native_rotor.SOLVE_ROUNDING). A
+#: difference with step h errs by up to it |f| / h, the extrapolated one by EXTRAPOLATION_ROUNDING times that.
+ROUNDING = {"CriticalSpeeds": {"unbalance_response": SOLVE_ROUNDING, "bearing_force_max": SOLVE_ROUNDING}}
 #: A cubic spline's slope moves by at most 8.62 times a change of its knot values over the knot spacing
 #: (not-a-knot ends; 2.9 inside; scipy, uniform knots).
 SPLINE_SLOPE_GAIN = 8.62
@@ -184,7 +182,7 @@ def test_directional_derivatives_equal_the_python_cores_extrapolated_differences
         at = np.array([values[c] for c in columns], dtype=float)
         error = derivatives.scaled_error(jacobian, reference, at)
         outputs = derivatives.core_rows(name, values, TIME)
-        rounding = EXTRAPOLATION_ROUNDING * _rounding(name, rows) * np.abs(outputs) / derivatives.CORE_STEP
+        rounding = derivatives.EXTRAPOLATION_ROUNDING * _rounding(name, rows) * np.abs(outputs) / derivatives.CORE_STEP
         tables = CORE_AGREEMENT[name](name, values, dict(zip(rows, outputs))) if name in CORE_AGREEMENT else {}
         slopes = np.array([tables.get(row, 0.0) for row in rows]) * np.max(derivatives.scales(at), initial=1.0)
         bound = derivatives.row_bounds(name, FMU_TOLERANCE, CORE_TOLERANCE)[1]

@@ -23,8 +23,9 @@ from driveline.rotor.fem import assemble, elements_by_length
 from driveline.rotor.loader import example_path, load_driveline, loads_driveline
 from driveline.rotor.unbalance_outputs import DAMPED_MODES, FE_ELEMENTS, TABLE_ELEMENTS, UnbalanceOutputs
 
-from support.native_rotor import (DOUBLE_P, ERROR_KIND, CDriveline, ErrorKind, P, c_driveline, compile_rotor, declare,
-                                  unbalances)
+from support.derivatives import EXTRAPOLATION_ROUNDING, extrapolated
+from support.native_rotor import (DOUBLE_P, ERROR_KIND, SOLVE_ROUNDING, CDriveline, ErrorKind, P, c_driveline,
+                                  compile_rotor, declare, unbalances)
 
 EPS = np.finfo(float).eps
 #: Natural frequencies, relative: scipy's and the C Cholesky reduction both lose the lowest
@@ -202,9 +203,6 @@ def test_unbalance_outputs_match_the_python_model(library, name):
     assert zeta <= bound, f"tabulated damping ratios differ by {zeta:.3g}"
 
 
-#: Relative rounding of the response and the bearing force: the banded solve's, about cond eps (measured at
-#: most 9.8e-12 on the FMU's points, test_native_derivatives.ROUNDING)
-SOLVE_ROUNDING = 3e-11
 #: Slopes at speeds off the mode table's knots and away from resonances and from where the nearest mode changes
 SLOPE_SPEEDS = (37.0, 310.0, 790.0, 1220.0)
 
@@ -214,18 +212,16 @@ def test_the_slopes_are_the_derivatives_of_the_outputs(library, name):
     """unbalance_outputs_slopes against Richardson-extrapolated central differences of the outputs (steps 2e-3,
     1e-3, 5e-4 of the speed: error O(h^6)): on the fixed ends' bearings (no row), the doubled system of
     anisotropic and cross-coupled bearings (elliptic orbits: |B| > 0, complex k_b), a layout's own unbalances
-    with a phase. Within 1e-9 of the slope, plus the values' rounding, which the extrapolation multiplies by
-    6.6 / h (its weights 1/45, 20/45, 64/45 on the steps h, h/2, h/4)."""
+    with a phase. Within 1e-9 of the slope, plus the values' rounding (SOLVE_ROUNDING, eps for the spline's
+    damping ratio) as the extrapolation multiplies it (EXTRAPOLATION_ROUNDING / h)."""
     d = OUTPUTS[name]
     items = excitation(d)
     got = outputs(library, d, items, 0.3, OMEGA_MAX, SLOPE_SPEEDS, slopes=True)
     for speed, slope in zip(SLOPE_SPEEDS, got):
         h = 2e-3 * speed
-        steps = [h, h / 2, h / 4]
-        values = outputs(library, d, items, 0.3, OMEGA_MAX, [speed + sign * k for k in steps for sign in (1, -1)])
-        d1, d2, d4 = ((values[2 * i] - values[2 * i + 1]) / (2 * k) for i, k in enumerate(steps))
-        reference = (16.0 * (4.0 * d4 - d2) / 3.0 - (4.0 * d2 - d1) / 3.0) / 15.0
-        rounding = np.array([SOLVE_ROUNDING, SOLVE_ROUNDING, EPS]) * np.abs(values).max(axis=0) * 6.6 / h
+        reference = extrapolated(lambda x: outputs(library, d, items, 0.3, OMEGA_MAX, [x])[0], speed, h)
+        size = np.abs(outputs(library, d, items, 0.3, OMEGA_MAX, [speed - h, speed + h])).max(axis=0)
+        rounding = np.array([SOLVE_ROUNDING, SOLVE_ROUNDING, EPS]) * size * EXTRAPOLATION_ROUNDING / h
         assert np.all(np.abs(slope - reference) <= 1e-9 * np.abs(reference) + rounding), (speed, slope, reference)
         assert slope[0] != 0.0 and (slope[1] != 0.0 or name == "ends"), (speed, slope)  # ends: bearings held
 

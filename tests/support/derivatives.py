@@ -10,6 +10,7 @@ The rows are the Real outputs, then der(<state>); the columns the Real inputs an
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -144,21 +145,30 @@ def core_rows(name: str, values: dict, time: float) -> np.ndarray:
                     dtype=float)
 
 
+#: What the extrapolation multiplies the values' rounding by, in units of |f| / h: its weights 1/45, 20/45, 64/45 on
+#: the central differences of steps h, h/2, h/4, whose rounding is up to that of the values times |f| / step.
+EXTRAPOLATION_ROUNDING = (1.0 + 20.0 * 2.0 + 64.0 * 4.0) / 45.0
+
+
+def extrapolated(function: Callable[[float], np.ndarray], x: float, h: float) -> np.ndarray:
+    """Richardson-extrapolated central differences of ``function`` at ``x``: D(h), D(h/2), D(h/4) combined
+    to cancel the h^2 and h^4 terms of the truncation error (error O(h^6))."""
+    def central(step: float) -> np.ndarray:
+        return (function(x + step) - function(x - step)) / (2.0 * step)
+    d1, d2, d4 = central(h), central(h / 2), central(h / 4)
+    r1, r2 = (4.0 * d2 - d1) / 3.0, (4.0 * d4 - d2) / 3.0
+    return (16.0 * r2 - r1) / 15.0
+
+
 def core_differences(name: str, values: dict, time: float) -> np.ndarray:
-    """Richardson-extrapolated central differences of the Python core: D(h), D(h/2), D(h/4) combined
-    to cancel the h^2 and h^4 terms of the truncation error."""
+    """Richardson-extrapolated central differences of the Python core (:func:`extrapolated`)."""
     _, columns = native.jacobian_layout(MODELS[name].spec)
     point = np.array([values[c] for c in columns], dtype=float)
     size = core_rows(name, values, time).size
     jacobian = np.zeros((size, len(columns)))
     for j, column in enumerate(columns):
-        def central(h: float) -> np.ndarray:
-            return (core_rows(name, {**values, column: point[j] + h}, time)
-                    - core_rows(name, {**values, column: point[j] - h}, time)) / (2.0 * h)
-        h = CORE_STEP * scales(point)[j]
-        d1, d2, d4 = central(h), central(h / 2), central(h / 4)
-        r1, r2 = (4.0 * d2 - d1) / 3.0, (4.0 * d4 - d2) / 3.0
-        jacobian[:, j] = (16.0 * r2 - r1) / 15.0
+        jacobian[:, j] = extrapolated(lambda x: core_rows(name, {**values, column: x}, time), point[j],
+                                      CORE_STEP * scales(point)[j])
     return jacobian
 
 
