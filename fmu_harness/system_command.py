@@ -37,6 +37,7 @@ from .studies.result_table import write_csv
 
 ENGINES = ("master", "gauss-seidel", "libcosim", "ecos", "model-exchange")
 JACOBI_ENGINES = ("master", "libcosim", "ecos")  # each couples by Jacobi: the inputs of a step are all one step late
+RTOL = 1e-8  # the model-exchange engine's relative tolerance unless --rtol
 PROGRESS_SHARE = 0.1  # a progress line every tenth of the run when stderr is no terminal
 
 
@@ -133,7 +134,7 @@ def progress_printer(stop_time: float, stream=sys.stderr) -> Callable[[int, int]
 
 
 def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Path], outputs: list[str],
-               stop_time: float, step_size: float, on_step: Callable[[int, int], None], rtol: float) -> np.ndarray:
+               stop_time: float, step_size: float, on_step: Callable[[int, int], None], rtol: float = RTOL) -> np.ndarray:
     """Rows of time and ``outputs`` for t_1 ... t_N from ``engine`` (``rtol``: Model Exchange's tolerance)."""
     steps = int(round(stop_time / step_size))
     if engine == "model-exchange":
@@ -166,8 +167,8 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
     parser.add_argument("--step", type=float, default=1e-3,
                         help="communication step [s], with model-exchange the output interval (default 1e-3)")
-    parser.add_argument("--rtol", type=float, default=1e-8,
-                        help="model-exchange: the integrator's relative tolerance (default 1e-8)")
+    parser.add_argument("--rtol", type=float, default=RTOL,
+                        help=f"model-exchange: the integrator's relative tolerance (default {RTOL:g})")
     parser.add_argument("--out", type=Path, help="CSV file to write (default: the package's name with .csv)")
     parser.add_argument("--set", action="append", default=[], metavar="Component.name=value",
                         help="bind a parameter or an unconnected input's start value; repeatable")
@@ -188,7 +189,7 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
         raise UsageError(f"--step {args.step!r} and --stop-time {stop_time!r}: need 0 < step <= stop time, finite")
     if not (math.isfinite(args.rtol) and 1e-13 <= args.rtol <= 1e-2):
         raise UsageError(f"--rtol {args.rtol!r}: need 1e-13 <= rtol <= 1e-2")
-    if args.rtol != 1e-8 and args.engine != "model-exchange":
+    if args.rtol != RTOL and args.engine != "model-exchange":
         raise UsageError(f"--rtol is the model-exchange engine's; --engine {args.engine} steps at --step")
     if abs(stop_time / args.step - round(stop_time / args.step)) > 1e-9 * stop_time / args.step:
         raise UsageError(f"--stop-time {stop_time!r} is no whole number of steps of {args.step!r} s")

@@ -112,6 +112,8 @@ def test_gauss_seidel_runs_the_launch_in_the_packages_order_at_a_step_jacobi_ref
     (["--step", "0"], "need 0 < step <= stop time"),
     (["--step", "0.003"], "no whole number of steps"),
     (["--engine", "dymola"], "invalid choice: 'dymola'"),
+    (["--engine", "model-exchange", "--rtol", "1e-20"], "need 1e-13 <= rtol <= 1e-2"),
+    (["--rtol", "1e-6"], "--rtol is the model-exchange engine's; --engine master steps at --step"),
 ])
 def test_a_mistake_is_one_line_and_status_2_before_any_work(options, words, native_ssp, tmp_path, capsys):
     out = tmp_path / "run.csv"
@@ -121,6 +123,19 @@ def test_a_mistake_is_one_line_and_status_2_before_any_work(options, words, nati
     assert exit_status.value.code == 2
     assert err.count("\n") == 1 and words in err and "error" in err
     assert not out.exists()
+
+
+def test_model_exchange_of_python_fmus_is_one_line(fmi2_dir, tmp_path, capsys):
+    """The Python package (co-simulation only): the engine is refused before any FMU is instantiated,
+    naming each component whose FMU has no Model Exchange interface."""
+    package = system.write_ssp(system.driveline(), fmi2_dir)
+    with pytest.raises(SystemExit) as exit_status:
+        _run(package, tmp_path / "run.csv", "--engine", "model-exchange")
+    err = capsys.readouterr().err
+    assert exit_status.value.code == 2 and err.count("\n") == 1
+    assert ("model-exchange needs every FMU's Model Exchange interface; source (SpeedSource.fmu), coupling "
+            "(TripodCoupling.fmu), critical (CriticalSpeeds.fmu) have none") in err
+    assert not (tmp_path / "run.csv").exists()
 
 
 @pytest.mark.parametrize("package", ["missing.ssp", "not_a_package.ssp"])
