@@ -13,6 +13,8 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "fmu_instance.h"
 #include "fmu_layer.h"
@@ -141,6 +143,41 @@ static void jacobian_at_point(Instance *instance, double partial[])
     }
 }
 
+/* 1 when the instance's point is the one its kept Jacobian was computed at. */
+static int same_point(const Instance *instance)
+{
+    const ModelData *now = &instance->data, *then = &instance->jacobian_point;
+    return instance->jacobian_valid && instance->jacobian_epoch == instance->epoch &&
+           memcmp(&now->time, &then->time, sizeof now->time) == 0 &&
+           memcmp(now->real_value, then->real_value, sizeof now->real_value) == 0 &&
+           memcmp(now->int_value, then->int_value, sizeof now->int_value) == 0;
+}
+
+/* The Jacobian at the instance's point: the kept one while the point is the same (a host asking for it
+ * column by column), else computed and kept; NULL with the reasons in the instance's messages. */
+static const double *jacobian_now(Instance *instance)
+{
+    if (instance->jacobian == NULL) {
+        instance->jacobian = malloc(JACOBIAN_SIZE * sizeof *instance->jacobian);
+        if (instance->jacobian == NULL) {
+            messages_add(&instance->messages, "out of memory for the partial derivatives", (const char *)NULL);
+            return NULL;
+        }
+    }
+    if (same_point(instance)) {
+        return instance->jacobian;
+    }
+    instance->jacobian_valid = 0;
+    jacobian_at_point(instance, instance->jacobian);
+    if (instance->messages.count) {
+        return NULL;
+    }
+    instance->jacobian_point = instance->data;
+    instance->jacobian_epoch = instance->epoch;
+    instance->jacobian_valid = 1;
+    return instance->jacobian;
+}
+
 Failure jacobian_of_time_alone(const ModelData *data UNUSED, double partial[] UNUSED)
 {
     return NO_FAILURE; /* every partial derivative is zero but the states' own, which are the layer's */
@@ -153,7 +190,8 @@ Status derivatives_get(Instance *instance, const char *function, const uint32_t 
                        const uint32_t knowns[], size_t n_knowns, const double seed[], size_t n_seed,
                        double sensitivity[], size_t n_sensitivity, int adjoint)
 {
-    double partial[JACOBIAN_SIZE], value;
+    const double *partial;
+    double value;
     char shown[40];
     size_t i, j;
     int finite = 1;
@@ -165,14 +203,16 @@ Status derivatives_get(Instance *instance, const char *function, const uint32_t 
                           n_sensitivity, adjoint)) {
         return STATUS_ERROR;
     }
-    jacobian_at_point(instance, partial);
-    if (instance->messages.count) {
+    partial = jacobian_now(instance);
+    if (partial == NULL) {
         return instance_refusal(instance);
     }
     for (i = 0; i < n_sensitivity; i++) {
         value = 0.0;
         for (j = 0; j < n_seed; j++) {
-            value += seed[j] * (adjoint ? ENTRY(j, i) : ENTRY(i, j));
+            if (seed[j] != 0.0) { /* a unit seed's zeros add nothing: a column costs one pass of the rows */
+                value += seed[j] * (adjoint ? ENTRY(j, i) : ENTRY(i, j));
+            }
         }
         sensitivity[i] = value;
         finite = finite && isfinite(value);

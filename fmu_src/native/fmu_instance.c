@@ -238,6 +238,7 @@ Status instance_reset(Instance *instance)
     if (model_hooks.reset_internal != NULL) {
         model_hooks.reset_internal(&instance->data);
     }
+    instance->epoch++;
     instance->start_time = 0.0;
     instance->terminated = 0;
     instance->refusal[0] = '\0';
@@ -435,6 +436,7 @@ void instance_free(Instance *instance)
     if (instance != NULL) {
         clear_cache(instance);
         free_strings(instance->data.string_value);
+        free(instance->jacobian);
         free(instance->resources);
         free(instance->name);
         free(instance);

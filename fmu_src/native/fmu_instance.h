@@ -165,6 +165,13 @@ struct Instance {
     int model_exchange; /* instantiated for Model Exchange (fmu_model_exchange.c) */
     int event_mode;     /* Model Exchange after initialisation: event mode, else continuous-time mode */
     int stale;          /* Model Exchange: a time, state or input was set since the outputs were evaluated */
+    /* The derivative functions' last Jacobian (fmu_derivatives.c), reused while the point is the same: the
+     * Real and Integer values and the time it was computed at, and no reset, restored FMU state or String
+     * set since (``epoch`` counts those). */
+    double *jacobian; /* allocated at the first call; NULL before */
+    ModelData jacobian_point;
+    unsigned epoch, jacobian_epoch;
+    int jacobian_valid;
 };
 
 /* A failure of a model's physics: its kind (ERROR_NONE: none) and Python's message of it

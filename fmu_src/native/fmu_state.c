@@ -110,6 +110,7 @@ Status state_set(Instance *instance, const char *function, const void *state)
     instance->terminated = 0;
     instance->refusal[0] = '\0';
     instance->stale = 1;
+    instance->epoch++;
     return STATUS_OK;
 }
 

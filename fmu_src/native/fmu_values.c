@@ -286,6 +286,7 @@ Status instance_set_string(Instance *instance, const char *function, const uint3
             instance->data.string_value[i] = copies[i];
         }
     }
+    instance->epoch++;
     return STATUS_OK;
 }
 

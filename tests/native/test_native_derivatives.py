@@ -386,3 +386,34 @@ def test_vehicle_driveline_at_standstill_gives_the_derivative_for_a_growing_spee
     assert exact[picked[2]] == pytest.approx(backward[2], rel=1e-8)
     assert np.all(np.abs(exact[picked[:2]] - backward[:2]) >= 0.09 / sigma)
     model.close()
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+def test_the_kept_jacobian_follows_every_change_of_the_point(native_dir, tmp_path, interface, fmi):
+    """The layer keeps the last Jacobian while the point is the same (a host asking column by column):
+    after an input, the state or the time changes the point, the derivatives are those of a fresh
+    instance there, bit for bit, and after restoring the first point's FMU state the first ones again."""
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    model = ModelExchange(path, fmi, {}, tmp_path / "kept", interface=interface)
+    first = derivatives.exact(model.fmu, "CardanJoint", fmi)
+    saved = model.fmu.getFMUState()
+    time = 0.0
+    changes = [("beta", lambda: model.set({"beta": 0.5}))]
+    if interface == "ModelExchange":
+        changes += [("state", lambda: model.set_states(model.get_states() + 0.3)),
+                    ("time", lambda: model.fmu.setTime(0.2))]
+    for what, change in changes:
+        change()
+        time = 0.2 if what == "time" else time
+        moved = derivatives.exact(model.fmu, "CardanJoint", fmi)
+        fresh = ModelExchange(path, fmi, {"beta": 0.5}, tmp_path / what, interface=interface)
+        if interface == "ModelExchange":
+            fresh.fmu.setTime(time)
+            fresh.set_states(model.get_states())
+        assert not np.array_equal(moved, first), what
+        assert np.array_equal(moved, derivatives.exact(fresh.fmu, "CardanJoint", fmi)), what
+        fresh.close()
+    model.fmu.setFMUState(saved)
+    assert np.array_equal(derivatives.exact(model.fmu, "CardanJoint", fmi), first)
+    model.fmu.freeFMUState(saved)
+    model.close()
