@@ -131,8 +131,31 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log):
             return work_unit(nodeid)
 
         def _assign_work_unit(self, node) -> None:
+            """The costliest unit left; a node holding fewer than two tests then gets the next unit too, or is told
+            to stop after them: a worker waits for a second test before it runs its first (pytest-xdist 1327)."""
             self.workqueue.move_to_end(max(self.workqueue, key=lambda unit: costs.get(unit, 0.0)), last=False)
             super()._assign_work_unit(node)
+            if self._pending_of(self.assigned_work[node]) < 2:
+                if self.workqueue:
+                    self._assign_work_unit(node)
+                else:
+                    node.shutdown()
+
+        def remove_node(self, node) -> str | None:
+            """xdist's, but after a crash only the node's unfinished work units go back on the queue, the test
+            it crashed on marked done (xdist reports it failed): xdist 3.8 re-queues the finished units too,
+            which come back empty, and the run then waits for ever (pytest-xdist issues 1323 and 1378)."""
+            workload = self.assigned_work.pop(node)
+            crashed = next((nodeid for unit in workload.values() for nodeid, done in unit.items() if not done), None)
+            if crashed is None:
+                return None
+            for unit in workload.values():
+                if crashed in unit:
+                    unit[crashed] = True
+            self.workqueue.update({scope: unit for scope, unit in workload.items() if not all(unit.values())})
+            for other in self.assigned_work:
+                self._reschedule(other)
+            return crashed
 
     return CostliestUnitFirst(config, log)
 

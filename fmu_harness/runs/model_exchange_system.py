@@ -44,6 +44,8 @@ class NotRunnable(ValueError):
 #: falling (measured: a 2-cycle of +-8.9e-13 on alpha_in = 5 rad/s2).
 LOOP_TOLERANCE = 1e-11
 MAX_LOOP_ITERATIONS = 20
+#: Event iterations at initialisation before the FMU is refused (the project's FMUs need none).
+MAX_EVENT_ITERATIONS = 100
 #: The integrators' absolute tolerance, on states of order 1 (angles, speeds) down to 1e-3 m.
 ATOL = 1e-12
 #: scipy's integrators by name: DOP853 (explicit, the default), Radau and BDF (implicit, given the
@@ -123,7 +125,7 @@ class ModelExchangeInstance:
     def exit_initialization(self) -> None:
         """Leave initialisation through event mode into continuous-time mode; a time event is refused."""
         self.call("exitInitializationMode")
-        while True:
+        for _ in range(MAX_EVENT_ITERATIONS):
             if self.fmi3:
                 needed, _, _, _, time_defined, _ = self.call("updateDiscreteStates")
             else:
@@ -132,6 +134,9 @@ class ModelExchangeInstance:
                 raise NotRunnable(f"{self.name}: the FMU asks for a time event, which this engine does not handle")
             if not needed:
                 break
+        else:
+            raise NotRunnable(f"{self.name}: the FMU still asks for new discrete states after "
+                              f"{MAX_EVENT_ITERATIONS} updates at initialisation")
         self.call("enterContinuousTimeMode")
 
     def set_point(self, time: float, states: np.ndarray) -> None:
