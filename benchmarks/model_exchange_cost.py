@@ -18,12 +18,13 @@ from ctypes import POINTER, c_double
 from pathlib import Path
 
 import numpy as np
-from fmpy import extract, instantiate_fmu, read_model_description
+from fmpy import extract, read_model_description
 
 from benchmarks import report
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
 from fmu_harness.console import summary
+from fmu_harness.runs.runner import LoggedInstance
 
 CALLS, ROUNDS = 2000, 7
 
@@ -33,8 +34,8 @@ class ContinuousTime:
 
     def __init__(self, fmu: Path, fmi: str, unzipdir: Path) -> None:
         description = read_model_description(str(fmu))
-        self.fmu = instantiate_fmu(extract(str(fmu), unzipdir=str(unzipdir)), description, "ModelExchange",
-                                   logger=lambda *args: None)
+        self.fmu = LoggedInstance(extract(str(fmu), unzipdir=str(unzipdir)), description, "ModelExchange", "instance",
+                                  lambda text: None).fmu
         if fmi == "3":
             self.fmu.enterInitializationMode(startTime=0.0)
         else:

@@ -25,11 +25,11 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
-from fmpy import extract, instantiate_fmu, read_model_description
+from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from scipy.integrate import BDF, DOP853, Radau
 
-from .runner import StepRefused
+from .runner import LoggedInstance, StepRefused
 
 Port = tuple[str, str]  # (instance, variable)
 
@@ -63,8 +63,9 @@ class ModelExchangeInstance:
             raise NotRunnable(f"{name}: {path.name} has no Model Exchange interface")
         self.fmi3 = self.description.fmiVersion.startswith("3")
         self.log: list[str] = []
-        self.fmu = instantiate_fmu(extract(str(path), unzipdir=str(scratch / name)), self.description,
-                                   "ModelExchange", logger=lambda *args: self.log.append(args[-1].decode()))
+        self._instance = LoggedInstance(extract(str(path), unzipdir=str(scratch / name)), self.description,
+                                        "ModelExchange", name, self.log.append)
+        self.fmu = self._instance.fmu
         self.references = {v.name: v.valueReference for v in self.description.modelVariables}
         self.size = len(self.description.derivatives)
         self.state_names = [u.variable.derivative.name for u in self.description.derivatives]
@@ -173,6 +174,7 @@ class ModelExchangeInstance:
         except FMICallException:
             pass
         self.fmu.freeInstance()
+        self._instance.release()
 
 
 def strongly_connected(nodes: int, after: Mapping[int, Collection[int]]) -> list[list[int]]:

@@ -27,6 +27,7 @@ import numpy as np
 from fmpy import calloc, extract, free, read_model_description
 from fmpy.fmi1 import FMICallException, printLogMessage
 from fmpy.fmi2 import (
+    FMU2Model,
     FMU2Slave,
     fmi2CallbackAllocateMemoryTYPE,
     fmi2CallbackFreeMemoryTYPE,
@@ -34,7 +35,7 @@ from fmpy.fmi2 import (
     fmi2CallbackLoggerTYPE,
     fmi2True,
 )
-from fmpy.fmi3 import FMU3Slave
+from fmpy.fmi3 import FMU3Model, FMU3Slave
 from fmpy.logging import addLoggerProxy
 from fmpy.model_description import ModelDescription
 
@@ -136,6 +137,36 @@ class Fmi2LogRouter:
 
 
 FMI2_LOG_ROUTER = Fmi2LogRouter()
+
+
+class LoggedInstance:
+    """fmpy's instance of an extracted FMU (FMI 2.0 or 3.0, ``interface`` "ModelExchange" or "CoSimulation"),
+    its messages' text handed to ``log``: FMI 2.0 through :data:`FMI2_LOG_ROUTER` (fmpy's ``instantiate_fmu``
+    with a logger of its own leaves fmpy's proxy forwarding every later instance's messages to that logger
+    once it is freed: a segfault at the next message); ``release()`` once the instance is freed."""
+
+    def __init__(self, unzipdir: str, description: ModelDescription, interface: str, instance_name: str,
+                 log: Callable[[str], None]) -> None:
+        fmi3 = description.fmiVersion.startswith("3")
+        classes = {"ModelExchange": (FMU2Model, FMU3Model), "CoSimulation": (FMU2Slave, FMU3Slave)}[interface]
+        identifier = (description.modelExchange if interface == "ModelExchange" else description.coSimulation)
+        self.fmu = classes[fmi3](guid=description.guid, unzipDirectory=unzipdir,
+                                 modelIdentifier=identifier.modelIdentifier, instanceName=instance_name)
+        self._key = None
+        if fmi3:
+            self.fmu.instantiate(loggingOn=True, logMessage=lambda _environment, *message: log(_text(message[-1])))
+        else:
+            self._key, self._callbacks = FMI2_LOG_ROUTER.callbacks(lambda status, category, text: log(_text(text)))
+            try:
+                self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+            except Exception:
+                self.release()
+                raise
+
+    def release(self) -> None:
+        if self._key is not None:
+            FMI2_LOG_ROUTER.release(self._key)
+            self._key = None
 
 
 class FmuInstance(ABC):

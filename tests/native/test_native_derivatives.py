@@ -26,11 +26,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import extract, instantiate_fmu, read_model_description
+from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
+from fmu_harness.runs.runner import LoggedInstance
 from support import derivatives
 from support.model_exchange import ModelExchange
 from support.native_rotor import SOLVE_ROUNDING
@@ -326,8 +327,9 @@ def test_outside_step_mode_the_call_is_an_error(native_dir, tmp_path, fmi):
     path = native.fmu_path(native_dir, "CardanJoint", fmi)
     description = read_model_description(str(path))
     log: list[str] = []
-    fmu = instantiate_fmu(extract(str(path), unzipdir=str(tmp_path)), description, "ModelExchange",
-                          logger=lambda *args: log.append(args[-1].decode()))
+    instance = LoggedInstance(extract(str(path), unzipdir=str(tmp_path)), description, "ModelExchange", "instance",
+                              log.append)
+    fmu = instance.fmu
     rows, columns = derivatives.references("CardanJoint", fmi)
     for mode in ("Instantiated", "InitializationMode"):
         if mode == "InitializationMode":
@@ -342,6 +344,7 @@ def test_outside_step_mode_the_call_is_an_error(native_dir, tmp_path, fmi):
         assert refused.value.status == 3
         assert log[-1] == f"fmi{fmi}GetDirectionalDerivative is not allowed in {mode}"
     fmu.freeInstance()
+    instance.release()
 
 
 @pytest.mark.parametrize("interface", INTERFACES)

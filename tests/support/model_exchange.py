@@ -6,9 +6,10 @@ from __future__ import annotations
 from ctypes import POINTER, c_double
 
 import numpy as np
-from fmpy import extract, instantiate_fmu, read_model_description
+from fmpy import extract, read_model_description
 
 from driveline.catalog import MODELS
+from fmu_harness.runs.runner import LoggedInstance
 
 
 class ModelExchange:
@@ -19,8 +20,9 @@ class ModelExchange:
     def __init__(self, path, fmi: str, start_values: dict, unzipdir, interface: str = "ModelExchange") -> None:
         self.description = read_model_description(str(path))
         self.log: list[str] = []
-        self.fmu = instantiate_fmu(extract(str(path), unzipdir=str(unzipdir)), self.description, interface,
-                                   logger=lambda *args: self.log.append(args[-1].decode()))
+        self._instance = LoggedInstance(extract(str(path), unzipdir=str(unzipdir)), self.description, interface,
+                                        "instance", self.log.append)
+        self.fmu = self._instance.fmu
         self.references = {v.name: v.valueReference for v in self.description.modelVariables}
         self.fmi3 = fmi == "3"
         if self.fmi3:
@@ -65,3 +67,4 @@ class ModelExchange:
     def close(self) -> None:
         self.fmu.terminate()
         self.fmu.freeInstance()
+        self._instance.release()
