@@ -29,7 +29,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from scipy.integrate import BDF, DOP853, Radau
 
-from .runner import LoggedInstance, StepRefused
+from .runner import LoggedInstance, StepRefused, status_name
 
 Port = tuple[str, str]  # (instance, variable)
 
@@ -84,8 +84,8 @@ class ModelExchangeInstance:
         try:
             return getattr(self.fmu, function)(*arguments)
         except FMICallException as error:
-            status = ("OK", "Warning", "Discard", "Error", "Fatal")[min(error.status, 4)]
-            raise StepRefused(f"{self.name}: {function}", status, self.time, self.log[first:]) from None
+            raise StepRefused(f"{self.name}: {function}", status_name(error.status), self.time,
+                              self.log[first:]) from None
 
     def get(self, names: Sequence[str]) -> list[float]:
         return self.call("getFloat64" if self.fmi3 else "getReal", [self.references[n] for n in names])

@@ -64,7 +64,8 @@ def _text(value: bytes | str | None) -> str:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else "" if value is None else str(value)
 
 
-def _status_name(status: int) -> str:
+def status_name(status: int) -> str:
+    """An FMI status's name ("Discard"), or its number if it is none."""
     return STATUS_NAMES[status] if 0 <= status < len(STATUS_NAMES) else str(status)
 
 
@@ -258,7 +259,7 @@ class FmuInstance(ABC):
 
     # -- logging -----------------------------------------------------------------
     def _record(self, status: int, category: bytes, message: bytes) -> None:
-        self.log.append(LogRecord(_status_name(status), _text(category), _text(message)))
+        self.log.append(LogRecord(status_name(status), _text(category), _text(message)))
 
     def messages_since(self, start: int) -> list[str]:
         return [record.message for record in self.log[start:]]
@@ -340,7 +341,7 @@ class FmuInstance(ABC):
 
     # -- life cycle --------------------------------------------------------------
     def _refused(self, call: str, error: FMICallException, first_message: int) -> StepRefused:
-        status = _status_name(error.status)
+        status = status_name(error.status)
         self.fatal = self.fatal or status == "Fatal"
         return StepRefused(call, status, self.time, self.messages_since(first_message))
 
