@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,13 +18,24 @@ HEADER = "mass = 200.0\ncentre_of_gravity = [0.0, 0.0, 0.3]\ninertia = [11.0, 8.
 MOUNT = "[[mounts]]\nposition = [0.2, 0.3, 0.5]\nstiffness = [1e5, 1e5, 2e5]\n"
 
 
-def test_the_default_layout_reads_with_its_loss_factors_converted():
-    """c = eta k / (2 pi f_eta): the engine mount's 0.15 at 10 Hz."""
-    layout = load_layout(shipped_layout("transverse_fwd_powertrain"))
+def test_a_linear_layout_reads_with_its_loss_factors_converted():
+    """c = eta k / (2 pi f_eta): the engine mount's 0.15 at 10 Hz (the linear model's default layout)."""
+    layout = load_layout(Path(__file__).parents[1] / "support" / "linear_powertrain.toml")
     assert layout.mass == 200.0 and len(layout.mounts) == 3
     engine = layout.mounts[0]
     assert engine.label == "engine mount"
     assert np.allclose(engine.damping, 0.15 * engine.stiffness / (2.0 * math.pi * 10.0), rtol=1e-15)
+    assert layout.inertia[0, 1] == -0.3 and layout.inertia[0, 2] == -1.0 and layout.inertia[1, 2] == -0.4
+    assert not engine.progressive and len(engine.branches) == 0
+
+
+def test_the_default_layout_reads_with_its_rubber_and_stops():
+    """Rubber damping (four branch weights a mount, no viscous damper), a snubber on every mount."""
+    layout = load_layout(shipped_layout("transverse_fwd_powertrain"))
+    assert layout.mass == 200.0 and len(layout.mounts) == 3
+    assert [m.label for m in layout.mounts] == ["engine mount", "transmission mount", "roll restrictor"]
+    for mount in layout.mounts:
+        assert mount.progressive and len(mount.branches) == 4 and not np.any(mount.damping)
     assert layout.inertia[0, 1] == -0.3 and layout.inertia[0, 2] == -1.0 and layout.inertia[1, 2] == -0.4
 
 
