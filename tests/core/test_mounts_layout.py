@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 import os
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,9 +17,9 @@ HEADER = "mass = 200.0\ncentre_of_gravity = [0.0, 0.0, 0.3]\ninertia = [11.0, 8.
 MOUNT = "[[mounts]]\nposition = [0.2, 0.3, 0.5]\nstiffness = [1e5, 1e5, 2e5]\n"
 
 
-def test_a_linear_layout_reads_with_its_loss_factors_converted():
-    """c = eta k / (2 pi f_eta): the engine mount's 0.15 at 10 Hz (the linear model's default layout)."""
-    layout = load_layout(Path(__file__).parents[1] / "support" / "linear_powertrain.toml")
+def test_the_default_layout_reads_with_its_loss_factors_converted():
+    """c = eta k / (2 pi f_eta): the engine mount's 0.15 at 10 Hz."""
+    layout = load_layout(shipped_layout("transverse_fwd_powertrain"))
     assert layout.mass == 200.0 and len(layout.mounts) == 3
     engine = layout.mounts[0]
     assert engine.label == "engine mount"
@@ -29,9 +28,9 @@ def test_a_linear_layout_reads_with_its_loss_factors_converted():
     assert not engine.progressive and len(engine.branches) == 0
 
 
-def test_the_default_layout_reads_with_its_rubber_and_stops():
+def test_the_rubber_layout_reads_with_its_rubber_and_stops():
     """Rubber damping (four branch weights a mount, no viscous damper), a snubber on every mount."""
-    layout = load_layout(shipped_layout("transverse_fwd_powertrain"))
+    layout = load_layout(shipped_layout("transverse_fwd_powertrain_rubber"))
     assert layout.mass == 200.0 and len(layout.mounts) == 3
     assert [m.label for m in layout.mounts] == ["engine mount", "transmission mount", "roll restrictor"]
     for mount in layout.mounts:

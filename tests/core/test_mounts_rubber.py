@@ -10,7 +10,6 @@ damping from a free decay's logarithmic decrement.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,9 +27,9 @@ from driveline.mounts.rubber import BAND, RELAXATION_FREQUENCIES, relative_stiff
 from driveline.mounts.spec import AXES, LOAD_INPUTS, VELOCITIES, derivative_name
 from driveline.mounts.system import MountSystem, Placement
 
-#: Today's default layout as it was before the rubber keys (linear rates, viscous loss factors).
-LINEAR_LAYOUT = Path(__file__).parents[1] / "support" / "linear_powertrain.toml"
-RUBBER = "transverse_fwd_powertrain"
+#: A layout written for the linear model (linear rates, viscous loss factors) and the one on rubber.
+LINEAR_LAYOUT = shipped_layout("transverse_fwd_powertrain")
+RUBBER = "transverse_fwd_powertrain_rubber"
 FULL_TORQUE = 2200.0  # N.m: the drive reaction at full motor torque (issue 42: 1.1 kN.m at half)
 
 
@@ -304,10 +303,10 @@ def test_the_energy_balance_of_a_run_closes_within_rounding():
     assert abs(energy(state) - start + dissipated - work) < 1e-10 * magnitude
 
 
-# ---- the default layout -------------------------------------------------------------------------------
+# ---- the rubber layout -------------------------------------------------------------------------------
 
 
-def test_the_default_layout_holds_the_wind_up_and_damps_its_modes_alike():
+def test_the_rubber_layout_holds_the_wind_up_and_damps_its_modes_alike():
     """Under 1.1 kN.m about the drive axis the wind-up is at most 2 degrees (designed: 1.5); the six modes'
     damping ratios lie within a ratio of 1.5 of each other, at idle and at full torque."""
     for torque in (0.0, 1100.0, FULL_TORQUE):
