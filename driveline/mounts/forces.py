@@ -21,7 +21,8 @@ from . import characteristic
 from .layout import Layout, Mount
 from .rubber import relaxation_times
 
-#: Newton's iterations at most, and the step (relative to the displacement) it stops at.
+#: Newton's iterations at most, and the step (relative to the displacement) it stops at (the static
+#: equilibrium here and the implicit step's, :mod:`.implicit_step`).
 MAX_NEWTON = 60
 NEWTON_STEP = 1e-14
 
@@ -111,12 +112,15 @@ class BranchMap:
     def __len__(self) -> int:
         return len(self.gains)
 
-    def stiffness(self, frequency: float) -> tuple[np.ndarray, np.ndarray]:
-        """The branches' storage and loss stiffness matrices (6 x 6) at ``frequency`` [Hz]."""
+    def stiffness(self, frequency: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The branches' storage and loss stiffness matrices (6 x 6) at ``frequency`` [Hz], and the
+        storage's slope ``w dK_s/dw`` (``x = w tau``: ``g x^2 / (1 + x^2)``, ``g x / (1 + x^2)``,
+        ``2 g x^2 / (1 + x^2)^2``)."""
         x = 2.0 * np.pi * frequency * self.times
         storage = self.gains * x * x / (1.0 + x * x)
         loss = self.gains * x / (1.0 + x * x)
-        return self.rows.T @ (storage[:, None] * self.rows), self.rows.T @ (loss[:, None] * self.rows)
+        slope = 2.0 * self.gains * x * x / (1.0 + x * x) ** 2
+        return tuple(self.rows.T @ (part[:, None] * self.rows) for part in (storage, loss, slope))
 
     def per_mount(self, layout: Layout, z: np.ndarray) -> list[np.ndarray]:
         """Each mount's branch forces summed along its axes."""

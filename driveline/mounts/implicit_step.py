@@ -25,12 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .forces import BranchMap, mean_elastic_load
+from .forces import MAX_NEWTON, NEWTON_STEP, BranchMap, mean_elastic_load
 from .layout import Layout
-
-#: Newton's iterations at most, and the correction (relative to the displacement) it stops at.
-MAX_NEWTON = 50
-NEWTON_STEP = 1e-14
 
 
 @dataclass(frozen=True)

@@ -99,39 +99,41 @@ class Modes:
 FREQUENCY_TOLERANCE = 1e-13
 MAX_FREQUENCY_ITERATIONS = 100
 
-BranchStiffness = Callable[[float], "tuple[np.ndarray, np.ndarray]"]
+BranchStiffness = Callable[[float], "tuple[np.ndarray, np.ndarray, np.ndarray]"]
 
 
 def modes(body: RigidBody, stiffness: np.ndarray | None = None, branches: BranchStiffness | None = None) -> Modes:
     """The six modes of ``body`` about an operating point whose tangent stiffness is ``stiffness``
-    (default: the mounts' linear rates), with the Maxwell branches' storage and loss stiffness at a
-    frequency ``branches(f)`` (None: none). Without branches the undamped modes of ``K`` and ``M``
-    (eigenvalues below zero by rounding read as zero); with them each mode j is the fixed point of
-    ``(K + K_s(f_j)) phi_j = (2 pi f_j)^2 M phi_j``, the storage stiffness at its own frequency. The
-    damping ratio is ``zeta_j = phi_j^T K_l(f_j) phi_j / (2 phi_j^T K_s,total phi_j)`` with the loss
-    stiffness ``K_l = 2 pi f C + K_l,branches`` (the modal strain energy method)."""
+    (default: the mounts' linear rates), with the Maxwell branches' storage and loss stiffness and the
+    storage's slope ``w dK_s/dw`` at a frequency, ``branches(f)`` (None: none). Without branches the
+    undamped modes of ``K`` and ``M`` (eigenvalues below zero by rounding read as zero); with them each
+    mode j is the fixed point of ``(K + K_s(f_j)) phi_j = (2 pi f_j)^2 M phi_j``, the storage stiffness at
+    its own frequency. The damping ratio is equation (4) of docs/powertrain_mounts.md,
+    ``zeta_j = phi^T K_l phi / (2 phi^T K_s,total phi - phi^T w dK_s/dw phi)`` with the loss stiffness
+    ``K_l = 2 pi f C + K_l,branches``: the modal strain energy's ratio, with the first-order correction
+    for a storage stiffness that grows with frequency (the pole of ``s^2 m + K(s)``)."""
     stiffness = body.stiffness if stiffness is None else stiffness
     eigenvalues, shapes = eigh(stiffness, body.mass)
     frequencies = np.sqrt(np.maximum(eigenvalues, 0.0)) / (2.0 * math.pi)
     ratios = np.zeros(6)
     for j in range(6):
-        storage, loss = stiffness, np.zeros((6, 6))
+        storage, loss, slope = stiffness, np.zeros((6, 6)), np.zeros((6, 6))
         if branches is not None:
             frequency = frequencies[j]
             for _ in range(MAX_FREQUENCY_ITERATIONS):
-                extra, loss = branches(frequency)
+                extra, loss, slope = branches(frequency)
                 storage = stiffness + extra
                 values, vectors = eigh(storage, body.mass)
                 previous, frequency = frequency, math.sqrt(max(values[j], 0.0)) / (2.0 * math.pi)
                 if abs(frequency - previous) <= FREQUENCY_TOLERANCE * frequency:
                     break
             frequencies[j], shapes[:, j] = frequency, vectors[:, j]
-            extra, loss = branches(frequency)
+            extra, loss, slope = branches(frequency)
             storage = stiffness + extra
         shape = shapes[:, j]
         loss = loss + 2.0 * math.pi * frequencies[j] * body.damping
-        energy = float(shape @ storage @ shape)
-        ratios[j] = float(shape @ loss @ shape) / (2.0 * energy) if energy > 0.0 else 0.0
+        energy = 2.0 * float(shape @ storage @ shape) - float(shape @ slope @ shape)
+        ratios[j] = float(shape @ loss @ shape) / energy if energy > 0.0 else 0.0
     momenta = body.mass @ shapes
     shares = (shapes * momenta).T / np.sum(shapes * momenta, axis=0)[:, None]
     return Modes(frequencies, shapes, shares, ratios)

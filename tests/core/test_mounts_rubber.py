@@ -183,8 +183,8 @@ def test_loaded_equilibrium_and_modes_against_an_independent_solve(torque):
     reference characteristics (1e-9 of the largest displacement: the root finder's xtol 1e-13 and
     cond(K_t) below 1e3); the modes against the poles of the linearised state-space with the branches
     (tangent rates from central differences of the reference, a general eigensolver): frequencies within
-    2 %, damping ratios within 10 % (the modal strain energy's approximation of a pole; measured below
-    1 % and 4 %)."""
+    2 %, damping ratios within 3 % (equation (4) is a first-order estimate of a pole, its error of the
+    order of zeta times the storage's slope; measured below 0.7 % and 1.0 %)."""
     layout = load_layout(shipped_layout(RUBBER))
     placement = _placement()
     system = MountSystem.build(layout, placement, 9.81, torque)
@@ -222,7 +222,7 @@ def test_loaded_equilibrium_and_modes_against_an_independent_solve(torque):
     assert len(poles) == 6
     found = system.operating_modes(sag)
     assert np.allclose(found.frequencies, np.abs(poles) / (2 * math.pi), rtol=0.02)
-    assert np.allclose(found.damping_ratios, -poles.real / np.abs(poles), rtol=0.10)
+    assert np.allclose(found.damping_ratios, -poles.real / np.abs(poles), rtol=0.03)
 
 
 # ---- free decay --------------------------------------------------------------------------------------
@@ -245,8 +245,8 @@ def test_free_decay_of_each_mode_matches_its_damping_ratio(torque):
     ``2 pi f_j`` times 50 um at the largest coordinate), stepped by the model (the implicit scheme,
     100 steps a period), its modal coordinate ``phi_j^T M q`` over six periods: the logarithmic
     decrement's damping ratio within 10 % of ``zeta_mode_j``, at idle and under the drive reaction (on the
-    stops); measured 4-7 % above it: the modal strain energy's estimate of the pole (the test above), and
-    the other modes, barely excited."""
+    stops); measured within 1.3 %: equation (4)'s estimate of the pole (the test above), the other
+    modes, barely excited, and the scheme's own error at 100 steps a period."""
     model = _model(RUBBER, T_mean=torque, T_motor=torque)  # loaded by the drive reaction T_mean describes
     system = model._system
     sag = system.static_sag(9.81, torque)
@@ -313,7 +313,7 @@ def test_the_rubber_layout_holds_the_wind_up_and_damps_its_modes_alike():
         model = _model(RUBBER, T_mean=torque)
         ratios = [getattr(model, f"zeta_mode_{j}") for j in range(1, 7)]
         assert max(ratios) / min(ratios) <= 1.5
-        assert all(0.05 <= r <= 0.1 for r in ratios)
+        assert all(0.07 <= r <= 0.09 for r in ratios)  # near eta / (2 - 2 eta / pi) = 0.079
         if torque == 1100.0:
             assert 0.0 < math.degrees(model.wind_up) <= 2.0
 
