@@ -36,23 +36,22 @@ _WEIGHTS = (5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0)
 def ramp(x: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``rho(x)`` of equation (C2), elementwise."""
     x, w = np.broadcast_arrays(np.asarray(x, float), np.asarray(w, float))
-    inside = x * x * x / (w * w) - x ** 4 / (2.0 * w ** 3)
-    return np.where(x <= 0.0, 0.0, np.where(x >= w, x - 0.5 * w, inside))
+    u = np.clip(x, 0.0, w)  # the cubic's piece evaluated within its range only (no overflow far out)
+    return np.where(x >= w, x - 0.5 * w, u * u * u / (w * w) - u ** 4 / (2.0 * w ** 3))
 
 
 def ramp_slope(x: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``rho'(x)``, elementwise."""
     x, w = np.broadcast_arrays(np.asarray(x, float), np.asarray(w, float))
-    u = x / w
-    return np.where(x <= 0.0, 0.0, np.where(x >= w, 1.0, u * u * (3.0 - 2.0 * u)))
+    u = np.clip(x, 0.0, w) / w
+    return u * u * (3.0 - 2.0 * u)
 
 
 def ramp_integral(x: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``P(x)``, the integral of rho from 0, elementwise."""
     x, w = np.broadcast_arrays(np.asarray(x, float), np.asarray(w, float))
-    inside = x ** 4 / (4.0 * w * w) - x ** 5 / (10.0 * w ** 3)
-    beyond = 0.5 * (x * x - w * w) - 0.5 * w * (x - w) + 0.15 * w * w
-    return np.where(x <= 0.0, 0.0, np.where(x >= w, beyond, inside))
+    u, beyond = np.clip(x, 0.0, w), np.maximum(x - w, 0.0)
+    return u ** 4 / (4.0 * w * w) - u ** 5 / (10.0 * w ** 3) + beyond * (0.5 * beyond + 0.5 * w)
 
 
 def force(d: np.ndarray, rate: np.ndarray, gap: np.ndarray, stop_rate: np.ndarray,

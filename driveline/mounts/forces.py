@@ -68,10 +68,18 @@ def mean_elastic_load(layout: Layout, q0: np.ndarray, q1: np.ndarray) -> tuple[n
 
 
 def equilibrium(layout: Layout, load: np.ndarray, linear_stiffness: np.ndarray) -> np.ndarray:
-    """``Q`` with ``elastic_load(Q) = load`` (Newton from the linear rates' solution)."""
-    q = np.linalg.solve(linear_stiffness, load)
+    """``Q`` with ``elastic_load(Q) = load`` (Newton from the linear rates' solution); ArithmeticError
+    when it does not converge or leaves the range of numbers (numpy's overflow warnings are silenced
+    here: the non-finite residual is the refusal's reason)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _newton(layout, load, np.linalg.solve(linear_stiffness, load))
+
+
+def _newton(layout: Layout, load: np.ndarray, q: np.ndarray) -> np.ndarray:
     residual = elastic_load(layout, q) - load
     for _ in range(MAX_NEWTON):
+        if not np.all(np.isfinite(residual)):
+            raise ArithmeticError("the static equilibrium is beyond the range of numbers (a load near 1e300)")
         step = np.linalg.solve(tangent_stiffness(layout, q), -residual)
         size = 1.0
         while True:

@@ -41,7 +41,16 @@ class StepParts:
 def implicit_step(layout: Layout, mass: np.ndarray, damping: np.ndarray, branches: BranchMap,
                   weight: np.ndarray, weight_sag: np.ndarray, state: np.ndarray, f0: np.ndarray,
                   f1: np.ndarray, h: float) -> tuple[np.ndarray, StepParts]:
-    """The state after a step of ``h`` from ``state`` under ``f0 + f1 tau`` (equations (I1))."""
+    """The state after a step of ``h`` from ``state`` under ``f0 + f1 tau`` (equations (I1)); ArithmeticError
+    when Newton does not converge or the motion leaves the range of numbers (numpy's overflow warnings
+    are silenced here: the non-finite residual is the refusal's reason)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _solve(layout, mass, damping, branches, weight, weight_sag, state, f0, f1, h)
+
+
+def _solve(layout: Layout, mass: np.ndarray, damping: np.ndarray, branches: BranchMap, weight: np.ndarray,
+           weight_sag: np.ndarray, state: np.ndarray, f0: np.ndarray, f1: np.ndarray,
+           h: float) -> tuple[np.ndarray, StepParts]:
     q0, v0, z0 = state[:6], state[6:12], state[12:]
     load = f0 + 0.5 * h * f1 + weight
     shrink = 0.5 * h / branches.times
@@ -56,6 +65,8 @@ def implicit_step(layout: Layout, mass: np.ndarray, damping: np.ndarray, branche
         residual = (mass @ (2.0 * dq / h - 2.0 * v0) / h - load + elastic + damping @ dq / h
                     + branches.rows.T @ (0.5 * (z0 + z1)))
         jacobian = 2.0 * mass / (h * h) + elastic_jacobian + damping / h + branch_jacobian
+        if not np.all(np.isfinite(residual)):
+            raise ArithmeticError("the step's motion is beyond the range of numbers (a load near 1e300)")
         correction = np.linalg.solve(jacobian, -residual)
         dq = dq + correction
         if np.max(np.abs(correction)) <= NEWTON_STEP * max(np.max(np.abs(big_q0 + dq)), 1e-300):

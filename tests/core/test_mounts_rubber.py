@@ -360,3 +360,17 @@ def test_the_branch_map_follows_the_layout():
     assert len(branches) == 36 and system.size == 48
     assert np.allclose(branches.gains[:4], layout.mounts[0].branches * layout.mounts[0].stiffness[0], rtol=1e-15)
     assert AXES == ("x", "y", "z")
+
+
+def test_loads_beyond_the_range_of_numbers_are_refused_not_garbage():
+    """A load near 1e300 on the stops: the step refused with the reason, the state kept; a mean torque
+    of 1e300: the parameters refused at initialisation (Newton finds no equilibrium)."""
+    model = _model(RUBBER)
+    before = [getattr(model, name) for name in COORDINATES]
+    model.F_x = 1e300
+    errors = model.step(0.0, 1e-3)
+    assert len(errors) == 1 and "beyond the range of numbers" in errors[0]
+    assert [getattr(model, name) for name in COORDINATES] == before
+    model = PowertrainMountsModel()
+    model.layout, model.T_mean = RUBBER, 1e300
+    assert model.initialize(0.0) == ["powertrain: no static equilibrium found in 60 Newton steps"]
