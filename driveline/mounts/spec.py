@@ -154,7 +154,7 @@ def _statics_and_modes() -> tuple[Variable, ...]:
     found.append(Variable("wind_up", "output", 0.0,
                           "Static rotation about motor_axis under T_mean, from the equilibrium under the weight "
                           "(positive along the reaction -T_mean)", "rad", "deg",
-                          depends_on=("layout", "T_mean", *MOTOR_AXIS)))
+                          depends_on=STATICS))
     found += [Variable(f"f_mode_{j}", "output", 0.0,
                        f"Natural frequency of mode {j} (ascending) at the static equilibrium under the weight and "
                        "T_mean, with the rubber's storage stiffness at that frequency", "Hz", depends_on=("layout",))

@@ -93,5 +93,5 @@ def test_progressive_and_rubber_mounts_are_refused_by_name_until_ported(native_d
     initialisation in one line naming the mount and key, not taken as linear mounts."""
     rubber = Path(__file__).parents[2] / "driveline" / "mounts" / "data" / "transverse_fwd_powertrain_rubber.toml"
     found = refusals(native.fmu_path(native_dir, NAME, fmi), {"layout": str(rubber)})
-    assert len(found) == 1 and "mounts[0].gap: progressive and rubber mounts are taken by the Python FMUs only" \
-        in found[0]
+    assert len(found) == 1 and "mounts[0].dynamic_ratio: progressive and rubber mounts are taken by the Python " \
+        "FMUs only" in found[0]
