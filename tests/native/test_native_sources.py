@@ -177,8 +177,12 @@ def test_an_fmu_carries_its_folder_the_layer_and_the_libraries_they_include(nati
 def test_powertrain_mounts_carries_the_layout_reader_and_no_rotor_file(native_dir, fmi):
     names, _ = _carried(native.fmu_path(native_dir, "PowertrainMounts", fmi))
     assert {"lib/toml.h", "lib/toml.c", "lib/layout_file.c", "lib/messages.c", "lib/pyrepr.c", "lib/arena.c"} <= names
-    rotor = {path.name for path in native.model_folder("CriticalSpeeds").iterdir()}
-    assert not [path for path in names if path.startswith("models/critical_speeds/") or Path(path).name in rotor]
+    rotor = {path.read_bytes() for path in native.model_folder("CriticalSpeeds").iterdir()}
+    with zipfile.ZipFile(native.fmu_path(native_dir, "PowertrainMounts", fmi)) as archive:
+        assert not [path for path in names if path.startswith("models/critical_speeds/")
+                    or archive.read(f"sources/{path}") in rotor]
+    assert {path for path in names if path.startswith("models/")} == {
+        f"models/powertrain_mounts/{path.name}" for path in native.model_folder("PowertrainMounts").iterdir()}
     cardan, _ = _carried(native.fmu_path(native_dir, "CardanJoint", fmi))
     assert {path for path in cardan if path.startswith("lib/")} == {"lib/python_numbers.h", "lib/python_numbers.c"}
 

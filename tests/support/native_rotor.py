@@ -47,20 +47,22 @@ def raised(kind: int, message: str) -> Exception:
     return exceptions[kind](message)
 
 
-#: The modules a module calls into besides itself (the shared layout reader's parts, in ``lib/``, and the
+#: The modules a module calls into besides itself (the layout reader's parts, shared in ``lib/``, and the
 #: elements' checks with the loader, the linear algebra with the damped model, the shaft elements with both
 #: models).
-NEEDS = {"layout": ("lib/layout_file", "lib/toml", "lib/messages", "lib/arena", "elements"), "damped": ("linalg",),
+NEEDS = {"layout": ("layout_file", "toml", "messages", "arena", "elements"), "damped": ("linalg",),
          "unbalance_outputs": ("damped", "linalg"),
          "transfer": ("elements",), "fem": ("elements",)}
 
 
 def compile_rotor(folder: Path, modules: list[str], shims: list[Path] = ()) -> ctypes.CDLL:
     """The shared library of the rotor ``modules`` (``"transfer"`` is ``transfer.c``) with the modules
-    they need (:data:`NEEDS`; ``"lib/toml"`` is ``lib/toml.c``) and ``shims``, built in ``folder``."""
+    they need (:data:`NEEDS`) and ``shims``, built in ``folder``; a module not in the rotor's folder is
+    one of ``lib/`` (``"toml"`` is ``lib/toml.c``)."""
     needed = list(dict.fromkeys(part for module in modules for part in (module, *NEEDS.get(module, ()))))
-    sources = [str((native.NATIVE_SRC if module.startswith("lib/") else ROTOR_SOURCES) / f"{module}.c")
-               for module in needed] + [str(shim) for shim in shims]
+    sources = [str(next(path for folder in (ROTOR_SOURCES, native.LIBRARY_SOURCES)
+                        if (path := folder / f"{module}.c").is_file())) for module in needed]
+    sources += [str(shim) for shim in shims]
     (folder / CONSTANTS_HEADER).write_text(constants_header())  # the native build's generated header
     library = folder / f"rotor_{'_'.join(modules)}.so"
     command = [*toolchain.host_compiler(), *TEST_FLAGS, "-shared", "-I", str(ROTOR_SOURCES),
