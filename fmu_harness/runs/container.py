@@ -12,10 +12,14 @@ other in the package's order (the Gauss-Seidel master). A host's communication s
 number of container steps.
 
 The toolbox's own SSP reader links the connections but drops the parameter set (the launch then ran with
-the components' defaults: 280 N.m, straight joints without friction); the bindings go in here. Its
-initialisation visits the components in the order of their links and warns that a loop's first component
-(``VehicleDriveline`` in the launch) starts without the loop's values: the master does the same (each
-input starts from its output's start value, the joints' torques 0 at rest), so the runs agree.
+the components' defaults: a 0.5 s ramp, both joints bent 30 deg with the closed-form kinematics and no
+friction); the bindings go in here. Its
+initialisation visits the components in the order of their links, each leaving initialisation before its
+outputs feed the next, and warns that a loop's first component (``VehicleDriveline`` in the launch) starts
+without the loop's values. The master instead passes the outputs as they are inside initialisation, where
+the project's FMUs have not computed them (0): in the launch every output is 0 at rest either way and the
+runs are equal bit for bit; in the driveline package the watcher starts at the coupling's speed here and at
+rest in the master, which changes its first step's outputs only (docs/vehicle_launch.md).
 
 What the container cannot carry is refused in one line before any work: a Python FMU (it needs Python in
 the host: take the native package), an FMU without Co-Simulation, a binding of a variable the FMU has not

@@ -37,7 +37,7 @@ from driveline.vehicle import dynamics
 from driveline.vehicle.dynamics import Drive
 from driveline.variables import UNITS, ModelSpec, Variable
 
-from ..packaging import fmu_path, native
+from ..packaging import native
 from . import container, ssp_package
 from .runner import FmuInstance, StepRefused
 from .ssp import SSC, SSD, SSV
@@ -221,6 +221,8 @@ def native_components(system: System, natives: Path | None) -> list[str]:
 def component_fmus(system: System, models: Path, natives: Path | None = None) -> dict[str, Path]:
     """``{model: FMI 2.0 FMU}`` for the models of ``system``: the native FMUs below ``natives``
     (``native/``) of :func:`native_components`, the Python FMUs in ``models`` of the others."""
+    from ..packaging import fmu_path  # the Python FMUs' builder, not needed to run a package
+
     fmus = {c.model: fmu_path(models, c.model) for c in system.components}
     if natives is not None:
         fmus |= {model: native.fmu_path(natives, model) for model in native_components(system, natives)}

@@ -160,3 +160,24 @@ def test_the_command_refuses_a_step_above_the_drives_limit_in_one_line(packages,
     container_command.main([str(packages["VehicleLaunch"]), "--step", "5e-4", "--gauss-seidel",
                             "--out", str(tmp_path / "x.fmu")])
     assert (tmp_path / "x.fmu").is_file()
+
+
+@pytest.mark.parametrize("engine", ["libcosimpy", "ecospy"])
+def test_libcosim_and_ecos_run_the_container_as_fmpy_does(engine, packages, tmp_path):
+    """The launch's container as one FMU in libcosim and in Ecos over 20 ms at its step: fmpy's run within
+    AGREEMENT (measured: equal bit for bit; both call the same doStep with the same values)."""
+    pytest.importorskip(engine)
+    from fmu_harness.checks import importers
+
+    read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
+    fmu = container.build(read, fmus, tmp_path / "launch.fmu", 1e-4)
+    outputs = ["drive.v_x", "drive.T_load_left", "drive.T_load_right", "mounts.pitch_ddot"]
+    expected = container.run(fmu, {}, 0.02, 1e-4, outputs)
+    session = {"libcosimpy": importers.cosim_session, "ecospy": importers.ecos_session}[engine](
+        1e-4, fmus={"launch": fmu})
+    try:
+        found = importers.record(session, 200, 1e-4, [f"launch.{name}" for name in outputs])
+    finally:
+        session.close()
+    scale = np.abs(expected).max(axis=0)
+    assert (np.abs(found - expected).max(axis=0) <= AGREEMENT * scale).all()
