@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 from benchmarks import report
-from fmu_harness.console import summary
+from benchmarks.launch_throughput import launch_arguments
 from fmu_harness.runs.model_exchange_system import run_model_exchange
 from fmu_harness.runs.system_sweep import SystemInterface, UnpackedSystem, container_of, run_system
 
@@ -32,11 +32,7 @@ MODEL_EXCHANGE_INTERVAL = 2e-4
 
 
 def main() -> None:
-    parser = report.parser(summary(__doc__))
-    parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp")
-    parser.add_argument("--stop-time", type=float, default=4.0, help="launch length [s] (default 4)")
-    parser.add_argument("--repeat", type=int, default=3, help="measurements per co-simulation engine (default 3)")
-    args = parser.parse_args()
+    args = launch_arguments(__doc__)
     measurement = report.Measurement()
     interface = SystemInterface.of(args.package)
     with tempfile.TemporaryDirectory(prefix="launch-cost-") as folder:

@@ -30,6 +30,7 @@ build time, user name and random token are replaced by the package's name and a 
 
 from __future__ import annotations
 
+import ctypes
 import logging
 import tempfile
 import zipfile
@@ -38,15 +39,17 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
+from fmpy.fmi2 import fmi2True
 from fmpy.model_description import ModelDescription
 
 from ..packaging import archive
-from .runner import FmuInstance
+from .runner import FmuInstance, StepRefused, status_name
 from .ssp_package import PackageError, SspSystem
 
 TOOLBOX = "fmu_manipulation_toolbox"
 AUTHOR = "driveline-fmus contributors"
 CONFIGURATION = "resources/container.txt"
+WARNING = 1  # FMI's status Warning: a step taken
 #: Attributes of a variable's type the container's description takes from the embedded FMU's.
 TYPE_ATTRIBUTES = ("declaredType", "quantity", "unit", "displayUnit", "min", "max", "nominal")
 
@@ -283,15 +286,39 @@ def run(fmu: Path, start_values: Mapping[str, float | int | bool], stop_time: fl
     instance = FmuInstance(fmu, "system", *(unpacked or (None, None)))
     try:
         instance.initialize(start_values)
-        read = instance.reader(tuple(outputs))
         interval = step_size * every
         count = int(round(stop_time / interval))
-        rows = []
-        for k in range(count):
-            instance.time = k * interval
-            instance.step(interval)
-            rows.append(read())
+        if instance.fmi_version == "2.0":
+            rows = _fmi2_rows(instance, outputs, count, interval)
+        else:
+            read, rows = instance.reader(tuple(outputs)), []
+            for k in range(count):
+                instance.time = k * interval
+                instance.step(interval)
+                rows.append(read())
         times = (np.arange(count) + 1.0) * interval
         return np.column_stack([times, np.array(rows, dtype=float).reshape(count, len(outputs))])
     finally:
         instance.close()
+
+
+def _fmi2_rows(instance: FmuInstance, outputs: Sequence[str], count: int, interval: float) -> np.ndarray:
+    """The run's rows from FMI 2.0's doStep and getReal called directly, without fmpy's wrapper of each call (a
+    sixth of a launch's cost in the map); a status beyond Warning raises :class:`StepRefused` as
+    :meth:`FmuInstance.step` does."""
+    references = (ctypes.c_uint * len(outputs))(*(instance.variables[name].valueReference for name in outputs))
+    values = (ctypes.c_double * len(outputs))()
+    do_step, get_real, component = instance.fmu.dll.fmi2DoStep, instance.fmu.dll.fmi2GetReal, instance.fmu.component
+    rows = np.empty((count, len(outputs)))
+    step = ctypes.c_double(interval)
+    for k in range(count):
+        instance.time = k * interval
+        first = len(instance.log)
+        status = do_step(component, ctypes.c_double(instance.time), step, fmi2True)
+        call = "doStep"
+        if status <= WARNING:
+            status, call = get_real(component, references, len(outputs), values), "getReal"
+        if status > WARNING:
+            raise StepRefused(call, status_name(status), instance.time, instance.messages_since(first))
+        rows[k] = values
+    return rows
