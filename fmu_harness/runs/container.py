@@ -51,7 +51,7 @@ AUTHOR = "driveline-fmus contributors"
 CONFIGURATION = "resources/container.txt"
 WARNING = 1  # FMI's status Warning: a step taken
 #: Attributes of a variable's type the container's description takes from the embedded FMU's.
-TYPE_ATTRIBUTES = ("declaredType", "quantity", "unit", "displayUnit", "min", "max", "nominal")
+TYPE_ATTRIBUTES = ("quantity", "unit", "displayUnit", "min", "max", "nominal")
 
 
 class ContainerRefused(PackageError):
@@ -185,7 +185,7 @@ def _describe(built: bytes, system: SspSystem, descriptions: Mapping[str, ET.Ele
         embedded = _variables(descriptions[component]).get(name)
         target, source = _type_element(variable), _type_element(embedded)
         for attribute in TYPE_ATTRIBUTES:
-            if source.get(attribute) is not None and attribute != "declaredType":
+            if source.get(attribute) is not None:
                 target.set(attribute, source.get(attribute))
         if embedded.get("description"):
             variable.set("description", f"{component}: {embedded.get('description')}")
