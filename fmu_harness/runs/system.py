@@ -37,7 +37,8 @@ from driveline.vehicle import dynamics
 from driveline.vehicle.dynamics import Drive
 from driveline.variables import UNITS, ModelSpec, Variable
 
-from ..packaging import fmu_path, native
+from ..packaging import native
+from . import container, ssp_package
 from .runner import FmuInstance, StepRefused
 from .ssp import SSC, SSD, SSV
 from .ssp_package import SspSystem
@@ -220,6 +221,8 @@ def native_components(system: System, natives: Path | None) -> list[str]:
 def component_fmus(system: System, models: Path, natives: Path | None = None) -> dict[str, Path]:
     """``{model: FMI 2.0 FMU}`` for the models of ``system``: the native FMUs below ``natives``
     (``native/``) of :func:`native_components`, the Python FMUs in ``models`` of the others."""
+    from ..packaging import fmu_path  # the Python FMUs' builder, not needed to run a package
+
     fmus = {c.model: fmu_path(models, c.model) for c in system.components}
     if natives is not None:
         fmus |= {model: native.fmu_path(natives, model) for model in native_components(system, natives)}
@@ -241,6 +244,21 @@ def write_ssp(system: System, models: Path, natives: Path | None = None) -> Path
         for model in sorted(fmus):
             archive.write(fmus[model], f"resources/{model}.fmu")
     return path
+
+
+def container_path(system: System, models: Path, fmi: str = "2") -> Path:
+    """Where :func:`write_container` puts the system as one FMU: ``models/native/<system>.fmu``, FMI 3.0 in
+    ``models/native/fmi3/``."""
+    return native.fmu_path(models, system.name, fmi)
+
+
+def write_container(system: System, models: Path, fmi: str = "2") -> Path:
+    """The native package of ``system`` (:func:`write_ssp` with ``natives``) as one co-simulation FMU
+    (:mod:`fmu_harness.runs.container`) at :func:`container_path`: the native FMUs of FMI version ``fmi``
+    inside, stepping by Jacobi at the system's step as the project's master does."""
+    package = ssp_package.read(ssp_path(system, models, models))
+    fmus = {c.name: native.fmu_path(models, c.model, fmi) for c in system.components}
+    return container.build(package, fmus, container_path(system, models, fmi), system.step_size, int(fmi))
 
 
 # -- fmpy master ----------------------------------------------------------------------------

@@ -147,7 +147,7 @@ def test_a_step_too_long_for_the_differential_mode_is_refused_before_the_run(lau
     assert stopped.value.code == 2 and not out.exists() and message.count("\n") == 1
     assert "drive (VehicleDriveline): --step 0.0005 s is above 0.000415 s" in message
     system_command.main([str(launch_ssp), "--stop-time", "0.01", "--step", "5e-4", "--out", str(out),
-                         "--set", "drive.J_side=0.03"])
+                         "--set", "drive.J_side=0.03", "--output-interval", "5e-4"])
     with out.open() as handle:
         assert len(list(csv.reader(handle))) == 21
 
