@@ -138,7 +138,7 @@ def vehicle_launch() -> System:
     (half its peak) in 0.3 s into ``VehicleDriveline``, whose side gears drive two ``TripodCoupling`` s
     (exact kinematics, friction 0.05; left 8 deg on the 0.45 m shaft, right 6 deg on the 0.70 m one)
     that twist the halfshafts; ``PowertrainMounts``, when the catalog has it, takes both joints' housing
-    loads. Communication step 0.1 ms (the differential's internal mode, 670 rad/s, needs it)."""
+    loads (its ``g`` the drive's standard gravity: one value across the models). Communication step 0.1 ms (the differential's internal mode, 670 rad/s, needs it)."""
     components = [
         Component("motor", "TorqueSource", {"T_level": 140.0, "ramp_time": 0.3}),
         Component("drive", "VehicleDriveline", {}),
@@ -153,7 +153,7 @@ def vehicle_launch() -> System:
         connections += [Connection(("drive", f"{name}_{side}"), (joint, name)) for name in JOINT_DRIVE]
         connections += [Connection((joint, name), ("drive", f"{name}_{side}")) for name in JOINT_FEEDBACK]
     if MOUNTS in MODELS:
-        components.append(Component("mounts", MOUNTS, {}))
+        components.append(Component("mounts", MOUNTS, {"g": dynamics.GRAVITY}))
         connections += [Connection((f"joint_{side}", name), ("mounts", f"{name}_{side}"))
                         for side in SIDES for name in HOUSING_LOADS]
     return System("VehicleLaunch", tuple(components), tuple(connections), 4.0, 1e-4)
