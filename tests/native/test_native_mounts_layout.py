@@ -86,3 +86,12 @@ def test_a_step_beyond_the_work_limit_is_refused_alike(native_dir, fmu_path, fmi
                 fmu.step(step)
             found.append([m for m in refused.value.messages if "squarings" in m])
     assert found[0] and found[0] == found[1]
+
+
+def test_progressive_and_rubber_mounts_are_refused_by_name_until_ported(native_dir, fmi):
+    """The rubber layout's keys (read by the Python core and FMUs) are refused by the native FMU at
+    initialisation in one line naming the mount and key, not taken as linear mounts."""
+    rubber = Path(__file__).parents[2] / "driveline" / "mounts" / "data" / "transverse_fwd_powertrain_rubber.toml"
+    found = refusals(native.fmu_path(native_dir, NAME, fmi), {"layout": str(rubber)})
+    assert len(found) == 1 and "mounts[0].dynamic_ratio: progressive and rubber mounts are taken by the Python " \
+        "FMUs only" in found[0]
