@@ -23,11 +23,13 @@
 #define STATE(data, k) ((data)->real_value[model_states[k]])
 #define DERIVATIVE(data, k) ((data)->real_value[model_state_derivatives[k]])
 #define NOMINAL(k) (model_state_nominals[k])
+#define STATE_NAME(k) (model_variables[model_states[k]].name)
 #else /* no state: the loops over them run zero times */
 #define STATE_SLOTS 1
 #define STATE(data, k) ((data)->real_value[0])
 #define DERIVATIVE(data, k) ((data)->real_value[0])
 #define NOMINAL(k) 1.0
+#define STATE_NAME(k) ""
 #endif
 
 int instance_is(Instance *instance, int model_exchange, const char *function)
@@ -136,11 +138,34 @@ Status model_exchange_set_time(Instance *instance, const char *function, double 
     return STATUS_OK;
 }
 
+/* FMI 2.0 sets the states in continuous-time mode only, FMI 3.0 in event mode too; not before initialisation
+ * ends (ExitInitializationMode computes them from the start values: a state set before would be lost). A
+ * state that is not finite is refused (Discard, none set): no evaluation takes it, and a state kept is one
+ * the host may read back. */
 Status model_exchange_set_states(Instance *instance, const char *function, const double x[], size_t n)
 {
+    char index[24], shown[40];
     int i;
     if (!continuous_allows(instance, function, x, n, MODEL_STATE_COUNT)) {
         return STATUS_ERROR;
+    }
+    if (instance->mode != MODE_STEP || (instance->event_mode && instance->fmi_prefix[3] == '2')) {
+        return instance_fail(instance, instance->fmi_prefix, function, " is not allowed in ",
+                             instance->mode != MODE_STEP ? "InitializationMode" : "EventMode",
+                             instance->fmi_prefix[3] == '2' ? " (only in ContinuousTimeMode)"
+                                                            : " (only in ContinuousTimeMode or EventMode)",
+                             (const char *)NULL);
+    }
+    instance->messages.count = 0;
+    for (i = 0; i < MODEL_STATE_COUNT; i++) {
+        if (!isfinite(x[i])) {
+            snprintf(index, sizeof index, "%d", i);
+            python_float_repr(x[i], shown, sizeof shown);
+            messages_add(&instance->messages, "the continuous state x[", index, "] (",
+                         STATE_NAME(i), ") = ", shown,
+                         " is not finite; the states were not set", (const char *)NULL);
+            return instance_refusal(instance);
+        }
     }
     for (i = 0; i < MODEL_STATE_COUNT; i++) {
         STATE(&instance->data, i) = x[i];
