@@ -68,6 +68,9 @@ class SteppedModel(ABC):
                 return errors
         if not (math.isfinite(step_size) and step_size > 0.0):
             return [f"communication step size must be positive and finite, got {step_size!r}"]
+        if not math.isfinite(current_time + step_size):
+            return [f"the communication step from t = {current_time!r} s by {step_size!r} s ends at a time that is "
+                    f"not finite"]
         parameters = tuple(getattr(self, name) for name in self._parameter_names)
         errors = (self.parameter_errors() if parameters != self._valid_parameters else []) + self.input_errors()
         if errors:

@@ -78,6 +78,14 @@ static void step(Instance *instance, double current_time, double step_size)
         messages_add(out, "communication step size must be positive and finite, got ", shown, (const char *)NULL);
         return;
     }
+    if (!isfinite(current_time + step_size)) {
+        char start[40];
+        python_float_repr(current_time, start, sizeof start);
+        python_float_repr(step_size, shown, sizeof shown);
+        messages_add(out, "the communication step from t = ", start, " s by ", shown,
+                     " s ends at a time that is not finite", (const char *)NULL);
+        return;
+    }
     parameter_errors(&instance->data, out);
     input_errors(&instance->data, out);
     if (out->count == 0 && model_hooks.step_size_errors != NULL) {
