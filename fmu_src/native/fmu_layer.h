@@ -12,6 +12,7 @@ void append_pieces(char *out, size_t size, const char *first, va_list pieces);
 void parameter_errors(const ModelData *data, Messages *out);
 void input_errors(const ModelData *data, Messages *out);
 void output_errors(const ModelData *data, Messages *out, Failure *failure);
+void restored_errors(const ModelData *data, double start_time, Messages *out);
 char *copy_text(const char *text, size_t length);
 void free_strings(char *strings[MODEL_VARIABLE_COUNT]);
 int copy_strings(char *const from[MODEL_VARIABLE_COUNT], char *to[MODEL_VARIABLE_COUNT]);
