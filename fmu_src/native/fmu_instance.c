@@ -239,7 +239,9 @@ Status instance_reset(Instance *instance)
     memset(&instance->data, 0, sizeof instance->data);
     for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
         instance->data.real_value[i] = model_variables[i].start;
-        instance->data.int_value[i] = (int32_t)model_variables[i].start;
+        if (model_variables[i].type == VAR_INTEGER || model_variables[i].type == VAR_BOOLEAN) {
+            instance->data.int_value[i] = (int32_t)model_variables[i].start; /* an int32 or 0 and 1: exact */
+        }
         instance->data.string_value[i] = strings[i];
     }
     instance->data.cache = &instance->cache;
