@@ -322,9 +322,10 @@ Status model_exchange_get_nominals(Instance *instance, const char *function, dou
 Status model_exchange_get_event_indicators(Instance *instance, const char *function, size_t n);
 /* Enters event mode (``event`` 1) or continuous-time mode (0). */
 Status model_exchange_enter_mode(Instance *instance, const char *function, int event);
-/* 1 when ``function``, of Model Exchange after initialisation, may run now with its output
- * arguments (``outputs_given``: none is NULL); else Error with the reason logged. */
-int model_exchange_call(Instance *instance, const char *function, int outputs_given);
+/* 1 when ``function``, of Model Exchange after initialisation in event mode (``event`` 1) or continuous-time
+ * mode (0), may run now with its output arguments (``outputs_given``: none is NULL); else Error with the
+ * reason logged. */
+int model_exchange_call(Instance *instance, const char *function, int outputs_given, int event);
 /* Error unless the instance is one of the interface's (``model_exchange`` 1: Model Exchange). */
 int instance_is(Instance *instance, int model_exchange, const char *function);
 /* Evaluates the outputs into ``data`` (the instance's values, or a copy of them) at its time, states and

@@ -218,9 +218,22 @@ Status model_exchange_get_event_indicators(Instance *instance, const char *funct
     return continuous_allows(instance, function, "", n, 0) ? STATUS_OK : STATUS_ERROR;
 }
 
-int model_exchange_call(Instance *instance, const char *function, int outputs_given)
+/* 1 when the instance is in event mode (``event`` 1) or continuous-time mode (0); else Error with the reason. */
+static int in_mode(Instance *instance, const char *function, int event)
 {
-    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function)) {
+    if (instance->event_mode == event) {
+        return 1;
+    }
+    instance_fail(instance, instance->fmi_prefix, function, " is not allowed in ",
+                  event ? "ContinuousTimeMode (only in EventMode)" : "EventMode (only in ContinuousTimeMode)",
+                  (const char *)NULL);
+    return 0;
+}
+
+int model_exchange_call(Instance *instance, const char *function, int outputs_given, int event)
+{
+    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function) ||
+        !in_mode(instance, function, event)) {
         return 0;
     }
     if (!outputs_given) {
@@ -230,10 +243,12 @@ int model_exchange_call(Instance *instance, const char *function, int outputs_gi
     return 1;
 }
 
-/* Event mode (``event``) or continuous-time mode: the models have no events, so neither changes a value. */
+/* Event mode (``event``) or continuous-time mode: the models have no events, so neither changes a value.
+ * Continuous-time mode is entered from event mode only. */
 Status model_exchange_enter_mode(Instance *instance, const char *function, int event)
 {
-    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function)) {
+    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function) ||
+        (!event && !in_mode(instance, function, 1))) {
         return STATUS_ERROR;
     }
     instance->event_mode = event;
