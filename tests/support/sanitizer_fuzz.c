@@ -16,7 +16,7 @@
  * -fno-sanitize-recover). Its last line: "calls N cases M".
  *
  * Compiled with -DFMI_VERSION=2 or 3 and the FMU's sources; it reads the generated variable table
- * (model_variables.h) through fmu_instance.h. */
+ * (model_variables.h) through fmi/fmu_instance.h. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -24,7 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 #if FMI_VERSION == 2
 #include "fmi2Functions.h"

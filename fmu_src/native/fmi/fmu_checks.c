@@ -1,0 +1,205 @@
+/* Checks of the native FMUs' shared layer (SteppedModel.parameter_errors,
+ * input_errors, output_errors of driveline/model.py), with the Python core's wording. */
+#include "fmu_instance.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A number as a message shows it: an Integer's digits, a Real's repr(), or in the display unit. */
+static void show(double value, int integer, int display, const VariableInfo *v, char *out, size_t size)
+{
+    if (display) {
+        python_format_g(v->display_factor * value + v->display_offset, 6, out, size);
+    } else if (integer) {
+        snprintf(out, size, "%ld", (long)value);
+    } else {
+        python_float_repr(value, out, size);
+    }
+}
+
+/* Fills a generated template with ``value`` (of variable ``v``) and ``bound``. */
+static void add_message(Messages *out, const MessageTemplate *message, const VariableInfo *v, double value,
+                        double bound, int integer_bound)
+{
+    char text[FMU_MESSAGE_SIZE] = "", shown[40];
+    int i;
+    for (i = 0; i < 3; i++) {
+        const MessagePiece *piece = &message->pieces[i];
+        strncat(text, piece->text, sizeof text - strlen(text) - 1);
+        if (piece->slot == SLOT_END) {
+            break;
+        }
+        if (piece->slot == SLOT_VALUE_REPR || piece->slot == SLOT_VALUE_DISPLAY) {
+            show(value, v->type == VAR_INTEGER, piece->slot == SLOT_VALUE_DISPLAY, v, shown, sizeof shown);
+        } else {
+            show(bound, integer_bound, piece->slot == SLOT_BOUND_DISPLAY, v, shown, sizeof shown);
+        }
+        strncat(text, shown, sizeof text - strlen(text) - 1);
+    }
+    messages_add(out, text, (const char *)NULL);
+}
+
+static double value_of(const ModelData *data, int variable)
+{
+    VariableType type = model_variables[variable].type;
+    return type == VAR_INTEGER || type == VAR_BOOLEAN ? (double)data->int_value[variable]
+                                                      : data->real_value[variable];
+}
+
+#if MODEL_EXTRA_MESSAGE_COUNT > 0
+void messages_add_extra(Messages *out, const ModelData *data, int message)
+{
+    const ExtraMessage *extra = &model_extra_messages[message];
+    add_message(out, &extra->message, &model_variables[extra->variable], value_of(data, extra->variable), 0.0, 0);
+}
+#endif
+
+/* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
+
+/* SteppedModel._range_error for every variable of ``causality``: finite, then the declared bounds (the
+ * generated list of the variables that have a check of these; the outputs' finiteness: output_errors). */
+static void range_errors(const ModelData *data, Causality causality, Messages *out)
+{
+    int k;
+    for (k = model_checked_from[causality]; k < model_checked_from[causality + 1]; k++) {
+        const VariableInfo *v = &model_variables[model_checked[k]];
+        const MessageTemplate *message = NULL;
+        double value = value_of(data, model_checked[k]);
+        if (v->type == VAR_REAL && !isfinite(value)) {
+            message = &v->not_finite;
+        } else if (v->has_min && (v->min_exclusive ? !(value > v->min) : value < v->min)) {
+            message = &v->outside_min;
+        } else if (v->has_max && (v->max_exclusive ? !(value < v->max) : value > v->max)) {
+            message = &v->outside_max;
+        }
+        if (message != NULL) {
+            add_message(out, message, v, value, 0.0, 0);
+        }
+    }
+}
+
+/* SteppedModel._relation_error for every declared relation checked with the inputs (``inputs``)
+ * or with the parameters. */
+static void relation_errors(const ModelData *data, int inputs, Messages *out)
+{
+#if MODEL_RELATION_COUNT > 0
+    int i;
+    for (i = 0; i < MODEL_RELATION_COUNT; i++) {
+        const RelationInfo *r = &model_relations[i];
+        double left = value_of(data, r->lhs), right = r->rhs >= 0 ? value_of(data, r->rhs) : r->constant;
+        double bound = r->scale == 1.0 && r->offset == 0.0 ? right : r->scale * right + r->offset;
+        int holds = r->op == OP_LT ? left < bound : r->op == OP_LE ? left <= bound : r->op == OP_GT ? left > bound
+                                                                                                     : left >= bound;
+        if (r->involves_input == inputs && !holds) {
+            add_message(out, &r->message, &model_variables[r->lhs], left, bound, r->integer_bound);
+        }
+    }
+#else
+    (void)data;
+    (void)inputs;
+    (void)out;
+#endif
+}
+
+/* The checks of one causality in the core's order: bounds, then relations, then the model's own
+ * (each only if the ones before found nothing). */
+static void causality_errors(const ModelData *data, Causality causality, int inputs,
+                             void (*extra)(const ModelData *, Messages *), Messages *out)
+{
+    int before = out->count;
+    range_errors(data, causality, out);
+    if (out->count == before) {
+        relation_errors(data, inputs, out);
+    }
+    if (out->count == before && extra != NULL) {
+        extra(data, out);
+    }
+}
+
+void parameter_errors(const ModelData *data, Messages *out)
+{
+    causality_errors(data, CAUSALITY_PARAMETER, 0, model_hooks.extra_parameter_errors, out);
+}
+
+void input_errors(const ModelData *data, Messages *out)
+{
+    causality_errors(data, CAUSALITY_INPUT, 1, model_hooks.extra_input_errors, out);
+}
+
+typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_FAILED } SumOutcome;
+
+/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it);
+ * exactly only where a partial sum could come near overflow. */
+static SumOutcome fsum_outcome(const double values[], int count, Failure *failure)
+{
+    double magnitude = 0.0, sum = 0.0;
+    const char *message;
+    ErrorKind kind;
+    int i;
+    for (i = 0; i < count; i++) {
+        magnitude += fabs(values[i]);
+    }
+    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
+        return SUM_FINITE;
+    }
+    kind = python_fsum(values, count, &sum, &message);
+    if (kind != ERROR_NONE) {
+        *failure = FAILURE(kind, message);
+        return SUM_FAILED;
+    }
+    return isfinite(sum) ? SUM_FINITE : SUM_NOT_FINITE;
+}
+
+/* SteppedModel.output_errors (not finite, then beyond the declared bounds); an arithmetic failure
+ * of the sum itself becomes ``failure``. */
+void output_errors(const ModelData *data, Messages *out, Failure *failure)
+{
+    double values[MODEL_REAL_OUTPUT_COUNT + 1];
+    const int *names = model_real_outputs;
+    int count = MODEL_REAL_OUTPUT_COUNT, i;
+    char shown[40];
+    SumOutcome outcome;
+    for (i = 0; i < count; i++) {
+        values[i] = data->real_value[names[i]];
+    }
+    outcome = fsum_outcome(values, count, failure);
+    if (outcome == SUM_FINITE) {
+        range_errors(data, CAUSALITY_OUTPUT, out);
+    } else if (outcome == SUM_NOT_FINITE) {
+        for (i = 0; i < count; i++) {
+            if (!isfinite(values[i])) {
+                python_float_repr(values[i], shown, sizeof shown);
+                messages_add(out, "output ", model_variables[names[i]].name, " is not finite (", shown,
+                             "); the step was not taken", (const char *)NULL);
+            }
+        }
+    }
+}
+
+
+/* SteppedModel.state_from_saved's check of the values a serialized state restores, as the model could have
+ * left them: the times finite, then every Real output finite, then every output within its bounds. */
+void restored_errors(const ModelData *data, double start_time, Messages *out)
+{
+    char shown[40];
+    int i;
+    if (!isfinite(start_time) || !isfinite(data->time)) {
+        python_float_repr(isfinite(start_time) ? data->time : start_time, shown, sizeof shown);
+        messages_add(out, isfinite(start_time) ? "time = " : "start time = ", shown, " is not finite",
+                     (const char *)NULL);
+        return;
+    }
+    for (i = 0; i < MODEL_REAL_OUTPUT_COUNT; i++) {
+        if (!isfinite(data->real_value[model_real_outputs[i]])) {
+            python_float_repr(data->real_value[model_real_outputs[i]], shown, sizeof shown);
+            messages_add(out, "output ", model_variables[model_real_outputs[i]].name, " = ", shown, " is not finite",
+                         (const char *)NULL);
+            return;
+        }
+    }
+    range_errors(data, CAUSALITY_OUTPUT, out);
+}

@@ -1,0 +1,46 @@
+/* The C library of the native PowertrainMounts FMU (port of driveline/mounts/; rigid_body.py, joints.py,
+ * system.py, exact_step.py and model.py are in the model file next to this folder):
+ *   layout.c     the layouts (layout.py), read by the shared layout reader (lib/toml.h)
+ *   dense.c      small dense linear algebra: products, solutions, symmetric eigenvalues, the matrix exponential
+ */
+#ifndef MOUNTS_H
+#define MOUNTS_H
+
+#include <stddef.h>
+
+#include "lib/toml.h"
+
+#define MOUNTS_AUGMENTED 24 /* exact_step.augmented: the order of Z h */
+
+/* ---- layout.c ---------------------------------------------------------------------------------- */
+
+typedef struct {
+    double position[3], stiffness[3], damping[3], axes[3][3]; /* axes: rows, the mount's axes in vehicle axes */
+} Mount;
+
+/* layout.Layout: mass [kg], centre of gravity [m], inertia tensor about it [kg m^2], mounts */
+typedef struct {
+    double mass, centre[3], inertia[3][3];
+    int count;
+    Mount mounts[MOUNTS_LAYOUT_MAX_MOUNTS];
+} Layout;
+
+/* layout.loads_layout into the Layout ``out`` (a LayoutLoads of layout_file_load) */
+ErrorKind loads_layout(const char *text, size_t length, const char *source, void *out, char *error, size_t size);
+
+/* ---- dense.c ----------------------------------------------------------------------------------- */
+
+/* c = a b: (n x m) (m x p) */
+void dense_multiply(const double *a, const double *b, double *c, int n, int m, int p);
+/* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) by Gaussian
+ * elimination with partial pivoting (a overwritten); 0 if a is singular. */
+int dense_solve(double *a, double *b, int n, int columns);
+/* Cyclic Jacobi rotations of the symmetric ``a`` (n x n): its eigenvalues on the diagonal, the
+ * eigenvectors in the columns of ``vectors``. */
+void dense_symmetric_eigen(double *a, double *vectors, int n);
+/* exp(z) of the MOUNTS_AUGMENTED-order ``z`` (overwritten) into ``out`` by the degree-13 Pade approximant
+ * after ``count`` halvings, squared ``count`` times (Higham 2005); 0 without memory or for a singular
+ * denominator. */
+int dense_exponential(double *z, int count, double *out);
+
+#endif

@@ -1,0 +1,179 @@
+/* Forward-mode automatic differentiation: a dual number holds a value and its partial derivatives with
+ * respect to the Jacobian's columns (the Real inputs and the state, COLUMN_<name>), so one evaluation in
+ * dual arithmetic gives a whole row of partial derivatives per result. Each operation is the chain rule of
+ * the operator or libm function it replaces; the values are not the step's bit for bit (the outputs come
+ * from the step), only their derivatives are used. Header only (static inline functions), standard C99
+ * that MSVC compiles (no complex arithmetic). */
+#ifndef TRIPOD_DUAL_H
+#define TRIPOD_DUAL_H
+
+#include <math.h>
+
+#include "fmi/fmu_instance.h"
+
+#if defined(_MSC_VER) && !defined(__cplusplus) && !defined(inline)
+#define inline __inline /* MSVC's C before C11 */
+#endif
+
+#define DUAL_SIZE MODEL_COLUMN_COUNT
+
+typedef struct {
+    double v, d[DUAL_SIZE];
+} Dual;
+
+/* v with the partial derivatives ``slope`` times a's: f(a) with f(a.v) = v, f'(a.v) = slope */
+static inline Dual dual_chain(Dual a, double v, double slope)
+{
+    Dual r;
+    int c;
+    r.v = v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        r.d[c] = slope * a.d[c];
+    }
+    return r;
+}
+
+/* a constant: no partial derivatives */
+static inline Dual dual_constant(double v)
+{
+    Dual r;
+    int c;
+    r.v = v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        r.d[c] = 0.0;
+    }
+    return r;
+}
+
+/* the known of column ``column`` (COLUMN_<name>) at value v: its own partial derivative 1 */
+static inline Dual dual_known(double v, int column)
+{
+    Dual r = dual_constant(v);
+    r.d[column] = 1.0;
+    return r;
+}
+
+static inline Dual dual_add(Dual a, Dual b)
+{
+    int c;
+    a.v += b.v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        a.d[c] += b.d[c];
+    }
+    return a;
+}
+
+static inline Dual dual_sub(Dual a, Dual b)
+{
+    int c;
+    a.v -= b.v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        a.d[c] -= b.d[c];
+    }
+    return a;
+}
+
+static inline Dual dual_mul(Dual a, Dual b)
+{
+    Dual r;
+    int c;
+    r.v = a.v * b.v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        r.d[c] = a.d[c] * b.v + a.v * b.d[c];
+    }
+    return r;
+}
+
+static inline Dual dual_div(Dual a, Dual b)
+{
+    Dual r;
+    int c;
+    r.v = a.v / b.v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        r.d[c] = (a.d[c] - r.v * b.d[c]) / b.v;
+    }
+    return r;
+}
+
+/* a times the constant s */
+static inline Dual dual_scale(Dual a, double s)
+{
+    return dual_chain(a, s * a.v, s);
+}
+
+/* a plus the constant s */
+static inline Dual dual_shift(Dual a, double s)
+{
+    a.v += s;
+    return a;
+}
+
+static inline Dual dual_neg(Dual a)
+{
+    return dual_scale(a, -1.0);
+}
+
+/* a b + c d, the pattern of the cross products */
+static inline Dual dual_mul2(Dual a, Dual b, Dual c, Dual d)
+{
+    return dual_add(dual_mul(a, b), dual_mul(c, d));
+}
+
+/* a b - c d */
+static inline Dual dual_cross(Dual a, Dual b, Dual c, Dual d)
+{
+    return dual_sub(dual_mul(a, b), dual_mul(c, d));
+}
+
+/* The square root; where a is 0 (a norm of a vector that vanishes: a kink, whose directional derivative
+ * |dv| is no linear map) its partial derivatives are taken 0, the smallest of the one-sided ones. */
+static inline Dual dual_sqrt(Dual a)
+{
+    double v = sqrt(a.v);
+    return dual_chain(a, v, v > 0.0 ? 0.5 / v : 0.0);
+}
+
+static inline Dual dual_sin(Dual a)
+{
+    return dual_chain(a, sin(a.v), cos(a.v));
+}
+
+static inline Dual dual_cos(Dual a)
+{
+    return dual_chain(a, cos(a.v), -sin(a.v));
+}
+
+static inline Dual dual_tan(Dual a)
+{
+    double c = cos(a.v);
+    return dual_chain(a, tan(a.v), 1.0 / (c * c));
+}
+
+static inline Dual dual_asin(Dual a)
+{
+    return dual_chain(a, asin(a.v), 1.0 / sqrt(1.0 - a.v * a.v));
+}
+
+/* atan2(y, x): d = (x dy - y dx) / (x^2 + y^2) */
+static inline Dual dual_atan2(Dual y, Dual x)
+{
+    Dual r;
+    double norm = x.v * x.v + y.v * y.v;
+    int c;
+    r.v = atan2(y.v, x.v);
+    for (c = 0; c < DUAL_SIZE; c++) {
+        r.d[c] = (x.v * y.d[c] - y.v * x.d[c]) / norm;
+    }
+    return r;
+}
+
+/* the partial derivatives of ``a`` into row ``row`` of the Jacobian ``partial`` */
+static inline void dual_row(double partial[], int row, Dual a)
+{
+    int c;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        partial[row * MODEL_COLUMN_COUNT + c] = a.d[c];
+    }
+}
+
+#endif

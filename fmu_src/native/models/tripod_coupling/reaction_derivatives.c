@@ -1,0 +1,308 @@
+/* The exact reactions' partial derivatives (reactions.py; the step's exact_reactions and frictional_balance
+ * in tripod_coupling.c): the same steps 1-5 in dual numbers, from the closure's axis and its partial
+ * derivatives. The two 3x3 Cramer solves (angular velocity, angular acceleration) and the moment balance
+ * are differentiated as written (the adjugate's and the determinant's derivatives included).
+ *
+ * Friction: the balance is a fixed point (lambda, mu) = G(lambda, mu; knowns), a contraction of rate about
+ * the friction coefficient, that the step solves by successive substitution. Its derivative is the fixed
+ * point of d = G_x d + G_q, the same substitution in dual numbers: from the frictionless forces, the values
+ * and the partial derivatives are iterated until both have settled (each column's change of the arm
+ * forces below FRICTION_TOLERANCE of their own size in that column). The regularised slip signs are
+ * smooth; the normal forces are norms (dual_sqrt: at a vanishing force, a kink, its partial derivatives
+ * are taken 0).
+ */
+#include "derivatives.h"
+
+#include "driveline_constants.h"
+
+/* One arm of the balance in dual numbers (the step's Arm) */
+typedef struct {
+    Dual gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, k[3];
+    Dual ax, ay, hx, hy, hz;
+    Dual zdot, sigma, zddot;
+} DualArm;
+
+/* sum_j rhs_j adj_j[i]: Cramer's rule for K v = rhs, component i */
+static Dual cramer(const Dual rhs[3], Dual adj[3][3], int i)
+{
+    return dual_add(dual_mul2(rhs[0], adj[0][i], rhs[1], adj[1][i]), dual_mul(rhs[2], adj[2][i]));
+}
+
+/* a . b of two vectors given by components */
+static Dual dot(Dual ax, Dual ay, Dual az, Dual bx, Dual by, Dual bz)
+{
+    return dual_add(dual_mul2(ax, bx, ay, by), dual_mul(az, bz));
+}
+
+/* K^T w = M: w_j = M . adj_j / det */
+static void transposed_solve(Dual Mx, Dual My, Dual Mz, Dual adj[3][3], Dual inv_det, Dual out[3])
+{
+    int j;
+    for (j = 0; j < 3; j++) {
+        out[j] = dual_mul(dot(Mx, My, Mz, adj[j][0], adj[j][1], adj[j][2]), inv_det);
+    }
+}
+
+/* reactions.slip_sign: u / sqrt(1 + u^2), u = speed / slip_speed */
+static Dual slip_sign(Dual speed, double slip_speed)
+{
+    Dual u = dual_scale(speed, 1.0 / slip_speed);
+    return dual_div(u, dual_sqrt(dual_shift(dual_mul(u, u), 1.0)));
+}
+
+/* adds |change| weighted by ``weight`` to each column's and the value's tally */
+static void tally(Dual change, double weight, double sums[DUAL_SIZE + 1])
+{
+    int c;
+    sums[DUAL_SIZE] += fabs(change.v) * weight;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        sums[c] += fabs(change.d[c]) * weight;
+    }
+}
+
+/* The friction balance (frictional_balance) in dual numbers: lams, mus from the frictionless ones to the
+ * fixed point, slips, grooves and the dissipated power; 0 when the partial derivatives do not settle. */
+static int frictional_balance(const DualArm arm[3], Dual adj[3][3], Dual inv_det, const Dual moment[3],
+                              const DualLoad *load, Dual lams[3], Dual mus[3], Dual slips[3], Dual grooves[3],
+                              Dual *power)
+{
+    Dual signs[3][2], new_mus[3], new_lams[3];
+    double m = load->m, friction = load->friction, change[DUAL_SIZE + 1], scale[DUAL_SIZE + 1];
+    int iteration, j, c, settled = 0;
+    for (j = 0; j < 3; j++) {
+        const DualArm *a = &arm[j];
+        signs[j][0] = slip_sign(a->zdot, load->slip_speed);
+        signs[j][1] = slip_sign(dual_mul(a->sigma, dual_sqrt(dual_add(a->exy2, dual_mul(a->ez, a->ez)))),
+                                load->slip_speed);
+    }
+    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && !settled; iteration++) {
+        Dual Mx = moment[0], My = moment[1], Mz = moment[2];
+        for (c = 0; c <= DUAL_SIZE; c++) {
+            change[c] = scale[c] = 0.0;
+        }
+        for (j = 0; j < 3; j++) {
+            const DualArm *a = &arm[j];
+            Dual lam = lams[j], mu = mus[j], e2 = dual_add(a->exy2, dual_mul(a->ez, a->ez));
+            Dual normal = dual_sqrt(dual_mul(a->exy2, dual_add(dual_mul(lam, lam), dual_mul(dual_mul(mu, mu), e2))));
+            Dual slip = dual_div(dual_scale(dual_mul(normal, signs[j][1]), friction), dual_sqrt(e2));
+            Dual mu_ez = dual_mul(mu, a->ez), groove;
+            Dual along = dual_add(mu_ez, slip);
+            Dual Nx = dual_add(dual_add(dual_scale(a->ax, m), dual_mul(lam, a->ey)), dual_mul(along, a->ex));
+            Dual Ny = dual_add(dual_sub(dual_scale(a->ay, m), dual_mul(lam, a->ex)), dual_mul(along, a->ey));
+            Dual new_mu, arm_x, arm_y, arm_z;
+            groove = dual_scale(dual_mul(dual_sqrt(dual_mul2(Nx, Nx, Ny, Ny)), signs[j][0]), -friction);
+            /* plunger along Z': groove - F_z = m zddot with F_z = -mu |n|^2 + phi e_z */
+            new_mu = dual_div(dual_add(dual_sub(dual_scale(a->zddot, m), groove), dual_mul(slip, a->ez)), a->exy2);
+            arm_x = dual_neg(dual_mul2(a->dy, a->exy2, a->dz, dual_mul(a->ez, a->ey))); /* d x (e x n) */
+            arm_y = dual_mul2(a->dz, dual_mul(a->ez, a->ex), a->dx, a->exy2);
+            arm_z = dual_mul(a->ez, dual_cross(a->dx, a->ey, a->dy, a->ex));
+            Mx = dual_sub(Mx, dual_mul2(new_mu, arm_x, slip, dual_cross(a->dy, a->ez, a->dz, a->ey)));
+            My = dual_sub(My, dual_mul2(new_mu, arm_y, slip, dual_cross(a->dz, a->ex, a->dx, a->ez)));
+            Mz = dual_sub(Mz, dual_mul2(new_mu, arm_z, slip, dual_cross(a->dx, a->ey, a->dy, a->ex)));
+            tally(dual_sub(new_mu, mu), sqrt(a->exy2.v * e2.v), change);
+            tally(new_mu, sqrt(a->exy2.v * e2.v), scale);
+            new_mus[j] = new_mu;
+            slips[j] = slip;
+            grooves[j] = groove;
+        }
+        transposed_solve(Mx, My, Mz, adj, inv_det, new_lams);
+        for (j = 0; j < 3; j++) {
+            tally(dual_sub(new_lams[j], lams[j]), sqrt(arm[j].exy2.v), change);
+            tally(new_lams[j], sqrt(arm[j].exy2.v), scale);
+            lams[j] = new_lams[j];
+            mus[j] = new_mus[j];
+        }
+        settled = 1;
+        for (c = 0; c <= DUAL_SIZE; c++) {
+            settled = settled && change[c] <= TRIPOD_REACTIONS_FRICTION_TOLERANCE * scale[c];
+        }
+    }
+    *power = dual_constant(0.0);
+    for (j = 0; j < 3; j++) {
+        /* dissipation: -g_j zdot_j (groove) + phi_j sdot_j (arm), sdot_j |e_j| = sigma_j |e_j|^2 */
+        Dual e2 = dual_add(arm[j].exy2, dual_mul(arm[j].ez, arm[j].ez));
+        Dual arm_power = dual_mul(dual_mul(slips[j], arm[j].sigma), e2);
+        *power = dual_add(dual_sub(*power, dual_mul(grooves[j], arm[j].zdot)), arm_power);
+    }
+    return settled;
+}
+
+/* Step 1, the pose of arm j at groove angle (c, s): ball centre, arm vector e, d = b - S, the row k of K */
+static void pose(DualArm *a, Dual c, Dual s, double r, double l, Dual P[3], Dual U[3], Dual p_dot_u)
+{
+    a->gx = dual_scale(c, r);
+    a->gy = dual_scale(s, r);
+    a->bz = dual_div(dual_sub(dual_sub(p_dot_u, dual_mul(a->gx, U[0])), dual_mul(a->gy, U[1])), U[2]);
+    a->ex = dual_sub(a->gx, P[0]);
+    a->ey = dual_sub(a->gy, P[1]);
+    a->ez = dual_sub(a->bz, P[2]);
+    a->dx = dual_sub(a->ex, dual_scale(U[0], l));
+    a->dy = dual_sub(a->ey, dual_scale(U[1], l));
+    a->dz = dual_sub(a->ez, dual_scale(U[2], l));
+    a->exy2 = dual_mul2(a->ex, a->ex, a->ey, a->ey);
+    a->k[0] = dual_mul(a->dz, a->ex);
+    a->k[1] = dual_mul(a->dz, a->ey);
+    a->k[2] = dual_neg(dual_mul2(a->dx, a->ex, a->dy, a->ey));
+}
+
+/* Steps 2 and 3's known terms of arm j: velocities, sliding rates, whirl and Coriolis terms */
+static void known_terms(DualArm *a, const Dual W[3], Dual W2, Dual omega, Dual omega_dot, const Dual Sv[2],
+                        const Dual Sa[2])
+{
+    Dual omega2 = dual_mul(omega, omega);
+    Dual vx = dual_add(dual_add(dual_cross(W[1], a->dz, W[2], a->dy), dual_mul(omega, a->gy)), Sv[0]);
+    Dual vy = dual_sub(dual_cross(W[2], a->dx, W[0], a->dz), dual_mul(omega, a->gx));
+    Dual wd = dot(W[0], W[1], W[2], a->dx, a->dy, a->dz); /* Omega x (Omega x d) = Omega (Omega . d) - d |Omega|^2 */
+    Dual sigma = dual_div(dual_neg(dual_mul2(vx, a->ex, vy, a->ey)), a->exy2), twice_sigma = dual_scale(sigma, 2.0);
+    Dual coriolis_x = dual_mul(twice_sigma, dual_cross(W[1], a->ez, W[2], a->ey));
+    Dual coriolis_y = dual_mul(twice_sigma, dual_cross(W[2], a->ex, W[0], a->ez));
+    Dual coriolis_z = dual_mul(twice_sigma, dual_cross(W[0], a->ey, W[1], a->ex));
+    a->sigma = sigma;
+    a->hx = dual_add(dual_add(dual_cross(W[0], wd, a->dx, W2), coriolis_x), Sa[0]);
+    a->hy = dual_add(dual_cross(W[1], wd, a->dy, W2), coriolis_y);
+    a->hz = dual_add(dual_add(dual_cross(W[2], wd, a->dz, W2), coriolis_z), Sa[1]);
+    a->ax = dual_neg(dual_mul2(omega_dot, a->gy, omega2, a->gx)); /* groove point's acceleration */
+    a->ay = dual_cross(omega_dot, a->gx, omega2, a->gy);
+    a->zdot = dual_add(dual_add(dual_cross(W[0], a->dy, W[1], a->dx), dual_mul(a->sigma, a->ez)), Sv[1]);
+}
+
+/* Step 5: the reactions from the arm forces (lambda, mu, slip along the arm, groove friction) */
+static void bearing_reactions(const DualArm arm[3], const Dual lams[3], const Dual mus[3], const Dual slips[3],
+                              const Dual grooves[3], const Dual E1[3], const Dual E2[3], const Dual U[3], double m,
+                              DualReactions *out)
+{
+    Dual R_out[3], R_in[2], L[3];
+    int j, i;
+    for (i = 0; i < 3; i++) {
+        R_out[i] = L[i] = dual_constant(0.0);
+    }
+    R_in[0] = R_in[1] = dual_constant(0.0);
+    for (j = 0; j < 3; j++) {
+        const DualArm *a = &arm[j];
+        Dual along = dual_add(dual_mul(mus[j], a->ez), slips[j]);
+        Dual Fx = dual_add(dual_mul(lams[j], a->ey), dual_mul(along, a->ex));
+        Dual Fy = dual_sub(dual_mul(along, a->ey), dual_mul(lams[j], a->ex));
+        Dual Fz = dual_cross(slips[j], a->ez, mus[j], a->exy2);
+        Dual Nx = dual_add(dual_scale(a->ax, m), Fx), Ny = dual_add(dual_scale(a->ay, m), Fy);
+        Dual tx = dual_cross(U[1], a->ez, U[2], a->ey), ty = dual_cross(U[2], a->ex, U[0], a->ez);
+        Dual tz = dual_cross(U[0], a->ey, U[1], a->ex); /* U x e_j, in the tripod plane */
+        R_out[0] = dual_sub(R_out[0], Fx);
+        R_out[1] = dual_sub(R_out[1], Fy);
+        R_out[2] = dual_sub(R_out[2], Fz);
+        R_in[0] = dual_add(R_in[0], Nx);
+        R_in[1] = dual_add(R_in[1], Ny);
+        L[0] = dual_add(dual_sub(L[0], dual_mul(a->bz, Ny)), dual_mul(a->gy, grooves[j]));
+        L[1] = dual_sub(dual_add(L[1], dual_mul(a->bz, Nx)), dual_mul(a->gx, grooves[j]));
+        L[2] = dual_add(L[2], dual_cross(a->gx, Ny, a->gy, Nx));
+        out->F_arm[j] = dual_div(dot(Fx, Fy, Fz, tx, ty, tz), dual_sqrt(dot(tx, ty, tz, tx, ty, tz)));
+        out->F_plunger[j] = dual_scale(a->zddot, m);
+    }
+    out->Rx_in = R_in[0];
+    out->Ry_in = R_in[1];
+    out->Mx_in = L[0];
+    out->My_in = L[1];
+    out->T_in = L[2];
+    out->Rx_out = dot(R_out[0], R_out[1], R_out[2], E1[0], E1[1], E1[2]);
+    out->Ry_out = dot(R_out[0], R_out[1], R_out[2], E2[0], E2[1], E2[2]);
+    out->Rz_out = dot(R_out[0], R_out[1], R_out[2], U[0], U[1], U[2]);
+    out->a_plunger_sum = dual_add(dual_add(arm[0].zddot, arm[1].zddot), arm[2].zddot);
+    out->Rz_in = dual_add(dual_add(grooves[0], grooves[1]), grooves[2]);
+}
+
+Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions *out)
+{
+    const double half_root_3 = 0.5 * sqrt(3.0), r = load->r, l = load->l, m = load->m;
+    Dual one = dual_constant(1.0), cb = load->cb, sb = load->sb, bd = load->beta_dot, bdd = load->beta_ddot;
+    Dual zn = dual_sqrt(dual_sub(one, dual_mul2(x, x, y, y))), k = dual_div(one, dual_shift(zn, 1.0));
+    Dual xyk = dual_mul(dual_mul(x, y), k), e1x = dual_sub(one, dual_mul(dual_mul(x, x), k));
+    Dual e2y = dual_sub(one, dual_mul(dual_mul(y, y), k)), bd2 = dual_mul(bd, bd);
+    Dual E1[3], E2[3], U[3], P[3], Sv[2], Sa[2], c[3], s[3], adj[3][3], inv_det, rhs[3], W[3], W2, A[3];
+    Dual moment[3], Mx, My, Mz, p_dot_u, lams[3], mus[3], slips[3], grooves[3], power = dual_constant(0.0);
+    DualArm arm[3];
+    int j;
+    /* twist-free frame (E1, E2, U) of the output shaft, nominal output frame -> input frame (eq 2) */
+    E1[0] = dual_mul2(cb, e1x, sb, x);
+    E1[1] = dual_neg(xyk);
+    E1[2] = dual_cross(sb, e1x, cb, x);
+    E2[0] = dual_cross(sb, y, cb, xyk);
+    E2[1] = e2y;
+    E2[2] = dual_neg(dual_mul2(sb, xyk, cb, y));
+    U[0] = dual_cross(cb, x, sb, zn);
+    U[1] = y;
+    U[2] = dual_mul2(sb, x, cb, zn);
+    P[0] = dual_scale(dual_add(sb, U[0]), -l); /* P = S - l U, S = l (-sin, 0, cos) */
+    P[1] = dual_scale(U[1], -l);
+    P[2] = dual_scale(dual_sub(cb, U[2]), l);
+    /* the moving bearing: Sdot = l betadot (-cos, 0, -sin), Sddot = l betaddot (-cos, 0, -sin) - l betadot^2 e_out */
+    Sv[0] = dual_scale(dual_mul(cb, bd), -l);
+    Sv[1] = dual_scale(dual_mul(sb, bd), -l);
+    Sa[0] = dual_scale(dual_cross(sb, bd2, cb, bdd), l);
+    Sa[1] = dual_scale(dual_mul2(cb, bd2, sb, bdd), -l);
+    p_dot_u = dot(P[0], P[1], P[2], U[0], U[1], U[2]);
+    c[0] = dual_cos(load->phi_in);
+    s[0] = dual_sin(load->phi_in);
+    c[1] = dual_sub(dual_scale(c[0], -0.5), dual_scale(s[0], half_root_3));
+    s[1] = dual_add(dual_scale(s[0], -0.5), dual_scale(c[0], half_root_3));
+    c[2] = dual_add(dual_scale(c[0], -0.5), dual_scale(s[0], half_root_3));
+    s[2] = dual_sub(dual_scale(s[0], -0.5), dual_scale(c[0], half_root_3));
+    for (j = 0; j < 3; j++) {
+        pose(&arm[j], c[j], s[j], r, l, P, U, p_dot_u);
+    }
+    /* Cramer's rule with the adjugate's rows, the cross products of the rows of K */
+    for (j = 0; j < 3; j++) {
+        const Dual *p = arm[(j + 1) % 3].k, *q = arm[(j + 2) % 3].k;
+        adj[j][0] = dual_cross(p[1], q[2], p[2], q[1]);
+        adj[j][1] = dual_cross(p[2], q[0], p[0], q[2]);
+        adj[j][2] = dual_cross(p[0], q[1], p[1], q[0]);
+    }
+    inv_det = dual_div(one, dot(arm[0].k[0], arm[0].k[1], arm[0].k[2], adj[0][0], adj[0][1], adj[0][2]));
+    /* 2. angular velocity of the output shaft */
+    for (j = 0; j < 3; j++) {
+        Dual g_dot_e = dual_mul2(arm[j].gx, arm[j].ex, arm[j].gy, arm[j].ey);
+        rhs[j] = dual_mul(dual_neg(dual_mul2(load->omega, g_dot_e, Sv[0], arm[j].ey)), inv_det);
+    }
+    for (j = 0; j < 3; j++) {
+        W[j] = cramer(rhs, adj, j);
+    }
+    W2 = dot(W[0], W[1], W[2], W[0], W[1], W[2]);
+    /* 3. accelerations: known terms per arm, then K Omegadot = (known . n_j) */
+    for (j = 0; j < 3; j++) {
+        known_terms(&arm[j], W, W2, load->omega, load->omega_dot, Sv, Sa);
+    }
+    for (j = 0; j < 3; j++) {
+        const DualArm *a = &arm[j];
+        rhs[j] = dual_mul(dual_cross(dual_sub(a->ax, a->hx), a->ey, dual_sub(a->ay, a->hy), a->ex), inv_det);
+    }
+    for (j = 0; j < 3; j++) {
+        A[j] = cramer(rhs, adj, j);
+    }
+    /* plunger accelerations and 4. the Z' parts of the arm forces, F_j = lambda_j n_j + mu_j (e_j x n_j) */
+    for (j = 0; j < 3; j++) {
+        moment[j] = dual_mul(load->T_load, U[j]);
+    }
+    Mx = moment[0];
+    My = moment[1];
+    Mz = moment[2];
+    for (j = 0; j < 3; j++) {
+        DualArm *a = &arm[j];
+        Dual wx = dual_sub(dual_add(dual_cross(A[1], a->dz, A[2], a->dy), a->hx), a->ax);
+        Dual wy = dual_sub(dual_add(dual_cross(A[2], a->dx, A[0], a->dz), a->hy), a->ay);
+        Dual wz = dual_add(dual_cross(A[0], a->dy, A[1], a->dx), a->hz);
+        Dual qx = dual_mul(a->ez, a->ex), qy = dual_mul(a->ez, a->ey), qz = dual_neg(a->exy2);
+        a->zddot = dual_sub(wz, dual_mul(dual_div(dual_mul2(wx, a->ex, wy, a->ey), a->exy2), a->ez));
+        mus[j] = dual_div(dual_scale(a->zddot, m), a->exy2);
+        Mx = dual_sub(Mx, dual_mul(mus[j], dual_cross(a->dy, qz, a->dz, qy)));
+        My = dual_sub(My, dual_mul(mus[j], dual_cross(a->dz, qx, a->dx, qz)));
+        Mz = dual_sub(Mz, dual_mul(mus[j], dual_cross(a->dx, qy, a->dy, qx)));
+        slips[j] = grooves[j] = dual_constant(0.0);
+    }
+    transposed_solve(Mx, My, Mz, adj, inv_det, lams);
+    if (load->friction != 0.0 &&
+        !frictional_balance(arm, adj, inv_det, moment, load, lams, mus, slips, grooves, &power)) {
+        return FAILURE(ERROR_ARITHMETIC, "tripod friction balance: its partial derivatives did not converge");
+    }
+    bearing_reactions(arm, lams, mus, slips, grooves, E1, E2, U, m, out);
+    out->omega_spin = dot(W[0], W[1], W[2], U[0], U[1], U[2]);
+    out->P_friction = power;
+    return NO_FAILURE;
+}
