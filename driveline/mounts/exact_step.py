@@ -65,15 +65,21 @@ def augmented(a: np.ndarray, b: np.ndarray, h: float) -> np.ndarray:
     return z
 
 
-def squarings(z: np.ndarray) -> int:
-    """Squarings the scaling and squaring method takes for ``exp(z)``."""
+def squarings(z: np.ndarray) -> int | None:
+    """Squarings the scaling and squaring method takes for ``exp(z)``; None where ``z``'s norm is not finite
+    (a step so long that the matrix overflows), which no count of squarings scales."""
     norm = float(np.max(np.sum(np.abs(z), axis=0)))
+    if not math.isfinite(norm):
+        return None
     return max(0, math.ceil(math.log2(norm / THETA_13))) if norm > THETA_13 else 0
 
 
 def work_error(a: np.ndarray, b: np.ndarray, h: float) -> str | None:
     """Why a step of ``h`` is refused (its exponential needs more than MAX_SQUARINGS squarings), or None."""
-    needed = squarings(augmented(a, b, h))
+    with np.errstate(over="ignore"):
+        needed = squarings(augmented(a, b, h))
+    if needed is None:
+        return f"a step of {h!r} s overflows the matrix exponential's norm: take shorter steps"
     if needed <= MAX_SQUARINGS:
         return None
     return (f"a step of {h!r} s would take {needed} squarings of the matrix exponential, more than the "

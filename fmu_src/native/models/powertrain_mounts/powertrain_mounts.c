@@ -485,7 +485,7 @@ static void augmented(const System *s, double h, double *z)
     }
 }
 
-/* exact_step.squarings */
+/* exact_step.squarings: -1 where the norm is not finite (no count of squarings scales it) */
 static int squarings(const double *z)
 {
     double norm = 0.0;
@@ -497,6 +497,10 @@ static int squarings(const double *z)
         }
         norm = fmax(norm, sum);
     }
+    if (!isfinite(norm)) {
+        return -1;
+    }
+    /* a finite norm needs at most log2(DBL_MAX / THETA_13) + 1 = 1022 squarings: an int holds the count */
     return norm > MOUNTS_EXACT_STEP_THETA_13 ? (int)fmax(0.0, ceil(log2(norm / MOUNTS_EXACT_STEP_THETA_13))) : 0;
 }
 
@@ -513,8 +517,14 @@ static int propagator(System *s, double h)
     e = z + AUGMENTED * AUGMENTED;
     augmented(s, h, z);
     count = squarings(z);
+    python_float_repr(h, step, sizeof step);
+    if (count < 0) {
+        snprintf(s->failure, ERROR_SIZE, "a step of %s s overflows the matrix exponential's norm: take shorter steps",
+                 step);
+        free(z);
+        return 0;
+    }
     if (count > MOUNTS_EXACT_STEP_MAX_SQUARINGS) {
-        python_float_repr(h, step, sizeof step);
         snprintf(s->failure, ERROR_SIZE, "a step of %s s would take %d squarings of the matrix exponential, more than "
                  "the %d accepted: take shorter steps", step, count, MOUNTS_EXACT_STEP_MAX_SQUARINGS);
         free(z);
