@@ -33,6 +33,7 @@ from .reactions import FRICTION_TOLERANCE, MAX_FRICTION_ITERATIONS, ExactReactio
 from .spec import SINGLE_ROLLER
 
 Array = NDArray[np.float64]
+NOT_CONVERGED = "roller tripod friction balance did not converge (friction coefficient too large?)"
 E_Z = np.array([0.0, 0.0, 1.0])
 
 
@@ -143,7 +144,7 @@ def roller_reactions(
         if np.all(change <= FRICTION_TOLERANCE * scale):
             break
     else:
-        raise ArithmeticError("roller tripod friction balance did not converge (friction coefficient too large?)")
+        raise ArithmeticError(NOT_CONVERGED)
     N_trunnion = np.sqrt(exy2 * (lam * lam + mu_q * mu_q * arm_length * arm_length))
     phi = mu * N_trunnion * trunnion_sign / arm_length
     force = lam[..., None] * normal_arm + mu_q[..., None] * tangent_arm + phi[..., None] * arm
@@ -170,6 +171,8 @@ def _skewed_slips(k: Array, axis: Array, zdot: Array, spin: Array, R: float):
 
 CONTACT_ITERATIONS = 100  # the contact normal's bracketed root: Illinois steps, far more than it takes
 CONTACT_TOLERANCE = 1e-15  # [rad] on the normal's angle or on the miss of H's direction
+FRICTION_SHARE_CAP = 0.99  # the largest friction share of the normal force the bracket allows for
+BRACKET_MARGIN = 1e-9  # [rad] the bracket's half width beyond asin(mu + mu_roll)
 
 
 def _skewed_contact(horizontal: Array, axis: Array, zdot: Array, spin: Array, R: float, mu: float,
@@ -180,7 +183,7 @@ def _skewed_contact(horizontal: Array, axis: Array, zdot: Array, spin: Array, R:
     ``asin(mu + mu_roll)`` of H's, found by the Illinois method on that bracket) and then N."""
     target = np.arctan2(horizontal[..., 1], horizontal[..., 0])
     size = np.sqrt(_dot(horizontal, horizontal))
-    spread = np.arcsin(min(mu + mu_roll, 0.99)) + 1e-9
+    spread = np.arcsin(min(mu + mu_roll, FRICTION_SHARE_CAP)) + BRACKET_MARGIN
 
     def evaluate(angle: Array):
         k = np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], -1)

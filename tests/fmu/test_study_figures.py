@@ -41,7 +41,7 @@ def drawn_labels(fig) -> list[str]:
 
 
 def test_every_tripod_figure_shows_each_curve(tripod_figures):
-    assert len(tripod_figures) == 9
+    assert len(tripod_figures) == 10
     for name, fig in tripod_figures.items():
         assert_clean(fig, name)
 
@@ -65,6 +65,22 @@ def test_turn_figure_draws_each_reaction_at_each_load_for_three_bend_angles(trip
             ax = titles[f"{column}, T_load = {load:.0f} N.m"]
             assert sorted(line.get_label() for line in ax.get_lines()) == [
                 f"beta = {beta} deg" for beta in tripod_study.TURN_BETAS]
+
+
+def test_joints_figure_draws_each_joint_with_the_plain_tripod_above_the_rollers(tripod_figures):
+    """The three joints at each load (against beta) and each marked angle (against the load); from 4 deg up
+    the plain tripod's axial force lies above both roller tripods', the single roller's grows with beta."""
+    left, right = tripod_figures["tripod_joints_axial_force.png"].axes
+    lines = {line.get_label(): line.get_ydata() for line in left.get_lines()}
+    assert len(lines) == len(tripod_study.JOINTS) * len(tripod_study.ROLLER_LOADS)
+    assert len(right.get_lines()) == len(tripod_study.JOINTS) * 3
+    from_4 = np.array(tripod_study.ROLLER_BETAS) >= 4
+    for load in tripod_study.ROLLER_LOADS:
+        plain = lines[f"plain tripod, T_load = {load:.0f} N.m"]
+        single = lines[f"single roller, T_load = {load:.0f} N.m"]
+        double = lines[f"double roller, T_load = {load:.0f} N.m"]
+        assert np.all(plain[from_4] > single[from_4]) and np.all(plain[from_4] > double[from_4])
+        assert np.all(np.diff(single) > 0)
 
 
 def test_seed_means_are_drawn_around_the_force_balance_at_no_load(tripod_figures):
