@@ -13,7 +13,7 @@
  */
 #include "derivatives.h"
 
-#include "../driveline_constants.h"
+#include "driveline_constants.h"
 
 static const double PI = 3.141592653589793; /* math.pi */
 
