@@ -47,6 +47,7 @@ BETA_COLOURS = dict(zip(BETAS_DEG, ("tab:blue", "tab:orange", "tab:green", "tab:
 JOINTS = {PLAIN_TRIPOD: "plain tripod", SINGLE_ROLLER: "single roller", DOUBLE_ROLLER: "double roller"}
 ROLLER_BETAS = (2, 4, 8, 12, 16, 20)
 ROLLER_LOADS = (100.0, 300.0, 500.0)
+JOINTS_LOAD, JOINTS_BETA = 300.0, 12  # the figure's load against the angle, and angle against the load
 #: The CSV's ``reactions`` column: which reactions a row holds, a label rather than a number.
 REACTIONS_COLUMN = "reactions [label]"
 
@@ -332,27 +333,23 @@ def friction_beta_figure(friction: dict[tuple[float, float, float], np.ndarray])
 
 def joints_figure(joints: dict[tuple[int, float, float], np.ndarray]) -> Figure:
     """The generated axial force's 3rd-order amplitude of the plain tripod and the two roller tripods against
-    the bend angle (one curve per joint and load) and against the load (one curve per joint and angle)."""
+    the bend angle at 300 N.m and against the load at 12 deg, one curve per joint (more loads or angles in one
+    panel would put the plain tripod's curves on the single roller's)."""
     fig, (left, right) = figure(1, 2, figsize=(13, 5.2))
-    styles = dict(zip(ROLLER_LOADS, (":", "--", "-")))
-    angles = dict(zip((4, 12, 20), (":", "--", "-")))
     for joint, name in JOINTS.items():
         colour = f"C{joint}"
-        for load in ROLLER_LOADS:
-            amplitude = [order_amplitude(-joints[joint, beta, load]["Rz_in"]) for beta in ROLLER_BETAS]
-            left.semilogy(ROLLER_BETAS, amplitude, "o" + styles[load], color=colour,
-                          label=f"{name}, T_load = {load:.0f} N.m")
-        for beta, style in angles.items():
-            amplitude = [order_amplitude(-joints[joint, beta, load]["Rz_in"]) for load in ROLLER_LOADS]
-            right.semilogy(ROLLER_LOADS, amplitude, "s" + style, color=colour, label=f"{name}, beta = {beta} deg")
+        amplitude = [order_amplitude(-joints[joint, beta, JOINTS_LOAD]["Rz_in"]) for beta in ROLLER_BETAS]
+        left.semilogy(ROLLER_BETAS, amplitude, "o-", color=colour, label=name)
+        amplitude = [order_amplitude(-joints[joint, JOINTS_BETA, load]["Rz_in"]) for load in ROLLER_LOADS]
+        right.semilogy(ROLLER_LOADS, amplitude, "s-", color=colour, label=name)
     left.set_xlabel("bend angle beta [deg]")
-    left.set_title("against the bend angle", fontsize=9)
+    left.set_title(f"against the bend angle, T_load = {JOINTS_LOAD:.0f} N.m", fontsize=9)
     right.set_xlabel("load torque T_load [N.m]")
-    right.set_title("against the load", fontsize=9)
+    right.set_title(f"against the load, beta = {JOINTS_BETA} deg", fontsize=9)
     for ax in (left, right):
         ax.set_ylabel("3rd-order amplitude of -Rz_in [N]")
         ax.grid(True, alpha=0.3, which="both")
-        ax.legend(fontsize=7, ncol=1)
+    left.legend(fontsize=8)  # one legend: the joints' colours are the same in both panels
     fig.suptitle(f"Generated axial force of the three joints (tripod_type 0, 1, 2): mu = {FRICTION_MU}, default "
                  "mu_roll, 2000 rpm, r = 26 mm, l = 700 mm, m = 0.2 kg", fontsize=10)
     fig.tight_layout()
