@@ -11,9 +11,10 @@ import numpy as np
 from ..scalar import Real, arcsin
 from . import closed_form, dynamics, plane_solver
 from .geometry import orbit_radius
-from .reactions import exact_reactions
+from .reactions import exact_reactions, mechanism
 from .reactions_closed_form import leading_order_reactions
-from .spec import EXACT
+from .rollers import roller_reactions
+from .spec import EXACT, PLAIN_TRIPOD
 
 ARMS = ("1", "2", "3")
 
@@ -42,7 +43,8 @@ def coupling_outputs(
     phi_in: Real, beta: Real, omega_in: Real, T_load: Real, r: float, l: float, m: float,
     kinematics: int, solution: plane_solver.Solution | None = None,
     alpha_in: Real = 0.0, seed_reactions: int = 0, mu: float = 0.0, v_slip: float = 1e-3,
-    beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
+    beta_dot: Real = 0.0, beta_ddot: Real = 0.0, tripod_type: int = PLAIN_TRIPOD, mu_roll: float = 0.0,
+    roller_radius: float = 0.0,
 ) -> tuple[dict[str, Real], plane_solver.Solution | None]:
     """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's solution.
 
@@ -52,14 +54,22 @@ def coupling_outputs(
     ``Rz_out``, ``Rx_in`` and ``Ry_in`` by the seed's eqs 20, 30, 33 and 34 as printed.
     ``mu`` > 0 (exact mode only) adds Coulomb friction regularised over ``v_slip`` [m/s].
     ``beta_dot``, ``beta_ddot``: rates of the bend angle (the output bearing moves with beta).
+    ``tripod_type`` 1 (single roller) or 2 (double roller) with the exact kinematics: the roller
+    tripods' contacts (:mod:`.rollers`), with rolling resistance ``mu_roll`` and the rollers' outer
+    radius ``roller_radius`` [m]; without friction, and in the closed form, every type is the plain one.
     """
     rho = orbit_radius(beta, r)
     pin = dynamics.pin_force(T_load, rho, r)
     if kinematics == EXACT:
         phi_out, ratio, solution = plane_solver.solve(phi_in, beta, r, l, solution)
         theta = solution.cone_angle
-        forces = exact_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, mu, v_slip,
-                                 beta_dot, beta_ddot)
+        if tripod_type == PLAIN_TRIPOD:
+            forces = exact_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, mu,
+                                     v_slip, beta_dot, beta_ddot)
+        else:
+            state = mechanism(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, beta_dot,
+                              beta_ddot)
+            forces = roller_reactions(state, omega_in, T_load, m, tripod_type, mu, mu_roll, v_slip, roller_radius)[0]
         omega_spin, axial_in, loss = forces.omega_spin, forces.Rz_in, forces.P_friction
     else:
         deviation, ratio = closed_form.kinematics(phi_in, beta, r, l)

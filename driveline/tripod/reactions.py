@@ -41,7 +41,7 @@ balance keeps its form (massless tripod, bearing force through S).
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -71,19 +71,31 @@ class ExactReactions(NamedTuple):
     P_friction: Real = 0.0  # power dissipated by friction [W]
 
 
-def exact_reactions(
+class Mechanism(NamedTuple):
+    """Steps 1-4 of the frictionless balance at one instant, what the friction laws start from
+    (:func:`exact_reactions`, :mod:`.rollers`); per arm j the tuples of the module's steps."""
+
+    xp: Any  # math for floats, numpy for arrays
+    arms: list  # (gx, gy, bz, ex, ey, ez, dx, dy, dz, |e_xy|^2, k_jx, k_jy, k_jz): pose, arm e_j, d_j, row k_j
+    adj: tuple  # adjugate rows of K (Cramer's rule)
+    inv_det: Real  # 1 / det K
+    known: list  # (ax, ay, hx, hy, hz): the groove point's acceleration and the tripod's known terms
+    zddot: list  # plunger (roller) accelerations along Z'
+    slides: list  # (zdot_j, sigma_j): axial speed on the groove, sliding rate along the arm (sdot_j / |e_j|)
+    lams: list  # lambda_j of the frictionless balance
+    mus: list  # mu_j of the frictionless balance
+    U: tuple  # the output shaft's axis (Ux, Uy, Uz)
+    E1: tuple  # its twist-free frame, E1 (bend-plane side)
+    E2: tuple  # ... and E2
+    Omega: tuple  # the output shaft's angular velocity (Wx, Wy, Wz)
+
+
+def mechanism(
     phi_in: Real, beta: Real, omega: Real, omega_dot: Real, T_load: Real,
-    r: float, l: float, m: float, x: Real, y: Real, friction: float = 0.0, slip_speed: float = 1e-3,
-    beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
-) -> ExactReactions:
-    """Reactions at input angle ``phi_in``, bend ``beta``, input speed ``omega`` and its rate
-    ``omega_dot``, for the output-shaft axis ``(x, y, sqrt(1 - x^2 - y^2))`` in the nominal
-    output frame that solves the closure (:func:`.plane_solver.solve`). Plain arithmetic on
-    floats or arrays, written out per component (the module's steps 1-5; with ``n_j``
-    horizontal, ``k_j = (d_z e_x, d_z e_y, -(d_x e_x + d_y e_y))`` and
-    ``e_j x n_j = (e_z e_x, e_z e_y, -(e_x^2 + e_y^2))``). ``friction`` > 0 adds Coulomb
-    friction in both sliding pairs (:func:`_frictional_balance`); 0 is the frictionless balance.
-    ``beta_dot``, ``beta_ddot``: the bend angle's rates, which move the output bearing S."""
+    r: float, l: float, m: float, x: Real, y: Real, beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
+) -> Mechanism:
+    """The module's steps 1-4 without friction: pose, velocities, accelerations and the arm forces,
+    for the arguments of :func:`exact_reactions`."""
     xp = lib(phi_in, beta, x, y)
     cb, sb = xp.cos(beta), xp.sin(beta)
     zn = xp.sqrt(1.0 - x * x - y * y)
@@ -165,6 +177,26 @@ def exact_reactions(
         zddot.append(acc)
         mus.append(mu)
     lams = [(Mx * a0 + My * a1 + Mz * a2) * inv_det for a0, a1, a2 in adj]
+    return Mechanism(xp, arms, adj, inv_det, known, zddot, slides, lams, mus, (Ux, Uy, Uz),
+                     (E1x, E1y, E1z), (E2x, E2y, E2z), (Wx, Wy, Wz))
+
+
+def exact_reactions(
+    phi_in: Real, beta: Real, omega: Real, omega_dot: Real, T_load: Real,
+    r: float, l: float, m: float, x: Real, y: Real, friction: float = 0.0, slip_speed: float = 1e-3,
+    beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
+) -> ExactReactions:
+    """Reactions at input angle ``phi_in``, bend ``beta``, input speed ``omega`` and its rate
+    ``omega_dot``, for the output-shaft axis ``(x, y, sqrt(1 - x^2 - y^2))`` in the nominal
+    output frame that solves the closure (:func:`.plane_solver.solve`). Plain arithmetic on
+    floats or arrays, written out per component (the module's steps 1-5; with ``n_j``
+    horizontal, ``k_j = (d_z e_x, d_z e_y, -(d_x e_x + d_y e_y))`` and
+    ``e_j x n_j = (e_z e_x, e_z e_y, -(e_x^2 + e_y^2))``). ``friction`` > 0 adds Coulomb
+    friction in both sliding pairs (:func:`_frictional_balance`); 0 is the frictionless balance.
+    ``beta_dot``, ``beta_ddot``: the bend angle's rates, which move the output bearing S."""
+    state = mechanism(phi_in, beta, omega, omega_dot, T_load, r, l, m, x, y, beta_dot, beta_ddot)
+    xp, arms, adj, inv_det, known, zddot, slides, lams, mus = state[:9]
+    (Ux, Uy, Uz), (E1x, E1y, E1z), (E2x, E2y, E2z), (Wx, Wy, Wz) = state.U, state.E1, state.E2, state.Omega
     slips = grooves = (0.0, 0.0, 0.0)
     power_loss = 0.0
     if friction:

@@ -7,6 +7,11 @@ import math
 from ..variables import SHAFT_ANGLE_NOMINAL, DefaultExperiment, ModelSpec, Relation, State, Variable
 
 CLOSED_FORM, EXACT = 0, 1
+PLAIN_TRIPOD, SINGLE_ROLLER, DOUBLE_ROLLER = 0, 1, 2  # tripod_type
+#: Rolling resistance of a roller on its track, tangential force over normal force: a needle roller and cage
+#: assembly's friction coefficient, 0.0020 to 0.0030 (JTEKT/Koyo rolling bearing catalogue, table of friction
+#: coefficients; docs/tripod_coupling.md, "Roller tripods").
+ROLLING_RESISTANCE = 0.0025
 #: The largest bend angle the model accepts with any beta_max: the declared max of beta and of beta_max.
 BETA_LIMIT = math.radians(60.0)
 RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
@@ -16,7 +21,7 @@ RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 # reactions (a_plunger_sum, Rz_out, Rx_in, Ry_in with the bend's rates, the load and friction) more.
 POSITION = ("phi_in", "beta", "r", "l", "kinematics")
 PLUNGERS = (*POSITION, "omega_in", "m_plunger", "alpha_in", "beta_dot", "beta_ddot", "beta_rate")
-FORCES = (*PLUNGERS, "T_load", "mu", "v_slip")
+FORCES = (*PLUNGERS, "T_load", "mu", "v_slip", "tripod_type", "mu_roll", "roller_radius")
 FRICTION = tuple(name for name in FORCES if name != "kinematics")  # zero without friction, which needs the exact
 ARM_OUTPUTS = tuple(
     Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N",
@@ -137,11 +142,36 @@ SPEC = ModelSpec(
                  "2 = automatic: the samples until the host sets beta_dot or beta_ddot non-zero (or their input "
                  "derivatives), the inputs from then on; a warning at the start while both are 0",
                  type="Integer", min=RATES_FROM_INPUTS, max=RATES_AUTOMATIC),
+        Variable("tripod_type", "parameter", PLAIN_TRIPOD,
+                 "Joint: 0 = plain tripod (plungers sliding in the grooves, the seed's), 1 = single roller (a roller "
+                 "turning and sliding on each trunnion, rolling and skewing on its track), 2 = double roller (outer "
+                 "roller kept parallel to its track, inner ring sliding on the trunnion); the rollers' friction needs "
+                 "the exact kinematics", type="Integer", min=PLAIN_TRIPOD, max=DOUBLE_ROLLER),
+        Variable("mu_roll", "parameter", ROLLING_RESISTANCE,
+                 "Rolling resistance of each roller on its track, tangential over normal force (roller tripods; "
+                 "their sliding contacts take mu)", "1", min=0.0),
+        Variable("roller_radius", "parameter", 0.0165,
+                 "Outer radius R of the rollers: the track contact lies R from the roller's centre (roller tripods)",
+                 "m", "mm", min=0.0, min_exclusive=True),
+        Variable("roller_bore_radius", "parameter", 0.0115,
+                 "Bore radius of the roller (single) or inner ring (double) on the trunnion, needles included "
+                 "(assembly check)", "m", "mm", min=0.0, min_exclusive=True),
+        Variable("trunnion_radius", "parameter", 0.009,
+                 "Radius of the trunnions (tripod arms) that carry the rollers (assembly check)", "m", "mm",
+                 min=0.0, min_exclusive=True),
+        Variable("track_width", "parameter", 0.0331,
+                 "Width of each roller track, flank to flank (assembly check)", "m", "mm", min=0.0,
+                 min_exclusive=True),
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
     relations=(
         Relation("l", ">", "r", reason="the bearing centre lies beyond the grooves"),
         Relation("beta", "<=", "beta_max"),
+        Relation("roller_bore_radius", "<", "roller_radius", reason="the roller's bore lies inside the roller"),
+        Relation("trunnion_radius", "<=", "roller_bore_radius",
+                 reason="the trunnion fits in the roller's bore: no negative clearance"),
+        Relation("track_width", ">=", "roller_radius", scale=2.0,
+                 reason="the roller fits in its track: no negative clearance"),
     ),
     states=(State("phi_in", ("phi_in_start",), derivative="omega_in", nominal=SHAFT_ANGLE_NOMINAL),),
 )

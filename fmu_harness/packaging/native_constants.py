@@ -39,11 +39,12 @@ SHARED = {
     "driveline.rotor.work": ("MAX_ANALYSIS_SECONDS", "RATE_SEARCH", "RATE_DENSE", "RATE_BANDED"),
     "driveline.rotor.model": ("MAX_ORDERS", "MAX_ORDER", "MAX_SEARCHED_MODES", "FE_ELEMENTS", "PLAUSIBLE_DEVIATION",
                               "CAMPBELL_POINTS", "WHIRL_MODES"),
-    "driveline.tripod.spec": ("EXACT",),
+    "driveline.tripod.spec": ("EXACT", "PLAIN_TRIPOD", "SINGLE_ROLLER"),
     "driveline.tripod.geometry": ("THIRD_TURN",),
     "driveline.tripod.closed_form": ("PAPER_PHASE",),
     "driveline.tripod.plane_solver": ("LAST_UPDATE", "MAX_ITERATIONS"),
     "driveline.tripod.reactions": ("FRICTION_TOLERANCE", "MAX_FRICTION_ITERATIONS"),
+    "driveline.tripod.rollers": ("CONTACT_ITERATIONS", "CONTACT_TOLERANCE", "FRICTION_SHARE_CAP", "BRACKET_MARGIN"),
     "driveline.vehicle.dynamics": ("GRAVITY", "RATE_STEP", "MAX_SUBSTEPS", "STATE_SIZE", "JACOBI_OMEGA_STEP",
                                    "JACOBI_DAMPING_STEP", "DIVERGENCE_OMEGA_STEP"),
 }

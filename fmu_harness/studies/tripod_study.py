@@ -19,7 +19,7 @@ from matplotlib.lines import Line2D
 
 from driveline.tripod import closed_form
 from driveline.tripod.exact import exact_pose
-from driveline.tripod.spec import SPEC
+from driveline.tripod.spec import DOUBLE_ROLLER, PLAIN_TRIPOD, SINGLE_ROLLER, SPEC
 
 from ..runs.runner import simulate
 from . import result_table
@@ -43,6 +43,11 @@ FRICTION_MU = 0.05  # the friction coefficient of the figure against beta
 #: How each reaction's curves are told apart: one colour per bend angle, the smallest drawn last.
 BETA_COLOURS = dict(zip(BETAS_DEG, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
                                     "tab:pink", "tab:gray", "tab:olive")))
+#: The joints of the roller tripods' figure (tripod_type), the bend angles and loads it runs, its friction
+JOINTS = {PLAIN_TRIPOD: "plain tripod", SINGLE_ROLLER: "single roller", DOUBLE_ROLLER: "double roller"}
+ROLLER_BETAS = (2, 4, 8, 12, 16, 20)
+ROLLER_LOADS = (100.0, 300.0, 500.0)
+JOINTS_LOAD, JOINTS_BETA = 300.0, 12  # the figure's load against the angle, and angle against the load
 #: The CSV's ``reactions`` column: which reactions a row holds, a label rather than a number.
 REACTIONS_COLUMN = "reactions [label]"
 
@@ -50,11 +55,13 @@ REACTIONS_COLUMN = "reactions [label]"
 @dataclass(frozen=True)
 class TripodRuns:
     """One turn per case: ``loaded[beta, T_load]`` and ``seed[beta]`` (the seed's reactions at
-    500 N.m) with every output of :data:`COLUMNS`, ``friction[beta, T_load, mu]`` the friction runs."""
+    500 N.m) with every output of :data:`COLUMNS`, ``friction[beta, T_load, mu]`` the friction runs,
+    ``joints[tripod_type, beta, T_load]`` the three joints with friction FRICTION_MU."""
 
     loaded: dict[tuple[float, float], np.ndarray]
     seed: dict[float, np.ndarray]
     friction: dict[tuple[float, float, float], np.ndarray]
+    joints: dict[tuple[int, float, float], np.ndarray]
 
 
 def run_turns(fmu: Path, beta_deg: float, kinematics: int, T_load: float = 500.0, seed_reactions: int = 0) -> np.ndarray:
@@ -68,12 +75,12 @@ def run_turns(fmu: Path, beta_deg: float, kinematics: int, T_load: float = 500.0
     )[:-1]
 
 
-def friction_turn(fmu: Path, beta_deg: float, T_load: float, mu: float) -> np.ndarray:
-    """One turn with friction ``mu`` in both sliding pairs."""
+def friction_turn(fmu: Path, beta_deg: float, T_load: float, mu: float, tripod_type: int = PLAIN_TRIPOD) -> np.ndarray:
+    """One turn with friction ``mu`` in the sliding pairs (rolling resistance at its default in a roller tripod)."""
     period = 2 * math.pi / SPEED
     return simulate(fmu, period, period / STEPS_PER_TURN,
                     inputs={"omega_in": SPEED, "beta": math.radians(beta_deg), "T_load": T_load},
-                    start_values={"kinematics": 1, "mu": mu},
+                    start_values={"kinematics": 1, "mu": mu, "tripod_type": tripod_type},
                     outputs=("phi_in", "Rz_in", "P_friction", "omega_spin"))[:-1]
 
 
@@ -85,6 +92,8 @@ def run(fmu: Path) -> TripodRuns:
         loaded={(beta, load): run_turns(fmu, beta, 1, load) for beta in BETAS_DEG for load in LOADS},
         seed={beta: run_turns(fmu, beta, 1, seed_reactions=1) for beta in BETAS_DEG},
         friction={case: friction_turn(fmu, *case) for case in sorted(friction_cases)},
+        joints={(joint, beta, load): friction_turn(fmu, beta, load, FRICTION_MU, joint)
+                for joint in JOINTS for beta in ROLLER_BETAS for load in ROLLER_LOADS},
     )
 
 
@@ -116,6 +125,7 @@ def figures(runs: TripodRuns) -> dict[str, Figure]:
     found["tripod_reactions_vs_beta.png"] = beta_figure(runs.loaded, runs.seed)
     found["tripod_friction_axial_force.png"] = friction_turn_figure(runs.friction)
     found["tripod_friction_vs_beta.png"] = friction_beta_figure(runs.friction)
+    found["tripod_joints_axial_force.png"] = joints_figure(runs.joints)
     found["tripod_fig06_peak_deviation.png"] = peak_deviation_figure(loaded)
     return found
 
@@ -317,5 +327,30 @@ def friction_beta_figure(friction: dict[tuple[float, float, float], np.ndarray])
         ax.legend(fontsize=8)
     fig.suptitle(f"Friction mu = {FRICTION_MU} in both sliding pairs, 2000 rpm, r = 26 mm, l = 700 mm, m = 0.2 kg",
                  fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def joints_figure(joints: dict[tuple[int, float, float], np.ndarray]) -> Figure:
+    """The generated axial force's 3rd-order amplitude of the plain tripod and the two roller tripods against
+    the bend angle at 300 N.m and against the load at 12 deg, one curve per joint (more loads or angles in one
+    panel would put the plain tripod's curves on the single roller's)."""
+    fig, (left, right) = figure(1, 2, figsize=(13, 5.2))
+    for joint, name in JOINTS.items():
+        colour = f"C{joint}"
+        amplitude = [order_amplitude(-joints[joint, beta, JOINTS_LOAD]["Rz_in"]) for beta in ROLLER_BETAS]
+        left.semilogy(ROLLER_BETAS, amplitude, "o-", color=colour, label=name)
+        amplitude = [order_amplitude(-joints[joint, JOINTS_BETA, load]["Rz_in"]) for load in ROLLER_LOADS]
+        right.semilogy(ROLLER_LOADS, amplitude, "s-", color=colour, label=name)
+    left.set_xlabel("bend angle beta [deg]")
+    left.set_title(f"against the bend angle, T_load = {JOINTS_LOAD:.0f} N.m", fontsize=9)
+    right.set_xlabel("load torque T_load [N.m]")
+    right.set_title(f"against the load, beta = {JOINTS_BETA} deg", fontsize=9)
+    for ax in (left, right):
+        ax.set_ylabel("3rd-order amplitude of -Rz_in [N]")
+        ax.grid(True, alpha=0.3, which="both")
+    left.legend(fontsize=8)  # one legend: the joints' colours are the same in both panels
+    fig.suptitle(f"Generated axial force of the three joints (tripod_type 0, 1, 2): mu = {FRICTION_MU}, default "
+                 "mu_roll, 2000 rpm, r = 26 mm, l = 700 mm, m = 0.2 kg", fontsize=10)
     fig.tight_layout()
     return fig

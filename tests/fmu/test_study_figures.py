@@ -41,7 +41,7 @@ def drawn_labels(fig) -> list[str]:
 
 
 def test_every_tripod_figure_shows_each_curve(tripod_figures):
-    assert len(tripod_figures) == 9
+    assert len(tripod_figures) == 10
     for name, fig in tripod_figures.items():
         assert_clean(fig, name)
 
@@ -65,6 +65,21 @@ def test_turn_figure_draws_each_reaction_at_each_load_for_three_bend_angles(trip
             ax = titles[f"{column}, T_load = {load:.0f} N.m"]
             assert sorted(line.get_label() for line in ax.get_lines()) == [
                 f"beta = {beta} deg" for beta in tripod_study.TURN_BETAS]
+
+
+def test_joints_figure_draws_each_joint_with_the_plain_tripod_above_the_rollers(tripod_figures):
+    """The three joints against beta (300 N.m) and against the load (12 deg); from 4 deg up the plain tripod's
+    axial force lies above both roller tripods', the single roller's grows with beta, every one with the load."""
+    left, right = tripod_figures["tripod_joints_axial_force.png"].axes
+    for ax in (left, right):
+        assert sorted(line.get_label() for line in ax.get_lines()) == sorted(tripod_study.JOINTS.values())
+    lines = {line.get_label(): line.get_ydata() for line in left.get_lines()}
+    from_4 = np.array(tripod_study.ROLLER_BETAS) >= 4
+    plain, single, double = (lines[name] for name in ("plain tripod", "single roller", "double roller"))
+    assert np.all(plain[from_4] > single[from_4]) and np.all(plain[from_4] > double[from_4])
+    assert np.all(np.diff(single) > 0)
+    for line in right.get_lines():
+        assert np.all(np.diff(line.get_ydata()) > 0)
 
 
 def test_seed_means_are_drawn_around_the_force_balance_at_no_load(tripod_figures):

@@ -1,7 +1,7 @@
 /* The exact partial derivatives of the native TripodCoupling FMU's outputs (its ``jacobian`` hook; the step
  * is tripod_coupling.c next to this folder), by forward-mode automatic differentiation (dual.h):
  *   closure_derivatives.c    the exact kinematics (plane_solver.py) by the implicit function theorem
- *   reaction_derivatives.c   the exact reactions (reactions.py), the friction balance's fixed point included
+ *   reaction_derivatives.c   the exact reactions (reactions.py, rollers.py), the friction balances' fixed points
  *   output_derivatives.c     the Jacobian of the outputs (outputs.py): modes, leading order, the seed's eqs
  */
 #ifndef TRIPOD_DERIVATIVES_H
@@ -27,6 +27,8 @@ DualClosure closure_derivatives(double x, double y, Dual phi_in, Dual cb, Dual s
 typedef struct {
     Dual phi_in, cb, sb, omega, omega_dot, T_load, beta_dot, beta_ddot;
     double r, l, m, friction, slip_speed;
+    int tripod_type;               /* 0 plain, 1 single roller, 2 double roller */
+    double mu_roll, roller_radius; /* the roller tripods' rolling resistance and rollers' outer radius */
 } DualLoad;
 
 /* The step's Reactions in dual numbers */

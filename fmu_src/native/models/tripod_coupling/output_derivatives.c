@@ -85,6 +85,9 @@ Failure tripod_jacobian(const ModelData *data, const double *axis, double partia
     load.m = VALUE(m_plunger);
     load.friction = VALUE(mu);
     load.slip_speed = VALUE(v_slip);
+    load.tripod_type = INTEGER(tripod_type);
+    load.mu_roll = VALUE(mu_roll);
+    load.roller_radius = VALUE(roller_radius);
     rho = dual_div(dual_scale(dual_sub(dual_constant(1.0), cb), r), dual_scale(cb, 2.0));
     pin = dual_div(T_load, dual_scale(dual_shift(rho, r), 3.0));
     if (axis != NULL) {

@@ -15,6 +15,8 @@
 
 #include "driveline_constants.h"
 
+static const double PI = 3.141592653589793; /* math.pi */
+
 /* One arm of the balance in dual numbers (the step's Arm) */
 typedef struct {
     Dual gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, k[3];
@@ -209,6 +211,298 @@ static void bearing_reactions(const DualArm arm[3], const Dual lams[3], const Du
     out->Rz_in = dual_add(dual_add(grooves[0], grooves[1]), grooves[2]);
 }
 
+/* ---- the roller tripods (rollers.py; the step's roller_reactions in tripod_coupling.c) ---------------
+ * The same successive substitution in dual numbers until values and partial derivatives have settled. The
+ * single roller's contact normal is the root of the miss of H's direction in its angle: its value by the
+ * step's bracketed Illinois iteration, its partial derivatives by the implicit function theorem,
+ * -(d miss / d knowns) / (d miss / d angle), the latter from the miss with the angle alone seeded. */
+
+typedef struct {
+    Dual v[3];
+} Vec;
+
+static Vec vec(Dual x, Dual y, Dual z)
+{
+    Vec r;
+    r.v[0] = x;
+    r.v[1] = y;
+    r.v[2] = z;
+    return r;
+}
+
+static Dual vdot(Vec a, Vec b)
+{
+    return dot(a.v[0], a.v[1], a.v[2], b.v[0], b.v[1], b.v[2]);
+}
+
+static Vec vcross(Vec a, Vec b)
+{
+    return vec(dual_cross(a.v[1], b.v[2], a.v[2], b.v[1]), dual_cross(a.v[2], b.v[0], a.v[0], b.v[2]),
+               dual_cross(a.v[0], b.v[1], a.v[1], b.v[0]));
+}
+
+static Vec vscale(Vec a, Dual s)
+{
+    return vec(dual_mul(a.v[0], s), dual_mul(a.v[1], s), dual_mul(a.v[2], s));
+}
+
+static Vec vadd(Vec a, Vec b)
+{
+    return vec(dual_add(a.v[0], b.v[0]), dual_add(a.v[1], b.v[1]), dual_add(a.v[2], b.v[2]));
+}
+
+/* a / |a| (a zero vector stays zero) and |a| */
+static Vec vunit(Vec a, Dual *size)
+{
+    Dual by;
+    *size = dual_sqrt(vdot(a, a));
+    by = size->v > 0.0 ? *size : dual_constant(1.0);
+    return vec(dual_div(a.v[0], by), dual_div(a.v[1], by), dual_div(a.v[2], by));
+}
+
+/* its value alone: the same vector without partial derivatives */
+static Vec vvalue(Vec a)
+{
+    return vec(dual_constant(a.v[0].v), dual_constant(a.v[1].v), dual_constant(a.v[2].v));
+}
+
+/* The single roller's contact at normal angle ``angle`` (rollers._skewed_slips and the miss) */
+typedef struct {
+    Vec k, u, s, pushed;
+    Dual across, v_roll, v_skew, miss;
+} DualContact;
+
+static DualContact skewed_contact_at(const DualLoad *load, Dual angle, Dual target, Vec axis, Dual zdot, Vec spin)
+{
+    DualContact c;
+    Dual R = dual_constant(load->roller_radius), zero = dual_constant(0.0), roll, skew;
+    Vec v0, g;
+    int i;
+    c.k = vec(dual_cos(angle), dual_sin(angle), zero);
+    c.u = vunit(vcross(axis, c.k), &c.across);
+    c.s = vcross(c.k, c.u);
+    v0 = vadd(vec(zero, zero, zdot), vscale(vcross(spin, c.k), dual_neg(R)));
+    c.v_roll = dual_add(vdot(v0, c.u), dual_mul(dual_mul(R, c.across), vdot(spin, axis)));
+    c.v_skew = vdot(v0, c.s);
+    roll = dual_scale(slip_sign(c.v_roll, load->slip_speed), -load->mu_roll);
+    skew = dual_scale(slip_sign(c.v_skew, load->slip_speed), load->friction);
+    g = vadd(vscale(c.u, roll), vscale(c.s, dual_neg(skew)));
+    for (i = 0; i < 2; i++) {
+        c.pushed.v[i] = dual_add(c.k.v[i], g.v[i]);
+    }
+    c.pushed.v[2] = zero;
+    /* the angle's miss, wrapped into [-pi, pi): a shift by whole turns, which moves no derivative */
+    c.miss = dual_sub(dual_atan2(c.pushed.v[1], c.pushed.v[0]), target);
+    c.miss.v = fmod(fmod(c.miss.v + PI, 2.0 * PI) + 2.0 * PI, 2.0 * PI) - PI;
+    return c;
+}
+
+static double sign_of(double a)
+{
+    return a > 0.0 ? 1.0 : (a < 0.0 ? -1.0 : 0.0);
+}
+
+/* rollers._skewed_contact for the three arms together: the angle's value by the Illinois method, then its
+ * partial derivatives; N = |H| / |k + g_h| and the friction forces. */
+static void skewed_contacts(const DualLoad *load, const Vec H[3], const Vec axis[3], const Dual zdot[3], Vec spin,
+                            DualContact c[3], Dual N[3], Dual F_roll[3], Dual F_skew[3])
+{
+    double low[3], high[3], f_low[3], f_high[3], angle;
+    double share = load->friction + load->mu_roll;
+    double spread = asin(share < TRIPOD_ROLLERS_FRICTION_SHARE_CAP ? share : TRIPOD_ROLLERS_FRICTION_SHARE_CAP)
+                    + TRIPOD_ROLLERS_BRACKET_MARGIN;
+    Dual target[3], size[3];
+    Vec axis_v[3], spin_v = vvalue(spin);
+    int side[3] = {0, 0, 0}, iteration, j;
+    for (j = 0; j < 3; j++) {
+        target[j] = dual_atan2(H[j].v[1], H[j].v[0]);
+        size[j] = dual_sqrt(vdot(H[j], H[j]));
+        axis_v[j] = vvalue(axis[j]);
+        low[j] = target[j].v - spread;
+        high[j] = target[j].v + spread;
+        f_low[j] = skewed_contact_at(load, dual_constant(low[j]), dual_constant(target[j].v), axis_v[j],
+                                     dual_constant(zdot[j].v), spin_v).miss.v;
+        f_high[j] = skewed_contact_at(load, dual_constant(high[j]), dual_constant(target[j].v), axis_v[j],
+                                      dual_constant(zdot[j].v), spin_v).miss.v;
+    }
+    for (iteration = 0; iteration < TRIPOD_ROLLERS_CONTACT_ITERATIONS; iteration++) {
+        int done = 1;
+        for (j = 0; j < 3; j++) {
+            double least = fabs(f_low[j]) < fabs(f_high[j]) ? fabs(f_low[j]) : fabs(f_high[j]);
+            done = done && (fabs(high[j] - low[j]) <= TRIPOD_ROLLERS_CONTACT_TOLERANCE
+                            || least <= TRIPOD_ROLLERS_CONTACT_TOLERANCE);
+        }
+        if (done) {
+            break;
+        }
+        for (j = 0; j < 3; j++) {
+            double a = f_high[j] != f_low[j] ? (low[j] * f_high[j] - high[j] * f_low[j]) / (f_high[j] - f_low[j])
+                                             : 0.5 * (low[j] + high[j]);
+            double f_mid = skewed_contact_at(load, dual_constant(a), dual_constant(target[j].v), axis_v[j],
+                                             dual_constant(zdot[j].v), spin_v).miss.v;
+            int lower = sign_of(f_mid) == sign_of(f_low[j]);
+            double new_low = lower ? f_mid : f_low[j], new_high = lower ? f_high[j] : f_mid;
+            if (lower) {
+                low[j] = a;
+            } else {
+                high[j] = a;
+            }
+            if (lower && side[j] == 1) {
+                new_high = 0.5 * new_high;
+            }
+            if (!lower && side[j] == -1) {
+                new_low = 0.5 * new_low;
+            }
+            side[j] = lower ? 1 : -1;
+            f_low[j] = new_low;
+            f_high[j] = new_high;
+        }
+    }
+    for (j = 0; j < 3; j++) {
+        Dual theta, slope;
+        DualContact knowns, own;
+        int col;
+        angle = fabs(f_low[j]) <= fabs(f_high[j]) ? low[j] : high[j];
+        knowns = skewed_contact_at(load, dual_constant(angle), target[j], axis[j], zdot[j], spin);
+        own = skewed_contact_at(load, dual_known(angle, 0), dual_constant(target[j].v), axis_v[j],
+                                dual_constant(zdot[j].v), spin_v);
+        slope = own.miss;
+        theta = dual_constant(angle);
+        for (col = 0; col < DUAL_SIZE; col++) {
+            theta.d[col] = -knowns.miss.d[col] / slope.d[0];
+        }
+        c[j] = skewed_contact_at(load, theta, target[j], axis[j], zdot[j], spin);
+        N[j] = dual_div(size[j], dual_sqrt(vdot(c[j].pushed, c[j].pushed)));
+        F_roll[j] = dual_mul(dual_scale(N[j], -load->mu_roll), slip_sign(c[j].v_roll, load->slip_speed));
+        F_skew[j] = dual_mul(dual_scale(N[j], -load->friction), slip_sign(c[j].v_skew, load->slip_speed));
+    }
+}
+
+/* rollers.roller_reactions in dual numbers (R5-R15), from the frictionless lams, mus; 0 when the partial
+ * derivatives do not settle. */
+static int roller_reactions(const DualArm arm[3], Dual adj[3][3], Dual inv_det, const DualLoad *load,
+                            const Dual E1[3], const Dual E2[3], const Dual U[3], const Dual W[3], Dual lam[3],
+                            Dual mu_q[3], DualReactions *out)
+{
+    const double m = load->m, R = load->roller_radius, mu = load->friction;
+    Vec centre[3], e[3], d[3], n[3], q[3], axis[3], groove_acc[3], force[3], friction[3], couple[3], H[3];
+    Vec friction_h[3], spin, load_moment, Uv = vec(U[0], U[1], U[2]), Wv = vec(W[0], W[1], W[2]);
+    Dual length[3], zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], N_trunnion[3], phi[3], N[3], F_roll[3];
+    Dual F_skew[3], v_roll[3], v_skew[3], zero = dual_constant(0.0), power = zero;
+    Vec R_out = vec(zero, zero, zero), R_in = R_out, L = R_out;
+    DualContact c[3];
+    double change[DUAL_SIZE + 1], scale[DUAL_SIZE + 1];
+    int iteration, i, j, col, settled = 0;
+    for (j = 0; j < 3; j++) {
+        const DualArm *a = &arm[j];
+        centre[j] = vec(a->gx, a->gy, a->bz);
+        e[j] = vec(a->ex, a->ey, a->ez);
+        d[j] = vec(a->dx, a->dy, a->dz);
+        n[j] = vec(a->ey, dual_neg(a->ex), zero);
+        q[j] = vcross(e[j], n[j]);
+        axis[j] = vunit(e[j], &length[j]);
+        groove_acc[j] = vec(a->ax, a->ay, zero);
+        zdot[j] = a->zdot;
+        zddot[j] = a->zddot;
+        v_trunnion[j] = dual_mul(a->sigma, length[j]);
+        trunnion_sign[j] = slip_sign(v_trunnion[j], load->slip_speed);
+        friction_h[j] = vec(zero, zero, zero);
+    }
+    spin = vec(W[0], W[1], dual_sub(W[2], load->omega));
+    load_moment = vscale(Uv, load->T_load);
+    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && !settled; iteration++) {
+        Vec moment = load_moment;
+        for (col = 0; col <= DUAL_SIZE; col++) {
+            change[col] = scale[col] = 0.0;
+        }
+        for (j = 0; j < 3; j++) {
+            N_trunnion[j] = dual_sqrt(dual_mul(arm[j].exy2, dual_add(dual_mul(lam[j], lam[j]),
+                                               dual_mul(dual_mul(mu_q[j], mu_q[j]), dual_mul(length[j], length[j])))));
+            phi[j] = dual_div(dual_scale(dual_mul(N_trunnion[j], trunnion_sign[j]), mu), length[j]);
+            force[j] = vadd(vadd(vscale(n[j], lam[j]), vscale(q[j], mu_q[j])), vscale(e[j], phi[j]));
+            H[j] = vec(dual_add(dual_scale(groove_acc[j].v[0], m), force[j].v[0]),
+                       dual_add(dual_scale(groove_acc[j].v[1], m), force[j].v[1]), zero);
+        }
+        if (load->tripod_type == TRIPOD_SPEC_SINGLE_ROLLER) {
+            skewed_contacts(load, H, axis, zdot, spin, c, N, F_roll, F_skew);
+            for (j = 0; j < 3; j++) {
+                friction[j] = vadd(vscale(c[j].u, F_roll[j]), vscale(c[j].s, F_skew[j]));
+                couple[j] = vadd(vcross(vscale(c[j].k, dual_constant(-R)), friction[j]),
+                                 vscale(axis[j], dual_mul(dual_scale(F_roll[j], R), c[j].across)));
+                v_roll[j] = c[j].v_roll;
+                v_skew[j] = c[j].v_skew;
+            }
+        } else {
+            for (j = 0; j < 3; j++) {
+                vunit(H[j], &N[j]);
+                v_roll[j] = zdot[j];
+                v_skew[j] = zero;
+                F_roll[j] = dual_mul(dual_scale(N[j], -load->mu_roll), slip_sign(v_roll[j], load->slip_speed));
+                F_skew[j] = zero;
+                friction[j] = vec(zero, zero, F_roll[j]);
+                couple[j] = vec(zero, zero, zero);
+            }
+        }
+        for (j = 0; j < 3; j++) {
+            Dual new_mu = dual_div(dual_add(dual_sub(dual_scale(zddot[j], m), friction[j].v[2]),
+                                            dual_mul(phi[j], e[j].v[2])), arm[j].exy2);
+            Vec h = vec(friction[j].v[0], friction[j].v[1], zero);
+            double weight = sqrt(arm[j].exy2.v) * length[j].v;
+            moment = vadd(moment, vscale(vcross(d[j], q[j]), dual_neg(new_mu)));
+            moment = vadd(moment, vscale(vcross(d[j], e[j]), dual_neg(phi[j])));
+            moment = vadd(moment, vscale(couple[j], dual_constant(-1.0)));
+            tally(dual_sub(new_mu, mu_q[j]), weight, change);
+            tally(new_mu, weight, scale);
+            for (i = 0; i < 2; i++) {
+                tally(dual_sub(h.v[i], friction_h[j].v[i]), 1.0, change);
+                tally(h.v[i], 1.0, scale);
+            }
+            friction_h[j] = h;
+            mu_q[j] = new_mu;
+        }
+        for (j = 0; j < 3; j++) {
+            Dual new_lam = dual_mul(vdot(moment, vec(adj[j][0], adj[j][1], adj[j][2])), inv_det);
+            tally(dual_sub(new_lam, lam[j]), sqrt(arm[j].exy2.v), change);
+            tally(new_lam, sqrt(arm[j].exy2.v), scale);
+            lam[j] = new_lam;
+        }
+        settled = iteration > 0;
+        for (col = 0; col <= DUAL_SIZE; col++) {
+            settled = settled && change[col] <= TRIPOD_REACTIONS_FRICTION_TOLERANCE * scale[col];
+        }
+    }
+    /* R14, R15 */
+    for (j = 0; j < 3; j++) {
+        Vec track, t;
+        N_trunnion[j] = dual_sqrt(dual_mul(arm[j].exy2, dual_add(dual_mul(lam[j], lam[j]),
+                                           dual_mul(dual_mul(mu_q[j], mu_q[j]), dual_mul(length[j], length[j])))));
+        phi[j] = dual_div(dual_scale(dual_mul(N_trunnion[j], trunnion_sign[j]), mu), length[j]);
+        force[j] = vadd(vadd(vscale(n[j], lam[j]), vscale(q[j], mu_q[j])), vscale(e[j], phi[j]));
+        track = vadd(vscale(vadd(groove_acc[j], vec(zero, zero, zddot[j])), dual_constant(m)), force[j]);
+        t = vcross(Uv, e[j]);
+        R_out = vadd(R_out, vscale(force[j], dual_constant(-1.0)));
+        R_in = vadd(R_in, track);
+        L = vadd(L, vadd(vcross(centre[j], track), couple[j]));
+        out->F_arm[j] = dual_div(vdot(force[j], t), dual_sqrt(vdot(t, t)));
+        out->F_plunger[j] = dual_scale(zddot[j], m);
+        power = dual_add(power, dual_sub(dual_mul(dual_mul(phi[j], length[j]), v_trunnion[j]),
+                                         dual_add(dual_mul(F_roll[j], v_roll[j]), dual_mul(F_skew[j], v_skew[j]))));
+    }
+    out->Rx_in = R_in.v[0];
+    out->Ry_in = R_in.v[1];
+    out->Mx_in = L.v[0];
+    out->My_in = L.v[1];
+    out->T_in = L.v[2];
+    out->Rx_out = vdot(R_out, vec(E1[0], E1[1], E1[2]));
+    out->Ry_out = vdot(R_out, vec(E2[0], E2[1], E2[2]));
+    out->Rz_out = vdot(R_out, Uv);
+    out->a_plunger_sum = dual_add(dual_add(zddot[0], zddot[1]), zddot[2]);
+    out->omega_spin = vdot(Wv, Uv);
+    out->Rz_in = R_in.v[2];
+    out->P_friction = power;
+    return settled;
+}
+
 Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions *out)
 {
     const double half_root_3 = 0.5 * sqrt(3.0), r = load->r, l = load->l, m = load->m;
@@ -297,6 +591,12 @@ Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions
         slips[j] = grooves[j] = dual_constant(0.0);
     }
     transposed_solve(Mx, My, Mz, adj, inv_det, lams);
+    if (load->tripod_type != TRIPOD_SPEC_PLAIN_TRIPOD) { /* outputs.coupling_outputs: the rollers' balance */
+        if (!roller_reactions(arm, adj, inv_det, load, E1, E2, U, W, lams, mus, out)) {
+            return FAILURE(ERROR_ARITHMETIC, "roller tripod friction balance: its partial derivatives did not converge");
+        }
+        return NO_FAILURE;
+    }
     if (load->friction != 0.0 &&
         !frictional_balance(arm, adj, inv_det, moment, load, lams, mus, slips, grooves, &power)) {
         return FAILURE(ERROR_ARITHMETIC, "tripod friction balance: its partial derivatives did not converge");

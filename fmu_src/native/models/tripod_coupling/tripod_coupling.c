@@ -15,6 +15,7 @@
 #include "driveline_constants.h"
 #include "fmi/fmu_instance.h"
 #include "derivatives.h"
+#include "step.h"
 
 #define INTEGER(name) (data->int_value[V_##name])
 /* the exact solver's warm start (plane_solver.Solution): a flag, then phi_in, x, y, dx/dphi, dy/dphi */
@@ -26,34 +27,6 @@
 #define SAMPLES (data->internal + 7)
 /* beta_rate = RATES_AUTOMATIC: 1 once the host has set beta_dot or beta_ddot non-zero (_rates_set) */
 #define RATES_SET (data->internal[11])
-
-static const char MATH_DOMAIN[] = "math domain error";           /* ValueError */
-static const char ZERO_DIVISION[] = "float division by zero";      /* ZeroDivisionError */
-
-/* The first arithmetic failure of an evaluation, as Python would raise it. */
-typedef struct {
-    Failure failure;
-} Guard;
-
-/* Python's float division, math.sqrt, math.cos, math.sin and math.asin: where those raise, the
- * first failure is kept and the evaluation goes on with 0 (its results are then discarded). */
-static double refuse(Guard *guard, ErrorKind kind, const char *why)
-{
-    if (guard->failure.kind == ERROR_NONE) {
-        guard->failure = FAILURE(kind, why);
-    }
-    return 0.0;
-}
-
-static double divide(Guard *guard, double a, double b)
-{
-    return b != 0.0 ? a / b : refuse(guard, ERROR_ZERO_DIVISION, ZERO_DIVISION);
-}
-
-static double root(Guard *guard, double a)
-{
-    return a < 0.0 ? refuse(guard, ERROR_VALUE, MATH_DOMAIN) : sqrt(a);
-}
 
 static double cosine(Guard *guard, double a)
 {
@@ -228,31 +201,6 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
 
 /* ---- reactions ----------------------------------------------------------------------------- */
 
-typedef struct {
-    double Rx_in, Ry_in, Mx_in, My_in, T_in, Rx_out, Ry_out, Rz_out;
-    double F_arm[3], F_plunger[3], a_plunger_sum, omega_spin, Rz_in, P_friction;
-} Reactions;
-
-typedef struct {
-    double phi_in, cb, sb, omega, omega_dot, T_load, r, l, m, friction, slip_speed; /* cb, sb: cos, sin of beta */
-    double beta_dot, beta_ddot;
-} Load;
-
-/* One arm of the exact balance: groove point g, ball height bz, arm vector e = b - P,
- * d = b - S, |n|^2 = ex^2 + ey^2 and k = d x n (a row of K). */
-typedef struct {
-    double gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, k[3];
-    double ax, ay, hx, hy, hz; /* groove point's acceleration; whirl and Coriolis terms */
-    double zdot, sigma, zddot;  /* plunger speed, sliding rate along the arm per |e|, plunger acceleration */
-} Arm;
-
-/* Regularised sign u / sqrt(1 + u^2), u = speed / slip_speed (reactions.slip_sign). */
-static double slip_sign(Guard *guard, double speed, double slip_speed)
-{
-    double u = divide(guard, speed, slip_speed);
-    return divide(guard, u, pow(1.0 + u * u, 0.5));
-}
-
 /* Arm forces with Coulomb friction in both sliding pairs of each arm, by successive substitution
  * from the frictionless forces (reactions._frictional_balance): lambda_j, mu_j, the slip forces
  * phi_j along the arms, the groove forces g_j and the dissipated power. */
@@ -415,6 +363,13 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     for (j = 0; j < 3; j++) {
         lams[j] = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det;
     }
+    if (load->tripod_type != TRIPOD_SPEC_PLAIN_TRIPOD) { /* outputs.coupling_outputs: the rollers' balance */
+        Shaft shaft = {{Ux, Uy, Uz}, {E1x, E1y, E1z}, {E2x, E2y, E2z}, {Wx, Wy, Wz}};
+        if (guard->failure.kind == ERROR_NONE) {
+            roller_reactions(guard, arm, (const double(*)[3])adj, inv_det, load, &shaft, lams, mus, out);
+        }
+        return;
+    }
     if (load->friction != 0.0 && guard->failure.kind == ERROR_NONE) {
         frictional_balance(guard, arm, (const double(*)[3])adj, inv_det, moment, load, lams, mus, slips, grooves,
                            &power);
@@ -559,6 +514,9 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     load.m = VALUE(m_plunger);
     load.friction = VALUE(mu);
     load.slip_speed = VALUE(v_slip);
+    load.tripod_type = INTEGER(tripod_type);
+    load.mu_roll = VALUE(mu_roll);
+    load.roller_radius = VALUE(roller_radius);
     rho = divide(&guard, r * (1.0 - cos_beta), 2.0 * cos_beta); /* orbit radius of the tripod centre */
     pin = divide(&guard, T_load, 3.0 * (r + rho));              /* eq 24 with the corrected eq 21 */
     if (INTEGER(kinematics) == TRIPOD_SPEC_EXACT) {
@@ -662,11 +620,15 @@ static Failure evaluate_now(ModelData *data, double time)
     return evaluate(data, time, 0.0);
 }
 
-/* TripodCouplingModel.extra_parameter_errors: friction needs the exact kinematics. */
+/* TripodCouplingModel.extra_parameter_errors: friction, and the rollers' rolling resistance, need the exact
+ * kinematics. */
 static void extra_parameter_errors(const ModelData *data, Messages *out)
 {
     if (VALUE(mu) > 0.0 && INTEGER(kinematics) != TRIPOD_SPEC_EXACT) {
         messages_add_extra(out, data, MESSAGE_friction_needs_exact);
+    } else if (INTEGER(tripod_type) != TRIPOD_SPEC_PLAIN_TRIPOD && VALUE(mu_roll) > 0.0
+               && INTEGER(kinematics) != TRIPOD_SPEC_EXACT) {
+        messages_add_extra(out, data, MESSAGE_rollers_need_exact);
     }
 }
 
