@@ -194,9 +194,12 @@ class SteppedModel(ABC):
 
     def input_errors(self) -> list[str]:
         """As :meth:`parameter_errors`, for the inputs and the relations involving them."""
+        return self.declared_input_errors() or self._guarded(self.extra_input_errors, "the inputs")
+
+    def declared_input_errors(self) -> list[str]:
+        """Each input against its bounds, then the relations involving inputs (the spec's rules alone)."""
         errors = [e for v in self._inputs if (e := self._range_error(v))]
-        errors = errors or [e for r in self._input_relations if (e := self._relation_error(r))]
-        return errors or self._guarded(self.extra_input_errors, "the inputs")
+        return errors or [e for r in self._input_relations if (e := self._relation_error(r))]
 
     @staticmethod
     def _guarded(check: Callable[[], list[str]], what: str) -> list[str]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import shutil
 import sys
 import threading
@@ -20,12 +21,45 @@ from typing import TextIO
 DISTRIBUTION = "driveline-fmus"
 
 
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+"""A negative number as a value, ``-2``, ``-.5``, ``-2e-4`` (argparse's own misses the exponent and
+takes ``--step -2e-4`` for an option)."""
+
+REFUSED = 1
+"""The exit status of start values an FMU would refuse (a command-line mistake exits with 2)."""
+
+
 class CommandParser(argparse.ArgumentParser):
     """An argument parser whose errors are one line, ``prog: error: message``, exit 2 (argparse's
-    own print the usage first)."""
+    own print the usage first); a negative number is a value, and ``--help`` shows every option's
+    default (:class:`DefaultsShown`)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", DefaultsShown)
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+class DefaultsShown(argparse.HelpFormatter):
+    """Help that ends each option's text with ``(default X)`` unless the text names its default or it
+    has none to show (None, False, an empty list or text)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        shown = action.default not in (None, False, [], "", argparse.SUPPRESS) and action.option_strings
+        if not shown or "default" in text:
+            return text
+        return f"{text} (default %(default)s)".lstrip()
+
+
+def refused(command: str, reason: str) -> SystemExit:
+    """The end of a command whose start values an FMU would refuse: ``command: refused: reason``, one
+    line, exit status :data:`REFUSED` (``driveline-fmus check``, ``system``, ``sweep`` and ``map`` alike)."""
+    print(f"{command}: refused: {reason}", file=sys.stderr)
+    return SystemExit(REFUSED)
 
 
 def summary(doc: str | None) -> str:

@@ -33,13 +33,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from driveline.vehicle.compact_car import MOTOR_PEAK_TORQUE
+from driveline.vehicle.compact_car import MASS, MOTOR_PEAK_TORQUE, RATIO, WHEEL_RADIUS
 
 from .console import CommandParser, summary
 from .runs import sweep
 from .runs.system_sweep import DerivedMetrics
 from .studies import figures
-from .studies.order_tracking import third_order_peak
+from .studies.order_tracking import REVOLUTIONS, third_order_peak
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -61,6 +61,27 @@ def pitch_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tu
 
 
 THIRD_ORDER = DerivedMetrics((SHAFT, SIGNAL), (PEAK, f"{SIGNAL}_order3_speed"), pitch_third_order)
+
+
+def shortest_duration(torque: float = TORQUE_RANGE[1], revolutions: float = REVOLUTIONS) -> float:
+    """The launch length [s] in which the motor's ``torque`` [N.m] could at best turn the halfshaft
+    ``revolutions`` times: the default car as one rigid mass, the torque a step at t = 0, no road load,
+    no wheel or motor inertia (each makes the car slower; the tyres' slip, under 1 % here, is the only
+    thing faster). The wheel turns ``a t^2 / (4 pi r)`` times at ``a = torque RATIO / (r MASS)``."""
+    acceleration = torque * RATIO / (WHEEL_RADIUS * MASS)
+    return math.sqrt(4.0 * math.pi * WHEEL_RADIUS * revolutions / acceleration)
+
+
+def duration_error(duration: float) -> str | None:
+    """Why ``duration`` [s] is too short for every launch of the map (the strongest one cannot turn the
+    shaft the order tracking window's revolutions: :func:`shortest_duration`); None when it is not, or
+    when it is no positive number (the plan refuses that)."""
+    shortest = shortest_duration()
+    if not (math.isfinite(duration) and 0.0 < duration < shortest):
+        return None
+    return (f"--duration {duration:g} s: the map's strongest launch ({TORQUE_RANGE[1]:g} N.m) turns the halfshaft "
+            f"less than the {REVOLUTIONS:g} revolutions of the order tracking window in it; give at least "
+            f"{math.ceil(shortest * 10.0) / 10.0:g} s (default 4)")
 
 
 def axes(count: int) -> dict[str, list[float]]:
@@ -112,7 +133,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--workers", type=sweep.workers_count, default=sweep.default_workers(),
                         help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
-    parser.add_argument("--out", type=Path, default=Path("results") / "shudder_map.parquet", help=".parquet or .csv")
+    parser.add_argument("--out", type=sweep.table_file, default=Path("results") / "shudder_map.parquet",
+                        help=".parquet or .csv")
     parser.add_argument("--figure", type=Path, default=Path("results") / "shudder_map.png", help="PNG file to write")
     parser.add_argument("--figure-only", action="store_true", help="draw the figure from the table at --out")
     args = parser.parse_args(argv)
@@ -123,6 +145,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         return
     if args.count < 2:
         parser.error(f"--count must be at least 2, got {args.count}")
+    too_short = duration_error(args.duration)
+    if too_short:
+        parser.error(too_short)
     try:
         plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count)), args.duration, args.step, args.master,
                                     (THIRD_ORDER,))
@@ -132,12 +157,13 @@ def main(argv: Sequence[str] | None = None) -> None:
         parser.error(str(error))
     table = sweep.run_plan(plan, args.scheduler, args.workers)
     sweep.write_table(table, args.out)
-    print(draw(table, args.figure))
     failed = sweep.failure_reasons(table)
+    if failed.total() < table.num_rows:
+        print(draw(table, args.figure))
     print(f"{table.num_rows} launches, {failed.total()} failed -> {args.out}")
     sweep.print_reasons(failed)
     if failed.total() == table.num_rows:
-        sys.exit(f"{COMMAND}: every launch failed")
+        sys.exit(f"{COMMAND}: every launch failed, no figure drawn")
 
 
 if __name__ == "__main__":

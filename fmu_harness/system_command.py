@@ -26,7 +26,7 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .checks import importers
-from .console import summary
+from .console import CommandParser, optional, refused, summary
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
@@ -36,6 +36,7 @@ from .runs.system import run_jacobi, step_limit_error
 from .studies.result_table import write_csv
 
 ENGINES = ("master", "gauss-seidel", "libcosim", "ecos", "model-exchange")
+ENGINE_EXTRAS = {"libcosim": "libcosimpy", "ecos": "ecospy"}  # the module of the interop extra each engine needs
 JACOBI_ENGINES = ("master", "libcosim", "ecos")  # each couples by Jacobi: the inputs of a step are all one step late
 RTOL = 1e-8  # the model-exchange engine's relative tolerance unless --rtol
 PROGRESS_SHARE = 0.1  # a progress line every tenth of the run when stderr is no terminal
@@ -43,13 +44,6 @@ PROGRESS_SHARE = 0.1  # a progress line every tenth of the run when stderr is no
 
 class UsageError(ValueError):
     """A mistake in the command line, found before any work starts."""
-
-
-class OneLineParser(argparse.ArgumentParser):
-    """A parser whose refusal of the command line is one line (no usage block) and exit status 2."""
-
-    def error(self, message: str):
-        self.exit(2, f"{self.prog}: error: {message}\n")
 
 
 def _description(path: Path) -> ModelDescription:
@@ -162,7 +156,7 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
 
 
 def _arguments(argv: list[str] | None) -> argparse.Namespace:
-    parser = OneLineParser(description=summary(__doc__))
+    parser = CommandParser(description=summary(__doc__))
     parser.add_argument("package", type=Path, help="the SSP package (.ssp)")
     parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
     parser.add_argument("--step", type=float, default=1e-3,
@@ -181,6 +175,12 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
 
 def run(args: argparse.Namespace, scratch: Path) -> Path:
     """Check everything, then run and write the CSV file; the file's path."""
+    out = args.out or Path(args.package.name).with_suffix(".csv")
+    if out.is_dir() or not out.parent.is_dir():
+        raise UsageError(f"--out {out}: a folder, not a file to write" if out.is_dir() else
+                         f"--out {out}: no folder {out.parent}")
+    if args.engine in ENGINE_EXTRAS:
+        optional(ENGINE_EXTRAS[args.engine], "interop", f"{sys.argv[0]} --engine {args.engine}")
     system = ssp_package.read(args.package)
     stop_time = args.stop_time if args.stop_time is not None else system.stop_time
     if stop_time is None:
@@ -216,9 +216,6 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
     if reason is not None:
         raise UsageError(reason)
     outputs, headers = output_columns(system, descriptions)
-    out = args.out or Path(args.package.name).with_suffix(".csv")
-    if not out.parent.is_dir():
-        raise UsageError(f"--out {out}: no folder {out.parent}")
     rows = run_engine(args.engine, package, system, fmus, outputs, stop_time, args.step, progress_printer(stop_time),
                       args.rtol)
     return write_csv(out, ["time [s]", *headers], rows.tolist())
@@ -229,7 +226,9 @@ def main(argv: list[str] | None = None) -> None:
     try:
         with tempfile.TemporaryDirectory(prefix="driveline-system-") as scratch:
             out = run(args, Path(scratch))
-    except (UsageError, PackageError, StartValuesRefused, NotRunnable) as error:
+    except StartValuesRefused as refusal:
+        raise refused(sys.argv[0], str(refusal)) from None
+    except (UsageError, PackageError, NotRunnable) as error:
         print(f"{sys.argv[0]}: error: {error}", file=sys.stderr)
         sys.exit(2)
     except StepRefused as error:

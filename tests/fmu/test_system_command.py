@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -110,6 +111,7 @@ def test_gauss_seidel_runs_the_launch_in_the_packages_order_at_a_step_jacobi_ref
     (["--set", "coupling.kinematics=0.5"], "'0.5' is no Integer value"),
     (["--set", "coupling.r=-0.01"], "coupling (TripodCoupling): parameter r = -10 mm must be positive"),
     (["--step", "0"], "need 0 < step <= stop time"),
+    (["--step", "-2e-4"], "--step -0.0002 and --stop-time"),
     (["--step", "0.003"], "no whole number of steps"),
     (["--engine", "dymola"], "invalid choice: 'dymola'"),
     (["--engine", "model-exchange", "--rtol", "1e-20"], "need 1e-13 <= rtol <= 1e-2"),
@@ -138,6 +140,23 @@ def test_model_exchange_of_python_fmus_is_one_line(fmi2_dir, tmp_path, capsys):
     assert not (tmp_path / "run.csv").exists()
 
 
+def test_an_existing_folder_as_out_is_refused_before_the_run(native_ssp, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_status:
+        system_command.main([str(native_ssp), "--stop-time", "100", "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert exit_status.value.code == 2 and err.count("\n") == 1 and f"--out {tmp_path}: a folder, not a file" in err
+
+
+@pytest.mark.parametrize("engine, module", system_command.ENGINE_EXTRAS.items())
+def test_an_engine_without_its_extra_names_it_in_one_line(engine, module, native_ssp, tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, module, None)
+    with pytest.raises(SystemExit) as exit_status:
+        _run(native_ssp, tmp_path / "run.csv", "--engine", engine)
+    message = str(exit_status.value.code)
+    assert message.count("\n") == 0 and f"--engine {engine} needs {module}" in message and "[interop]" in message
+    assert not (tmp_path / "run.csv").exists()
+
+
 @pytest.mark.parametrize("package", ["missing.ssp", "not_a_package.ssp"])
 def test_a_file_that_is_no_package_is_one_line(package, tmp_path, capsys):
     (tmp_path / "not_a_package.ssp").write_text("time,x\n0,1\n")
@@ -152,10 +171,11 @@ def test_a_start_value_the_fmu_refuses_stops_every_engine_naming_the_component(e
                                                                                capsys):
     """A bend beyond beta_max, which the coupling refuses at ExitInitializationMode (libcosim would
     abort the process on the native FMU's Error): whatever the engine, the run stops before it
-    starts, in one line naming the component, its model and the FMU's reason, status 2."""
+    starts, in one line naming the component, its model and the FMU's reason, status 1: the words and status of
+    ``driveline-fmus check`` (tests/project/test_cli.py)."""
     with pytest.raises(SystemExit) as exit_status:
         _run(native_ssp, tmp_path / "run.csv", "--engine", engine, "--set", "coupling.beta=1.0")
     err = capsys.readouterr().err
-    assert exit_status.value.code == 2 and err.count("\n") == 1
-    assert "error: coupling (TripodCoupling): input beta = 57.2958 deg must not exceed beta_max = 45 deg" in err
+    assert exit_status.value.code == 1 and err.count("\n") == 1
+    assert ": refused: coupling (TripodCoupling): input beta = 57.2958 deg must not exceed beta_max = 45 deg" in err
     assert not (tmp_path / "run.csv").exists()

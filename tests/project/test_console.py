@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from fmu_harness.console import Progress, optional, summary
+from fmu_harness.console import CommandParser, Progress, optional, refused, summary
 
 
 class Terminal(io.StringIO):
@@ -53,6 +53,33 @@ def test_a_missing_optional_package_ends_the_command_naming_its_extra():
     assert exited.value.code == ("driveline-fmus sweep needs a_package_that_is_not_there, which is not installed: "
                                  "pip install 'driveline-fmus[sweep]'")
     assert optional("json", "sweep", "driveline-fmus sweep").__name__ == "json"
+
+
+def test_a_negative_number_in_exponent_form_is_a_value():
+    parser = CommandParser(prog="x")
+    parser.add_argument("--step", type=float)
+    assert parser.parse_args(["--step", "-2e-4"]).step == -2e-4
+    assert parser.parse_args(["--step", "-.5"]).step == -0.5
+
+
+def test_help_shows_each_options_default_once(capsys):
+    parser = CommandParser(prog="x")
+    parser.add_argument("--steps", type=int, default=360, help="steps of a turn")
+    parser.add_argument("--step", type=float, default=1e-3, help="the step (default 1e-3)")
+    parser.add_argument("--flag", action="store_true", help="a flag")
+    parser.add_argument("--set", action="append", default=[], help="repeatable")
+    parser.add_argument("--layout", default="", help="a layout")
+    text = " ".join(parser.format_help().split())
+    assert "steps of a turn (default 360)" in text and "the step (default 1e-3) " in text
+    assert "a flag " in text and "a flag (default" not in text and "repeatable (default" not in text
+    assert text.endswith("a layout")
+
+
+def test_a_refusal_is_one_line_and_status_1(capsys):
+    with pytest.raises(SystemExit) as exited:
+        raise refused("driveline-fmus check", "joint (TripodCoupling): parameter r = -10 mm must be positive")
+    assert exited.value.code == 1
+    assert capsys.readouterr().err == "driveline-fmus check: refused: joint (TripodCoupling): parameter r = -10 mm must be positive\n"
 
 
 def _commands() -> list[str]:
