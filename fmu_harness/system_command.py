@@ -129,22 +129,23 @@ def progress_printer(stop_time: float, stream=sys.stderr) -> Callable[[int, int]
 
 def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Path], outputs: list[str],
                stop_time: float, step_size: float, on_step: Callable[[int, int], None], rtol: float = RTOL) -> np.ndarray:
-    """Rows of time and ``outputs`` for t_1 ... t_N from ``engine`` (``rtol``: Model Exchange's tolerance)."""
+    """Rows of time and ``outputs`` for t_0 = 0 ... t_N from ``engine`` (``rtol``: Model Exchange's tolerance);
+    libcosim's from t_1, as it initialises the FMUs in its first step."""
     steps = int(round(stop_time / step_size))
     if engine == "model-exchange":
         with tempfile.TemporaryDirectory(prefix="driveline-model-exchange-") as scratch:
             return run_model_exchange(fmus, {c.name: c.parameters for c in system.components}, system.connections,
-                                      stop_time, step_size, outputs, Path(scratch), rtol, on_step)
+                                      stop_time, step_size, outputs, Path(scratch), rtol, on_step, initial=True)
     if engine in ("master", "gauss-seidel"):
         order = [c.name for c in system.components] if engine == "gauss-seidel" else None
         return run_jacobi(fmus, {c.name: c.parameters for c in system.components}, system.connections,
-                          stop_time, step_size, outputs, on_step, order=order)
+                          stop_time, step_size, outputs, on_step, order=order, initial=True)
     if engine == "libcosim":
         session = importers.cosim_session(step_size, ssp=package)
     else:
         session = importers.ecos_session(step_size, ssp=package, parameter_set=system.parameter_set)
     try:
-        rows = []
+        rows = [] if engine == "libcosim" else [[0.0, *session.get(outputs)]]
         for k in range(steps):
             if session.step() is False:
                 raise StepRefused(f"{engine} step", "refused", k * step_size, [])

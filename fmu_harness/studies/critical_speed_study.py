@@ -100,7 +100,7 @@ def write(fmu: Path, out: Path) -> list[Path]:
     result = ramp(fmu, ramp_speeds(BEYOND * max(criticals), criticals))
     table = write_csv(out / "critical_speeds.csv",
                       ("mode [1]", "critical speed [rad/s]", "critical speed [rpm]"),
-                      ((k, f"{w:.6g}", f"{w * RPM:.6g}") for k, w in enumerate(criticals, start=1)))
+                      ((k, float(f"{w:.6g}"), float(f"{w * RPM:.6g}")) for k, w in enumerate(criticals, start=1)))
     names = result.dtype.names
     ramp_csv = write_csv(out / "critical_speeds_ramp.csv", ("time [s]", *(column(SPEC, n) for n in names[1:])),
                          result.tolist())

@@ -90,7 +90,8 @@ def run(package: Path, torque: float = TORQUE, stop_time: float = STOP_TIME, ste
         with zipfile.ZipFile(package) as archive:
             archive.extractall(scratch)
         fmus = {c.name: Path(scratch) / c.source for c in system.components}
-        rows = run_jacobi(fmus, parameters, system.connections, stop_time, step, outputs, order=LAUNCH_ORDER)
+        rows = run_jacobi(fmus, parameters, system.connections, stop_time, step, outputs, order=LAUNCH_ORDER,
+                          initial=True)
     return Launch(rows[:, 0], {name: rows[:, k + 1] for k, name in enumerate(outputs)})
 
 
@@ -167,6 +168,23 @@ def third_order_peaks(launch: Launch) -> tuple[list[Peak], np.ndarray, np.ndarra
         peaks.append(Peak(j + 1, float(frequencies[j]), COORDINATES[found.dominant[j]], float(damping[j]),
                           float(crossings[j]), measured if reached else None, swept))
     return peaks, speeds, amplitudes
+
+
+PEAK_COLUMNS = ("mode [1]", "f_mode [Hz]", "dominant", "damping_ratio [1]", "crossing_speed [rad/s]", "crossing",
+                "peak_speed [rad/s]", "difference [%]", "swept_peak_speed [rad/s]", "peak_amplitude [m/s2 or rad/s2]")
+"""launch_shudder_peaks.csv: ``crossing`` says whether the launch reaches the mode's crossing; where it
+does not, the peak's columns hold the launch's end (its last tracked speed and the amplitude there)."""
+
+
+def peak_row(peak: Peak, end_speed: float, end_amplitude: float) -> tuple:
+    """A row of :data:`PEAK_COLUMNS`: ``end_speed`` [rad/s] and ``end_amplitude``, the order tracking's last
+    speed and the mode's amplitude there, stand for a peak the launch does not reach."""
+    if peak.measured is not None:
+        return (peak.mode, peak.frequency, peak.coordinate, peak.damping, peak.crossing, "reached",
+                peak.measured[1], peak.difference, peak.swept, peak.measured[0])
+    return (peak.mode, peak.frequency, peak.coordinate, peak.damping, peak.crossing,
+            f"not reached: the launch ends at {end_speed:.1f} rad/s", end_speed,
+            100.0 * (end_speed / peak.crossing - 1.0), end_speed, end_amplitude)
 
 
 def speed_torque_figure(launch: Launch) -> Figure:
@@ -269,17 +287,12 @@ def write(package: Path, out: Path) -> list[Path]:
     units = {name: MODELS[model].spec[variable].unit
              for name, model, variable in _column_models(package)}
     header = ["time [s]", *(f"{csv_name} [{units[name]}]" for name, csv_name in COLUMNS)]
-    kept = slice(EVERY - 1, None, EVERY)
+    kept = slice(0, None, EVERY)  # from t = 0
     table = np.column_stack([launch.time[kept], *(launch.values[name][kept] for name, _ in COLUMNS)])
     run_csv = write_csv(out / "vehicle_launch.csv", header, table.tolist())
     peaks, speeds, amplitudes = third_order_peaks(launch)
-    peaks_csv = write_csv(out / "launch_shudder_peaks.csv",
-                          ("mode [1]", "f_mode [Hz]", "dominant [1]", "damping_ratio [1]", "crossing_speed [rad/s]",
-                           "peak_speed [rad/s]", "difference [%]", "swept_peak_speed [rad/s]",
-                           "peak_amplitude [m/s2 or rad/s2]"),
-                          ((p.mode, p.frequency, p.coordinate, p.damping, p.crossing,
-                            np.nan if p.measured is None else p.measured[1], p.difference, p.swept,
-                            np.nan if p.measured is None else p.measured[0]) for p in peaks))
+    peaks_csv = write_csv(out / "launch_shudder_peaks.csv", PEAK_COLUMNS,
+                          (peak_row(p, speeds[-1], amplitudes[p.mode - 1][-1]) for p in peaks))
     return [run_csv, peaks_csv,
             save(speed_torque_figure(launch), out / "launch_speed_torque.png"),
             save(axial_force_figure(launch), out / "launch_axial_force.png"),

@@ -44,7 +44,7 @@ FRICTION_MU = 0.05  # the friction coefficient of the figure against beta
 BETA_COLOURS = dict(zip(BETAS_DEG, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
                                     "tab:pink", "tab:gray", "tab:olive")))
 #: The CSV's ``reactions`` column: which reactions a row holds, a label rather than a number.
-REACTIONS_COLUMN = "reactions [label]"
+REACTIONS_COLUMN = "reactions"
 
 
 @dataclass(frozen=True)
