@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import re
 import shutil
 import sys
@@ -77,6 +78,17 @@ def optional(module: str, extra: str, command: str) -> ModuleType:
                          f"pip install '{DISTRIBUTION}[{extra}]'") from None
 
 
+def require(module: str, extra: str, command: str) -> None:
+    """End ``command`` as :func:`optional` does unless ``module`` can be imported, without importing it
+    (Ecos's module loads only once its TBB library is)."""
+    try:
+        found = importlib.util.find_spec(module) is not None
+    except (ImportError, ValueError):
+        found = False
+    if not found:
+        raise SystemExit(f"{command} needs {module}, which is not installed: pip install '{DISTRIBUTION}[{extra}]'")
+
+
 class Progress:
     """``what [n/N] item`` on ``stream`` (standard error): rewritten in place on a terminal,
     elsewhere (a log, a pipe) one line per item at most every ``interval`` seconds, the first and
@@ -100,6 +112,13 @@ class Progress:
             self.stream.write("\n")
             self.stream.flush()
 
+    def start(self, item: str) -> None:
+        """The next of the ``total`` starts: ``what [n/N] item ...``, shown at once, for work whose items
+        each take long (a study of the main job)."""
+        with self._lock:
+            if self.enabled:
+                self._show(f"{self.what} [{self.done + 1}/{self.total}] {item} ...")
+
     def advance(self, item: str = "") -> None:
         """One more of the ``total`` done; ``item`` names it."""
         with self._lock:
@@ -110,11 +129,14 @@ class Progress:
             if not self.terminal and self.done not in (1, self.total) and now - self._shown < self.interval:
                 return
             self._shown = now
-            line = f"{self.what} [{self.done}/{self.total}] {item}".rstrip()
-            if self.terminal:  # cut to the terminal's width: a wrapped line cannot be rewritten
-                line = line[:shutil.get_terminal_size().columns - 1]
-                self.stream.write("\r" + line.ljust(self._width))
-                self._width = len(line)
-            else:
-                self.stream.write(line + "\n")
-            self.stream.flush()
+            self._show(f"{self.what} [{self.done}/{self.total}] {item}".rstrip())
+
+    def _show(self, line: str) -> None:
+        """``line`` on the stream: in place of the last on a terminal, else a line of its own."""
+        if self.terminal:  # cut to the terminal's width: a wrapped line cannot be rewritten
+            line = line[:shutil.get_terminal_size().columns - 1]
+            self.stream.write("\r" + line.ljust(self._width))
+            self._width = len(line)
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()

@@ -26,7 +26,7 @@ from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
 from .checks import importers
-from .console import CommandParser, optional, refused, summary
+from .console import CommandParser, refused, require, summary
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
@@ -181,7 +181,7 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
         raise UsageError(f"--out {out}: a folder, not a file to write" if out.is_dir() else
                          f"--out {out}: no folder {out.parent}")
     if args.engine in ENGINE_EXTRAS:
-        optional(ENGINE_EXTRAS[args.engine], "interop", f"{sys.argv[0]} --engine {args.engine}")
+        require(ENGINE_EXTRAS[args.engine], "interop", f"{sys.argv[0]} --engine {args.engine}")
     system = ssp_package.read(args.package)
     stop_time = args.stop_time if args.stop_time is not None else system.stop_time
     if stop_time is None:

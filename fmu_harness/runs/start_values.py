@@ -11,7 +11,8 @@ the FMUs run, and stops with the first reason.
 Usage: ``driveline-fmus check TARGET [NAME=VALUE ...]``, TARGET an SSP package (its parameter
 bindings) or an FMU (the values given, ``beta=0.3``): prints what would be refused in one line,
 ``driveline-fmus check: refused: instance (Model): reason``, and exits with 1 (as ``driveline-fmus
-system`` does for the same values), or prints that every start value is accepted.
+system`` does for the same values), or prints that every start value is accepted and the platforms
+whose binaries each FMU carries (the folders of its ``binaries/``).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from driveline.catalog import MODELS
 from .ssp import bindings
 from .ssp_package import read
 from ..console import CommandParser, refused, summary
+from ..packaging.toolchain import platforms_sentence
 
 _KINDS = {"Real": float, "Integer": int, "Boolean": lambda text: str(text).lower() in ("true", "1"), "String": str}
 
@@ -134,6 +136,21 @@ def main(argv: list[str] | None = None) -> None:
     except (OSError, KeyError, ValueError, zipfile.BadZipFile, ET.ParseError) as error:
         parser.error(f"{args.target}: cannot be read ({type(error).__name__}: {error})")
     print(f"{args.target}: every start value accepted ({', '.join(i.name for i in instances)})")
+    for fmu, members in fmu_members(args.target).items():
+        print(f"{fmu}: {platforms_sentence(members)}")
+
+
+def fmu_members(target: Path) -> dict[str, list[str]]:
+    """The file names in each FMU of ``target``: an FMU's own, or those of every FMU an SSP package holds
+    (by its path in the package)."""
+    with zipfile.ZipFile(target) as archive:
+        if target.suffix.lower() != ".ssp":
+            return {target.name: archive.namelist()}
+        found = {}
+        for name in sorted(n for n in archive.namelist() if n.lower().endswith(".fmu")):
+            with archive.open(name) as data, zipfile.ZipFile(data) as fmu:
+                found[name] = fmu.namelist()
+        return found
 
 
 if __name__ == "__main__":

@@ -112,7 +112,6 @@ def test_gauss_seidel_runs_the_launch_in_the_packages_order_at_a_step_jacobi_ref
     (["--set", "coupling.omega_in=1"], "it is a connected input"),
     (["--set", "coupling.T_load=abc"], "'abc' is no Real value"),
     (["--set", "coupling.kinematics=0.5"], "'0.5' is no Integer value"),
-    (["--set", "coupling.r=-0.01"], "coupling (TripodCoupling): parameter r = -10 mm must be positive"),
     (["--step", "0"], "need 0 < step <= stop time"),
     (["--step", "-2e-4"], "--step -0.0002 and --stop-time"),
     (["--step", "0.003"], "no whole number of steps"),
