@@ -27,6 +27,10 @@ FMI 2.0 FMUs without the slow and importer tests (``-m "not slow and not importe
 and does not even import the modules that hold slow tests only (ROSS takes seconds to import):
 ``python -m pytest -q -n 2 --quick``.
 
+Property tests (hypothesis) run the ``ci`` profile: derandomised, so every machine draws the same
+cases and a run is repeatable; ``--hypothesis-profile explore`` draws new cases on every run and keeps
+the failing ones in ``.hypothesis/`` (docs/development.md: a failure found so becomes an explicit case).
+
 With ``-n`` (pytest-xdist's default ``load`` distribution), a worker takes a whole work unit at a
 time (:func:`work_unit`: a test file, or the part of it for one family of FMUs), the costliest unit
 left first by ``tests/durations.json`` (:func:`pytest_xdist_make_scheduler`): a module's fixtures
@@ -56,6 +60,7 @@ from datetime import datetime, timezone  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import pytest  # noqa: E402
+from hypothesis import settings  # noqa: E402
 
 from driveline.catalog import MODELS  # noqa: E402
 from fmu_harness import packaging  # noqa: E402
@@ -78,6 +83,13 @@ SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "tripod_fmu", "native_dir",
 
 
 QUICK_VERSIONS = ["2"]
+
+
+#: The suite's profile: the same cases everywhere, no example database between runs.
+settings.register_profile("ci", derandomize=True, database=None, print_blob=True)
+#: On demand (``--hypothesis-profile explore``): new cases each run, failures kept and replayed first.
+settings.register_profile("explore", derandomize=False, print_blob=True)
+settings.load_profile("ci")
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:

@@ -199,14 +199,17 @@ def test_at_most_max_dips_are_rescanned_on_one_line(periods, refused):
 def test_the_round_off_layout_is_searched_in_a_bounded_number_of_evaluations():
     """The layout of extreme materials whose determinant ripples at about its rounding level near a
     close pair at 11 384 rad/s (docs/critical_speeds.md): at standstill the search once took 1.7
-    million evaluations; now the pair is a double root and the search takes well under a thousand."""
+    million evaluations; now it takes well under a thousand. What the design guarantees is the bound
+    and the pair found twice; whether the pair resolves into two sign changes or bottoms out as a
+    double root depends on the libraries' rounding (numpy 2.4 resolves it 1.1e-4 rad/s apart), so the
+    double-root path is held by the constructed ripple above, whose outcome is certain."""
     driveline = loads_driveline(ROUND_OFF_LAYOUT)
     for spin in (0.0, 0.051854897560696):
         grid = driveline._grid(4.0e4, 1.0)
         report = find_roots_batch(
             lambda x, k: transfer.determinant_and_rounding(driveline._chain, x, spin), [grid])
         roots = report.roots[0]
-        assert report.evaluations < 1000 and report.double_roots >= 1
+        assert report.evaluations < 1000
         assert np.allclose(roots[:2], [98.4798381, 312.0615041], rtol=1e-8)
         assert np.count_nonzero(np.abs(roots - 11384.045) < 1e-2) == 2
 

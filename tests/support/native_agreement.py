@@ -40,6 +40,24 @@ SIGNAL_TOLERANCE |= {f"F_{axis}_mount{i}": 1e-10 for i in range(1, MAX_MOUNTS + 
 SCALE_FLOOR = {"resonance_margin": 1.0}
 
 
+#: Where the agreement rule ends: a quantity of up to this magnitude can be multiplied by another
+#: (a mount force by its deflection, a step matrix's norm by a state) and stay finite; beyond about
+#: sqrt(max float) = 1.3e154 equally valid orders of evaluation overflow in one core and not the other,
+#: and the two cores' last digits stop meaning anything (a drawn PowertrainMounts run with an accepted
+#: input of 1e300 N grew states of 1e290-1e294 that differed beyond the tolerance). A run is compared
+#: up to its first row with an output beyond this; past it both cores must still refuse the same steps.
+AGREEMENT_MAGNITUDE = 1e150
+
+
+def within_the_agreement_range(core_rows: list[list[float]]) -> int:
+    """How many leading rows hold only outputs of at most :data:`AGREEMENT_MAGNITUDE` (NaN, a
+    refused output's value, does not end the range)."""
+    for count, row in enumerate(core_rows):
+        if np.any(np.abs(np.asarray(row, dtype=float)) > AGREEMENT_MAGNITUDE):
+            return count
+    return len(core_rows)
+
+
 def scale(name: str, values: np.ndarray) -> float:
     """An output's largest magnitude, the scale its tolerance is relative to (at least its
     :data:`SCALE_FLOOR`; 1 for an output that stays zero)."""
