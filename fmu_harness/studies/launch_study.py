@@ -34,7 +34,7 @@ from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody, modes
 from ..runs import ssp_package
 from ..runs.system import LAUNCH_ORDER, run_jacobi
 from . import order_tracking
-from .figures import figure, save
+from .figures import BLUE, ORANGE, PALETTE, SKY, YELLOW, figure, save
 from .result_table import write_csv
 
 TORQUE = 20.0  # motor torque after the ramp [N.m]
@@ -55,6 +55,7 @@ COLUMNS = (("drive.v_x", "v_x"), ("motor.T_motor", "T_motor"),
 FREQUENCIES = tuple(f"mounts.f_mode_{j}" for j in range(1, 7))
 WINDOW_MARGIN = 0.25  # a peak belongs to a crossing within this fraction of its speed (a fast sweep: 22 %)
 SPECTRUM_TOP = 25.0  # the spectrogram's highest frequency [Hz]
+LABEL_SHARE = 0.17  # the spectrogram's mode labels take this share of its width, their lines the rest
 
 
 @dataclass(frozen=True)
@@ -187,15 +188,24 @@ def peak_row(peak: Peak, end_speed: float, end_amplitude: float) -> tuple:
             100.0 * (end_speed / peak.crossing - 1.0), end_speed, end_amplitude)
 
 
+TAKE_OFF = 2.0  # the torque panel's span [s]: the ramp and the halfshafts' wind-up, then the torques hold
+
+
 def speed_torque_figure(launch: Launch) -> Figure:
-    """Vehicle speed and both halfshaft torques over time."""
-    fig, (speed, torque) = figure(2, 1, figsize=(8, 6), sharex=True)
-    speed.plot(launch.time, launch.values["drive.v_x"] * KMH, color="tab:blue", label="vehicle speed")
+    """Vehicle speed over the launch; both halfshaft torques over the take-off, where they change."""
+    fig, (speed, torque) = figure(2, 1, figsize=(8, 6.4))
+    speed.plot(launch.time, launch.values["drive.v_x"] * KMH, color=BLUE, label="vehicle speed")
     speed.set_ylabel("vehicle speed [km/h]")
+    speed.set_xlabel("time [s]")
+    speed.set_xlim(launch.time[0], launch.time[-1])
     speed.set_title(f"Launch from standstill, motor torque ramped to {TORQUE:g} N.m: vehicle speed", fontsize=10)
-    for side, color in (("left", "tab:red"), ("right", "tab:green")):
-        torque.plot(launch.time, launch.values[f"drive.T_load_{side}"], color=color, lw=0.8, label=f"{side} halfshaft")
-    torque.set_title("Halfshaft torques, each in its joint's frame (the right one turns negatively)", fontsize=10)
+    early = launch.time <= min(TAKE_OFF, launch.time[-1])
+    for side, color, style in (("left", BLUE, "-"), ("right", ORANGE, "--")):
+        torque.plot(launch.time[early], launch.values[f"drive.T_load_{side}"][early], style, color=color, lw=1.0,
+                    label=f"{side} halfshaft")
+    torque.set_xlim(launch.time[0], launch.time[early][-1])
+    torque.set_title(f"Halfshaft torques over the first {launch.time[early][-1]:.3g} s (held after), each in its "
+                     "joint's frame: the right one turns negatively", fontsize=9)
     torque.set_ylabel("T_load [N.m]")
     torque.set_xlabel("time [s]")
     torque.legend(loc="center right")
@@ -206,21 +216,33 @@ def speed_torque_figure(launch: Launch) -> Figure:
 
 
 def axial_force_figure(launch: Launch) -> Figure:
-    """Both joints' generated axial force -Rz_in over the halfshaft speed, with its third-order amplitude."""
-    fig, axes = figure(2, 1, figsize=(8, 6), sharex=True)
+    """Both joints' generated axial force -Rz_in: its third-order amplitude over the halfshaft speed, and
+    its shape over the launch's last turn."""
+    fig, (orders, turn) = figure(2, 1, figsize=(8, 6.4))
     omega = order_tracking.shaft_speed(launch.time, launch.shaft_angle)
-    for ax, side, color in zip(axes, ("left", "right"), ("tab:red", "tab:green")):
+    top = 0.0
+    for side, color, style in (("left", BLUE, "-"), ("right", ORANGE, "--")):
         force = -launch.values[f"joint_{side}.Rz_in"]
-        ax.plot(omega, force, color=color, lw=0.4, label=f"-Rz_in, {side} joint")
         speeds, amplitude = order_tracking.order_track(launch.time, launch.shaft_angle, force, 3)
-        ax.plot(speeds, amplitude, color="black", lw=1.6, label="its third-order amplitude")
-        ax.set_ylim(-1.5 * amplitude.max(), 1.6 * amplitude.max())
-        ax.set_ylabel("generated axial force [N]")
-        ax.set_title(f"Generated axial force of the {side} joint (friction's sign follows the sliding: "
-                     "its third order is 4/pi of its peak)", fontsize=9)
-        ax.legend(loc="upper center", ncols=2, fontsize=8)
+        orders.plot(speeds, amplitude, style, color=color, lw=1.4, label=f"{side} joint")
+        top = max(top, amplitude.max())
+        angle = np.abs(launch.values[f"joint_{side}.phi_out"])
+        last = angle >= angle[-1] - 2.0 * np.pi
+        turn.plot(np.degrees(angle[last] - angle[last][0]), force[last], style, color=color, lw=1.2,
+                  label=f"{side} joint")
+    orders.set_xlim(speeds[0], speeds[-1])
+    orders.set_ylim(0.0, 1.15 * top)
+    orders.set_xlabel("left halfshaft speed [rad/s] (the right one turns as fast, negatively)")
+    orders.set_ylabel("third-order amplitude [N]")
+    orders.set_title("Generated axial force -Rz_in, third order (friction's sign follows the sliding: 4/pi of "
+                     "its peak)", fontsize=9)
+    turn.set_xlim(0.0, 360.0)
+    turn.set_xlabel("shaft angle over the launch's last turn [deg]")
+    turn.set_ylabel("-Rz_in [N]")
+    turn.set_title(f"Its shape over the last turn, at {omega[-1]:.1f} rad/s", fontsize=9)
+    for ax in (orders, turn):
+        ax.legend(loc="lower right", fontsize=8)
         ax.grid(alpha=0.3)
-    axes[-1].set_xlabel("left halfshaft speed [rad/s] (the right one turns as fast, negatively)")
     fig.tight_layout()
     return fig
 
@@ -240,13 +262,14 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
     line = np.array([left, right])
     for order, style in ((1, ":"), (3, "--")):
         top.plot(line, order * line / (2.0 * np.pi), style, color="white", lw=1.2, label=f"order {order}")
+    label_end = left + LABEL_SHARE * (right - left)  # each mode's line starts after its label, written on its height
     for peak in peaks:
-        top.plot(line, [peak.frequency] * 2, color="cyan", lw=0.7, ls="-.", label=f"_mode {peak.mode}")
+        top.plot([label_end, right], [peak.frequency] * 2, color=SKY, lw=0.7, ls="-.", label=f"_mode {peak.mode}")
         top.annotate(f"mode {peak.mode} ({peak.coordinate}) {peak.frequency:.2f} Hz", (left, peak.frequency),
-                     xytext=(3, 2), textcoords="offset points", color="cyan", fontsize=7)
+                     xytext=(3, 0), textcoords="offset points", color=SKY, fontsize=7, va="center")
     reached = [peak for peak in peaks if peak.measured is not None]
-    ring = {"ls": "none", "marker": "o", "ms": 13, "mfc": "none", "mec": "cyan", "mew": 1.6}
-    dot = {"ls": "none", "marker": "o", "ms": 5, "color": "lime", "zorder": 4}
+    ring = {"ls": "none", "marker": "o", "ms": 13, "mfc": "none", "mec": SKY, "mew": 1.6}
+    dot = {"ls": "none", "marker": "o", "ms": 5, "color": YELLOW, "zorder": 4}
     top.plot([p.crossing for p in reached], [p.frequency for p in reached], **ring, label="3 x f_shaft = f_mode")
     top.plot([p.measured[1] for p in reached], [3.0 * p.measured[1] / (2.0 * np.pi) for p in reached], **dot,
              label="measured third-order peak")
@@ -259,7 +282,7 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
                   fontsize=10)
     top.legend(loc="upper left", fontsize=8)
     inside = (speeds >= left) & (speeds <= right)
-    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    colors = PALETTE[:6]
     for peak, amplitude in zip(peaks, amplitudes):
         if peak.measured is None:
             continue
