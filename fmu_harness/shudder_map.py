@@ -38,7 +38,6 @@ from driveline.vehicle.compact_car import MASS, MOTOR_PEAK_TORQUE, RATIO, WHEEL_
 from .console import CommandParser, summary
 from .runs import sweep
 from .runs.system_sweep import DerivedMetrics
-from .studies import figures
 from .studies.order_tracking import REVOLUTIONS, third_order_peak
 
 if TYPE_CHECKING:
@@ -94,6 +93,8 @@ def draw(table: pa.Table, path: Path) -> Path:
     """A panel per friction coefficient: the peak third-order pitch acceleration [rad/s2] over the bend
     angle [deg] and the launch torque [% of the motor's peak], one colour scale for all panels; a
     failed launch is left blank."""
+    from .studies import figures  # matplotlib, when a figure is drawn: a mistake is refused before it loads
+
     rows = table.to_pylist()
     betas, torques, mus = (sorted({row[name] for row in rows}) for name in (BETA, TORQUE, MU))
     peaks = np.full((len(mus), len(torques), len(betas)), np.nan)
@@ -102,7 +103,8 @@ def draw(table: pa.Table, path: Path) -> Path:
             peaks[mus.index(row[MU]), torques.index(row[TORQUE]), betas.index(row[BETA])] = row[PEAK]
     columns = min(4, len(mus))
     fig, panels = figures.figure(math.ceil(len(mus) / columns), columns, squeeze=False, sharex=True, sharey=True,
-                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6))
+                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6),
+                                 layout="constrained")
     top = np.nanmax(peaks) if np.any(np.isfinite(peaks)) else 1.0
     x, y = np.degrees(betas), 100.0 * np.array(torques) / MOTOR_PEAK_TORQUE
     for k, panel in enumerate(panels.flat):
@@ -110,13 +112,15 @@ def draw(table: pa.Table, path: Path) -> Path:
             panel.set_visible(False)
             continue
         image = panel.pcolormesh(x, y, peaks[k], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
+        panel.set_xlim(x[0], x[-1])  # the grid's range: its outer cells shown to their values, no further
+        panel.set_ylim(y[0], y[-1])
         panel.set_title(f"mu = {mus[k]:.3g}", fontsize=9)
     for panel in panels[-1]:
         panel.set_xlabel("bend angle beta [deg]")
     for panel in panels[:, 0]:
         panel.set_ylabel("launch torque [% of peak]")
     fig.colorbar(image, ax=panels, label="peak 3rd-order pitch acceleration [rad/s2]")
-    fig.suptitle(f"Launch shudder map: {len(rows)} launches of VehicleLaunch, both joints alike")
+    fig.suptitle(f"Launch shudder map: {len(rows)} launches of VehicleLaunch, both joints alike", fontsize=10)
     path.parent.mkdir(parents=True, exist_ok=True)
     return figures.save(fig, path)
 
