@@ -153,7 +153,8 @@ class SteppedModel(ABC):
 
     def start_notice(self) -> str | None:
         """What the log says once, at initialisation, of how the model reads inputs the host left at
-        their start values (a default it may not expect), or None; a warning, not a refusal."""
+        their start values (a default it may not expect), or None; an information line (FMI status OK,
+        category ``logAll``), not a warning: the default gives the right answer."""
         return None
 
     def step_size_errors(self, step_size: float) -> list[str]:

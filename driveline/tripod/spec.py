@@ -135,7 +135,7 @@ SPEC = ModelSpec(
                  "Source of the bend angle's rates: 0 = the inputs beta_dot and beta_ddot, 1 = estimated "
                  "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored), "
                  "2 = automatic: the samples until the host sets beta_dot or beta_ddot non-zero (or their input "
-                 "derivatives), the inputs from then on; a warning at the start while both are 0",
+                 "derivatives), the inputs from then on; an information line at the start while both are 0",
                  type="Integer", min=RATES_FROM_INPUTS, max=RATES_AUTOMATIC),
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),

@@ -48,6 +48,9 @@ def results(models, tmp_path_factory) -> Path:
                           capture_output=True, text=True, timeout=900)
     assert done.returncode == 0, done.stderr
     assert {Path(line).name for line in done.stdout.split()} == {path.name for path in out.iterdir()}
+    shown = done.stderr.splitlines()  # each study's start shown before its end
+    assert shown.index("main job [1/6] tripod coupling ...") < shown.index("main job [1/6] tripod coupling done")
+    assert "main job [5/6] launch shudder ..." in shown and "beta_rate" not in done.stderr  # no notice of a default
     return out
 
 
