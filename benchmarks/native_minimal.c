@@ -4,7 +4,7 @@
  * and FMI traffic; every Real output takes the first Real input's value (the time if there is
  * none), as the Python twins of benchmarks/minimal_models.py do.
  */
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 static Failure copy_first_input(ModelData *data, double time)
 {

@@ -8,7 +8,7 @@ the car's speed and travel, and each tyre's transient slip. The joints are outsi
 a joint's input shaft (torque ``T_in`` on it from the joint), each joint's output angle and speed
 (``phi_out``, ``omega_out``) twist the halfshaft against the wheel.
 
-Scalar code in a fixed order of operations: ``fmu_src/native/vehicle_driveline.c`` ports it line for
+Scalar code in a fixed order of operations: ``fmu_src/native/models/vehicle_driveline/vehicle_driveline.c`` ports it line for
 line.
 """
 

@@ -1,9 +1,10 @@
 """Native (C) co-simulation FMUs, FMI 2.0 and 3.0, generated from the same specs as the Python FMUs.
 
-A model is native when ``fmu_src/native/<model_in_snake_case>.c`` ports its physics and, if it
-has a library folder ``fmu_src/native/<model_in_snake_case>/``, every module the folder's headers
-list is there (:func:`library_modules`); the others are skipped. For each native model and FMI
-version this module
+The C sources lie by role under ``fmu_src/native/``: ``fmi/`` the shared FMI 2.0/3.0 layer, ``lib/`` the
+libraries more than one model uses, ``models/<model_in_snake_case>/`` one folder per model. A model is
+native when its folder holds ``<model_in_snake_case>.c``, the port of its physics, and every module
+the folder's headers list (:func:`library_modules`); the others are skipped. For each native model
+and FMI version this module
 
 * generates ``model_variables.h``/``.c`` from the spec: the variable table (value reference =
   position in the spec, as in the Python FMUs) and the range checks' messages, cut from
@@ -15,7 +16,9 @@ version this module
   FMI 3.0 ``sources/buildDescription.xml``);
 * compiles the shared library for each platform (:mod:`.toolchain`: zig, five platforms) with
   the FMI headers fmpy installs (``fmpy/c-code``), warnings as errors, and packs the FMU with its
-  sources (the library folder's as ``<folder>/<file>``), the resource files its model class
+  sources: the layer, the model's folder and the files of ``lib/`` they include (:func:`used_library`),
+  by their paths below ``fmu_src/native/``, the generated files at the top (the one include folder a
+  host needs, as fmpy's ``build_platform_binary`` gives it); then the resource files its model class
   declares (``SteppedModel.resource_files``, into ``resources/``), its doc page and the licence.
 
 FMI 2.0 FMUs land in ``<dest>/native/``, FMI 3.0 ones in ``<dest>/native/fmi3/``.
@@ -53,16 +56,21 @@ from .native_constants import constants_header
 GENERATION_TOOL = "driveline-fmus native build"
 
 NATIVE_SRC = Path(fmu_src.__file__).resolve().parent / "native"
-MODEL_SOURCES = NATIVE_SRC
-SHARED_SOURCES = ("fmu_instance.h", "fmu_layer.h", "fmu_instance.c", "fmu_checks.c", "fmu_values.c", "fmu_state.c",
-                  "fmu_model_exchange.c", "fmu_derivatives.c", "python_numbers.h", "python_numbers.c")
-LAYER = {"2": "fmi2_functions.c", "3": "fmi3_functions.c"}
+#: The shared FMI layer, the libraries more than one model uses, the models' folders
+LAYER_SOURCES, LIBRARY_SOURCES, MODEL_SOURCES = NATIVE_SRC / "fmi", NATIVE_SRC / "lib", NATIVE_SRC / "models"
+#: Each FMI version's functions (the rest of the layer serves both)
+LAYER = {"2": "fmi/fmi2_functions.c", "3": "fmi/fmi3_functions.c"}
 SUBDIR = {"2": "native", "3": "native/fmi3"}
 LOG_CATEGORIES = ("Warning", "Discard", "Error", "Fatal")
 
 
+def model_folder(name: str) -> Path:
+    """The folder of a model's C port: its model file and its own library (modules and headers)."""
+    return MODEL_SOURCES / snake_case(name)
+
+
 def model_source(name: str) -> Path:
-    return MODEL_SOURCES / f"{snake_case(name)}.c"
+    return model_folder(name) / f"{snake_case(name)}.c"
 
 
 _JACOBIAN_HOOK = re.compile(r"\.jacobian\s*=")
@@ -84,27 +92,65 @@ def jacobian_layout(spec: ModelSpec) -> tuple[list[str], list[str]]:
     return rows, columns
 
 
-def library_folder(name: str) -> Path:
-    """The folder of a model's C library (its modules and headers), if it has one."""
-    return MODEL_SOURCES / snake_case(name)
-
-
 _MODULE_LINE = re.compile(r"^\s*\*\s+(\w+\.c)\s", re.MULTILINE)
 
 
 def library_modules(name: str) -> list[str]:
-    """The modules of a model's library folder, as its headers list them: a comment line
-    `` *   transfer.c   what it holds`` per module (rotor.h). None for a model without a folder."""
-    folder = library_folder(name)
+    """The modules of a model's own library, as the headers of its folder list them: a comment line
+    `` *   transfer.c   what it holds`` per module (rotor.h). None for a model whose folder has no header."""
+    folder = model_folder(name)
     return sorted({module for header in folder.glob("*.h") for module in _MODULE_LINE.findall(header.read_text())})
 
 
 def has_c_port(name: str) -> bool:
-    """The model file exists and, with a library folder, every module its headers list."""
+    """The model file exists and every module its folder's headers list."""
     if not model_source(name).exists():
         return False
-    folder = library_folder(name)
-    return not folder.is_dir() or all((folder / module).is_file() for module in library_modules(name))
+    return all((model_folder(name) / module).is_file() for module in library_modules(name))
+
+
+_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.MULTILINE)
+
+
+def included(source: Path, root: Path = NATIVE_SRC) -> list[Path]:
+    """The files below ``root`` (``fmu_src/native/``, or an FMU's ``sources/``) that ``source`` includes: a
+    name is looked up next to the file, then from ``root`` (the one include folder; in ``fmu_src/native/``
+    the generated headers are not there, the FMI headers nowhere)."""
+    found = []
+    for name in _INCLUDE.findall(source.read_text()):
+        for folder in (source.parent, root):
+            if (folder / name).is_file():
+                found.append((folder / name).resolve())
+                break
+    return found
+
+
+def header_modules(header: Path) -> list[Path]:
+    """The modules that define what ``header`` declares: those its comment lists (toml.h), else the
+    module of its own name, if there is one."""
+    names = _MODULE_LINE.findall(header.read_text()) or [header.with_suffix(".c").name]
+    return [header.parent / module for module in names if (header.parent / module).is_file()]
+
+
+def used_sources(starts: list[Path], root: Path = NATIVE_SRC) -> list[Path]:
+    """``starts`` and every file below ``root`` they use: what they include, and the modules of each
+    header included, followed to the end."""
+    seen, pending = set(), [start.resolve() for start in starts]
+    while pending:
+        source = pending.pop()
+        if source in seen:
+            continue
+        seen.add(source)
+        pending += included(source, root)
+        if source.suffix == ".h":
+            pending += header_modules(source)
+    return sorted(seen)
+
+
+def used_library(name: str) -> list[Path]:
+    """The files of ``lib/`` that the layer and the model's folder use."""
+    roots = [*LAYER_SOURCES.glob("*.[ch]"), *model_folder(name).glob("*.[ch]")]
+    return [path for path in used_sources(roots) if path.is_relative_to(LIBRARY_SOURCES.resolve())]
 
 
 def native_models() -> list[str]:
@@ -365,7 +411,7 @@ enum {{
  * from its spec: do not edit. */
 #include <math.h>
 
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 const char model_token[] = {_c_string(token)};
 
@@ -555,26 +601,17 @@ def build_description(name: str, sources: list[str]) -> bytes:
 # -- build ------------------------------------------------------------------------------------------
 
 
-#: Models that read layout files and are not CriticalSpeeds compile the layout reader of CriticalSpeeds'
-#: library too: the header and the modules it lists (``critical_speeds/toml.h``).
-LAYOUT_READER = NATIVE_SRC / "critical_speeds" / "toml.h"
-READS_LAYOUTS = ("PowertrainMounts",)
+def source_paths(name: str) -> list[Path]:
+    """The C files an FMU of ``name`` carries besides the generated ones: the layer, the libraries it
+    and the model use, the model's folder."""
+    own = sorted(path for path in model_folder(name).iterdir() if path.suffix in (".c", ".h") and path.is_file())
+    return [*sorted(LAYER_SOURCES.glob("*.[ch]")), *used_library(name), *own]
 
 
-def _layout_reader_sources() -> dict[str, bytes]:
-    folder = LAYOUT_READER.parent
-    names = [LAYOUT_READER.name, *sorted(_MODULE_LINE.findall(LAYOUT_READER.read_text()))]
-    return {f"{folder.name}/{file}": (folder / file).read_bytes() for file in names}
-
-
-def _library_sources(name: str) -> dict[str, bytes]:
-    """The model's library folder (``critical_speeds/rotor.h`` and the like), by relative path."""
-    folder = library_folder(name)
-    reader = _layout_reader_sources() if name in READS_LAYOUTS else {}
-    if not folder.is_dir():
-        return reader
-    return {**reader, **{f"{folder.name}/{path.name}": path.read_bytes() for path in sorted(folder.iterdir())
-                         if path.suffix in (".c", ".h") and path.is_file()}}
+def _source_files(name: str) -> dict[str, bytes]:
+    """:func:`source_paths` by their path below ``fmu_src/native/``."""
+    root = NATIVE_SRC.resolve()
+    return {path.resolve().relative_to(root).as_posix(): path.read_bytes() for path in source_paths(name)}
 
 
 def resource_files(name: str) -> dict[str, bytes]:
@@ -584,10 +621,10 @@ def resource_files(name: str) -> dict[str, bytes]:
 
 def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
     """Every source file the FMU carries, by name, with the token computed from all of them."""
-    files = {source: (NATIVE_SRC / source).read_bytes() for source in (*SHARED_SOURCES, LAYER[fmi])}
+    files = {source: data for source, data in _source_files(name).items()
+             if source not in LAYER.values() or source == LAYER[fmi]}
     files[CONSTANTS_HEADER] = constants_header().encode()
-    files[model_file.name] = model_file.read_bytes()
-    files.update(_library_sources(name))
+    files[model_source(name).relative_to(NATIVE_SRC).as_posix()] = model_file.read_bytes()
     untokened = variable_table(MODELS[name], "")
     digest = hashlib.sha256(repr((name, fmi, sorted(files.items()), sorted(untokened.items()),
                                   sorted(resource_files(name).items()))).encode())
@@ -598,7 +635,8 @@ def _sources(name: str, fmi: str, model_file: Path) -> dict[str, bytes]:
 
 
 VERSIONED = ("model_variables.c", *LAYER.values())  # compiled per FMI version; the rest once per platform
-SHARED_OBJECTS = ("python_numbers.c",)  # compiled once per platform for every model
+GENERATED_PER_VERSION = ("model_variables.c",)  # differs between the FMI versions: written apart
+SHARED_OBJECTS = ("lib/python_numbers.c",)  # compiled once per platform for every model
 
 
 def _write(folder: Path, files: dict[str, bytes]) -> None:
@@ -646,10 +684,11 @@ def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] =
     files = {(name, v): _sources(name, v, model_file or model_source(name)) for name in chosen for v in fmi}
     with tempfile.TemporaryDirectory() as work:
         root = Path(work)
-        for (name, v), sources in files.items():  # the FMI version's own files apart, the rest shared
-            _write(root / "sources" / name / f"fmi{v}", {s: d for s, d in sources.items() if s in VERSIONED})
+        for (name, v), sources in files.items():  # the FMI version's own generated file apart, the rest shared
+            _write(root / "sources" / name / f"fmi{v}",
+                   {s: d for s, d in sources.items() if s in GENERATED_PER_VERSION})
             _write(root / "sources" / name / "common",
-                   {s: d for s, d in sources.items() if s not in VERSIONED and s != "token"})
+                   {s: d for s, d in sources.items() if s not in GENERATED_PER_VERSION and s != "token"})
         compiles, links, libraries = [], [], {}
         for target in platforms:
             objects = root / "objects" / target.tuple
@@ -664,8 +703,9 @@ def build_all(dest: Path, names: list[str] | None = None, fmi: tuple[str, ...] =
                 for v in fmi:
                     own = [s for s in files[name, v] if s in VERSIONED]
                     own_objects = [objects / name / f"fmi{v}" / f"{s}.o" for s in own]
-                    compiles += [toolchain.compile_step(target, source_dir / f"fmi{v}" / s, obj, *include, host_only)
-                                 for s, obj in zip(own, own_objects)]
+                    compiles += [toolchain.compile_step(
+                        target, source_dir / (f"fmi{v}" if s in GENERATED_PER_VERSION else "common") / s, obj,
+                        *include, host_only) for s, obj in zip(own, own_objects)]
                     library = root / "binaries" / target.tuple / f"fmi{v}" / f"{name}{target.suffix}"
                     links.append(toolchain.link_step(target, [*model_objects, *own_objects], library, host_only))
                     libraries.setdefault((name, v), {})[target] = library

@@ -1,4 +1,4 @@
-/* The rotor library's complex type (critical_speeds/cplx.h) against the C99 complex arithmetic it
+/* The rotor library's complex type (models/critical_speeds/cplx.h) against the C99 complex arithmetic it
  * replaces, on the host that compiles this: every operation, on random operands of every
  * magnitude and on the special values (signed zeros, infinities, NaN, subnormals, the extremes).
  *

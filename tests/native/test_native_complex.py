@@ -1,4 +1,4 @@
-"""The rotor library's own complex type (``critical_speeds/cplx.h``, standard C99 that MSVC also
+"""The rotor library's own complex type (``models/critical_speeds/cplx.h``, standard C99 that MSVC also
 compiles) rounds every operation as the C99 complex arithmetic it replaced did on the reference
 platform (gcc's operators and libgcc's division, glibc's csqrt, cexp and cabs on x86_64 Linux): the
 native CriticalSpeeds FMU's results stay bit for bit those of before, and are the same on every
@@ -27,7 +27,7 @@ def test_the_own_complex_type_rounds_as_c99_complex_arithmetic(tmp_path):
     executable = tmp_path / "native_complex_check"
     # C11 for CMPLX (exact operands with infinite or NaN parts); the header itself is C99
     subprocess.run([GCC, "-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2",
-                    "-I", str(native.NATIVE_SRC / "critical_speeds"), str(CHECK_SOURCE), "-o", str(executable), "-lm"],
+                    "-I", str(native.model_folder("CriticalSpeeds")), str(CHECK_SOURCE), "-o", str(executable), "-lm"],
                    check=True, capture_output=True, text=True)
     done = subprocess.run([str(executable), "400000"], capture_output=True, text=True)
     mismatches = {name: int(count) for name, count in (line.split() for line in done.stdout.splitlines())}

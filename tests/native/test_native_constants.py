@@ -92,7 +92,7 @@ def test_the_rule_of_which_parameter_redoes_which_analysis_part_is_generated_fro
     assert [tuple(re.findall(r"V_(\w+)", row)) for row in rows] == list(ANALYSIS_PARTS.values())
     assert [f"PART_{name.upper()}" for name in ANALYSIS_PARTS] == re.findall(
         r"^    (PART_\w+),$", generated["model_variables.h"], re.MULTILINE)
-    c_model = (native.NATIVE_SRC / "critical_speeds.c").read_text()
+    c_model = native.model_source("CriticalSpeeds").read_text()
     assert "model_part_values" in c_model and not re.search(r"\bPART_\w+\s*[,=]", c_model.split("typedef int Part;")[0])
 
 
@@ -151,8 +151,7 @@ def test_the_rotor_library_returns_its_failures_as_error_kinds():
     (the Python exception, ErrorKind of the generated header), not an int that the model casts: -1
     would be ERROR_VALUE only by the order of ERROR_KINDS."""
     sources = {path.relative_to(native.NATIVE_SRC).as_posix(): path.read_text()
-               for path in [native.NATIVE_SRC / "critical_speeds.c",
-                            *sorted((native.NATIVE_SRC / "critical_speeds").glob("*.c"))]}
+               for path in sorted(native.model_folder("CriticalSpeeds").glob("*.c"))}
     assert _kind_seams(sources) == []
 
 

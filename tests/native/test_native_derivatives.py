@@ -1,4 +1,4 @@
-"""Directional and adjoint derivatives of the native FMUs (``fmu_src/native/fmu_derivatives.c``), both FMI
+"""Directional and adjoint derivatives of the native FMUs (``fmu_src/native/fmi/fmu_derivatives.c``), both FMI
 versions, both interfaces: declared in the model description exactly for the models whose C port gives
 the ``jacobian`` hook, equal to central differences of the same FMU and to Richardson-extrapolated
 differences of the Python core, the adjoint the transpose of the directional derivative, and every

@@ -1,4 +1,4 @@
-"""TripodCoupling's exact directional derivatives (``fmu_src/native/tripod_coupling/``) in every mode.
+"""TripodCoupling's exact directional derivatives (``fmu_src/native/models/tripod_coupling/``) in every mode.
 
 The generic checks (``tests/native/test_native_derivatives.py``) run at the start values (closed form,
 leading-order reactions) and the model's dependency points (exact with friction and the seed's eqs; rates

@@ -1,6 +1,6 @@
-"""The native CriticalSpeeds FMU's rotor library (``fmu_src/native/critical_speeds/``) compiled on its own
-(with the shared ``python_numbers.c``), for tests that call its modules through ctypes and compare them
-with the Python core.
+"""The native CriticalSpeeds FMU's rotor library (``fmu_src/native/models/critical_speeds/``) compiled on
+its own (with the shared libraries of ``fmu_src/native/lib/`` it uses), for tests that call its modules
+through ctypes and compare them with the Python core.
 
 Compiled with the native FMUs' flags (warnings as errors) except hidden visibility, so that the
 library's functions can be called; a test passes the modules it needs and, where ctypes cannot call a
@@ -25,7 +25,7 @@ from fmu_harness.packaging.native_constants import ERROR_KINDS, error_kind_name
 from fmu_harness.packaging.native_constants import HEADER as CONSTANTS_HEADER
 from fmu_harness.packaging.native_constants import constants_header
 
-ROTOR_SOURCES = native.NATIVE_SRC / "critical_speeds"
+ROTOR_SOURCES = native.model_folder("CriticalSpeeds")
 TEST_FLAGS = (*(flag for flag in toolchain.CFLAGS if not flag.startswith("-fvisibility")), "-fPIC")
 
 #: Relative rounding of the unbalance response and the bearing forces: the banded solve of the dynamic stiffness
@@ -47,8 +47,9 @@ def raised(kind: int, message: str) -> Exception:
     return exceptions[kind](message)
 
 
-#: The modules a module calls into besides itself (the layout reader's parts and the elements' checks
-#: with the loader, the linear algebra with the damped model, the shaft elements with both models).
+#: The modules a module calls into besides itself (the layout reader's parts, shared in ``lib/``, and the
+#: elements' checks with the loader, the linear algebra with the damped model, the shaft elements with both
+#: models).
 NEEDS = {"layout": ("layout_file", "toml", "messages", "arena", "elements"), "damped": ("linalg",),
          "unbalance_outputs": ("damped", "linalg"),
          "transfer": ("elements",), "fem": ("elements",)}
@@ -56,13 +57,17 @@ NEEDS = {"layout": ("layout_file", "toml", "messages", "arena", "elements"), "da
 
 def compile_rotor(folder: Path, modules: list[str], shims: list[Path] = ()) -> ctypes.CDLL:
     """The shared library of the rotor ``modules`` (``"transfer"`` is ``transfer.c``) with the modules
-    they need (:data:`NEEDS`) and ``shims``, built in ``folder``."""
+    they need (:data:`NEEDS`) and ``shims``, built in ``folder``; a module not in the rotor's folder is
+    one of ``lib/`` (``"toml"`` is ``lib/toml.c``)."""
     needed = list(dict.fromkeys(part for module in modules for part in (module, *NEEDS.get(module, ()))))
-    sources = [str(ROTOR_SOURCES / f"{module}.c") for module in needed] + [str(shim) for shim in shims]
+    sources = [str(next(path for folder in (ROTOR_SOURCES, native.LIBRARY_SOURCES)
+                        if (path := folder / f"{module}.c").is_file())) for module in needed]
+    sources += [str(shim) for shim in shims]
     (folder / CONSTANTS_HEADER).write_text(constants_header())  # the native build's generated header
     library = folder / f"rotor_{'_'.join(modules)}.so"
-    command = [*toolchain.host_compiler(), *TEST_FLAGS, "-shared", "-I", str(ROTOR_SOURCES), "-I", str(folder), *sources,
-               str(native.NATIVE_SRC / "python_numbers.c"), "-o", str(library), "-lm"]
+    command = [*toolchain.host_compiler(), *TEST_FLAGS, "-shared", "-I", str(ROTOR_SOURCES),
+               "-I", str(native.NATIVE_SRC), "-I", str(folder), *sources,
+               str(native.LIBRARY_SOURCES / "python_numbers.c"), "-o", str(library), "-lm"]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode:
         raise RuntimeError(f"compiling {', '.join(modules)} failed:\n{done.stderr}")

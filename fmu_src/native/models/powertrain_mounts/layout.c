@@ -1,5 +1,5 @@
 /* The layouts of a powertrain on its mounts (port of driveline/mounts/layout.py), read with the layout
- * reader of critical_speeds/toml.h (driveline/layout_files.py's rules), with the Python loader's messages. */
+ * reader of lib/toml.h (driveline/layout_files.py's rules), with the Python loader's messages. */
 #include "mounts.h"
 
 #include <math.h>

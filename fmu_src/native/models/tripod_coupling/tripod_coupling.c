@@ -13,8 +13,8 @@
 #include <math.h>
 
 #include "driveline_constants.h"
-#include "fmu_instance.h"
-#include "tripod_coupling/derivatives.h"
+#include "fmi/fmu_instance.h"
+#include "derivatives.h"
 
 #define INTEGER(name) (data->int_value[V_##name])
 /* the exact solver's warm start (plane_solver.Solution): a flag, then phi_in, x, y, dx/dphi, dy/dphi */

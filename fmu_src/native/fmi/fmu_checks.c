@@ -1,7 +1,6 @@
-/* Messages and checks of the native FMUs' shared layer (SteppedModel.parameter_errors,
+/* Checks of the native FMUs' shared layer (SteppedModel.parameter_errors,
  * input_errors, output_errors of driveline/model.py), with the Python core's wording. */
 #include "fmu_instance.h"
-#include "fmu_layer.h"
 
 #include <float.h>
 #include <math.h>
@@ -9,39 +8,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* ---- text -------------------------------------------------------------------------------- */
-
-void append_pieces(char *out, size_t size, const char *first, va_list pieces)
-{
-    size_t used = strlen(out);
-    const char *piece;
-    for (piece = first; piece != NULL; piece = va_arg(pieces, const char *)) {
-        size_t length = strlen(piece);
-        if (used + 1 >= size) {
-            break;
-        }
-        if (length > size - 1 - used) {
-            length = size - 1 - used;
-        }
-        memcpy(out + used, piece, length);
-        used += length;
-        out[used] = '\0';
-    }
-}
-
-void messages_add(Messages *out, const char *first, ...)
-{
-    va_list pieces;
-    if (out->count >= FMU_MAX_MESSAGES) {
-        return;
-    }
-    out->text[out->count][0] = '\0';
-    va_start(pieces, first);
-    append_pieces(out->text[out->count], FMU_MESSAGE_SIZE, first, pieces);
-    va_end(pieces);
-    out->count++;
-}
 
 /* A number as a message shows it: an Integer's digits, a Real's repr(), or in the display unit. */
 static void show(double value, int integer, int display, const VariableInfo *v, char *out, size_t size)

@@ -6,7 +6,7 @@
  */
 #include <math.h>
 
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 #define OMEGA_SAMPLE (data->internal[0]) /* omega_in of the last evaluation [rad/s] */
 #define SAMPLE_TIME (data->internal[1])  /* time of that evaluation [s] */

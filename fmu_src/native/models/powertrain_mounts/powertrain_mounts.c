@@ -1,7 +1,7 @@
 /* PowertrainMounts: a rigid powertrain on linear rubber mounts, small motion about its static equilibrium
  * (port of driveline/mounts/: layout.py, rigid_body.py, joints.py, exact_step.py, system.py, model.py).
  *
- * The layout is read with CriticalSpeeds' layout reader (critical_speeds/toml.h: the file rules of
+ * The layout is read with the shared layout reader (lib/toml.h: the file rules of
  * driveline/layout_files.py). The system (matrices, modes, input map, the weight's sag) is the model's
  * derived data, built when the parameters change; the propagator of a step size (Phi, Gamma0, Gamma1, one
  * exponential of the augmented matrix: Pade 13 with scaling and squaring, exact_step.squarings' count) is
@@ -13,8 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmu_instance.h"
-#include "powertrain_mounts/mounts.h"
+#include "fmi/fmu_instance.h"
+#include "mounts.h"
 
 #define ERROR_SIZE FMU_MESSAGE_SIZE
 #define AUGMENTED MOUNTS_AUGMENTED

@@ -11,7 +11,7 @@
  */
 #include "derivatives.h"
 
-#include "../driveline_constants.h"
+#include "driveline_constants.h"
 
 #define INTEGER(name) (data->int_value[V_##name])
 #define ROW(name, dual) dual_row(partial, ROW_##name, (dual))

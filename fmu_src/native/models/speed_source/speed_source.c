@@ -1,7 +1,7 @@
 /* SpeedSource: shaft speed ramp plus sine, exact in time (port of driveline/source/model.py). */
 #include <math.h>
 
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 
 /* omega_out(t) = omega_out_start + ramp_rate t + a sin(w t), alpha_out = d(omega_out)/dt, phi_out its exact

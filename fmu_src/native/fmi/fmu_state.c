@@ -1,6 +1,5 @@
 /* FMU state of the native FMUs' shared layer: get, set, free, serialize and deserialize. */
 #include "fmu_instance.h"
-#include "fmu_layer.h"
 
 #include <float.h>
 #include <math.h>

@@ -4,7 +4,7 @@
  */
 #include <math.h>
 
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 #define INTEGER(name) (data->int_value[V_##name])
 

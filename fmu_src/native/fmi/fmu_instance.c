@@ -1,11 +1,11 @@
 /* Shared core of the native co-simulation FMUs: life cycle, stepping, logging, instances; the
- * checks in fmu_checks.c, the values in fmu_values.c, the FMU state in fmu_state.c.
+ * checks in fmu_checks.c, the values in fmu_values.c, the FMU state in fmu_state.c, the messages in
+ * fmu_messages.c.
  *
  * Stepping mirrors driveline/model.py (SteppedModel.initialize, step, _undoable, output_errors),
  * including the wording of every reason, so a host sees the same refusals from either FMU.
  */
 #include "fmu_instance.h"
-#include "fmu_layer.h"
 
 #include <float.h>
 #include <math.h>

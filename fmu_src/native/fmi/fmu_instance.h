@@ -13,7 +13,8 @@
 #include <stdint.h>
 
 #include "model_variables.h"
-#include "python_numbers.h"
+#include "fmu_messages.h"
+#include "lib/python_numbers.h"
 
 /* Marks a parameter the standard's signature has and this implementation does not need. */
 #if defined(__GNUC__) || defined(__clang__)
@@ -22,8 +23,6 @@
 #define UNUSED
 #endif
 
-#define FMU_MESSAGE_SIZE 1024 /* a message names a layout file by its absolute path: room for a long one */
-#define FMU_MAX_MESSAGES 48
 /* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
  * five-number warm start, the bend samples, the rates' choice); a new count needs a new
  * STATE_FORMAT (fmu_state.c). */
@@ -134,11 +133,6 @@ typedef struct {
     ModelCache *cache;
 } ModelData;
 
-typedef struct {
-    int count;
-    char text[FMU_MAX_MESSAGES][FMU_MESSAGE_SIZE];
-} Messages;
-
 typedef enum { MODE_INSTANTIATED, MODE_INITIALIZATION, MODE_STEP, MODE_TERMINATED, MODE_ERROR } Mode;
 
 typedef enum { STATUS_OK = 0, STATUS_WARNING = 1, STATUS_DISCARD = 2, STATUS_ERROR = 3 } Status;
@@ -240,12 +234,22 @@ extern const ModelHooks model_hooks;
         return evaluate(data, current_time);                                                                    \
     }
 
-/* ---- helpers for model files ---------------------------------------------------------- */
-void messages_add(Messages *out, const char *first, ...);
+/* ---- helpers for model files (and messages_add, fmu_messages.h) ------------------------ */
 #if MODEL_EXTRA_MESSAGE_COUNT > 0
 /* Adds generated message ``message`` (a MESSAGE_* of model_variables.h) with its variable's value. */
 void messages_add_extra(Messages *out, const ModelData *data, int message);
 #endif
+
+/* ---- between the layer's modules -------------------------------------------------------- */
+/* fmu_checks.c: SteppedModel.parameter_errors, input_errors, output_errors */
+void parameter_errors(const ModelData *data, Messages *out);
+void input_errors(const ModelData *data, Messages *out);
+void output_errors(const ModelData *data, Messages *out, Failure *failure);
+/* fmu_instance.c and fmu_values.c: String values */
+char *copy_text(const char *text, size_t length);
+void free_strings(char *strings[MODEL_VARIABLE_COUNT]);
+int copy_strings(char *const from[MODEL_VARIABLE_COUNT], char *to[MODEL_VARIABLE_COUNT]);
+size_t characters(const char *text, size_t length);
 
 /* ---- life cycle (used by the FMI layers) -------------------------------------------- */
 Status instance_reset(Instance *instance);

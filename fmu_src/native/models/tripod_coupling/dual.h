@@ -9,7 +9,7 @@
 
 #include <math.h>
 
-#include "../fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 #if defined(_MSC_VER) && !defined(__cplusplus) && !defined(inline)
 #define inline __inline /* MSVC's C before C11 */

@@ -1,6 +1,6 @@
 /* The C library of the native PowertrainMounts FMU (port of driveline/mounts/; rigid_body.py, joints.py,
  * system.py, exact_step.py and model.py are in the model file next to this folder):
- *   layout.c     the layouts (layout.py), read by CriticalSpeeds' layout reader (critical_speeds/toml.h)
+ *   layout.c     the layouts (layout.py), read by the shared layout reader (lib/toml.h)
  *   dense.c      small dense linear algebra: products, solutions, symmetric eigenvalues, the matrix exponential
  */
 #ifndef MOUNTS_H
@@ -8,7 +8,7 @@
 
 #include <stddef.h>
 
-#include "../critical_speeds/toml.h"
+#include "lib/toml.h"
 
 #define MOUNTS_AUGMENTED 24 /* exact_step.augmented: the order of Z h */
 

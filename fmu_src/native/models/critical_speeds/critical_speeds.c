@@ -1,6 +1,6 @@
 /* CriticalSpeeds: bending critical speeds, whirl frequencies, order resonances and the unbalance
  * response of a driveline shaft (Hruby, Nahlik 2021; port of driveline/rotor/model.py over the
- * rotor library, critical_speeds/rotor.h).
+ * rotor library, rotor.h next to this file).
  *
  * The analysis is the model's derived data (CriticalSpeedsModel.derived_state): built when the
  * parameters are checked, and only in the parts a change affects, each part kept with the
@@ -14,8 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "critical_speeds/rotor.h"
-#include "fmu_instance.h"
+#include "rotor.h"
+#include "fmi/fmu_instance.h"
 
 #define ERROR_SIZE FMU_MESSAGE_SIZE
 

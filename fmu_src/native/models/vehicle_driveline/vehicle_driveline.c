@@ -10,7 +10,7 @@
 #include <stdio.h>
 
 #include "driveline_constants.h"
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 #define STATE (data->internal) /* dynamics.py's state tuple, VEHICLE_DYNAMICS_STATE_SIZE numbers */
 

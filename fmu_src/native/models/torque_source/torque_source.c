@@ -1,5 +1,5 @@
 /* TorqueSource: a torque ramp to a level, then held, exact in time (port of driveline/torque/model.py). */
-#include "fmu_instance.h"
+#include "fmi/fmu_instance.h"
 
 /* ramp_share: 0 before t_ramp, 1 from t_ramp + ramp_time on, linear between */
 static double ramp_share(double t, double t_ramp, double ramp_time)

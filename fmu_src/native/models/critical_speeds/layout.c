@@ -4,7 +4,7 @@
  * the failure's kind with its message in loader->error: ERROR_VALUE (loader.py raises ValueError, and
  * the FMU reports out of memory as one), but for the length's math.fsum (its own kind). */
 #include "elements.h"
-#include "toml.h"
+#include "lib/toml.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -16,7 +16,6 @@
 #include <stdio.h>
 
 #include "fmu_instance.h"
-#include "fmu_layer.h"
 
 #if MODEL_STATE_COUNT > 0
 #define STATE_SLOTS MODEL_STATE_COUNT

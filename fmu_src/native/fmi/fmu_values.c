@@ -1,7 +1,6 @@
 /* Values of the native FMUs' shared layer: getting and setting variables by value reference,
  * with the accessibility checks of each mode; debug logging categories. */
 #include "fmu_instance.h"
-#include "fmu_layer.h"
 
 #include <float.h>
 #include <math.h>

@@ -17,7 +17,6 @@
 #include <string.h>
 
 #include "fmu_instance.h"
-#include "fmu_layer.h"
 
 #define JACOBIAN_SIZE (MODEL_ROW_COUNT * MODEL_COLUMN_COUNT > 0 ? MODEL_ROW_COUNT * MODEL_COLUMN_COUNT : 1)
 

@@ -1,6 +1,6 @@
 /* The layouts' TOML-subset reader and the rules every model's layout files share
- * (driveline/layout_files.py), for the modules that read a layout (the rotor library's layout.c, the
- * PowertrainMounts port, which compiles these modules too):
+ * (driveline/layout_files.py), the library of every model that reads layout files (CriticalSpeeds' rotor
+ * library, PowertrainMounts), one module per concern:
  *   messages.c     the messages: Python's repr() of the values read, the loader's format (%r, %v, %g)
  *   pyrepr.c       Python's repr() of the values the messages show
  *   arena.c        the memory of one reading, freed at once
@@ -12,7 +12,7 @@
 
 #include <stddef.h>
 
-#include "../python_numbers.h"
+#include "python_numbers.h"
 
 /* Tables and arrays nested below the document at the most (deeper is refused as malformed TOML:
  * a bound on a key's parts and on the stack of text_put_repr). */

@@ -13,7 +13,7 @@
  */
 #include "derivatives.h"
 
-#include "../driveline_constants.h"
+#include "driveline_constants.h"
 
 /* One arm of the balance in dual numbers (the step's Arm) */
 typedef struct {
