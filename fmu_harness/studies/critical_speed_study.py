@@ -156,6 +156,6 @@ def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray]
     fig.canvas.draw()
     for label, sense in labels:  # each crossing's speed beside its mark, where no line crosses it
         below, above = (-1, 1) if sense == "forward" else (1, -1)  # forward speeds first below, backward above
-        clear_of_lines(ax, label, [(x, y) for y in (12 * below, 12 * above, 22 * below, 22 * above)
+        clear_of_lines(ax, label, [{"xyann": (x, y)} for y in (12 * below, 12 * above, 22 * below, 22 * above)
                                    for x in (24, -24, 40, -40)])
     return fig

@@ -60,17 +60,22 @@ def by_scale(sizes: Mapping[Hashable, float], within: float = WITHIN) -> list[li
     return groups
 
 
-def clear_of_lines(ax, annotation, offsets: list[tuple[float, float]]) -> None:
-    """Move ``annotation`` (written at offset points from its point) to the first of ``offsets`` where no
-    visible line of ``ax`` crosses its text, tested on the figure as it is drawn; the last offset when
-    none is clear."""
+def clear_of_lines(ax, annotation, placements: list[dict]) -> object:
+    """Move ``annotation`` to the first of ``placements`` (its ``xy``, its offset ``xyann`` in points, its
+    ``ha``) where no visible line of ``ax`` crosses its text, tested on the figure as it is drawn; the last
+    when none is clear. Its box in data coordinates."""
     renderer = ax.figure.canvas.get_renderer()
     lines = [line for line in ax.get_lines() if line.get_visible() and line.get_linestyle() not in ("None", "")]
-    for offset in offsets:
-        annotation.xyann = offset
+    for placement in placements:
+        for name, value in placement.items():
+            if name == "ha":
+                annotation.set_horizontalalignment(value)
+            else:
+                setattr(annotation, name, value)
         box = annotation.get_window_extent(renderer).transformed(ax.transData.inverted())
         if not any(line.get_path().intersects_bbox(box, filled=False) for line in lines):
-            return
+            break
+    return box
 
 
 def span(keys: list, unit: str = "deg") -> str:

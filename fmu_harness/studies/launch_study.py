@@ -34,7 +34,7 @@ from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody, modes
 from ..runs import ssp_package
 from ..runs.system import LAUNCH_ORDER, run_jacobi
 from . import order_tracking
-from .figures import BLUE, ORANGE, PALETTE, SKY, YELLOW, figure, save
+from .figures import BLUE, ORANGE, PALETTE, SKY, YELLOW, clear_of_lines, figure, save
 from .result_table import write_csv
 
 TORQUE = 20.0  # motor torque after the ramp [N.m]
@@ -55,7 +55,6 @@ COLUMNS = (("drive.v_x", "v_x"), ("motor.T_motor", "T_motor"),
 FREQUENCIES = tuple(f"mounts.f_mode_{j}" for j in range(1, 7))
 WINDOW_MARGIN = 0.25  # a peak belongs to a crossing within this fraction of its speed (a fast sweep: 22 %)
 SPECTRUM_TOP = 25.0  # the spectrogram's highest frequency [Hz]
-LABEL_SHARE = 0.17  # the spectrogram's mode labels take this share of its width, their lines the rest
 
 
 @dataclass(frozen=True)
@@ -240,8 +239,8 @@ def axial_force_figure(launch: Launch) -> Figure:
     turn.set_xlabel("shaft angle over the launch's last turn [deg]")
     turn.set_ylabel("-Rz_in [N]")
     turn.set_title(f"Its shape over the last turn, at {omega[-1]:.1f} rad/s", fontsize=9)
+    orders.legend(loc="lower right", fontsize=8)  # one legend: both panels draw the joints alike
     for ax in (orders, turn):
-        ax.legend(loc="lower right", fontsize=8)
         ax.grid(alpha=0.3)
     fig.tight_layout()
     return fig
@@ -262,24 +261,27 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
     line = np.array([left, right])
     for order, style in ((1, ":"), (3, "--")):
         top.plot(line, order * line / (2.0 * np.pi), style, color="white", lw=1.2, label=f"order {order}")
-    label_end = left + LABEL_SHARE * (right - left)  # each mode's line starts after its label, written on its height
-    for peak in peaks:
-        top.plot([label_end, right], [peak.frequency] * 2, color=SKY, lw=0.7, ls="-.", label=f"_mode {peak.mode}")
-        top.annotate(f"mode {peak.mode} ({peak.coordinate}) {peak.frequency:.2f} Hz", (left, peak.frequency),
-                     xytext=(3, 0), textcoords="offset points", color=SKY, fontsize=7, va="center")
+    top.set_facecolor("black")  # where no window is centred, as where the spectrum is 0
+    top.set_ylabel("frequency [Hz]")
+    top.set_title("Powertrain pitch acceleration at its centre of gravity over the halfshaft speed:\n"
+                  "orders 1 and 3, mount modes, their crossings with the 3rd order and the measured peaks",
+                  fontsize=10)
+    top.set_xlim(left, right)
+    top.set_ylim(0.0, SPECTRUM_TOP)
+    fig.canvas.draw()
+    for peak in peaks:  # each mode's label on its line's height, at the end the order lines leave clear
+        label = top.annotate(f"mode {peak.mode} ({peak.coordinate}) {peak.frequency:.2f} Hz", (left, peak.frequency),
+                             xytext=(3, 0), textcoords="offset points", color=SKY, fontsize=7, va="center")
+        box = clear_of_lines(top, label, [{"xy": (left, peak.frequency), "xyann": (3, 0), "ha": "left"},
+                                          {"xy": (right, peak.frequency), "xyann": (-3, 0), "ha": "right"}])
+        span = [box.x1, right] if label.get_horizontalalignment() == "left" else [left, box.x0]
+        top.plot(span, [peak.frequency] * 2, color=SKY, lw=0.7, ls="-.", label=f"_mode {peak.mode}")
     reached = [peak for peak in peaks if peak.measured is not None]
     ring = {"ls": "none", "marker": "o", "ms": 13, "mfc": "none", "mec": SKY, "mew": 1.6}
     dot = {"ls": "none", "marker": "o", "ms": 5, "color": YELLOW, "zorder": 4}
     top.plot([p.crossing for p in reached], [p.frequency for p in reached], **ring, label="3 x f_shaft = f_mode")
     top.plot([p.measured[1] for p in reached], [3.0 * p.measured[1] / (2.0 * np.pi) for p in reached], **dot,
              label="measured third-order peak")
-    top.set_facecolor("black")  # where no window is centred, as where the spectrum is 0
-    top.set_xlim(left, right)
-    top.set_ylim(0.0, SPECTRUM_TOP)
-    top.set_ylabel("frequency [Hz]")
-    top.set_title("Powertrain pitch acceleration at its centre of gravity over the halfshaft speed:\n"
-                  "orders 1 and 3, mount modes, their crossings with the 3rd order and the measured peaks",
-                  fontsize=10)
     top.legend(loc="upper left", fontsize=8)
     inside = (speeds >= left) & (speeds <= right)
     colors = PALETTE[:6]
