@@ -12,6 +12,7 @@ CPU per 4 s launch.
 
 from __future__ import annotations
 
+import argparse
 import tempfile
 import time
 from pathlib import Path
@@ -36,12 +37,17 @@ def cpu_seconds(interface: SystemInterface, unpacked: UnpackedSystem, master: st
     return time.process_time() - start
 
 
-def main() -> None:
-    parser = report.parser(summary(__doc__))
+def launch_arguments(doc: str | None) -> argparse.Namespace:
+    """The command line of a benchmark of whole launches: ``--package``, ``--stop-time``, ``--repeat``."""
+    parser = report.parser(summary(doc))
     parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp")
     parser.add_argument("--stop-time", type=float, default=4.0, help="launch length [s] (default 4)")
-    parser.add_argument("--repeat", type=int, default=3, help="measurements per master (default 3)")
-    args = parser.parse_args()
+    parser.add_argument("--repeat", type=int, default=3, help="measurements of each (default 3)")
+    return parser.parse_args()
+
+
+def main() -> None:
+    args = launch_arguments(__doc__)
     measurement = report.Measurement()
     interface = SystemInterface.of(args.package)
     lines = ["| master | step [s] | steps | CPU per launch [s] | CPU per step [us] | of the goal |",

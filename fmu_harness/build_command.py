@@ -11,7 +11,9 @@ the build says what to install in one line and builds the rest; it fails only wi
 Then the FMI Cross-Check reference results are written next to each FMU, Python and native
 (:mod:`fmu_harness.checks.crosscheck`), and, once their FMI 2.0 FMUs are there, the systems' SSP
 packages (``Driveline.ssp``, ``VehicleLaunch.ssp``) with the Python FMUs and under ``native/`` with the
-native ones (:mod:`fmu_harness.runs.system`). Each stage shows its progress on standard error.
+native ones (:mod:`fmu_harness.runs.system`), and each native package as one co-simulation FMU next to it
+(``native/VehicleLaunch.fmu``, FMI 3.0 in ``native/fmi3/``: :mod:`fmu_harness.runs.container`). Each stage
+shows its progress on standard error.
 """
 
 from __future__ import annotations
@@ -33,6 +35,16 @@ def unknown_model(name: str) -> str:
     """The one-line refusal of a name that is no catalog model, with the nearest one."""
     near = difflib.get_close_matches(name, MODELS, n=1, cutoff=0.0)
     return f"no model {name!r} (did you mean {near[0]}? the models: {', '.join(MODELS)})"
+
+
+def _containers(packaged: system.System, dest: Path, fmi: list[str], natives: list[Path]) -> list[Path]:
+    """The native package of ``packaged`` as one FMU per FMI version built, where all its FMUs are native."""
+    written = []
+    for version in fmi if natives else ():
+        fmus = [native.fmu_path(dest, c.model, version) for c in packaged.components]
+        if system.ssp_path(packaged, dest, dest).exists() and all(fmu in natives for fmu in fmus):
+            written.append(system.write_container(packaged, dest, version))
+    return written
 
 
 def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Path("models")) -> None:
@@ -78,6 +90,7 @@ def main(argv: list[str] | None = None, prog: str | None = None, dest: Path = Pa
             else:
                 print(f"{system.ssp_path(packaged, args.dest, variant)} not written: not all its FMUs were built",
                       file=sys.stderr)
+        paths += _containers(packaged, args.dest, fmi, natives)
     here = Path.cwd()
     for path in paths:
         print(path.relative_to(here) if path.is_relative_to(here) else path)

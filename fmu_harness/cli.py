@@ -2,7 +2,8 @@
 
 ``driveline-fmus build`` builds the FMUs, ``run`` runs the main job, ``sweep`` a parameter sweep
 on Dask, ``map`` the launch shudder map, ``interop`` the importer matrix, ``check`` the start values
-of an SSP package or FMU before another engine runs it; ``driveline-fmus COMMAND --help`` lists a
+of an SSP package or FMU before another engine runs it, ``system`` runs an SSP package, ``container`` makes
+one FMU of it; ``driveline-fmus COMMAND --help`` lists a
 command's options. Each command is the ``main`` of the module named in :data:`COMMANDS`.
 """
 
@@ -22,6 +23,7 @@ COMMANDS = {
     "interop": ("fmu_harness.checks.interop", "every FMU in every importer: the interoperability matrix"),
     "check": ("fmu_harness.runs.start_values", "the start values of an SSP package or an FMU, as the FMUs check them"),
     "system": ("fmu_harness.system_command", "run an SSP package, every output of every component to CSV"),
+    "container": ("fmu_harness.container_command", "an SSP package as one co-simulation FMU for any host"),
 }
 
 

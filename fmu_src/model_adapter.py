@@ -108,6 +108,7 @@ class ModelAdapter:
         self.fault: str | None = None
         self._refusal: str | None = None  # the first reason of the last refused step
         self._notice: str | None = None  # the model's last step notice: a repeat is not logged
+        self._initial: SteppedModel | None = None  # Initialization Mode: the values read, None when stale
         self._log_texts: dict[str, str] = {}
         self._spec_of_reference: dict[int, Any] = {}
         for variable in spec.variables:
@@ -179,12 +180,31 @@ class ModelAdapter:
         """The host's start time, the time the model is initialised at; one not finite is misuse."""
         if _finite(start_time):
             self.start_time = start_time
+            self._initial = None
         else:
             self._fail(call, f"start time {start_time!r} is not finite")
 
     def enter_initialization_mode(self) -> None:
         if self._in_phase("enterInitializationMode", Phase.INSTANTIATED):
             self.phase = Phase.INITIALIZATION
+
+    def readable_model(self) -> SteppedModel:
+        """The model whose values a get reads. In Initialization Mode, a copy initialised at the start
+        time from what has been set so far, as ``exitInitializationMode`` initialises the model itself
+        (so a value read there is the first one read after it, bit for bit); recomputed after a set.
+        Values it cannot compute (refused parameters or start values) are the start values, the
+        reasons logged as a warning: the refusal itself comes at ``exitInitializationMode``."""
+        if self.phase is not Phase.INITIALIZATION:
+            return self.model
+        if self._initial is None:
+            trial = type(self.model)()
+            trial.set_state(self.model.get_state())
+            errors = trial.parameter_errors() or trial.initialize(self.start_time)
+            self._initial = self.model if errors else trial
+            for reason in errors:
+                self.log(self.log_text(f"values read in initialization mode are the start values: {reason}"),
+                         self.warning_status, _WARNING_CATEGORY)
+        return self._initial
 
     def exit_initialization_mode(self) -> None:
         """Initialise the model at the start time. Parameters that no input can make valid, and
@@ -259,11 +279,12 @@ class ModelAdapter:
 
     def _get(self, call: str, references: list[int], kind: str) -> list[Any]:
         values = []
+        model = self.readable_model()
         for reference in references:
             variable = self._variable(call, reference, kind)
             value = None
             if variable is not None:
-                value = self._guarded(call, lambda name=variable.name: _KIND_TYPE[kind](getattr(self.model, name)))
+                value = self._guarded(call, lambda name=variable.name: _KIND_TYPE[kind](getattr(model, name)))
             values.append(_PLACEHOLDER[kind] if value is None else value)
         return values
 
@@ -283,6 +304,7 @@ class ModelAdapter:
                 self._fail(call, f"{variable.name} is {len(value)} characters long (at most {MAX_STRING})")
             else:
                 setattr(self.model, variable.name, _KIND_TYPE[kind](value))
+                self._initial = None
 
     def get_real(self, vrs: list[int]) -> list[float]:
         return self._guarded("getReal", lambda: self._get("getReal", vrs, "Real"), [_PLACEHOLDER["Real"]] * len(vrs))
@@ -326,6 +348,7 @@ class ModelAdapter:
 
     def _restore(self, state: Snapshot) -> None:
         self.model.set_state(state.model)
+        self._initial = None
         self.start_time, self.stepped = state.start_time, state.stepped
         if self.phase is not Phase.TERMINATED:
             self.phase = state.phase

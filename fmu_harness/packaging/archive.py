@@ -5,6 +5,7 @@ FMI 3.0 ``instantiationToken``) is a name-based UUID in :data:`TOKEN_NAMESPACE` 
 
 from __future__ import annotations
 
+import hashlib
 import uuid
 import zipfile
 from collections.abc import Mapping
@@ -25,3 +26,9 @@ def write_zip(target: Path, members: Mapping[str, bytes]) -> None:
             entry.compress_type = zipfile.ZIP_DEFLATED
             entry.external_attr = (FOLDER_MODE if name.endswith("/") else FILE_MODE) << 16
             archive.writestr(entry, members[name])
+
+
+def content_token(description: bytes, others: Mapping[str, bytes]) -> str:
+    """An FMU's token from its model description without one and its other members (name -> bytes)."""
+    digest = hashlib.sha256(repr((description, sorted(others.items()))).encode())
+    return str(uuid.uuid5(TOKEN_NAMESPACE, digest.hexdigest()))

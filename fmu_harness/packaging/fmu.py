@@ -8,10 +8,8 @@ model's spec (:mod:`.model_description`).
 
 from __future__ import annotations
 
-import hashlib
 import shutil
 import tempfile
-import uuid
 import xml.etree.ElementTree as ET
 import zipfile
 from collections.abc import Callable
@@ -26,7 +24,7 @@ from driveline.model import SteppedModel
 from driveline.variables import ModelSpec
 
 from . import documentation
-from .archive import TOKEN_NAMESPACE, write_zip
+from .archive import content_token, write_zip
 from .model_description import complete_fmi2, complete_fmi3
 from .shipped_files import shipped_files
 
@@ -97,8 +95,7 @@ def _fixed_description(xml: bytes, others: dict[str, bytes]) -> bytes:
     root.attrib.pop("generationDateAndTime", None)
     attribute = "guid" if "guid" in root.attrib else "instantiationToken"
     root.set(attribute, "")
-    digest = hashlib.sha256(repr((ET.tostring(root), sorted(others.items()))).encode())
-    root.set(attribute, str(uuid.uuid5(TOKEN_NAMESPACE, digest.hexdigest())))
+    root.set(attribute, content_token(ET.tostring(root), others))
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 

@@ -47,7 +47,7 @@ import zipfile
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -66,6 +66,7 @@ from .system_sweep import (
     DerivedMetrics,
     SystemInterface,
     UnpackedSystem,
+    container_of,
     run_system,
     stop_and_step,
 )
@@ -299,6 +300,8 @@ class ShippedSystem:
     stop_time: float
     step_size: float
     master: str
+    container: bytes | None = None
+    """The package as one container FMU for the master's scheme and step (:func:`container_of`), if it runs one."""
 
     @classmethod
     def read(cls, path: Path, duration: float | None, step_size: float | None, master: str,
@@ -311,13 +314,20 @@ class ShippedSystem:
         return cls(interface, hashlib.sha256(data).hexdigest(), data, *stop_and_step(interface, duration, step_size),
                    master)
 
+    def contained(self, path: Path) -> ShippedSystem:
+        """The same with the package at ``path`` as its master's container (:func:`container_of`), when one runs it."""
+        built = container_of(path, self.interface, self.step_size, self.master)
+        if built is None:
+            return self
+        return replace(self, digest=hashlib.sha256(self.data + built).hexdigest(), container=built)
+
     def run(self, point: Point, timing: Timing) -> dict[str, Any]:
         """On a worker: one run of the system at ``point`` (``timing`` is the FMU sweep's, unused)."""
         try:
             with _UNPACK_LOCK:
                 if self.digest not in _UNPACKED:
                     folder = _scratch() / f"ssp-{self.digest[:16]}"
-                    _UNPACKED[self.digest] = UnpackedSystem.write(self.data, folder, self.interface)
+                    _UNPACKED[self.digest] = UnpackedSystem.write(self.data, folder, self.interface, self.container)
             with tempfile.TemporaryDirectory(dir=_scratch()) as scratch:
                 metrics = run_system(self.interface, _UNPACKED[self.digest], point, self.stop_time, self.step_size,
                                      self.master, Path(scratch))
@@ -450,7 +460,10 @@ class Plan:
         for point in points:
             shipped.interface.changes(point)
         found = {i: shipped.interface.refusal(point, shipped.step_size, master) for i, point in enumerate(points)}
-        return cls(shipped, points, Timing(), {i: reason for i, reason in found.items() if reason}, None)
+        refused = {i: reason for i, reason in found.items() if reason}
+        if len(refused) < len(points):
+            shipped = shipped.contained(package)
+        return cls(shipped, points, Timing(), refused, None)
 
 
 def run(client: Client, plan: Plan, show_progress: bool = False) -> pa.Table:

@@ -37,7 +37,8 @@ from driveline.vehicle import dynamics
 from driveline.vehicle.dynamics import Drive
 from driveline.variables import UNITS, ModelSpec, Variable
 
-from ..packaging import fmu_path, native
+from ..packaging import native
+from . import container, ssp_package
 from .runner import FmuInstance, StepRefused
 from .ssp import SSC, SSD, SSV
 from .ssp_package import SspSystem
@@ -126,17 +127,26 @@ JOINT_DRIVE = ("omega_in", "alpha_in", "T_load")
 HOUSING_LOADS = ("Rx_in", "Ry_in", "Rz_in", "Mx_in", "My_in", "T_in")
 
 
+#: The joints' connected inputs at the launch's consistent start (the drive at rest, the halfshafts untwisted):
+#: their start values in the package, so that a master that iterates the initialisation exchange from the
+#: start values (libcosim, Ecos: a few Jacobi sweeps of the loop) starts at its fixed point, not at the
+#: joint's own defaults (2000 rpm, 100 N.m), from which a few sweeps leave about 1 N.m in the loop.
+JOINT_AT_REST = {"omega_in": 0.0, "alpha_in": 0.0, "T_load": 0.0}
+
+
 def vehicle_launch() -> System:
     """A launch of a front-wheel-drive car from standstill: ``TorqueSource`` ramps the motor to 140 N.m
     (half its peak) in 0.3 s into ``VehicleDriveline``, whose side gears drive two ``TripodCoupling`` s
     (exact kinematics, friction 0.05; left 8 deg on the 0.45 m shaft, right 6 deg on the 0.70 m one)
     that twist the halfshafts; ``PowertrainMounts``, when the catalog has it, takes both joints' housing
-    loads. Communication step 0.1 ms (the differential's internal mode, 670 rad/s, needs it)."""
+    loads (its ``g`` the drive's standard gravity: one value across the models). Communication step 0.1 ms (the differential's internal mode, 670 rad/s, needs it)."""
     components = [
         Component("motor", "TorqueSource", {"T_level": 140.0, "ramp_time": 0.3}),
         Component("drive", "VehicleDriveline", {}),
-        Component("joint_left", "TripodCoupling", {"kinematics": 1, "mu": 0.05, "l": 0.45, "beta": math.radians(8.0)}),
-        Component("joint_right", "TripodCoupling", {"kinematics": 1, "mu": 0.05, "l": 0.70, "beta": math.radians(6.0)}),
+        Component("joint_left", "TripodCoupling", {**JOINT_AT_REST, "kinematics": 1, "mu": 0.05, "l": 0.45,
+                                                   "beta": math.radians(8.0), "phi_in_start": 0.0}),
+        Component("joint_right", "TripodCoupling", {**JOINT_AT_REST, "kinematics": 1, "mu": 0.05, "l": 0.70,
+                                                    "beta": math.radians(6.0), "phi_in_start": 0.0}),
     ]
     connections = [Connection(("motor", "T_motor"), ("drive", "T_motor"))]
     for side in SIDES:
@@ -144,7 +154,7 @@ def vehicle_launch() -> System:
         connections += [Connection(("drive", f"{name}_{side}"), (joint, name)) for name in JOINT_DRIVE]
         connections += [Connection((joint, name), ("drive", f"{name}_{side}")) for name in JOINT_FEEDBACK]
     if MOUNTS in MODELS:
-        components.append(Component("mounts", MOUNTS, {}))
+        components.append(Component("mounts", MOUNTS, {"g": dynamics.GRAVITY}))
         connections += [Connection((f"joint_{side}", name), ("mounts", f"{name}_{side}"))
                         for side in SIDES for name in HOUSING_LOADS]
     return System("VehicleLaunch", tuple(components), tuple(connections), 4.0, 1e-4)
@@ -220,6 +230,8 @@ def native_components(system: System, natives: Path | None) -> list[str]:
 def component_fmus(system: System, models: Path, natives: Path | None = None) -> dict[str, Path]:
     """``{model: FMI 2.0 FMU}`` for the models of ``system``: the native FMUs below ``natives``
     (``native/``) of :func:`native_components`, the Python FMUs in ``models`` of the others."""
+    from ..packaging import fmu_path  # the Python FMUs' builder, not needed to run a package
+
     fmus = {c.model: fmu_path(models, c.model) for c in system.components}
     if natives is not None:
         fmus |= {model: native.fmu_path(natives, model) for model in native_components(system, natives)}
@@ -241,6 +253,21 @@ def write_ssp(system: System, models: Path, natives: Path | None = None) -> Path
         for model in sorted(fmus):
             archive.write(fmus[model], f"resources/{model}.fmu")
     return path
+
+
+def container_path(system: System, models: Path, fmi: str = "2") -> Path:
+    """Where :func:`write_container` puts the system as one FMU: ``models/native/<system>.fmu``, FMI 3.0 in
+    ``models/native/fmi3/``."""
+    return native.fmu_path(models, system.name, fmi)
+
+
+def write_container(system: System, models: Path, fmi: str = "2") -> Path:
+    """The native package of ``system`` (:func:`write_ssp` with ``natives``) as one co-simulation FMU
+    (:mod:`fmu_harness.runs.container`) at :func:`container_path`: the native FMUs of FMI version ``fmi``
+    inside, stepping by Jacobi at the system's step as the project's master does."""
+    package = ssp_package.read(ssp_path(system, models, models))
+    fmus = {c.name: native.fmu_path(models, c.model, fmi) for c in system.components}
+    return container.build(package, fmus, container_path(system, models, fmi), system.step_size, int(fmi))
 
 
 # -- fmpy master ----------------------------------------------------------------------------

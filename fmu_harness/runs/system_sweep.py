@@ -9,7 +9,10 @@ for everything a point leaves alone.
 Masters (``--master``): ``jacobi``, the project's fixed-step Jacobi master
 (:func:`fmu_harness.runs.system.run_jacobi`); ``gauss-seidel``, the same master stepping the
 components one after the other in the package's order (for ``VehicleLaunch.ssp`` that is
-:data:`fmu_harness.runs.system.LAUNCH_ORDER`); ``libcosim``, libcosim's Jacobi master running the
+:data:`fmu_harness.runs.system.LAUNCH_ORDER`). Both run in the package's container
+(:mod:`fmu_harness.runs.container`, built once by the client for the master's scheme and step and
+sent to every worker), which gives the master's results bit for bit at a fraction of its cost; a
+package the container cannot carry (Python FMUs) runs in the master itself. ``libcosim``, libcosim's Jacobi master running the
 whole launch in C++ (:func:`fmu_harness.runs.libcosim_run.cosim_run`; the ``interop`` extra). A point
 whose start values a component would refuse, or whose step is above a ``VehicleDriveline``'s
 limit for a Jacobi coupling (``jacobi`` and ``libcosim``), is not run: its row fails with the reason.
@@ -30,13 +33,14 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.model_description import ModelDescription
 
-from . import ssp_package
+from . import container, ssp_package
 from .libcosim_run import cosim_run
 from .ssp_package import SspSystem
 from .start_values import refusals
 from .system import run_jacobi, step_limit_error
 
 MASTERS = ("jacobi", "gauss-seidel", "libcosim")
+CONTAINED = ("jacobi", "gauss-seidel")  # the masters a container runs
 JOIN = "+"
 Value = float | int | str
 Point = dict[str, Value]
@@ -183,16 +187,35 @@ def _descriptions(path: Path, package: SspSystem) -> dict[str, ModelDescription]
         return found
 
 
+def container_of(path: Path, interface: SystemInterface, step_size: float, master: str) -> bytes | None:
+    """The package at ``path`` as one container FMU stepping by ``master``'s scheme at ``step_size``; None for
+    a master no container runs or a package it cannot carry."""
+    if master not in CONTAINED:
+        return None
+    with tempfile.TemporaryDirectory(prefix="driveline-sweep-") as scratch, zipfile.ZipFile(path) as archive:
+        archive.extractall(scratch)
+        fmus = {c.name: Path(scratch) / c.source for c in interface.package.components}
+        try:
+            built = container.build(interface.package, fmus, Path(scratch) / "container.fmu", step_size,
+                                    sequential=master == "gauss-seidel")
+        except container.ContainerRefused:
+            return None
+        return built.read_bytes()
+
+
 @dataclass(frozen=True)
 class UnpackedSystem:
-    """A package on a worker: its file, each component's FMU extracted and its description parsed."""
+    """A package on a worker: its file, each component's FMU extracted and its description parsed, and
+    its container's file, extracted folder and description when there is one."""
 
     path: Path
     fmus: dict[str, Path]
     unpacked: dict[str, tuple[str, ModelDescription]]
+    container: tuple[Path, str, ModelDescription] | None = None
 
     @classmethod
-    def write(cls, data: bytes, folder: Path, interface: SystemInterface) -> UnpackedSystem:
+    def write(cls, data: bytes, folder: Path, interface: SystemInterface,
+              container_data: bytes | None = None) -> UnpackedSystem:
         folder.mkdir(parents=True, exist_ok=True)
         path = folder / f"{interface.name}.ssp"
         path.write_bytes(data)
@@ -205,7 +228,13 @@ class UnpackedSystem:
                 target = folder / "extracted" / Path(component.source).stem
                 unzipdir = extract(str(fmus[component.name]), unzipdir=target)
                 by_source[component.source] = (unzipdir, read_model_description(unzipdir))
-        return cls(path, fmus, {c.name: by_source[c.source] for c in interface.package.components})
+        contained = None
+        if container_data is not None:
+            fmu = folder / "container.fmu"
+            fmu.write_bytes(container_data)
+            unzipdir = extract(str(fmu), unzipdir=folder / "extracted" / "container")
+            contained = (fmu, unzipdir, read_model_description(unzipdir))
+        return cls(path, fmus, {c.name: by_source[c.source] for c in interface.package.components}, contained)
 
 
 STATISTICS: dict[str, Callable[[np.ndarray], Any]] = {
@@ -225,6 +254,10 @@ def run_system(interface: SystemInterface, unpacked: UnpackedSystem, point: Poin
     if master == "libcosim":
         package = ssp_package.with_parameters(unpacked.path, interface.changes(point), scratch / unpacked.path.name)
         rows = cosim_run(package, step_size, stop_time, outputs)
+    elif master in CONTAINED and unpacked.container is not None:
+        fmu, unzipdir, description = unpacked.container
+        changes = {f"{component}.{variable}": value for (component, variable), (_, value) in interface.changes(point).items()}
+        rows = container.run(fmu, changes, stop_time, step_size, outputs, unpacked=(unzipdir, description))
     else:
         order = [c.name for c in system.components] if master == "gauss-seidel" else None
         rows = run_jacobi(unpacked.fmus, {c.name: c.parameters for c in system.components}, system.connections,

@@ -95,7 +95,7 @@ def test_gauss_seidel_runs_the_launch_in_the_packages_order_at_a_step_jacobi_ref
         system_command.main(arguments)
     err = capsys.readouterr().err
     assert exit_status.value.code == 2 and err.count("\n") == 1 and err.rstrip().endswith("or the Gauss-Seidel master")
-    system_command.main([*arguments, "--engine", "gauss-seidel"])
+    system_command.main([*arguments, "--engine", "gauss-seidel", "--output-interval", str(step)])
     with (tmp_path / "run.csv").open() as handle:
         header, *rows = list(csv.reader(handle))
     launch = dataclasses.replace(system.vehicle_launch(), stop_time=stop, step_size=step)
@@ -181,3 +181,21 @@ def test_a_start_value_the_fmu_refuses_stops_every_engine_naming_the_component(e
     assert exit_status.value.code == 1 and err.count("\n") == 1
     assert ": refused: coupling (TripodCoupling): input beta = 57.2958 deg must not exceed beta_max = 45 deg" in err
     assert not (tmp_path / "run.csv").exists()
+
+
+def test_rows_every_output_interval_to_csv_or_parquet(native_ssp, tmp_path, fmi2_dir, native_dir):
+    """``--output-interval 3e-3`` at 1 ms steps: every third row of the master's run, the last (at 50 ms, no
+    whole number of intervals) kept; the same values to Parquet; an interval of no whole number of steps is
+    one line. The default at a 1 ms step is every step (the first interval at or above 1 ms)."""
+    every = _master(fmi2_dir, native_dir)
+    header, values = _run(native_ssp, tmp_path / "run.csv", "--output-interval", "3e-3")
+    np.testing.assert_array_equal(values, np.vstack([every[2::3], every[-1:]]))
+    pyarrow_parquet = pytest.importorskip("pyarrow.parquet")
+    system_command.main([str(native_ssp), "--stop-time", str(STOP), "--step", str(STEP), "--out",
+                         str(tmp_path / "run.parquet"), "--output-interval", "3e-3"])
+    table = pyarrow_parquet.read_table(tmp_path / "run.parquet")
+    assert table.column_names == header
+    np.testing.assert_array_equal(np.column_stack([table.column(n).to_numpy() for n in header]), values)
+    assert system_command.steps_per_row(None, STEP) == 1 and system_command.steps_per_row(None, 1e-4) == 10
+    with pytest.raises(system_command.UsageError, match="--output-interval 0.0015: need a whole number of steps"):
+        system_command.steps_per_row(1.5e-3, STEP)

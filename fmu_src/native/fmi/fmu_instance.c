@@ -18,24 +18,23 @@
 
 typedef enum { ACTION_START, ACTION_ADVANCE } Action;
 
-/* Runs the action; if it fails arithmetically or leaves a non-finite output, undoes it and says why
- * ("the start values ..." or "the step from t = ... s ...", formatted only then). */
-static void undoable(Instance *instance, Action action, double time, double step_size)
+/* Runs the action on ``data``; if it fails arithmetically or leaves a non-finite output, undoes it and
+ * says why in ``out`` ("the start values ..." or "the step from t = ... s ...", formatted only then). */
+static void undoable(ModelData *data, Messages *out, Action action, double time, double step_size)
 {
-    ModelData snapshot = instance->data;
-    Messages *out = &instance->messages;
+    ModelData snapshot = *data;
     int before = out->count;
     char shown[40];
     Failure failure;
     if (model_hooks.at_time != NULL) {
-        failure = model_hooks.at_time(&instance->data, action == ACTION_START ? time : time + step_size);
+        failure = model_hooks.at_time(data, action == ACTION_START ? time : time + step_size);
     } else if (action == ACTION_START) {
-        failure = model_hooks.start(&instance->data, time);
+        failure = model_hooks.start(data, time);
     } else {
-        failure = model_hooks.advance(&instance->data, time, step_size);
+        failure = model_hooks.advance(data, time, step_size);
     }
     if (failure.kind == ERROR_NONE) {
-        output_errors(&instance->data, out, &failure);
+        output_errors(data, out, &failure);
     }
     if (failure.kind != ERROR_NONE && action == ACTION_START) {
         messages_add(out, "the start values could not be computed (", ERROR_KIND_NAME(failure.kind), ": ",
@@ -46,21 +45,21 @@ static void undoable(Instance *instance, Action action, double time, double step
                      ": ", failure.message, ")", (const char *)NULL);
     }
     if (out->count != before) {
-        instance->data = snapshot;
+        *data = snapshot;
     }
 }
 
-static void initialize(Instance *instance, double start_time)
+/* SteppedModel.initialize: the parameters and inputs checked, then the outputs at ``start_time``. */
+static void initialize(ModelData *data, Messages *out, double start_time)
 {
-    Messages *out = &instance->messages;
-    parameter_errors(&instance->data, out);
-    input_errors(&instance->data, out);
+    parameter_errors(data, out);
+    input_errors(data, out);
     if (out->count) {
         return;
     }
-    instance->data.time = start_time;
-    undoable(instance, ACTION_START, start_time, 0.0);
-    instance->data.initialized = out->count == 0;
+    data->time = start_time;
+    undoable(data, out, ACTION_START, start_time, 0.0);
+    data->initialized = out->count == 0;
 }
 
 static void step(Instance *instance, double current_time, double step_size)
@@ -68,7 +67,7 @@ static void step(Instance *instance, double current_time, double step_size)
     Messages *out = &instance->messages;
     char shown[40];
     if (!instance->data.initialized) {
-        initialize(instance, current_time);
+        initialize(&instance->data, out, current_time);
         if (out->count) {
             return;
         }
@@ -86,7 +85,7 @@ static void step(Instance *instance, double current_time, double step_size)
     if (out->count) {
         return;
     }
-    undoable(instance, ACTION_ADVANCE, current_time, step_size);
+    undoable(&instance->data, out, ACTION_ADVANCE, current_time, step_size);
     if (out->count == 0) {
         instance->data.time = current_time + step_size;
     }
@@ -241,6 +240,7 @@ Status instance_reset(Instance *instance)
         model_hooks.reset_internal(&instance->data);
     }
     instance->epoch++;
+    instance->stale = 1;
     instance->start_time = 0.0;
     instance->terminated = 0;
     instance->refusal[0] = '\0';
@@ -259,6 +259,7 @@ Status instance_set_start_time(Instance *instance, const char *function, double 
     }
     instance->start_time = start_time;
     instance->data.time = start_time;
+    instance->stale = 1;
     return STATUS_OK;
 }
 
@@ -274,7 +275,7 @@ Status instance_exit_initialization(Instance *instance)
         instance->mode = MODE_ERROR;
         return STATUS_ERROR;
     }
-    initialize(instance, instance->start_time);
+    initialize(&instance->data, &instance->messages, instance->start_time);
     if (instance->messages.count) { /* start values the model refuses (an input beyond its bounds): Error */
         instance_log_messages(instance, STATUS_ERROR);
         instance->mode = MODE_ERROR;
@@ -290,6 +291,32 @@ Status instance_exit_initialization(Instance *instance)
     instance->event_mode = instance->model_exchange;
     instance->stale = instance->messages.count > 0;
     return STATUS_OK;
+}
+
+const ModelData *instance_readable(Instance *instance, Status *status)
+{
+    *status = STATUS_OK;
+    if (instance->mode != MODE_INITIALIZATION) {
+        return &instance->data;
+    }
+    if (instance->stale) {
+        int i;
+        instance->initial = instance->data;
+        instance->messages.count = 0;
+        initialize(&instance->initial, &instance->messages, instance->start_time);
+        instance->initial_refused = instance->messages.count > 0;
+        instance->stale = 0;
+        for (i = 0; i < instance->messages.count; i++) {
+            instance_log(instance, STATUS_WARNING, "values read in initialization mode are the start values: ",
+                         instance->messages.text[i], (const char *)NULL);
+        }
+        instance->messages.count = 0;
+    }
+    if (instance->initial_refused) {
+        *status = STATUS_WARNING;
+        return &instance->data;
+    }
+    return &instance->initial;
 }
 
 Status instance_terminate(Instance *instance)

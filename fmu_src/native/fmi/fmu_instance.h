@@ -159,7 +159,13 @@ struct Instance {
     int model_exchange; /* instantiated for Model Exchange (fmu_model_exchange.c) */
     int logging_on;     /* the host's loggingOn: an information line (status OK) is logged only then */
     int event_mode;     /* Model Exchange after initialisation: event mode, else continuous-time mode */
-    int stale;          /* Model Exchange: a time, state or input was set since the outputs were evaluated */
+    int stale;          /* a time, state, input or parameter was set since the outputs were evaluated (Model
+                         * Exchange) or the values read in Initialization Mode computed (``initial``) */
+    /* Initialization Mode: the values a get reads, initialised at the start time from what has been set so
+     * far on a copy, as ExitInitializationMode initialises (instance_readable); ``initial_refused``: the
+     * copy's initialisation was refused, a get reads the start values with a warning */
+    ModelData initial;
+    int initial_refused;
     /* The derivative functions' last Jacobian (fmu_derivatives.c), reused while the point is the same: the
      * Real and Integer values and the time it was computed at, and no reset, restored FMU state or String
      * set since (``epoch`` counts those). */
@@ -260,6 +266,10 @@ void instance_log_messages(Instance *instance, Status status);
 /* Error unless the instance is in one of the modes of ``allowed`` (a bit mask of 1 << mode). */
 int instance_allows(Instance *instance, unsigned allowed, const char *function);
 Status instance_exit_initialization(Instance *instance);
+/* The values a get reads now: in Initialization Mode those the instance would have after
+ * ExitInitializationMode with nothing more set (``status`` Warning, the reasons logged once, where it would
+ * refuse them: then the values set so far), else its own. */
+const ModelData *instance_readable(Instance *instance, Status *status);
 Status instance_terminate(Instance *instance);
 Status instance_do_step(Instance *instance, double current_time, double step_size);
 /* Discard with the instance's messages logged (once while they stay the same) if there are any;

@@ -150,28 +150,33 @@ Status model_exchange_set_states(Instance *instance, const char *function, const
 
 Status model_exchange_get_states(Instance *instance, const char *function, double x[], size_t n)
 {
+    Status status;
+    const ModelData *values;
     int i;
     if (!continuous_allows(instance, function, x, n, MODEL_STATE_COUNT)) {
         return STATUS_ERROR;
     }
+    values = instance_readable(instance, &status);
     for (i = 0; i < MODEL_STATE_COUNT; i++) {
-        x[i] = STATE(&instance->data, i);
+        x[i] = STATE(values, i);
     }
-    return STATUS_OK;
+    return status;
 }
 
 Status model_exchange_get_derivatives(Instance *instance, const char *function, double dx[], size_t n)
 {
-    Status status;
+    Status status, initial;
+    const ModelData *values;
     int i;
     if (!continuous_allows(instance, function, dx, n, MODEL_STATE_COUNT)) {
         return STATUS_ERROR;
     }
     status = model_exchange_update(instance);
+    values = instance_readable(instance, &initial);
     for (i = 0; i < MODEL_STATE_COUNT; i++) {
-        dx[i] = DERIVATIVE(&instance->data, i);
+        dx[i] = DERIVATIVE(values, i);
     }
-    return status;
+    return status > initial ? status : initial;
 }
 
 /* Nominal values: State.nominal of the spec, the states' typical magnitudes (model_state_nominals). */

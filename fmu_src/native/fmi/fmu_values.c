@@ -23,7 +23,7 @@ static int is_time(const Instance *instance, uint32_t reference)
 }
 
 #if MODEL_STATE_COUNT > 0
-#define DERIVATIVE_VALUE(k) (instance->data.real_value[model_state_derivatives[k]])
+#define DERIVATIVE_VALUE(k) (values->real_value[model_state_derivatives[k]])
 #else
 #define DERIVATIVE_VALUE(k) 0.0 /* no state: never used */
 #endif
@@ -163,33 +163,37 @@ Status instance_set_integer(Instance *instance, const char *function, const uint
 Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[])
 {
     size_t i;
-    Status status;
+    Status status, initial;
+    const ModelData *values;
     int k;
     if (!all_accessible(instance, function, vr, n, value, VAR_REAL, 0)) {
         return STATUS_ERROR;
     }
     status = model_exchange_update(instance);
+    values = instance_readable(instance, &initial);
     for (i = 0; i < n; i++) {
         k = vr[i] < MODEL_VARIABLE_COUNT ? -1 : derivative_of(instance, vr[i]);
-        value[i] = vr[i] < MODEL_VARIABLE_COUNT ? instance->data.real_value[vr[i]]
+        value[i] = vr[i] < MODEL_VARIABLE_COUNT ? values->real_value[vr[i]]
                    : k >= 0                     ? DERIVATIVE_VALUE(k)
-                                                : instance->data.time;
+                                                : values->time;
     }
-    return status;
+    return status > initial ? status : initial;
 }
 
 Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[])
 {
     size_t i;
-    Status status;
+    Status status, initial;
+    const ModelData *values;
     if (!all_accessible(instance, function, vr, n, value, VAR_INTEGER, 0)) {
         return STATUS_ERROR;
     }
     status = model_exchange_update(instance);
+    values = instance_readable(instance, &initial);
     for (i = 0; i < n; i++) {
-        value[i] = instance->data.int_value[vr[i]];
+        value[i] = values->int_value[vr[i]];
     }
-    return status;
+    return status > initial ? status : initial;
 }
 
 static int boolean_at(const void *values, size_t size, size_t i)
@@ -221,14 +225,16 @@ Status instance_get_boolean(Instance *instance, const char *function, const uint
                             size_t size)
 {
     size_t i;
-    Status status;
+    Status status, initial;
+    const ModelData *values;
     if (!all_accessible(instance, function, vr, n, value, VAR_BOOLEAN, 0)) {
         return STATUS_ERROR;
     }
     status = model_exchange_update(instance);
+    values = instance_readable(instance, &initial);
     for (i = 0; i < n; i++) {
         unsigned char *at = (unsigned char *)value + i * size;
-        int truth = instance->data.int_value[vr[i]] != 0;
+        int truth = values->int_value[vr[i]] != 0;
         if (size == sizeof(int)) {
             memcpy(at, &truth, sizeof truth);
         } else {
@@ -236,7 +242,7 @@ Status instance_get_boolean(Instance *instance, const char *function, const uint
             at[0] = (unsigned char)truth;
         }
     }
-    return status;
+    return status > initial ? status : initial;
 }
 
 /* Characters (code points, as Python's len()) of the UTF-8 ``text`` of ``length`` bytes. */

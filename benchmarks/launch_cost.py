@@ -1,0 +1,78 @@
+"""CPU time of one 4 s vehicle launch per engine in one run: the package's container, the project's master,
+libcosim and the Model Exchange engine.
+
+Usage: ``python -m benchmarks.launch_cost [--package models/native/VehicleLaunch.ssp] [--stop-time 4]
+[--repeat 3] [--update-docs]`` after ``python build_fmu.py``. Not part of the test suite. Each engine runs
+the launch in this process as a sweep runs it (:func:`fmu_harness.runs.system_sweep.run_system`: the
+outputs of the sweep's metrics recorded at every step, instantiation included; the container built once
+beforehand, as the sweep's client does, and extracted once, as each worker does); the Model Exchange engine
+(DOP853 at rtol 1e-8, rows every 0.2 ms) records the same outputs. CPU by ``time.process_time`` (every
+thread of the process: libcosim's workers count), the least of ``--repeat`` alternating measurements (other
+load only adds), Model Exchange measured once. The last column divides by the container's cost at the same
+step and order.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+from benchmarks import report
+from benchmarks.launch_throughput import launch_arguments
+from fmu_harness.runs.model_exchange_system import run_model_exchange
+from fmu_harness.runs.system_sweep import SystemInterface, UnpackedSystem, container_of, run_system
+
+GOAL = 0.3
+"""CPU seconds per 4 s launch in the shudder map (issue 43)."""
+ENGINES = (("container", "jacobi", 1e-4), ("master", "jacobi", 1e-4), ("libcosim", "libcosim", 1e-4),
+           ("container", "gauss-seidel", 2e-4), ("master", "gauss-seidel", 2e-4))
+"""(engine, scheme, step): the package's step by Jacobi (the FMU as built), the map's Gauss-Seidel at 2e-4 s."""
+MODEL_EXCHANGE_INTERVAL = 2e-4
+
+
+def main() -> None:
+    args = launch_arguments(__doc__)
+    measurement = report.Measurement()
+    interface = SystemInterface.of(args.package)
+    with tempfile.TemporaryDirectory(prefix="launch-cost-") as folder:
+        scratch = Path(folder)
+        data = args.package.read_bytes()
+        unpacked = {("master", None): UnpackedSystem.write(data, scratch / "package", interface)}
+        for engine, scheme, step in ENGINES:
+            if engine == "container":
+                unpacked[engine, scheme] = UnpackedSystem.write(data, scratch / scheme, interface,
+                                                                container_of(args.package, interface, step, scheme))
+
+        def cpu(engine: str, scheme: str, step: float) -> float:
+            start = time.process_time()
+            run_system(interface, unpacked.get((engine, scheme), unpacked["master", None]), {}, args.stop_time,
+                       step, scheme, scratch)
+            return time.process_time() - start
+
+        measured = [[cpu(*engine) for engine in ENGINES] for _ in range(args.repeat)]
+        best = dict(zip(ENGINES, map(min, zip(*measured))))
+        package = unpacked["master", None]
+        start = time.process_time()
+        run_model_exchange(package.fmus, {c.name: c.parameters for c in interface.package.components},
+                           interface.package.connections, args.stop_time, MODEL_EXCHANGE_INTERVAL,
+                           interface.recorded(), scratch / "model_exchange")
+        model_exchange = time.process_time() - start
+    lines = ["| engine | scheme | step [s] | CPU per launch [s] | CPU per step [us] | of the map's goal | "
+             "against the container |", "|---|---|---|---|---|---|---|"]
+    for (engine, scheme, step), seconds in best.items():
+        steps = round(args.stop_time / step)
+        container = best["container", scheme if scheme != "libcosim" else "jacobi", step]
+        lines.append(f"| {engine} | {scheme} | {step:g} | {seconds:.2f} | {1e6 * seconds / steps:.1f} | "
+                     f"{seconds / (GOAL * args.stop_time / 4.0):.2f} | {seconds / container:.1f} |")
+    lines.append(f"| Model Exchange | DOP853, rtol 1e-08 | rows every {MODEL_EXCHANGE_INTERVAL:g} | "
+                 f"{model_exchange:.1f} | | {model_exchange / (GOAL * args.stop_time / 4.0):.0f} | "
+                 f"{model_exchange / best['container', 'jacobi', 1e-4]:.0f} |")
+    report.publish("benchmark-launch-cost", measurement.stamp(
+        f"{args.stop_time:g} s launches of {args.package.stem} (native FMUs), one process, CPU by "
+        f"time.process_time, least of {args.repeat} alternating measurements (Model Exchange: one)"),
+        "\n".join(lines), args.update_docs)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,185 @@
+"""An SSP package as one co-simulation FMU (``fmu_harness.runs.container``, FMU Manipulation Toolbox's
+container): the same runs as the project's master, the package's bindings and a host's values applied, the
+drive's step limit kept inside, what it cannot carry refused in one line, the same bytes from a rebuild."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import math
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy.validation import validate_fmu
+
+from fmu_harness import container_command
+from fmu_harness.packaging import archive, native
+from fmu_harness.runs import container, ssp_package, system
+from fmu_harness.runs.runner import StepRefused
+from fmu_harness.runs.ssp_package import SspComponent, SspSystem
+
+STOP = 0.1
+#: Agreement of the container with the master at the same step and order: the container runs the same FMUs
+#: by the same scheme with the same values in the same order, so only the order of floating-point operations
+#: inside the FMUs could differ, and it does not (measured: equal bit for bit over 4 s of launch). 1e-9 of a
+#: column's largest magnitude leaves room for a runtime that sums its time differently (the motor's ramp
+#: would then differ in the last bits of t, 1e-16 relative) and stays far below any modelling difference.
+AGREEMENT = 1e-9
+
+
+@pytest.fixture(scope="module")
+def packages(native_dir: Path) -> dict[str, Path]:
+    """The launch's and the driveline's native packages (every component has a native FMU)."""
+    return {made.name: system.write_ssp(made, native_dir, native_dir) for made in system.systems()}
+
+
+def _fmus(package: Path, folder: Path) -> tuple[SspSystem, dict[str, Path]]:
+    read = ssp_package.read(package)
+    with zipfile.ZipFile(package) as archive_file:
+        archive_file.extractall(folder)
+    return read, {c.name: folder / c.source for c in read.components}
+
+
+def _compare(package: Path, tmp_path: Path, step: float, sequential: bool,
+             changes: dict[tuple[str, str], float] | None = None, first_row_apart: str = "") -> None:
+    """The container of ``package`` against the project's master over STOP: every Real output, but the first
+    row of component ``first_row_apart``'s."""
+    read, fmus = _fmus(package, tmp_path / "package")
+    fmu = container.build(read, fmus, tmp_path / "container.fmu", step, sequential=sequential)
+    changes = changes or {}
+    bound = [dataclasses.replace(c, parameters={**c.parameters, **{v: x for (n, v), x in changes.items()
+                                                                     if n == c.name}}) for c in read.components]
+    outputs = [f"{c.name}.{v.get('name')}" for c in read.components
+               for v in container.model_descriptions(read, fmus)[c.name].iter("ScalarVariable")
+               if v.get("causality") == "output" and v.find("Real") is not None]
+    order = [c.name for c in read.components] if sequential else None
+    expected = system.run_jacobi(fmus, {c.name: c.parameters for c in bound}, read.connections, STOP, step, outputs,
+                                 order=order)
+    found = container.run(fmu, {f"{n}.{v}": x for (n, v), x in changes.items()}, STOP, step, outputs)
+    assert found.shape == expected.shape
+    scale = np.maximum(np.abs(expected).max(axis=0), 1e-300)
+    apart = np.array([False, *(name.startswith(f"{first_row_apart}.") for name in outputs)]) & bool(first_row_apart)
+    worst = np.maximum(np.abs(found[1:] - expected[1:]).max(axis=0), np.abs(found[0] - expected[0]) * ~apart) / scale
+    assert worst.max() <= AGREEMENT, outputs[int(np.argmax(worst[1:]))]
+    assert not first_row_apart or np.any(found[0, apart] != expected[0, apart])
+
+
+@pytest.mark.parametrize("sequential", [False, True], ids=["jacobi", "gauss-seidel"])
+def test_the_launch_container_runs_as_the_master(packages, tmp_path, sequential):
+    """All 176 outputs of the launch over 0.1 s at 1e-4 s, Jacobi and Gauss-Seidel in the package's order."""
+    _compare(packages["VehicleLaunch"], tmp_path, 1e-4, sequential)
+
+
+def test_the_driveline_container_runs_as_the_master(packages, tmp_path):
+    """The driveline package (speed source, tripod joint, critical speeds) at its 1 ms step: the same but for
+    the watcher's outputs at the first step. The container initialises the components in the order of their
+    links, each leaving initialisation before its outputs feed the next, so ``CriticalSpeeds`` starts at the
+    coupling's initial speed; the master carries the outputs as they are inside initialisation, where the
+    project's FMUs have not computed them yet (0), so its watcher starts at rest and its whirl-tracked
+    outputs after the first step differ (by 0.1 % here); from the second step on both runs are equal."""
+    _compare(packages["Driveline"], tmp_path, 1e-3, False, first_row_apart="critical")
+
+
+def test_a_hosts_values_replace_the_packages_bindings(packages, tmp_path):
+    """A host sets the launch's torque, a joint's bend (an input the package binds) and friction: the run is
+    the master's with those bindings (the toolbox re-applied a bound input's start value on entering
+    initialisation, which undid the host's bend)."""
+    changes = {("motor", "T_level"): 200.0, ("joint_left", "beta"): 0.25, ("joint_right", "mu"): 0.09}
+    _compare(packages["VehicleLaunch"], tmp_path, 1e-4, False, changes)
+
+
+def test_the_drives_step_limit_holds_inside(packages, tmp_path):
+    """At 1.2 ms, above the drive's limit for any order, the container's first step fails with the drive's
+    own reason."""
+    read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
+    fmu = container.build(read, fmus, tmp_path / "coarse.fmu", 1.2e-3)
+    with pytest.raises(StepRefused) as refused:
+        container.run(fmu, {}, 2.4e-3, 1.2e-3, ["drive.v_x"])
+    assert "drive.fmu: communication step 0.0012 s is above 0.00104 s" in str(refused.value)
+
+
+def test_the_container_is_a_valid_fmu_and_the_same_bytes_again(packages, tmp_path):
+    """fmpy validate finds nothing; two builds are equal byte for byte (sorted entries at one fixed time, no
+    build time, a token from the contents); each exposed variable carries its component's unit; the
+    package's bindings are the start values."""
+    read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
+    first = container.build(read, fmus, tmp_path / "first.fmu", 1e-4)
+    second = container.build(read, fmus, tmp_path / "second.fmu", 1e-4)
+    assert first.read_bytes() == second.read_bytes()
+    assert validate_fmu(str(first)) == []
+    with zipfile.ZipFile(first) as built:
+        assert {entry.date_time for entry in built.infolist()} == {archive.FIXED_TIME}
+        description = built.read("modelDescription.xml")
+    assert b"generationDateAndTime" not in description
+    from fmpy import read_model_description
+
+    variables = {v.name: v for v in read_model_description(str(first)).modelVariables}
+    assert variables["drive.v_x"].unit == "m/s" and variables["joint_left.beta"].unit == "rad"
+    assert float(variables["motor.T_level"].start) == 140.0
+    assert float(variables["joint_left.beta"].start) == pytest.approx(math.radians(8.0), rel=1e-15)
+    assert not [v for v in variables.values() if v.causality == "local"]
+
+
+def test_the_fmi3_container_runs_as_the_fmi2_one(packages, native_dir, tmp_path):
+    """The FMI 3.0 container of the native FMI 3.0 FMUs gives the FMI 2.0 container's run bit for bit."""
+    read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
+    models = {c.name: c.model for c in system.vehicle_launch().components}
+    fmi3 = {name: native.fmu_path(native_dir, model, "3") for name, model in models.items()}
+    outputs = ["drive.v_x", "drive.T_load_left", "mounts.pitch_ddot"]
+    two = container.run(container.build(read, fmus, tmp_path / "two.fmu", 1e-4), {}, 0.02, 1e-4, outputs)
+    three = container.run(container.build(read, fmi3, tmp_path / "three.fmu", 1e-4, fmi_version=3), {}, 0.02, 1e-4,
+                          outputs)
+    assert np.array_equal(two, three)
+
+
+def test_what_the_container_cannot_carry_is_refused_in_one_line(packages, fmu_path, tmp_path):
+    """Python FMUs (they need Python in the host), a binding of no variable, a connection of two inputs:
+    each named, in one line, before the toolbox is called."""
+    read, fmus = _fmus(packages["Driveline"], tmp_path / "package")
+    python = SspSystem("P", [SspComponent("source", "resources/SpeedSource.fmu")], [], 1.0, None)
+    with pytest.raises(container.ContainerRefused) as refused:
+        container.build(python, {"source": fmu_path("SpeedSource")}, tmp_path / "p.fmu", 1e-3)
+    assert "the Python FMU of source (SpeedSource.fmu), which need Python in the host" in str(refused.value)
+    broken = dataclasses.replace(read, components=[dataclasses.replace(read.components[0], parameters={"nope": 1.0}),
+                                                   *read.components[1:]],
+                                 connections=[*read.connections, (("coupling", "beta"), ("critical", "omega_in"))])
+    with pytest.raises(container.ContainerRefused) as refused:
+        container.build(broken, fmus, tmp_path / "b.fmu", 1e-3)
+    message = str(refused.value)
+    assert "\n" not in message and "parameter source.nope: SpeedSource.fmu has no such variable" in message
+    assert "connection coupling.beta -> critical.omega_in: coupling.beta is no output" in message
+
+
+def test_the_command_refuses_a_step_above_the_drives_limit_in_one_line(packages, tmp_path, capsys):
+    with pytest.raises(SystemExit) as ended:
+        container_command.main([str(packages["VehicleLaunch"]), "--step", "5e-4", "--out", str(tmp_path / "x.fmu")])
+    assert ended.value.code == 2
+    error = capsys.readouterr().err
+    assert len(error.splitlines()) == 1 and "drive (VehicleDriveline): --step 0.0005 s is above 0.000415 s" in error
+    container_command.main([str(packages["VehicleLaunch"]), "--step", "5e-4", "--gauss-seidel",
+                            "--out", str(tmp_path / "x.fmu")])
+    assert (tmp_path / "x.fmu").is_file()
+
+
+@pytest.mark.parametrize("engine", ["libcosimpy", "ecospy"])
+def test_libcosim_and_ecos_run_the_container_as_fmpy_does(engine, packages, tmp_path):
+    """The launch's container as one FMU in libcosim and in Ecos over 20 ms at its step: fmpy's run within
+    AGREEMENT (measured: equal bit for bit; both call the same doStep with the same values)."""
+    if importlib.util.find_spec(engine) is None:  # not imported here: Ecos needs its tbb loaded first
+        pytest.skip(f"{engine} is not installed (pip install '.[interop]')")
+    from fmu_harness.checks import importers
+
+    read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
+    fmu = container.build(read, fmus, tmp_path / "launch.fmu", 1e-4)
+    outputs = ["drive.v_x", "drive.T_load_left", "drive.T_load_right", "mounts.pitch_ddot"]
+    expected = container.run(fmu, {}, 0.02, 1e-4, outputs)
+    session = {"libcosimpy": importers.cosim_session, "ecospy": importers.ecos_session}[engine](
+        1e-4, fmus={"launch": fmu})
+    try:
+        found = importers.record(session, 200, 1e-4, [f"launch.{name}" for name in outputs])
+    finally:
+        session.close()
+    scale = np.abs(expected).max(axis=0)
+    assert (np.abs(found - expected).max(axis=0) <= AGREEMENT * scale).all()
