@@ -184,12 +184,14 @@ def test_a_start_value_the_fmu_refuses_stops_every_engine_naming_the_component(e
 
 
 def test_rows_every_output_interval_to_csv_or_parquet(native_ssp, tmp_path, fmi2_dir, native_dir):
-    """``--output-interval 3e-3`` at 1 ms steps: every third row of the master's run, the last (at 50 ms, no
-    whole number of intervals) kept; the same values to Parquet; an interval of no whole number of steps is
-    one line. The default at a 1 ms step is every step (the first interval at or above 1 ms)."""
+    """``--output-interval 3e-3`` at 1 ms steps: the row at t = 0, then every third row of the master's run,
+    the last (at 50 ms, no whole number of intervals) kept; the same values to Parquet; an interval of no
+    whole number of steps is one line. The default at a 1 ms step is every step (the first interval at or
+    above 1 ms)."""
     every = _master(fmi2_dir, native_dir)
     header, values = _run(native_ssp, tmp_path / "run.csv", "--output-interval", "3e-3")
-    np.testing.assert_array_equal(values, np.vstack([every[2::3], every[-1:]]))
+    assert values[0, 0] == 0.0
+    np.testing.assert_array_equal(values[1:], np.vstack([every[2::3], every[-1:]]))
     pyarrow_parquet = pytest.importorskip("pyarrow.parquet")
     system_command.main([str(native_ssp), "--stop-time", str(STOP), "--step", str(STEP), "--out",
                          str(tmp_path / "run.parquet"), "--output-interval", "3e-3"])
