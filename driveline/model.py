@@ -68,6 +68,9 @@ class SteppedModel(ABC):
                 return errors
         if not (math.isfinite(step_size) and step_size > 0.0):
             return [f"communication step size must be positive and finite, got {step_size!r}"]
+        if not math.isfinite(current_time + step_size):
+            return [f"the communication step from t = {current_time!r} s by {step_size!r} s ends at a time that is "
+                    f"not finite"]
         parameters = tuple(getattr(self, name) for name in self._parameter_names)
         errors = (self.parameter_errors() if parameters != self._valid_parameters else []) + self.input_errors()
         if errors:
@@ -282,12 +285,27 @@ class SteppedModel(ABC):
         state["time"] = _saved_value("time", values["time"], _SAVED_TYPES["Real"])
         _saved_value("_initialized", values["_initialized"], (bool,))
         state.update(self.internal_from_saved(state))
+        reason = self._restored_error(state)
+        if reason is not None:
+            raise ValueError(f"the state holds an impossible value ({reason})")
         for name in self.derived_state:
             state.pop(name, None)
             if name in fresh:
                 state[name] = fresh[name]
         state["_valid_parameters"] = None
         return state
+
+    def _restored_error(self, state: dict[str, Any]) -> str | None:
+        """Why the values a saved state restores are none the model could have left: the time not finite,
+        then a Real output not finite, then an output beyond its bounds (as :meth:`_range_error` says it)."""
+        if not math.isfinite(state["time"]):
+            return f"time = {state['time']!r} is not finite"
+        not_finite = (f"output {name} = {state[name]!r} is not finite" for name in self._real_outputs
+                      if not math.isfinite(state[name]))
+        probe = type(self).__new__(type(self))
+        probe.__dict__.update(state)
+        beyond = (error for v in self.spec.of("output") if (error := probe._range_error(v)) is not None)
+        return next(not_finite, None) or next(beyond, None)
 
     def internal_from_saved(self, state: dict[str, Any]) -> dict[str, Any]:
         """Hook: internal values of a saved state rebuilt as the model holds them (ValueError if odd)."""

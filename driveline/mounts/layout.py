@@ -15,7 +15,13 @@ File layout (SI units, ISO 8855 vehicle axes: x forward, y left, z up)::
     # orientation = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]  rows: the mount's axes 1, 2, 3 in vehicle
     #                                                  axes (a rotation; default aligned)
     # damping = [150.0, 100.0, 250.0]      # N s/m along the mount's axes (default none), or
-    # loss_factor = 0.1                    # c_i = loss_factor k_i / (2 pi loss_factor_frequency)
+    # loss_factor = 0.1                    # c_i = loss_factor k_i / (2 pi loss_factor_frequency), or with
+    # dynamic_ratio = 1.4                  # rubber's constant loss factor in (0, 1) by Maxwell branches
+    #                                      # (:mod:`.rubber`), no loss_factor_frequency needed
+    # gap = [0.004, 0.004, 0.003]          # m, snubber gap along each axis (both ways), with
+    # stop_rate = [1e6, 1e6, 1e6]          # N/m, the rate the stop adds beyond it, and
+    # stop_blend = 0.002                   # m, the length over which it builds up (default STOP_BLEND);
+    #                                      # the law: :mod:`.characteristic`
 
 Products of inertia are the integrals ``Ixy = int x y dm`` (positive for mass in the first
 quadrant): the inertia tensor about the centre of gravity is
@@ -25,13 +31,15 @@ quadrant): the inertia tensor about the centre of gravity is
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..layout_files import counted, number, parse, read_layout, shipped_path, unknown
+from .rubber import fit_branches, fit_error
 
 __all__ = ["Layout", "Mount", "load_layout", "loads_layout", "shipped_layout"]
 
@@ -41,19 +49,34 @@ MAX_MOUNTS = 8
 ROTATION_TOLERANCE = 1e-9
 
 _TOP_KEYS = {"name", "mass", "centre_of_gravity", "inertia", "loss_factor_frequency", "mounts"}
-_MOUNT_KEYS = {"label", "position", "stiffness", "orientation", "damping", "loss_factor"}
+_MOUNT_KEYS = {"label", "position", "stiffness", "orientation", "damping", "loss_factor", "dynamic_ratio", "gap",
+               "stop_rate", "stop_blend"}
+#: The blend length of a stop that gives none [m].
+STOP_BLEND = 0.002
 
 
 @dataclass(frozen=True)
 class Mount:
-    """A linear rubber mount: ``axes`` (rows: its axes 1, 2, 3 in vehicle axes), the stiffness
-    [N/m] and viscous damping [N s/m] along each."""
+    """A rubber mount: ``axes`` (rows: its axes 1, 2, 3 in vehicle axes), the linear rate
+    (``stiffness`` [N/m]) and viscous damping [N s/m] along each; a snubber along each (``gap`` [m],
+    ``stop_rate`` [N/m], ``stop_blend`` [m]: :mod:`.characteristic`; ``stop_rate`` 0: none); the
+    Maxwell branches' weights (``branches``, relative to the linear rate, :mod:`.rubber`; empty:
+    none)."""
 
     position: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
     axes: np.ndarray
     label: str = ""
+    gap: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    stop_rate: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    stop_blend: float = STOP_BLEND
+    branches: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def progressive(self) -> bool:
+        """Whether a stop makes the characteristic nonlinear."""
+        return bool(np.any(self.stop_rate != 0.0))
 
 
 @dataclass(frozen=True)
@@ -65,6 +88,21 @@ class Layout:
     inertia: np.ndarray
     mounts: tuple[Mount, ...]
     name: str = ""
+
+    @cached_property
+    def maps(self) -> tuple[np.ndarray, ...]:
+        """Each mount's ``A_i T(p_i)`` (3 x 6): the deflections along its axes from ``q``."""
+        return tuple(m.axes @ point_map(m.position, self.centre_of_gravity) for m in self.mounts)
+
+
+def cross_matrix(a: np.ndarray) -> np.ndarray:
+    """``[a]x``: ``cross_matrix(a) @ b == np.cross(a, b)``."""
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+def point_map(point: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """``T(p)`` (3 x 6): the displacement of the body point ``point`` from ``q``."""
+    return np.hstack([np.eye(3), -cross_matrix(np.asarray(point) - centre)])
 
 
 def inertia_tensor(Ixx: float, Iyy: float, Izz: float, Ixy: float, Ixz: float, Iyz: float) -> np.ndarray:
@@ -98,7 +136,11 @@ def _mount(i: int, t: dict[str, Any], loss_frequency: float | None) -> Mount:
     stiffness = _vector(where, "stiffness", t["stiffness"])
     if "damping" in t and "loss_factor" in t:
         raise ValueError(f"{where}: give either 'damping' or 'loss_factor', not both")
-    if "loss_factor" in t:
+    branches = np.zeros(0)
+    if "dynamic_ratio" in t:
+        branches = _branches(where, t)
+        damping = np.zeros(3)
+    elif "loss_factor" in t:
         if loss_frequency is None:
             raise ValueError(f"{where}.loss_factor needs the top-level key 'loss_factor_frequency'")
         damping = number(where, "loss_factor", t["loss_factor"]) * stiffness / (2.0 * math.pi * loss_frequency)
@@ -108,7 +150,45 @@ def _mount(i: int, t: dict[str, Any], loss_frequency: float | None) -> Mount:
     if not isinstance(label, str):
         raise ValueError(f"{where}.label must be a string, got {label!r}")
     axes = _orientation(where, t["orientation"]) if "orientation" in t else np.eye(3)
-    return Mount(_vector(where, "position", t["position"], signed=True), stiffness, damping, axes, label)
+    gap, stop_rate, blend = _stop(where, t, stiffness)
+    return Mount(_vector(where, "position", t["position"], signed=True), stiffness, damping, axes, label,
+                 gap, stop_rate, blend, branches)
+
+
+def _branches(where: str, t: dict[str, Any]) -> np.ndarray:
+    """The Maxwell weights of a mount's ``loss_factor`` in (0, 1) and ``dynamic_ratio`` >= 1."""
+    if "loss_factor" not in t:
+        raise ValueError(f"{where}.dynamic_ratio needs the key 'loss_factor' (the loss factor its branches fit)")
+    eta = number(where, "loss_factor", t["loss_factor"])
+    if not 0.0 < eta < 1.0:
+        raise ValueError(f"{where}.loss_factor must lie in (0, 1) for rubber damping, got {t['loss_factor']!r}")
+    ratio = number(where, "dynamic_ratio", t["dynamic_ratio"])
+    if not ratio >= 1.0:
+        raise ValueError(f"{where}.dynamic_ratio must be >= 1 (dynamic over static rate), got {t['dynamic_ratio']!r}")
+    fit = fit_branches(eta, ratio)
+    reason = fit_error(where, fit, eta, ratio)
+    if reason is not None:
+        raise ValueError(reason)
+    return fit.weights
+
+
+def _stop(where: str, t: dict[str, Any], stiffness: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """A mount's snubber: ``gap`` >= 0 and ``stop_rate`` given together, the characteristic monotonic."""
+    given = [key for key in ("gap", "stop_rate") if key in t]
+    if len(given) == 1:
+        other = "stop_rate" if given[0] == "gap" else "gap"
+        raise ValueError(f"{where}.{given[0]} needs the key {other!r} (a snubber has both)")
+    blend = number(where, "stop_blend", t["stop_blend"], positive=True) if "stop_blend" in t else STOP_BLEND
+    if not given:
+        return np.zeros(3), np.zeros(3), blend
+    gap = _vector(where, "gap", t["gap"])
+    stop_rate = _vector(where, "stop_rate", t["stop_rate"], signed=True)
+    for k in range(3):
+        if stiffness[k] + stop_rate[k] < 0.0:
+            raise ValueError(f"{where}.stop_rate[{k}] {float(stop_rate[k])!r} makes the characteristic not monotonic: "
+                             f"stiffness[{k}] + stop_rate[{k}] = {float(stiffness[k] + stop_rate[k])!r} < 0 beyond "
+                             "the gap")
+    return gap, stop_rate, blend
 
 
 def loads_layout(text: str, source: str = "<string>") -> Layout:

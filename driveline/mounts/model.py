@@ -15,6 +15,7 @@ import numpy as np
 
 from ..model import SteppedModel
 from .exact_step import Propagator, work_error
+from .implicit_step import implicit_step
 from .layout import MAX_MOUNTS, Layout, load_layout, shipped_layout
 from .rigid_body import COORDINATES
 from .spec import AXES, INPUTS, SHARED_LAYOUT, SIDES, SPEC, VELOCITIES, derivative_name
@@ -40,12 +41,14 @@ class PowertrainMountsModel(SteppedModel):
                           "shaft_z_right": 0.04, "bend_y_right": 0.15, "motor_axis_x": 0.1, "motor_axis_z": 0.2,
                           "T_mean": 150.0},)
     derived_state = ("_system", "_built_for", "_propagator")
+    #: the Maxwell branches' forces [N] (:mod:`.rubber`), a tuple of floats: part of the saved state
     resource_files = (Path(__file__).parent / "data" / f"{SHARED_LAYOUT}.toml",)
 
     def reset_internal_state(self) -> None:
         self._system: MountSystem | None = None
         self._built_for: tuple | None = None
         self._propagator: Propagator | None = None
+        self._branch_forces: tuple[float, ...] = ()
 
     def _vector(self, template: str, side: str = "") -> np.ndarray:
         return np.array([float(getattr(self, template.format(axis=axis, side=side))) for axis in AXES])
@@ -62,7 +65,7 @@ class PowertrainMountsModel(SteppedModel):
                 {side: self._vector("shaft_{axis}_{side}", side) for side in SIDES},
                 {side: self._vector("bend_{axis}_{side}", side) for side in SIDES},
                 self._vector("motor_axis_{axis}"))
-            system = MountSystem.build(read_layout(self.layout), placement, self.g)
+            system = MountSystem.build(read_layout(self.layout), placement, self.g, self.T_mean)
         except (ValueError, ArithmeticError) as error:
             return [f"powertrain: {error}"]
         self._system, self._built_for, self._propagator = system, key, None
@@ -71,30 +74,50 @@ class PowertrainMountsModel(SteppedModel):
     def _values(self, names: tuple[str, ...]) -> np.ndarray:
         return np.array([float(getattr(self, name)) for name in names])
 
+    def internal_from_saved(self, state: dict) -> dict:
+        """The branch forces of a saved state: a tuple of finite floats."""
+        forces = state.get("_branch_forces", ())
+        if not isinstance(forces, (tuple, list)) or not all(
+                isinstance(v, float) and np.isfinite(v) for v in forces):
+            raise ValueError("the saved state's branch forces are not a list of finite numbers")
+        return {"_branch_forces": tuple(forces)}
+
+    def _state(self) -> np.ndarray:
+        """``(q, q', z)`` of the outputs and the branch forces."""
+        return np.concatenate([self._values(COORDINATES + VELOCITIES), np.array(self._branch_forces, dtype=float)])
+
     def start(self, start_time: float) -> None:
         system = self._system
         force = system.inputs @ self._values(INPUTS)
-        state = np.concatenate([system.body.static_displacement(force), np.zeros(6)])
+        if system.progressive:
+            sag = system.equilibrium(system.weight + force) - system.weight_sag
+        else:
+            sag = system.body.static_displacement(force)
+        state = np.concatenate([sag, np.zeros(system.size - 6)])
         self._show(state, force)
         self._show_analysis()
 
     def rounding_scales(self) -> dict[str, float]:
         """The accelerations: zero in the equilibrium the model starts in, up to rounding."""
         system = self._system
-        scales = system.acceleration_scales(self._values(COORDINATES + VELOCITIES),
-                                            system.inputs @ self._values(INPUTS))
+        scales = system.acceleration_scales(self._state(), system.inputs @ self._values(INPUTS))
         return dict(zip(ACCELERATIONS, (float(scale) for scale in scales)))
 
     def advance(self, current_time: float, step_size: float) -> None:
         system = self._system
+        held, rates = system.inputs @ self._values(INPUTS), system.inputs @ self._values(RATES)
+        if system.progressive:
+            state, _ = implicit_step(system.body.layout, system.body.mass, system.body.damping, system.branches,
+                                     system.weight, system.weight_sag, self._state(), held, rates, step_size)
+            self._show(state, held + rates * step_size)
+            return
         propagator = self._propagator
         if propagator is None or propagator.h != step_size:
             reason = work_error(system.a, system.b, step_size)
             if reason is not None:
                 raise ValueError(reason)
             propagator = Propagator.build(system.a, system.b, step_size)
-        held, rates = system.inputs @ self._values(INPUTS), system.inputs @ self._values(RATES)
-        state = propagator.step(self._values(COORDINATES + VELOCITIES), held, rates)
+        state = propagator.step(self._state(), held, rates)
         self._propagator = propagator
         self._show(state, held + rates * step_size)
 
@@ -104,14 +127,15 @@ class PowertrainMountsModel(SteppedModel):
         errors = self.extra_parameter_errors()
         if errors:
             raise ValueError(errors[0])
-        self._show(self._values(COORDINATES + VELOCITIES), self._system.inputs @ self._values(INPUTS))
+        self._show(self._state(), self._system.inputs @ self._values(INPUTS))
 
     def _show(self, state: np.ndarray, force: np.ndarray) -> None:
         """Motion and mount-force outputs of ``state`` under the generalised ``force``."""
         system = self._system
         for name, value in zip(COORDINATES + VELOCITIES + ACCELERATIONS,
-                               np.concatenate([state, system.accelerations(state, force)])):
+                               np.concatenate([state[:12], system.accelerations(state, force)])):
             setattr(self, name, float(value))
+        self._branch_forces = tuple(float(value) for value in state[12:])
         forces = system.mount_forces(state)
         for i in range(MAX_MOUNTS):
             for k, axis in enumerate(AXES):
@@ -120,11 +144,14 @@ class PowertrainMountsModel(SteppedModel):
     def _show_analysis(self) -> None:
         """Static sag, modal table and torque roll axis (fixed by the parameters)."""
         system = self._system
-        for name, value in zip(COORDINATES, system.static_sag(self.g, self.T_mean)):
+        sag = system.static_sag(self.g, self.T_mean)
+        for name, value in zip(COORDINATES, sag):
             setattr(self, f"{name}_static", float(value))
-        found = system.modes
+        self.wind_up = system.wind_up(sag)
+        found = system.operating_modes(sag)
         for j in range(6):
             setattr(self, f"f_mode_{j + 1}", float(found.frequencies[j]))
+            setattr(self, f"zeta_mode_{j + 1}", float(found.damping_ratios[j]))
             dominant = int(found.dominant[j])
             setattr(self, f"mode_{j + 1}_coordinate", dominant + 1)
             setattr(self, f"mode_{j + 1}_share", float(found.shares[j, dominant]))

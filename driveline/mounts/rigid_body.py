@@ -20,27 +20,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from scipy.linalg import eigh
 
-from .layout import Layout
+from .layout import Layout, cross_matrix, point_map  # noqa: F401  (the body's point map, used here and by tests)
 
 #: The coordinates in order, as the outputs name them.
 COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
 #: A mode whose frequency lies below this fraction of the highest is a rigid-body motion the
 #: mounts leave unrestrained (real layouts span a factor of 3 to 10).
 MIN_FREQUENCY_RATIO = 1e-4
-
-
-def cross_matrix(a: np.ndarray) -> np.ndarray:
-    """``[a]x``: ``cross_matrix(a) @ b == np.cross(a, b)``."""
-    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-
-
-def point_map(point: np.ndarray, centre: np.ndarray) -> np.ndarray:
-    """``T(p)`` (3 x 6): the displacement of the body point ``point`` from ``q``."""
-    return np.hstack([np.eye(3), -cross_matrix(np.asarray(point) - centre)])
 
 
 @dataclass(frozen=True)
@@ -90,11 +81,13 @@ class RigidBody:
 @dataclass(frozen=True)
 class Modes:
     """Undamped modes: ``frequencies`` [Hz] ascending, ``shapes`` (columns, mass-normalised),
-    ``shares`` (row j: the kinetic-energy distribution of mode j over the coordinates)."""
+    ``shares`` (row j: the kinetic-energy distribution of mode j over the coordinates), and the
+    damping ratios of the modal strain energy (equation (4) of docs/powertrain_mounts.md)."""
 
     frequencies: np.ndarray
     shapes: np.ndarray
     shares: np.ndarray
+    damping_ratios: np.ndarray
 
     @property
     def dominant(self) -> np.ndarray:
@@ -102,13 +95,48 @@ class Modes:
         return np.argmax(self.shares, axis=1)
 
 
-def modes(body: RigidBody) -> Modes:
-    """The six undamped modes of ``body`` (eigenvalues below zero by rounding read as zero)."""
-    eigenvalues, shapes = eigh(body.stiffness, body.mass)
+#: The relative change of a mode's frequency at which its fixed point (below) stops, and its iterations at most.
+FREQUENCY_TOLERANCE = 1e-13
+MAX_FREQUENCY_ITERATIONS = 100
+
+BranchStiffness = Callable[[float], "tuple[np.ndarray, np.ndarray, np.ndarray]"]
+
+
+def modes(body: RigidBody, stiffness: np.ndarray | None = None, branches: BranchStiffness | None = None) -> Modes:
+    """The six modes of ``body`` about an operating point whose tangent stiffness is ``stiffness``
+    (default: the mounts' linear rates), with the Maxwell branches' storage and loss stiffness and the
+    storage's slope ``w dK_s/dw`` at a frequency, ``branches(f)`` (None: none). Without branches the
+    undamped modes of ``K`` and ``M`` (eigenvalues below zero by rounding read as zero); with them each
+    mode j is the fixed point of ``(K + K_s(f_j)) phi_j = (2 pi f_j)^2 M phi_j``, the storage stiffness at
+    its own frequency. The damping ratio is equation (4) of docs/powertrain_mounts.md,
+    ``zeta_j = phi^T K_l phi / (2 phi^T K_s,total phi - phi^T w dK_s/dw phi)`` with the loss stiffness
+    ``K_l = 2 pi f C + K_l,branches``: the modal strain energy's ratio, with the first-order correction
+    for a storage stiffness that grows with frequency (the pole of ``s^2 m + K(s)``)."""
+    stiffness = body.stiffness if stiffness is None else stiffness
+    eigenvalues, shapes = eigh(stiffness, body.mass)
     frequencies = np.sqrt(np.maximum(eigenvalues, 0.0)) / (2.0 * math.pi)
+    ratios = np.zeros(6)
+    for j in range(6):
+        storage, loss, slope = stiffness, np.zeros((6, 6)), np.zeros((6, 6))
+        if branches is not None:
+            frequency = frequencies[j]
+            for _ in range(MAX_FREQUENCY_ITERATIONS):
+                extra, loss, slope = branches(frequency)
+                storage = stiffness + extra
+                values, vectors = eigh(storage, body.mass)
+                previous, frequency = frequency, math.sqrt(max(values[j], 0.0)) / (2.0 * math.pi)
+                if abs(frequency - previous) <= FREQUENCY_TOLERANCE * frequency:
+                    break
+            frequencies[j], shapes[:, j] = frequency, vectors[:, j]
+            extra, loss, slope = branches(frequency)
+            storage = stiffness + extra
+        shape = shapes[:, j]
+        loss = loss + 2.0 * math.pi * frequencies[j] * body.damping
+        energy = 2.0 * float(shape @ storage @ shape) - float(shape @ slope @ shape)
+        ratios[j] = float(shape @ loss @ shape) / energy if energy > 0.0 else 0.0
     momenta = body.mass @ shapes
     shares = (shapes * momenta).T / np.sum(shapes * momenta, axis=0)[:, None]
-    return Modes(frequencies, shapes, shares)
+    return Modes(frequencies, shapes, shares, ratios)
 
 
 def unrestrained_error(found: Modes) -> str | None:

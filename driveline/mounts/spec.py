@@ -151,8 +151,17 @@ def _statics_and_modes() -> tuple[Variable, ...]:
         found.append(Variable(f"{name}_static", "output", 0.0,
                               f"Static sag {name} under the weight and T_mean, from the unloaded mounts",
                               unit, display, depends_on=STATICS))
-    found += [Variable(f"f_mode_{j}", "output", 0.0, f"Undamped natural frequency of mode {j} (ascending)", "Hz",
-                       depends_on=("layout",))
+    found.append(Variable("wind_up", "output", 0.0,
+                          "Static rotation about motor_axis under T_mean, from the equilibrium under the weight "
+                          "(positive along the reaction -T_mean)", "rad", "deg",
+                          depends_on=STATICS))
+    found += [Variable(f"f_mode_{j}", "output", 0.0,
+                       f"Natural frequency of mode {j} (ascending) at the static equilibrium under the weight and "
+                       "T_mean, with the rubber's storage stiffness at that frequency", "Hz", depends_on=("layout",))
+              for j in range(1, 7)]
+    found += [Variable(f"zeta_mode_{j}", "output", 0.0,
+                       f"Damping ratio of mode {j} (modal strain energy: loss over twice the storage stiffness "
+                       "at its frequency)", "1", depends_on=("layout",))
               for j in range(1, 7)]
     for j in range(1, 7):
         found.append(Variable(f"mode_{j}_coordinate", "output", 0,

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .exact_step import state_matrices
+from .forces import BranchMap, elastic_forces, elastic_load, equilibrium, tangent_stiffness
 from .joints import housing_load, joint_frame
 from .layout import Layout
 from .rigid_body import Modes, RigidBody, modes, torque_roll_axis, unrestrained_error
@@ -55,45 +56,116 @@ def input_map(body: RigidBody, placement: Placement) -> np.ndarray:
 
 @dataclass(frozen=True)
 class MountSystem:
-    """Matrices, modes, input map and the weight's equilibrium of one set of parameters."""
+    """Matrices, input map, the weight's equilibrium and the Maxwell branches of one set of parameters.
+
+    The state is ``(q, q', z)``: q from the weight's equilibrium, z the branches' forces (none without
+    rubber damping). Linear characteristics step exactly (``a``, ``b``: :mod:`.exact_step`),
+    progressive ones by the implicit scheme of :mod:`.implicit_step`."""
 
     body: RigidBody
-    modes: Modes
+    modes: Modes  # of the linear rates, undamped: what the unrestrained check reads
     a: np.ndarray
     b: np.ndarray
     inputs: np.ndarray
     placement: Placement
-    weight_sag: np.ndarray  # q of the static equilibrium under the weight, from the unloaded mounts
+    weight_sag: np.ndarray  # Q of the static equilibrium under the weight, from the unloaded mounts
+    branches: BranchMap
+    weight: np.ndarray  # the weight's generalised force
 
     @classmethod
-    def build(cls, layout: Layout, placement: Placement, g: float) -> MountSystem:
-        """ValueError when the mounts leave a rigid-body motion unrestrained."""
+    def build(cls, layout: Layout, placement: Placement, g: float, mean_torque: float = 0.0) -> MountSystem:
+        """ValueError when the mounts leave a rigid-body motion unrestrained. The branches' rates are
+        those at the operating point, the static equilibrium under the weight and ``-mean_torque``
+        about the motor axis."""
         body = RigidBody.of(layout)
         found = modes(body)
         reason = unrestrained_error(found)
         if reason is not None:
             raise ValueError(reason)
-        a, b = state_matrices(body)
+        weight = body.gravity(g)
+        operating = _equilibrium(body, weight + _torque(placement, mean_torque))
+        branches = BranchMap(layout, operating)
+        a, b = state_matrices(body, branches)
         return cls(body, found, a, b, input_map(body, placement), placement,
-                   body.static_displacement(body.gravity(g)))
+                   _equilibrium(body, weight), branches, weight)
+
+    @property
+    def progressive(self) -> bool:
+        """Whether a mount's characteristic is nonlinear (stepped implicitly)."""
+        return any(mount.progressive for mount in self.body.layout.mounts)
+
+    @property
+    def size(self) -> int:
+        """The state's length: 12 and the branches."""
+        return 12 + len(self.branches)
+
+    def equilibrium(self, load: np.ndarray) -> np.ndarray:
+        """``Q`` of the static equilibrium under the generalised ``load`` (the weight's included)."""
+        return _equilibrium(self.body, load)
 
     def static_sag(self, g: float, mean_torque: float) -> np.ndarray:
         """Static displacement from the unloaded mounts under the weight and ``-mean_torque`` about the motor axis."""
-        torque = np.concatenate([np.zeros(3), -mean_torque * self.placement.motor_axis])
-        return self.body.static_displacement(self.body.gravity(g) + torque)
+        return self.equilibrium(self.body.gravity(g) + _torque(self.placement, mean_torque))
+
+    def wind_up(self, sag: np.ndarray) -> float:
+        """The rotation about the motor axis from the weight's equilibrium to ``sag``, positive along the
+        drive torque's reaction ``-e`` (so positive for a positive ``T_mean``)."""
+        return float(-(sag[3:] - self.weight_sag[3:]) @ self.placement.motor_axis)
+
+    def operating_modes(self, sag: np.ndarray) -> Modes:
+        """The modes linearised about the static equilibrium ``sag``: the tangent rates there, the
+        branches at each mode's frequency (:func:`.rigid_body.modes`)."""
+        stiffness = tangent_stiffness(self.body.layout, sag) if self.progressive else None
+        return modes(self.body, stiffness, self.branches.stiffness if len(self.branches) else None)
 
     def torque_roll_axis(self) -> np.ndarray:
         return torque_roll_axis(self.body.layout.inertia, self.placement.motor_axis)
 
     def accelerations(self, state: np.ndarray, force: np.ndarray) -> np.ndarray:
         """``q''`` at ``state`` under the generalised force ``force``."""
-        return (self.a @ state + self.b @ force)[6:]
+        if not self.progressive:
+            return (self.a @ state + self.b @ force)[6:12]
+        q, velocity, z = state[:6], state[6:12], state[12:]
+        total = (force + self.weight - elastic_load(self.body.layout, self.weight_sag + q)
+                 - self.body.damping @ velocity - self.branches.rows.T @ z)
+        return np.linalg.solve(self.body.mass, total)
 
     def acceleration_scales(self, state: np.ndarray, force: np.ndarray) -> np.ndarray:
         """The sum of the magnitudes of the terms of each ``q''`` (:meth:`accelerations`): zero in
         an equilibrium, the computed ``q''`` is its rounding error, a few eps times this."""
-        return (np.abs(self.a) @ np.abs(state) + np.abs(self.b) @ np.abs(force))[6:]
+        if not self.progressive:
+            return (np.abs(self.a) @ np.abs(state) + np.abs(self.b) @ np.abs(force))[6:12]
+        inverse = np.abs(np.linalg.inv(self.body.mass))
+        loads = (np.abs(force) + np.abs(self.weight) + _elastic_magnitude(self.body.layout, self.weight_sag + state[:6])
+                 + np.abs(self.body.damping) @ np.abs(state[6:12]) + np.abs(self.branches.rows.T) @ np.abs(state[12:]))
+        return inverse @ loads
 
     def mount_forces(self, state: np.ndarray) -> np.ndarray:
         """Each mount's force on the powertrain (rows), the weight's preload included."""
-        return self.body.mount_forces(self.weight_sag + state[:6], state[6:])
+        if not self.progressive and not len(self.branches):
+            return self.body.mount_forces(self.weight_sag + state[:6], state[6:12])
+        layout = self.body.layout
+        elastic = elastic_forces(layout, self.weight_sag + state[:6])
+        forces = []
+        for mount, to_axes, spring, branch in zip(layout.mounts, layout.maps, elastic,
+                                                  self.branches.per_mount(layout, state[12:])):
+            local = spring + mount.damping * (to_axes @ state[6:12]) + branch
+            forces.append(-(mount.axes.T @ local))
+        return np.array(forces)
+
+
+def _torque(placement: Placement, mean_torque: float) -> np.ndarray:
+    """The generalised force of the reaction ``-mean_torque`` about the motor axis."""
+    return np.concatenate([np.zeros(3), -mean_torque * placement.motor_axis])
+
+
+def _elastic_magnitude(layout: Layout, q: np.ndarray) -> np.ndarray:
+    """``sum_i |T_i^T A_i^T| |F_i|``: the scale of :func:`.forces.elastic_load`'s rounding."""
+    return sum(np.abs(to_axes.T) @ np.abs(f) for to_axes, f in zip(layout.maps, elastic_forces(layout, q)))
+
+
+def _equilibrium(body: RigidBody, load: np.ndarray) -> np.ndarray:
+    """``K^-1 load`` for linear mounts (as ever), else Newton's root of the characteristics."""
+    if not any(mount.progressive for mount in body.layout.mounts):
+        return body.static_displacement(load)
+    return equilibrium(body.layout, load, body.stiffness)

@@ -25,6 +25,17 @@ def test_the_default_layout_reads_with_its_loss_factors_converted():
     assert engine.label == "engine mount"
     assert np.allclose(engine.damping, 0.15 * engine.stiffness / (2.0 * math.pi * 10.0), rtol=1e-15)
     assert layout.inertia[0, 1] == -0.3 and layout.inertia[0, 2] == -1.0 and layout.inertia[1, 2] == -0.4
+    assert not engine.progressive and len(engine.branches) == 0
+
+
+def test_the_rubber_layout_reads_with_its_rubber_and_stops():
+    """Rubber damping (four branch weights a mount, no viscous damper), a snubber on every mount."""
+    layout = load_layout(shipped_layout("transverse_fwd_powertrain_rubber"))
+    assert layout.mass == 200.0 and len(layout.mounts) == 3
+    assert [m.label for m in layout.mounts] == ["engine mount", "transmission mount", "roll restrictor"]
+    for mount in layout.mounts:
+        assert mount.progressive and len(mount.branches) == 4 and not np.any(mount.damping)
+    assert layout.inertia[0, 1] == -0.3 and layout.inertia[0, 2] == -1.0 and layout.inertia[1, 2] == -0.4
 
 
 @pytest.mark.parametrize("text, fragment", [

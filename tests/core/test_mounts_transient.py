@@ -115,3 +115,4 @@ def test_a_step_beyond_the_work_bound_is_refused():
     assert work_error(a, b, 10.0) is None
     message = work_error(a, b, 1e12)
     assert f"more than the {MAX_SQUARINGS} accepted" in message
+    assert work_error(a, b, 1e305) == "a step of 1e+305 s overflows the matrix exponential's norm: take shorter steps"

@@ -183,3 +183,16 @@ def test_the_variable_table_shows_the_rules():
     assert "| `module` | parameter | m (mm) | 0.002 | > 0 |  |" in table
     assert "| `intersection_angle_max` | parameter | rad (deg) | 2.96706 | 0 | < 3.14159 |" in table
     assert "`z1 > z2` (i = z1 / (z1 - z2))" in table and "inclusive min or max" in table
+
+
+@pytest.mark.parametrize("name", ["TorqueSource", "CardanJoint", "SpeedSource"])
+def test_a_step_whose_end_time_is_not_finite_is_refused(name):
+    """From t = 1e308 s by 1e308 s the end time overflows: refused, the model left at the time it reached, whose
+    check of time going backwards then still holds (it compared against NaN after an infinite time)."""
+    model = MODELS[name]()
+    assert model.initialize(0.0) == [] and model.step(0.0, 1e-3) == []
+    before = model.outputs()
+    assert model.step(1e308, 1e308) == [
+        "the communication step from t = 1e+308 s by 1e+308 s ends at a time that is not finite"]
+    assert model.time == 1e-3 and model.outputs() == before
+    assert model.goes_back(0.0)

@@ -74,6 +74,26 @@ def test_bad_step_size_is_refused(family, name, step):
 
 
 @pytest.mark.parametrize("name", list(MODELS))
+def test_a_step_whose_end_time_is_not_finite_is_refused(family, name):
+    """DoStep(1e308, 1e308) ends beyond the largest double: refused like a step size out of range, the model
+    left as it was; the time it reached stays finite, so the next step's check of time going backwards holds."""
+    with family.open(name) as fmu:
+        fmu.initialize()
+        fmu.step(1e-3)
+        before = fmu.get(fmu.outputs())
+        fmu.time = 1e308
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1e308)
+        assert (refused.value.status, refused.value.messages) == (
+            "Discard", ["the communication step from t = 1e+308 s by 1e+308 s ends at a time that is not finite"])
+        assert fmu.get(fmu.outputs()) == before
+        fmu.time = 0.0
+        with pytest.raises(StepRefused) as backwards:
+            fmu.step(1e-3)
+        assert "is before the time the FMU reached, 0.001" in backwards.value.messages[0]
+
+
+@pytest.mark.parametrize("name", list(MODELS))
 def test_initial_outputs_are_those_at_the_start_time(family, name, fmi, native_dir):
     """Initialised at t0 = 5 s (FMI 2.0: fmi2SetupExperiment, FMI 3.0: fmi3EnterInitializationMode),
     the outputs read before the first step are the core's at t0, and the native FMI 2.0 FMU's

@@ -105,3 +105,20 @@ def test_tripod_warm_start_is_rebuilt_or_refused():
     values["_solution"] = (1.0, "x")
     with pytest.raises(ValueError, match="warm start"):
         model.state_from_saved(values)
+
+
+@pytest.mark.parametrize("name, change, reason", [
+    ("SpeedSource", {"omega_out": math.nan}, "output omega_out = nan is not finite"),
+    ("SpeedSource", {"phi_out": -math.inf, "omega_out": 1e300}, "output phi_out = -inf is not finite"),
+    ("SpeedSource", {"time": math.inf}, "time = inf is not finite"),
+    ("UniversalReducer", {"sigma_eq": 2e10}, "output sigma_eq = 20000000000.0 Pa is above its maximum 10000000000.0 Pa"),
+])
+def test_restored_values_the_model_cannot_leave_are_refused(name, change, reason):
+    """A state whose checksum a host remade by hand: its time and outputs are checked as the model leaves them
+    (finite, within their bounds), the first reason named."""
+    model = _stepped(name)
+    values = model.saved_values(model.get_state())
+    values.update(change)
+    with pytest.raises(ValueError) as refused:
+        model.state_from_saved(values)
+    assert str(refused.value) == f"the state holds an impossible value ({reason})"

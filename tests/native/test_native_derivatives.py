@@ -420,3 +420,53 @@ def test_the_kept_jacobian_follows_every_change_of_the_point(native_dir, tmp_pat
     assert np.array_equal(derivatives.exact(model.fmu, "CardanJoint", fmi), first)
     model.fmu.freeFMUState(saved)
     model.close()
+
+
+def _refuse_the_point(model, interface: str, fmi: str) -> None:
+    """A refusal at the instance's point with beta beyond beta_max: a refused step in co-simulation, refused
+    derivatives in Model Exchange."""
+    model.set({"beta": 1.0})
+    with pytest.raises(FMICallException) as refused:
+        if interface == "CoSimulation":
+            model.fmu.doStep(0.0, 1e-3)
+        else:
+            model.derivatives()
+    assert refused.value.status == 2
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+def test_an_earlier_refusal_does_not_refuse_the_kept_jacobian(native_dir, tmp_path, interface, fmi):
+    """The kept Jacobian's point refused in between (a refused step, refused Model Exchange values) and then set
+    again: the derivatives are given with OK, as before, and the refusal's messages are not logged again."""
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    model = ModelExchange(path, fmi, {}, tmp_path, interface=interface)
+    beta = model.get(["beta"])[0]
+    first = derivatives.exact(model.fmu, "CardanJoint", fmi)
+    _refuse_the_point(model, interface, fmi)
+    logged = len(model.log)
+    model.set({"beta": beta})
+    assert np.array_equal(derivatives.exact(model.fmu, "CardanJoint", fmi), first)
+    assert np.array_equal(derivatives.exact(model.fmu, "CardanJoint", fmi, adjoint=fmi == "3"), first)
+    assert len(model.log) == logged
+    model.close()
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+def test_an_overflowing_seed_leaves_the_sensitivities_and_the_next_call_alone(native_dir, tmp_path, interface, fmi):
+    """Seeds of 1e308 overflow the products: Discard with the reason, the sensitivities the host passed left
+    as they were (the layer's promise); the next call at the same point is OK."""
+    path = native.fmu_path(native_dir, "CardanJoint", fmi)
+    model = ModelExchange(path, fmi, {}, tmp_path, interface=interface)
+    rows, columns = derivatives.references("CardanJoint", fmi)
+    first = derivatives.exact(model.fmu, "CardanJoint", fmi)
+    unknowns, knowns = (c_uint * len(rows))(*rows), (c_uint * len(columns))(*columns)
+    seed, sensitivity = (c_double * len(columns))(*[1e308] * len(columns)), (c_double * len(rows))(*[7.0] * len(rows))
+    arguments = ((unknowns, len(rows), knowns, len(columns), seed, len(columns), sensitivity, len(rows)) if fmi == "3"
+                 else (unknowns, len(rows), knowns, len(columns), seed, sensitivity))
+    with pytest.raises(FMICallException) as refused:
+        getattr(model.fmu, f"fmi{fmi}GetDirectionalDerivative")(model.fmu.component, *arguments)
+    assert refused.value.status == 2
+    assert model.log[-1] == "the directional derivative at t = 0.0 s overflows: the seed is too large"
+    assert list(sensitivity) == [7.0] * len(rows)
+    assert np.array_equal(derivatives.exact(model.fmu, "CardanJoint", fmi), first)
+    model.close()

@@ -20,17 +20,19 @@ the output points only, with no restart. At the step's instant an output with di
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
+from ctypes import POINTER, c_double
 
 import numpy as np
 import pytest
-from fmpy import read_model_description, simulate_fmu
+from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native
-from fmu_harness.runs.runner import FmuInstance, StepRefused
+from fmu_harness.runs.runner import FmuInstance, LoggedInstance, StepRefused
 from support.dependency_points import points
 from support.model_exchange import ModelExchange
 
@@ -214,3 +216,73 @@ def test_a_refused_input_is_refused_as_in_co_simulation(native_dir, tmp_path, fm
     model.set({"beta": 0.5})
     assert model.derivatives()[0] == MODELS["CardanJoint"].spec["omega_in"].start
     model.close()
+
+
+def _instance(path, fmi: str, folder) -> tuple[LoggedInstance, list[str]]:
+    """A Model Exchange instance of ``path`` in Initialization Mode, and its log."""
+    log: list[str] = []
+    instance = LoggedInstance(extract(str(path), unzipdir=str(folder)), read_model_description(str(path)),
+                              "ModelExchange", "instance", log.append)
+    enter_initialization_mode(instance.fmu, fmi)
+    return instance, log
+
+
+def enter_initialization_mode(fmu, fmi: str) -> None:
+    if fmi == "3":
+        fmu.enterInitializationMode(startTime=0.0)
+    else:
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+
+
+@pytest.mark.parametrize("mode", ["InitializationMode", "EventMode"])
+@pytest.mark.parametrize("value", [0.3, math.nan])
+def test_the_states_are_set_in_the_modes_the_standard_allows(native_dir, tmp_path, fmi, mode, value):
+    """fmi2SetContinuousStates in continuous-time mode only, fmi3SetContinuousStates in event mode too: in
+    Initialization Mode (where ExitInitializationMode would replace them) and FMI 2.0's event mode, Error with
+    the reason, NaN included, nothing set; in FMI 3.0's event mode a finite state is taken, NaN refused."""
+    instance, log = _instance(_path(native_dir, "CardanJoint", fmi), fmi, tmp_path)
+    fmu, states = instance.fmu, np.zeros(1)
+    if mode == "EventMode":
+        fmu.exitInitializationMode()
+    fmu.getContinuousStates(states.ctypes.data_as(POINTER(c_double)), 1)
+    if mode == "EventMode" and fmi == "3":
+        if math.isfinite(value):
+            assert fmu.setContinuousStates((c_double * 1)(value), 1) == 0
+            states[0] = value
+        else:
+            with pytest.raises(FMICallException) as refused:
+                fmu.setContinuousStates((c_double * 1)(value), 1)
+            assert (refused.value.status, log[-1]) == (
+                2, "the continuous state x[0] (phi_in) = nan is not finite; the states were not set")
+    else:
+        only = " (only in ContinuousTimeMode)" if fmi == "2" else " (only in ContinuousTimeMode or EventMode)"
+        with pytest.raises(FMICallException) as refused:
+            fmu.setContinuousStates((c_double * 1)(value), 1)
+        assert (refused.value.status, log[-1]) == (3, f"fmi{fmi}SetContinuousStates is not allowed in {mode}{only}")
+        fmu.reset()  # the Error state's way out: the states are the start values' again
+        enter_initialization_mode(fmu, fmi)
+        if mode == "EventMode":
+            fmu.exitInitializationMode()
+    got = np.zeros(1)
+    fmu.getContinuousStates(got.ctypes.data_as(POINTER(c_double)), 1)
+    assert got[0] == states[0]
+    fmu.freeInstance()
+    instance.release()
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf])
+def test_a_state_that_is_not_finite_is_refused_and_never_echoed(native_dir, tmp_path, fmi, value):
+    """In continuous-time mode a state that is not finite is refused (Discard, the reason logged), the states
+    left as they were; after an error the values got are still the last ones taken, never the refused state."""
+    model = ModelExchange(_path(native_dir, "CardanJoint", fmi), fmi, {}, tmp_path)
+    before, outputs = model.get_states(), model.get(["phi_in", "phi_out"])
+    with pytest.raises(FMICallException) as refused:
+        model.set_states(np.array([value]))
+    assert refused.value.status == 2
+    assert model.log[-1] == f"the continuous state x[0] (phi_in) = {value!r} is not finite; the states were not set"
+    assert np.array_equal(model.get_states(), before)
+    with pytest.raises(FMICallException):
+        model.fmu.setTime(math.nan)  # misuse: the Error state
+    assert model.get(["phi_in", "phi_out"]) == outputs
+    model.free()

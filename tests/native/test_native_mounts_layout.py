@@ -74,15 +74,24 @@ def test_layout_and_placement_refusals_are_the_python_fmus(native_dir, fmu_path,
         assert expected and found == expected, parameters
 
 
-@pytest.mark.parametrize("step", [1e12, 1e300])
-def test_a_step_beyond_the_work_limit_is_refused_alike(native_dir, fmu_path, fmi, step):
-    """A step whose exponential needs more than MAX_SQUARINGS squarings: the same refusal, and a
-    shorter step after it is taken."""
+@pytest.mark.parametrize("step, reason", [(1e12, "squarings"), (1e300, "squarings"), (1e305, "overflows")])
+def test_a_step_beyond_the_work_limit_is_refused_alike(native_dir, fmu_path, fmi, step, reason):
+    """A step whose exponential needs more than MAX_SQUARINGS squarings, or whose matrix overflows (a step of
+    1e305 s: its norm is infinite, no count of squarings): the same refusal, word for word."""
     found = []
     for path in (fmu_path(NAME, fmi), native.fmu_path(native_dir, NAME, fmi)):
         with FmuInstance(path) as fmu:
             fmu.initialize({"F_z": 100.0})
             with pytest.raises(StepRefused) as refused:
                 fmu.step(step)
-            found.append([m for m in refused.value.messages if "squarings" in m])
-    assert found[0] and found[0] == found[1]
+            found.append(refused.value.messages)
+    assert len(found[0]) == 1 and reason in found[0][0] and found[0] == found[1]
+
+
+def test_progressive_and_rubber_mounts_are_refused_by_name_until_ported(native_dir, fmi):
+    """The rubber layout's keys (read by the Python core and FMUs) are refused by the native FMU at
+    initialisation in one line naming the mount and key, not taken as linear mounts."""
+    rubber = Path(__file__).parents[2] / "driveline" / "mounts" / "data" / "transverse_fwd_powertrain_rubber.toml"
+    found = refusals(native.fmu_path(native_dir, NAME, fmi), {"layout": str(rubber)})
+    assert len(found) == 1 and "mounts[0].dynamic_ratio: progressive and rubber mounts are taken by the Python " \
+        "FMUs only" in found[0]

@@ -66,5 +66,9 @@ class ModelExchange:
 
     def close(self) -> None:
         self.fmu.terminate()
+        self.free()
+
+    def free(self) -> None:
+        """Frees the instance without terminating it (the way out of the Error state)."""
         self.fmu.freeInstance()
         self._instance.release()

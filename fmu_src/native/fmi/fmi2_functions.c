@@ -166,7 +166,7 @@ ON_INSTANCE(fmi2, model_exchange_enter_mode(instance, "EnterEventMode", 1))
 fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo)
 {
     INSTANCE(c, fmi2Error)
-    if (!model_exchange_call(instance, "NewDiscreteStates", eventInfo != NULL)) {
+    if (!model_exchange_call(instance, "NewDiscreteStates", eventInfo != NULL, 1)) {
         return fmi2Error;
     }
     eventInfo->newDiscreteStatesNeeded = fmi2False;
@@ -186,7 +186,7 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
 {
     INSTANCE(c, fmi2Error)
     if (!model_exchange_call(instance, "CompletedIntegratorStep",
-                             enterEventMode != NULL && terminateSimulation != NULL)) {
+                             enterEventMode != NULL && terminateSimulation != NULL, 0)) {
         return fmi2Error;
     }
     *enterEventMode = fmi2False;

@@ -308,7 +308,8 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesN
     if (!model_exchange_call(instance, "UpdateDiscreteStates",
                              discreteStatesNeedUpdate != NULL && terminateSimulation != NULL &&
                                  nominalsOfContinuousStatesChanged != NULL && valuesOfContinuousStatesChanged != NULL &&
-                                 nextEventTimeDefined != NULL && nextEventTime != NULL)) {
+                                 nextEventTimeDefined != NULL && nextEventTime != NULL,
+                             1)) {
         return fmi3Error;
     }
     *discreteStatesNeedUpdate = fmi3False;
@@ -328,7 +329,7 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUState
 {
     INSTANCE(c, fmi3Error)
     if (!model_exchange_call(instance, "CompletedIntegratorStep",
-                             enterEventMode != NULL && terminateSimulation != NULL)) {
+                             enterEventMode != NULL && terminateSimulation != NULL, 0)) {
         return fmi3Error;
     }
     *enterEventMode = fmi3False;

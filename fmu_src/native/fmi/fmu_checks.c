@@ -180,3 +180,26 @@ void output_errors(const ModelData *data, Messages *out, Failure *failure)
     }
 }
 
+
+/* SteppedModel.state_from_saved's check of the values a serialized state restores, as the model could have
+ * left them: the times finite, then every Real output finite, then every output within its bounds. */
+void restored_errors(const ModelData *data, double start_time, Messages *out)
+{
+    char shown[40];
+    int i;
+    if (!isfinite(start_time) || !isfinite(data->time)) {
+        python_float_repr(isfinite(start_time) ? data->time : start_time, shown, sizeof shown);
+        messages_add(out, isfinite(start_time) ? "time = " : "start time = ", shown, " is not finite",
+                     (const char *)NULL);
+        return;
+    }
+    for (i = 0; i < MODEL_REAL_OUTPUT_COUNT; i++) {
+        if (!isfinite(data->real_value[model_real_outputs[i]])) {
+            python_float_repr(data->real_value[model_real_outputs[i]], shown, sizeof shown);
+            messages_add(out, "output ", model_variables[model_real_outputs[i]].name, " = ", shown, " is not finite",
+                         (const char *)NULL);
+            return;
+        }
+    }
+    range_errors(data, CAUSALITY_OUTPUT, out);
+}

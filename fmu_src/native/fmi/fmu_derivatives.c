@@ -185,15 +185,27 @@ Failure jacobian_of_time_alone(const ModelData *data UNUSED, double partial[] UN
 /* d unknowns[u] / d knowns[k] of the call */
 #define ENTRY(u, k) (partial[row_of(instance, unknowns[u]) * MODEL_COLUMN_COUNT + column_of(knowns[k])])
 
+/* sensitivity[i] of the call: row i of J times the seed, or the seed times column i of J (``adjoint``) */
+static double sensitivity_of(Instance *instance, const double *partial, const uint32_t unknowns[],
+                             const uint32_t knowns[], const double seed[], size_t n_seed, size_t i, int adjoint)
+{
+    double value = 0.0;
+    size_t j;
+    for (j = 0; j < n_seed; j++) {
+        if (seed[j] != 0.0) { /* a unit seed's zeros add nothing: a column costs one pass of the rows */
+            value += seed[j] * (adjoint ? ENTRY(j, i) : ENTRY(i, j));
+        }
+    }
+    return value;
+}
+
 Status derivatives_get(Instance *instance, const char *function, const uint32_t unknowns[], size_t n_unknowns,
                        const uint32_t knowns[], size_t n_knowns, const double seed[], size_t n_seed,
                        double sensitivity[], size_t n_sensitivity, int adjoint)
 {
     const double *partial;
-    double value;
     char shown[40];
-    size_t i, j;
-    int finite = 1;
+    size_t i;
     if (model_hooks.jacobian == NULL || model_hooks.evaluate == NULL) {
         return instance_unsupported(instance, function);
     }
@@ -202,24 +214,21 @@ Status derivatives_get(Instance *instance, const char *function, const uint32_t 
                           n_sensitivity, adjoint)) {
         return STATUS_ERROR;
     }
+    instance->messages.count = 0; /* the messages are this call's: an earlier refusal's are not */
     partial = jacobian_now(instance);
     if (partial == NULL) {
         return instance_refusal(instance);
     }
-    for (i = 0; i < n_sensitivity; i++) {
-        value = 0.0;
-        for (j = 0; j < n_seed; j++) {
-            if (seed[j] != 0.0) { /* a unit seed's zeros add nothing: a column costs one pass of the rows */
-                value += seed[j] * (adjoint ? ENTRY(j, i) : ENTRY(i, j));
-            }
+    for (i = 0; i < n_sensitivity; i++) { /* finite partials and seeds whose products overflow: none is written */
+        if (!isfinite(sensitivity_of(instance, partial, unknowns, knowns, seed, n_seed, i, adjoint))) {
+            python_float_repr(instance->data.time, shown, sizeof shown);
+            messages_add(&instance->messages, "the ", adjoint ? "adjoint" : "directional", " derivative at t = ",
+                         shown, " s overflows: the seed is too large", (const char *)NULL);
+            return instance_refusal(instance);
         }
-        sensitivity[i] = value;
-        finite = finite && isfinite(value);
     }
-    if (!finite) { /* finite partials and seeds whose products overflow */
-        python_float_repr(instance->data.time, shown, sizeof shown);
-        messages_add(&instance->messages, "the ", adjoint ? "adjoint" : "directional", " derivative at t = ", shown,
-                     " s overflows: the seed is too large", (const char *)NULL);
+    for (i = 0; i < n_sensitivity; i++) {
+        sensitivity[i] = sensitivity_of(instance, partial, unknowns, knowns, seed, n_seed, i, adjoint);
     }
     return instance_refusal(instance);
 }

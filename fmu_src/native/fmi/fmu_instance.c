@@ -77,6 +77,14 @@ static void step(Instance *instance, double current_time, double step_size)
         messages_add(out, "communication step size must be positive and finite, got ", shown, (const char *)NULL);
         return;
     }
+    if (!isfinite(current_time + step_size)) {
+        char start[40];
+        python_float_repr(current_time, start, sizeof start);
+        python_float_repr(step_size, shown, sizeof shown);
+        messages_add(out, "the communication step from t = ", start, " s by ", shown,
+                     " s ends at a time that is not finite", (const char *)NULL);
+        return;
+    }
     parameter_errors(&instance->data, out);
     input_errors(&instance->data, out);
     if (out->count == 0 && model_hooks.step_size_errors != NULL) {
@@ -232,7 +240,9 @@ Status instance_reset(Instance *instance)
     memset(&instance->data, 0, sizeof instance->data);
     for (i = 0; i < MODEL_VARIABLE_COUNT; i++) {
         instance->data.real_value[i] = model_variables[i].start;
-        instance->data.int_value[i] = (int32_t)model_variables[i].start;
+        if (model_variables[i].type == VAR_INTEGER || model_variables[i].type == VAR_BOOLEAN) {
+            instance->data.int_value[i] = (int32_t)model_variables[i].start; /* an int32 or 0 and 1: exact */
+        }
         instance->data.string_value[i] = strings[i];
     }
     instance->data.cache = &instance->cache;

@@ -247,10 +247,11 @@ void messages_add_extra(Messages *out, const ModelData *data, int message);
 #endif
 
 /* ---- between the layer's modules -------------------------------------------------------- */
-/* fmu_checks.c: SteppedModel.parameter_errors, input_errors, output_errors */
+/* fmu_checks.c: SteppedModel.parameter_errors, input_errors, output_errors, the check of state_from_saved */
 void parameter_errors(const ModelData *data, Messages *out);
 void input_errors(const ModelData *data, Messages *out);
 void output_errors(const ModelData *data, Messages *out, Failure *failure);
+void restored_errors(const ModelData *data, double start_time, Messages *out);
 /* fmu_instance.c and fmu_values.c: String values */
 char *copy_text(const char *text, size_t length);
 void free_strings(char *strings[MODEL_VARIABLE_COUNT]);
@@ -338,9 +339,10 @@ Status model_exchange_get_nominals(Instance *instance, const char *function, dou
 Status model_exchange_get_event_indicators(Instance *instance, const char *function, size_t n);
 /* Enters event mode (``event`` 1) or continuous-time mode (0). */
 Status model_exchange_enter_mode(Instance *instance, const char *function, int event);
-/* 1 when ``function``, of Model Exchange after initialisation, may run now with its output
- * arguments (``outputs_given``: none is NULL); else Error with the reason logged. */
-int model_exchange_call(Instance *instance, const char *function, int outputs_given);
+/* 1 when ``function``, of Model Exchange after initialisation in event mode (``event`` 1) or continuous-time
+ * mode (0), may run now with its output arguments (``outputs_given``: none is NULL); else Error with the
+ * reason logged. */
+int model_exchange_call(Instance *instance, const char *function, int outputs_given, int event);
 /* Error unless the instance is one of the interface's (``model_exchange`` 1: Model Exchange). */
 int instance_is(Instance *instance, int model_exchange, const char *function);
 /* Evaluates the outputs into ``data`` (the instance's values, or a copy of them) at its time, states and

@@ -22,11 +22,13 @@
 #define STATE(data, k) ((data)->real_value[model_states[k]])
 #define DERIVATIVE(data, k) ((data)->real_value[model_state_derivatives[k]])
 #define NOMINAL(k) (model_state_nominals[k])
+#define STATE_NAME(k) (model_variables[model_states[k]].name)
 #else /* no state: the loops over them run zero times */
 #define STATE_SLOTS 1
 #define STATE(data, k) ((data)->real_value[0])
 #define DERIVATIVE(data, k) ((data)->real_value[0])
 #define NOMINAL(k) 1.0
+#define STATE_NAME(k) ""
 #endif
 
 int instance_is(Instance *instance, int model_exchange, const char *function)
@@ -135,11 +137,34 @@ Status model_exchange_set_time(Instance *instance, const char *function, double 
     return STATUS_OK;
 }
 
+/* FMI 2.0 sets the states in continuous-time mode only, FMI 3.0 in event mode too; not before initialisation
+ * ends (ExitInitializationMode computes them from the start values: a state set before would be lost). A
+ * state that is not finite is refused (Discard, none set): no evaluation takes it, and a state kept is one
+ * the host may read back. */
 Status model_exchange_set_states(Instance *instance, const char *function, const double x[], size_t n)
 {
+    char index[24], shown[40];
     int i;
     if (!continuous_allows(instance, function, x, n, MODEL_STATE_COUNT)) {
         return STATUS_ERROR;
+    }
+    if (instance->mode != MODE_STEP || (instance->event_mode && instance->fmi_prefix[3] == '2')) {
+        return instance_fail(instance, instance->fmi_prefix, function, " is not allowed in ",
+                             instance->mode != MODE_STEP ? "InitializationMode" : "EventMode",
+                             instance->fmi_prefix[3] == '2' ? " (only in ContinuousTimeMode)"
+                                                            : " (only in ContinuousTimeMode or EventMode)",
+                             (const char *)NULL);
+    }
+    instance->messages.count = 0;
+    for (i = 0; i < MODEL_STATE_COUNT; i++) {
+        if (!isfinite(x[i])) {
+            snprintf(index, sizeof index, "%d", i);
+            python_float_repr(x[i], shown, sizeof shown);
+            messages_add(&instance->messages, "the continuous state x[", index, "] (",
+                         STATE_NAME(i), ") = ", shown,
+                         " is not finite; the states were not set", (const char *)NULL);
+            return instance_refusal(instance);
+        }
     }
     for (i = 0; i < MODEL_STATE_COUNT; i++) {
         STATE(&instance->data, i) = x[i];
@@ -197,9 +222,22 @@ Status model_exchange_get_event_indicators(Instance *instance, const char *funct
     return continuous_allows(instance, function, "", n, 0) ? STATUS_OK : STATUS_ERROR;
 }
 
-int model_exchange_call(Instance *instance, const char *function, int outputs_given)
+/* 1 when the instance is in event mode (``event`` 1) or continuous-time mode (0); else Error with the reason. */
+static int in_mode(Instance *instance, const char *function, int event)
 {
-    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function)) {
+    if (instance->event_mode == event) {
+        return 1;
+    }
+    instance_fail(instance, instance->fmi_prefix, function, " is not allowed in ",
+                  event ? "ContinuousTimeMode (only in EventMode)" : "EventMode (only in ContinuousTimeMode)",
+                  (const char *)NULL);
+    return 0;
+}
+
+int model_exchange_call(Instance *instance, const char *function, int outputs_given, int event)
+{
+    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function) ||
+        !in_mode(instance, function, event)) {
         return 0;
     }
     if (!outputs_given) {
@@ -209,10 +247,12 @@ int model_exchange_call(Instance *instance, const char *function, int outputs_gi
     return 1;
 }
 
-/* Event mode (``event``) or continuous-time mode: the models have no events, so neither changes a value. */
+/* Event mode (``event``) or continuous-time mode: the models have no events, so neither changes a value.
+ * Continuous-time mode is entered from event mode only. */
 Status model_exchange_enter_mode(Instance *instance, const char *function, int event)
 {
-    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function)) {
+    if (!model_exchange_allows(instance, function) || !instance_allows(instance, MODE_BIT(MODE_STEP), function) ||
+        (!event && !in_mode(instance, function, 1))) {
         return STATUS_ERROR;
     }
     instance->event_mode = event;

@@ -351,6 +351,13 @@ Status state_deserialize(Instance *instance, const char *function, const char *b
     }
     decoded_mode = (Mode)mode;
     decoded.initialized = initialized;
+    instance->messages.count = 0;
+    restored_errors(&decoded, decoded_start, &instance->messages);
+    if (instance->messages.count) { /* a checksum made by hand: the values are checked as the model leaves them */
+        free_strings(decoded.string_value);
+        return instance_fail(instance, instance->fmi_prefix, function, ": refused: the state holds an impossible "
+                             "value (", instance->messages.text[0], ")", (const char *)NULL);
+    }
     target = state_slot(instance, function, *state);
     if (target == NULL) {
         free_strings(decoded.string_value);

@@ -8,8 +8,10 @@
 
 static const char *const TOP_KEYS[] = {"centre_of_gravity", "inertia", "loss_factor_frequency", "mass", "mounts",
                                        "name", NULL};
-static const char *const MOUNT_KEYS[] = {"damping", "label", "loss_factor", "orientation", "position", "stiffness",
-                                         NULL};
+static const char *const MOUNT_KEYS[] = {"damping",  "dynamic_ratio", "gap",       "label",      "loss_factor",
+                                         "orientation", "position",  "stiffness", "stop_blend", "stop_rate", NULL};
+/* The keys of progressive and rubber mounts (layout._stop, layout._branches), not ported yet: refused by name */
+static const char *const RUBBER_KEYS[] = {"dynamic_ratio", "gap", "stop_blend", "stop_rate", NULL};
 
 /* layout._vector */
 static ErrorKind vector3(const Loader *loader, const char *where, const char *key, const Value *value, int signed_,
@@ -89,6 +91,13 @@ static ErrorKind mount(const Loader *loader, int i, const Value *t, double loss_
     snprintf(where, sizeof where, "mounts[%d]", i);
     if ((failed = layout_unknown(loader, where, t, MOUNT_KEYS)) != ERROR_NONE) {
         return failed;
+    }
+    for (k = 0; RUBBER_KEYS[k] != NULL; k++) {
+        if (layout_get(t, RUBBER_KEYS[k]) != NULL) {
+            return layout_error(loader->error, loader->size,
+                                "%s.%s: progressive and rubber mounts are taken by the Python FMUs only so far (the "
+                                "native FMU reads linear mounts)", where, RUBBER_KEYS[k]);
+        }
     }
     for (k = 0; k < 2; k++) {
         if (layout_get(t, required[k]) == NULL) {

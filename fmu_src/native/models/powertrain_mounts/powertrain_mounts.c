@@ -43,7 +43,7 @@ typedef struct {
     Layout layout;
     double mass[6][6], stiffness[6][6], damping[6][6], a[12][12], b[12][6], inputs[6][N_INPUTS];
     double maps[MOUNTS_LAYOUT_MAX_MOUNTS][3][6]; /* each mount's A T(p) */
-    double frequencies[6], shares[6][6], roll_axis[3], motor_axis[3], weight_sag[6];
+    double frequencies[6], shares[6][6], damping_ratios[6], roll_axis[3], motor_axis[3], weight_sag[6];
     int dominant[6];
     int has_propagator;
     Propagator propagator;
@@ -148,7 +148,8 @@ static void matrices(System *s)
     }
 }
 
-/* rigid_body.modes: K phi = w^2 M phi through M = L L^T (Cholesky) and Jacobi on L^-1 K L^-T */
+/* rigid_body.modes: K phi = w^2 M phi through M = L L^T (Cholesky) and Jacobi on L^-1 K L^-T; the damping
+ * ratios of the modal strain energy, phi^T (2 pi f C) phi / (2 phi^T K phi) */
 static void modes(System *s)
 {
     double l[6][6] = {{0}}, c[36], vectors[36], shapes[6][6], momenta[6], w2[6];
@@ -213,8 +214,18 @@ static void modes(System *s)
         }
     }
     for (j = 0; j < 6; j++) {
-        double total = 0.0;
+        double total = 0.0, storage = 0.0, loss = 0.0;
         s->frequencies[j] = sqrt(fmax(w2[order[j]], 0.0)) / (2.0 * FMU_PI);
+        for (i = 0; i < 6; i++) {
+            double stiff = 0.0, damp = 0.0;
+            for (k = 0; k < 6; k++) {
+                stiff += s->stiffness[i][k] * shapes[k][j];
+                damp += 2.0 * FMU_PI * s->frequencies[j] * s->damping[i][k] * shapes[k][j];
+            }
+            storage += shapes[i][j] * stiff;
+            loss += shapes[i][j] * damp;
+        }
+        s->damping_ratios[j] = storage > 0.0 ? loss / (2.0 * storage) : 0.0;
         for (i = 0; i < 6; i++) {
             momenta[i] = 0.0;
             for (k = 0; k < 6; k++) {
@@ -474,7 +485,7 @@ static void augmented(const System *s, double h, double *z)
     }
 }
 
-/* exact_step.squarings */
+/* exact_step.squarings: -1 where the norm is not finite (no count of squarings scales it) */
 static int squarings(const double *z)
 {
     double norm = 0.0;
@@ -486,6 +497,10 @@ static int squarings(const double *z)
         }
         norm = fmax(norm, sum);
     }
+    if (!isfinite(norm)) {
+        return -1;
+    }
+    /* a finite norm needs at most log2(DBL_MAX / THETA_13) + 1 = 1022 squarings: an int holds the count */
     return norm > MOUNTS_EXACT_STEP_THETA_13 ? (int)fmax(0.0, ceil(log2(norm / MOUNTS_EXACT_STEP_THETA_13))) : 0;
 }
 
@@ -502,8 +517,14 @@ static int propagator(System *s, double h)
     e = z + AUGMENTED * AUGMENTED;
     augmented(s, h, z);
     count = squarings(z);
+    python_float_repr(h, step, sizeof step);
+    if (count < 0) {
+        snprintf(s->failure, ERROR_SIZE, "a step of %s s overflows the matrix exponential's norm: take shorter steps",
+                 step);
+        free(z);
+        return 0;
+    }
     if (count > MOUNTS_EXACT_STEP_MAX_SQUARINGS) {
-        python_float_repr(h, step, sizeof step);
         snprintf(s->failure, ERROR_SIZE, "a step of %s s would take %d squarings of the matrix exponential, more than "
                  "the %d accepted: take shorter steps", step, count, MOUNTS_EXACT_STEP_MAX_SQUARINGS);
         free(z);
@@ -605,11 +626,16 @@ static Failure show_analysis(System *s, ModelData *data)
     if (!static_displacement(s, load, sag)) {
         return FAILURE(ERROR_VALUE, "Singular matrix");
     }
+    data->real_value[V_wind_up] = 0.0;
     for (i = 0; i < 6; i++) {
         data->real_value[STATIC_VARIABLES[i]] = sag[i];
     }
+    for (i = 0; i < 3; i++) { /* MountSystem.wind_up */
+        data->real_value[V_wind_up] -= (sag[3 + i] - s->weight_sag[3 + i]) * s->motor_axis[i];
+    }
     for (j = 0; j < 6; j++) {
         data->real_value[V_f_mode_1 + j] = s->frequencies[j];
+        data->real_value[V_zeta_mode_1 + j] = s->damping_ratios[j];
         data->int_value[V_mode_1_coordinate + 2 * j] = s->dominant[j] + 1;
         data->real_value[V_mode_1_share + 2 * j] = s->shares[j][s->dominant[j]];
         for (i = 0; i < 6; i++) {
