@@ -156,7 +156,8 @@ class SteppedModel(ABC):
 
     def start_notice(self) -> str | None:
         """What the log says once, at initialisation, of how the model reads inputs the host left at
-        their start values (a default it may not expect), or None; a warning, not a refusal."""
+        their start values (a default it may not expect), or None; an information line (FMI status OK,
+        category ``logAll``), not a warning: the default gives the right answer."""
         return None
 
     def step_size_errors(self, step_size: float) -> list[str]:
@@ -197,9 +198,12 @@ class SteppedModel(ABC):
 
     def input_errors(self) -> list[str]:
         """As :meth:`parameter_errors`, for the inputs and the relations involving them."""
+        return self.declared_input_errors() or self._guarded(self.extra_input_errors, "the inputs")
+
+    def declared_input_errors(self) -> list[str]:
+        """Each input against its bounds, then the relations involving inputs (the spec's rules alone)."""
         errors = [e for v in self._inputs if (e := self._range_error(v))]
-        errors = errors or [e for r in self._input_relations if (e := self._relation_error(r))]
-        return errors or self._guarded(self.extra_input_errors, "the inputs")
+        return errors or [e for r in self._input_relations if (e := self._relation_error(r))]
 
     @staticmethod
     def _guarded(check: Callable[[], list[str]], what: str) -> list[str]:

@@ -38,8 +38,9 @@ def simulate(models: Path, out: Path) -> list[Path]:
     written = []
     with Progress("main job", len(studies)) as shown:
         for name, study in studies.items():
+            shown.start(name)
             written += study()
-            shown.advance(name)
+            shown.advance(f"{name} done")
     return written
 
 

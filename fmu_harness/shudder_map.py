@@ -33,13 +33,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from driveline.vehicle.compact_car import MOTOR_PEAK_TORQUE
+from driveline.vehicle.compact_car import MASS, MOTOR_PEAK_TORQUE, RATIO, WHEEL_RADIUS
 
 from .console import CommandParser, summary
 from .runs import sweep
 from .runs.system_sweep import DerivedMetrics
-from .studies import figures
-from .studies.order_tracking import third_order_peak
+from .studies.order_tracking import REVOLUTIONS, third_order_peak
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -63,6 +62,27 @@ def pitch_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tu
 THIRD_ORDER = DerivedMetrics((SHAFT, SIGNAL), (PEAK, f"{SIGNAL}_order3_speed"), pitch_third_order)
 
 
+def shortest_duration(torque: float = TORQUE_RANGE[1], revolutions: float = REVOLUTIONS) -> float:
+    """The launch length [s] in which the motor's ``torque`` [N.m] could at best turn the halfshaft
+    ``revolutions`` times: the default car as one rigid mass, the torque a step at t = 0, no road load,
+    no wheel or motor inertia (each makes the car slower; the tyres' slip, under 1 % here, is the only
+    thing faster). The wheel turns ``a t^2 / (4 pi r)`` times at ``a = torque RATIO / (r MASS)``."""
+    acceleration = torque * RATIO / (WHEEL_RADIUS * MASS)
+    return math.sqrt(4.0 * math.pi * WHEEL_RADIUS * revolutions / acceleration)
+
+
+def duration_error(duration: float) -> str | None:
+    """Why ``duration`` [s] is too short for every launch of the map (the strongest one cannot turn the
+    shaft the order tracking window's revolutions: :func:`shortest_duration`); None when it is not, or
+    when it is no positive number (the plan refuses that)."""
+    shortest = shortest_duration()
+    if not (math.isfinite(duration) and 0.0 < duration < shortest):
+        return None
+    return (f"--duration {duration:g} s: the map's strongest launch ({TORQUE_RANGE[1]:g} N.m) turns the halfshaft "
+            f"less than the {REVOLUTIONS:g} revolutions of the order tracking window in it; give at least "
+            f"{math.ceil(shortest * 10.0) / 10.0:g} s (default 4)")
+
+
 def axes(count: int) -> dict[str, list[float]]:
     """The map's grid axes, ``count`` values each, both ends included."""
     return {name: np.linspace(*bounds, count).tolist()
@@ -73,6 +93,8 @@ def draw(table: pa.Table, path: Path) -> Path:
     """A panel per friction coefficient: the peak third-order pitch acceleration [rad/s2] over the bend
     angle [deg] and the launch torque [% of the motor's peak], one colour scale for all panels; a
     failed launch is left blank."""
+    from .studies import figures  # matplotlib, when a figure is drawn: a mistake is refused before it loads
+
     rows = table.to_pylist()
     betas, torques, mus = (sorted({row[name] for row in rows}) for name in (BETA, TORQUE, MU))
     peaks = np.full((len(mus), len(torques), len(betas)), np.nan)
@@ -81,7 +103,8 @@ def draw(table: pa.Table, path: Path) -> Path:
             peaks[mus.index(row[MU]), torques.index(row[TORQUE]), betas.index(row[BETA])] = row[PEAK]
     columns = min(4, len(mus))
     fig, panels = figures.figure(math.ceil(len(mus) / columns), columns, squeeze=False, sharex=True, sharey=True,
-                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6))
+                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6),
+                                 layout="constrained")
     top = np.nanmax(peaks) if np.any(np.isfinite(peaks)) else 1.0
     x, y = np.degrees(betas), 100.0 * np.array(torques) / MOTOR_PEAK_TORQUE
     for k, panel in enumerate(panels.flat):
@@ -89,13 +112,15 @@ def draw(table: pa.Table, path: Path) -> Path:
             panel.set_visible(False)
             continue
         image = panel.pcolormesh(x, y, peaks[k], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
+        panel.set_xlim(x[0], x[-1])  # the grid's range: its outer cells shown to their values, no further
+        panel.set_ylim(y[0], y[-1])
         panel.set_title(f"mu = {mus[k]:.3g}", fontsize=9)
     for panel in panels[-1]:
         panel.set_xlabel("bend angle beta [deg]")
     for panel in panels[:, 0]:
         panel.set_ylabel("launch torque [% of peak]")
     fig.colorbar(image, ax=panels, label="peak 3rd-order pitch acceleration [rad/s2]")
-    fig.suptitle(f"Launch shudder map: {len(rows)} launches of VehicleLaunch, both joints alike")
+    fig.suptitle(f"Launch shudder map: {len(rows)} launches of VehicleLaunch, both joints alike", fontsize=10)
     path.parent.mkdir(parents=True, exist_ok=True)
     return figures.save(fig, path)
 
@@ -112,7 +137,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--workers", type=sweep.workers_count, default=sweep.default_workers(),
                         help="local cluster size")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
-    parser.add_argument("--out", type=Path, default=Path("results") / "shudder_map.parquet", help=".parquet or .csv")
+    parser.add_argument("--out", type=sweep.table_file, default=Path("results") / "shudder_map.parquet",
+                        help=".parquet or .csv")
     parser.add_argument("--figure", type=Path, default=Path("results") / "shudder_map.png", help="PNG file to write")
     parser.add_argument("--figure-only", action="store_true", help="draw the figure from the table at --out")
     args = parser.parse_args(argv)
@@ -123,6 +149,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         return
     if args.count < 2:
         parser.error(f"--count must be at least 2, got {args.count}")
+    too_short = duration_error(args.duration)
+    if too_short:
+        parser.error(too_short)
     try:
         plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count)), args.duration, args.step, args.master,
                                     (THIRD_ORDER,))
@@ -132,12 +161,13 @@ def main(argv: Sequence[str] | None = None) -> None:
         parser.error(str(error))
     table = sweep.run_plan(plan, args.scheduler, args.workers)
     sweep.write_table(table, args.out)
-    print(draw(table, args.figure))
     failed = sweep.failure_reasons(table)
+    if failed.total() < table.num_rows:
+        print(draw(table, args.figure))
     print(f"{table.num_rows} launches, {failed.total()} failed -> {args.out}")
     sweep.print_reasons(failed)
     if failed.total() == table.num_rows:
-        sys.exit(f"{COMMAND}: every launch failed")
+        sys.exit(f"{COMMAND}: every launch failed, no figure drawn")
 
 
 if __name__ == "__main__":

@@ -28,7 +28,7 @@ import numpy as np
 from fmpy import read_model_description
 from fmpy.model_description import ModelDescription
 
-from .console import optional, summary
+from .console import CommandParser, optional, refused, require, summary
 from .runs import ssp_package
 from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
@@ -37,6 +37,7 @@ from .runs.system import run_jacobi, step_limit_error
 from .studies.result_table import write_csv
 
 ENGINES = ("master", "gauss-seidel", "libcosim", "ecos", "model-exchange")
+ENGINE_EXTRAS = {"libcosim": "libcosimpy", "ecos": "ecospy"}  # the module of the interop extra each engine needs
 JACOBI_ENGINES = ("master", "libcosim", "ecos")  # each couples by Jacobi: the inputs of a step are all one step late
 RTOL = 1e-8  # the model-exchange engine's relative tolerance unless --rtol
 PROGRESS_SHARE = 0.1  # a progress line every tenth of the run when stderr is no terminal
@@ -45,13 +46,6 @@ OUTPUT_INTERVAL = 1e-3  # the rows' default interval [s], rounded up to a whole 
 
 class UsageError(ValueError):
     """A mistake in the command line, found before any work starts."""
-
-
-class OneLineParser(argparse.ArgumentParser):
-    """A parser whose refusal of the command line is one line (no usage block) and exit status 2."""
-
-    def error(self, message: str):
-        self.exit(2, f"{self.prog}: error: {message}\n")
 
 
 def _description(path: Path) -> ModelDescription:
@@ -137,7 +131,8 @@ def progress_printer(stop_time: float, stream=sys.stderr) -> Callable[[int, int]
 
 def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Path], outputs: list[str],
                stop_time: float, step_size: float, on_step: Callable[[int, int], None], rtol: float = RTOL) -> np.ndarray:
-    """Rows of time and ``outputs`` for t_1 ... t_N from ``engine`` (``rtol``: Model Exchange's tolerance)."""
+    """Rows of time and ``outputs`` for t_0 = 0 ... t_N from ``engine`` (``rtol``: Model Exchange's tolerance);
+    libcosim's from t_1, as it initialises the FMUs in its first step."""
     steps = int(round(stop_time / step_size))
     if engine == "model-exchange":
         from .runs.model_exchange_system import NotRunnable, run_model_exchange
@@ -145,13 +140,14 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
         with tempfile.TemporaryDirectory(prefix="driveline-model-exchange-") as scratch:
             try:
                 return run_model_exchange(fmus, {c.name: c.parameters for c in system.components}, system.connections,
-                                          stop_time, step_size, outputs, Path(scratch), rtol, on_step)
-            except NotRunnable as refused:
-                raise UsageError(str(refused)) from None
+                                          stop_time, step_size, outputs, Path(scratch), rtol, on_step,
+                                          initial=True)
+            except NotRunnable as not_runnable:
+                raise UsageError(str(not_runnable)) from None
     if engine in ("master", "gauss-seidel"):
         order = [c.name for c in system.components] if engine == "gauss-seidel" else None
         return run_jacobi(fmus, {c.name: c.parameters for c in system.components}, system.connections,
-                          stop_time, step_size, outputs, on_step, order=order)
+                          stop_time, step_size, outputs, on_step, order=order, initial=True)
     from .checks import importers  # the engines of the importer matrix, imported for them alone
 
     if engine == "libcosim":
@@ -159,7 +155,7 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
     else:
         session = importers.ecos_session(step_size, ssp=package, parameter_set=system.parameter_set)
     try:
-        rows = []
+        rows = [] if engine == "libcosim" else [[0.0, *session.get(outputs)]]
         for k in range(steps):
             if session.step() is False:
                 raise StepRefused(f"{engine} step", "refused", k * step_size, [])
@@ -171,7 +167,7 @@ def run_engine(engine: str, package: Path, system: SspSystem, fmus: dict[str, Pa
 
 
 def _arguments(argv: list[str] | None) -> argparse.Namespace:
-    parser = OneLineParser(description=summary(__doc__))
+    parser = CommandParser(description=summary(__doc__))
     parser.add_argument("package", type=Path, help="the SSP package (.ssp)")
     parser.add_argument("--stop-time", type=float, help="end of the run [s] (default: the package's DefaultExperiment)")
     parser.add_argument("--step", type=float, default=1e-3,
@@ -194,6 +190,12 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
 
 def run(args: argparse.Namespace, scratch: Path) -> Path:
     """Check everything, then run and write the CSV file; the file's path."""
+    out = args.out or Path(args.package.name).with_suffix(".csv")
+    if out.is_dir() or not out.parent.is_dir():
+        raise UsageError(f"--out {out}: a folder, not a file to write" if out.is_dir() else
+                         f"--out {out}: no folder {out.parent}")
+    if args.engine in ENGINE_EXTRAS:
+        require(ENGINE_EXTRAS[args.engine], "interop", f"{sys.argv[0]} --engine {args.engine}")
     system = ssp_package.read(args.package)
     stop_time = args.stop_time if args.stop_time is not None else system.stop_time
     if stop_time is None:
@@ -229,9 +231,6 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
     if reason is not None:
         raise UsageError(reason)
     outputs, headers = output_columns(system, descriptions)
-    out = args.out or Path(args.package.name).with_suffix(".csv")
-    if not out.parent.is_dir():
-        raise UsageError(f"--out {out}: no folder {out.parent}")
     # model-exchange: --step is the rows' interval already
     every = 1 if args.engine == "model-exchange" and args.output_interval is None else steps_per_row(
         args.output_interval, args.step)
@@ -239,8 +238,9 @@ def run(args: argparse.Namespace, scratch: Path) -> Path:
         optional("pyarrow", "sweep", "driveline-fmus system --out NAME.parquet")
     rows = run_engine(args.engine, package, system, fmus, outputs, stop_time, args.step, progress_printer(stop_time),
                       args.rtol)
-    kept = rows[every - 1::every]
-    if len(rows) % every:
+    start = 0 if rows[0, 0] == 0.0 else every - 1  # from the row at t = 0 (libcosim's first: t_1)
+    kept = rows[start::every]
+    if (len(rows) - 1 - start) % every:
         kept = np.vstack([kept, rows[-1:]])
     return write_rows(out, ["time [s]", *headers], kept)
 
@@ -271,7 +271,9 @@ def main(argv: list[str] | None = None) -> None:
     try:
         with tempfile.TemporaryDirectory(prefix="driveline-system-") as scratch:
             out = run(args, Path(scratch))
-    except (UsageError, PackageError, StartValuesRefused) as error:
+    except StartValuesRefused as refusal:
+        raise refused(sys.argv[0], str(refusal)) from None
+    except (UsageError, PackageError) as error:
         print(f"{sys.argv[0]}: error: {error}", file=sys.stderr)
         sys.exit(2)
     except StepRefused as error:

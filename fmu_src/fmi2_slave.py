@@ -35,6 +35,7 @@ class ModelSlave(ModelAdapter, Fmi2Slave):
     variabilities = Fmi2Variability
     error_status = Fmi2Status.error
     warning_status = Fmi2Status.warning
+    ok_status = Fmi2Status.ok
     deploy_command = "pythonfmu deploy"
 
     def __init_subclass__(cls, **kwargs: Any) -> None:

@@ -49,6 +49,7 @@ class ModelSlave(ModelAdapter, Fmi3Slave):
     variabilities = Fmi3Variability
     error_status = Fmi3Status.error
     warning_status = Fmi3Status.warning
+    ok_status = Fmi3Status.ok
     deploy_command = "pythonfmu3 deploy"
 
     def __init__(self, **kwargs: Any) -> None:

@@ -40,6 +40,7 @@ _LOG_TEXTS_KEPT = 1024
 #: One category object for every message (the wrappers would build, and leak, a new one each time).
 _ERROR_CATEGORY = "logStatusError"
 _WARNING_CATEGORY = "logStatusWarning"
+_INFO_CATEGORY = "logAll"  # an information line: a default in use, said once
 
 
 class Phase(Enum):
@@ -85,6 +86,7 @@ class ModelAdapter:
     variabilities: ClassVar[type[Enum]]
     error_status: ClassVar[Enum]
     warning_status: ClassVar[Enum]
+    ok_status: ClassVar[Enum]
     author = "driveline-fmus contributors"
     license = "MIT"
     version = __version__
@@ -223,8 +225,8 @@ class ModelAdapter:
             self._fail("exitInitializationMode", reason)
         if errors == []:
             notice = self.model.start_notice()
-            if notice is not None:
-                self.log(self.log_text(notice), self.warning_status, _WARNING_CATEGORY)
+            if notice is not None:  # a default in use: information, not a warning
+                self.log(self.log_text(notice), self.ok_status, _INFO_CATEGORY)
 
     def terminate(self) -> None:
         if self._in_phase("terminate", Phase.STEPPING):

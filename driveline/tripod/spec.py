@@ -140,7 +140,7 @@ SPEC = ModelSpec(
                  "Source of the bend angle's rates: 0 = the inputs beta_dot and beta_ddot, 1 = estimated "
                  "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored), "
                  "2 = automatic: the samples until the host sets beta_dot or beta_ddot non-zero (or their input "
-                 "derivatives), the inputs from then on; a warning at the start while both are 0",
+                 "derivatives), the inputs from then on; an information line at the start while both are 0",
                  type="Integer", min=RATES_FROM_INPUTS, max=RATES_AUTOMATIC),
         Variable("tripod_type", "parameter", PLAIN_TRIPOD,
                  "Joint: 0 = plain tripod (plungers sliding in the grooves, the seed's), 1 = single roller (a roller "

@@ -27,16 +27,30 @@ def snake_case(name: str) -> str:
     return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
 
 
-def members(name: str) -> dict[str, bytes]:
+def members(name: str, platforms: str = "") -> dict[str, bytes]:
     """The ``documentation/`` members of model ``name``'s FMU, by their name in the archive (a
-    model outside the catalog, such as the benchmarks' twins, has no page: the licence alone)."""
+    model outside the catalog, such as the benchmarks' twins, has no page: the licence alone);
+    ``platforms``, a sentence naming the platforms whose binaries the FMU carries, opens the HTML
+    page's text (:func:`with_platforms`)."""
     page = DOCS / f"{snake_case(name)}.md"
     pages = {}
     if page.is_file():
-        text = page.read_text(encoding="utf-8")
+        text = with_platforms(page.read_text(encoding="utf-8"), platforms)
         pages = {"documentation/index.html": to_html(text, page.name).encode(),
                  f"documentation/{page.name}": page.read_bytes()}
     return {**pages, "documentation/licenses/LICENSE.txt": LICENSE.read_bytes()}
+
+
+PLATFORMS_HEADING = "Platforms of this FMU"
+
+
+def with_platforms(markdown: str, platforms: str) -> str:
+    """The page with a section :data:`PLATFORMS_HEADING` holding ``platforms`` after its title; the page
+    as it is without."""
+    if not platforms:
+        return markdown
+    title, _, rest = markdown.partition("\n")
+    return f"{title}\n\n## {PLATFORMS_HEADING}\n\nThis FMU carries {platforms}.\n{rest}"
 
 
 def anchor(heading: str) -> str:

@@ -656,12 +656,13 @@ def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain
     if fmi == "2" and intel in libraries and arm in libraries:
         # FMI 2.0's darwin64 universal: importers on Apple silicon (fmpy among them) look there
         libraries[intel] = toolchain.universal([libraries[intel], libraries[arm]])
+    carried = {f"binaries/{p.folder(fmi)}/{name}{p.suffix}": data for p, data in libraries.items()}
     members = {
         "modelDescription.xml": model_description(MODELS[name].spec, fmi, token, compiled),
-        **{f"binaries/{p.folder(fmi)}/{name}{p.suffix}": data for p, data in libraries.items()},
+        **carried,
         **{f"sources/{source}": data for source, data in sources.items()},
         **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
-        **documentation.members(name),
+        **documentation.members(name, toolchain.platforms_sentence(carried)),
     }
     if fmi == "3":
         members["sources/buildDescription.xml"] = build_description(name, compiled)

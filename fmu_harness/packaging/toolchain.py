@@ -45,6 +45,9 @@ class Platform:
     fmi2: str  # FMI 2.0 binaries folder: the standard's name, FMI 2.0.4's platform tuple beyond them
     zig: str  # zig's target triple
     suffix: str  # of the shared library
+    name: str  # what a host's user calls it
+    oldest: str  # the oldest system the binary runs on
+
 
     @property
     def system(self) -> str:
@@ -55,13 +58,44 @@ class Platform:
 
 
 PLATFORMS = (
-    Platform("x86_64-linux", "linux64", f"x86_64-linux-gnu.{GLIBC}", ".so"),
-    Platform("x86_64-windows", "win64", "x86_64-windows-gnu", ".dll"),
-    Platform("aarch64-linux", "aarch64-linux", f"aarch64-linux-gnu.{GLIBC}", ".so"),
-    Platform("x86_64-darwin", "darwin64", f"x86_64-macos.{MACOS}", ".dylib"),
-    Platform("aarch64-darwin", "aarch64-darwin", f"aarch64-macos.{MACOS}", ".dylib"),
+    Platform("x86_64-linux", "linux64", f"x86_64-linux-gnu.{GLIBC}", ".so", "x86_64 Linux", f"glibc {GLIBC}"),
+    Platform("x86_64-windows", "win64", "x86_64-windows-gnu", ".dll", "x86_64 Windows", "Windows 10"),
+    Platform("aarch64-linux", "aarch64-linux", f"aarch64-linux-gnu.{GLIBC}", ".so", "aarch64 Linux", f"glibc {GLIBC}"),
+    Platform("x86_64-darwin", "darwin64", f"x86_64-macos.{MACOS}", ".dylib", "x86_64 macOS", "macOS 11"),
+    Platform("aarch64-darwin", "aarch64-darwin", f"aarch64-macos.{MACOS}", ".dylib", "aarch64 macOS", "macOS 11"),
 )
 BY_TUPLE = {p.tuple: p for p in PLATFORMS}
+RELEASE_COMMAND = "python build_fmu.py --all-platforms"
+"""The one command that builds the native FMUs to hand on: every one with the binaries of :data:`PLATFORMS`."""
+
+
+def carried_platforms(members: Iterable[str]) -> tuple[list[Platform], list[str]]:
+    """The platforms whose binaries an FMU's archive ``members`` (its file names) hold, in the order of
+    :data:`PLATFORMS`, and the folders of ``binaries/`` that name none of them (another tool's FMU)."""
+    members = list(members)
+    folders = {parts[1] for parts in (name.split("/") for name in members)
+               if len(parts) > 2 and parts[0] == "binaries" and parts[2]}
+    known = [p for p in PLATFORMS if {p.tuple, p.fmi2} & folders]
+    return known, sorted(folders - {folder for p in known for folder in (p.tuple, p.fmi2)})
+
+
+def platforms_sentence(members: Iterable[str]) -> str:
+    """Which platforms' binaries an FMU carries, by its archive's ``members`` (file names), each with the
+    oldest system it runs on; for a native FMU (C sources in ``sources/``) lacking some, the command that
+    adds them, for a Python FMU what its host needs besides."""
+    members = list(members)
+    known, others = carried_platforms(members)
+    native = any(name.startswith("sources/") and name.endswith(".c") for name in members)
+    names = [f"{p.name} ({p.oldest} or newer)" if native else p.name for p in known] + others
+    carried = f"binaries for {_joined(names)}" if names else "no binary"
+    if not native:
+        return f"{carried}; a Python FMU: the host needs Python with numpy and scipy"
+    missing = [p.name for p in PLATFORMS if p not in known]
+    return f"{carried}{f' only; `{RELEASE_COMMAND}` adds {_joined(missing)}' if missing else ''}"
+
+
+def _joined(names: Sequence[str]) -> str:
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
 
 
 def host_platform() -> Platform | None:

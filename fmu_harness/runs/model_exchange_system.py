@@ -359,8 +359,9 @@ class ModelExchangeSystem:
 def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, object]],
                        connections: Sequence[tuple[Port, Port]], stop_time: float, interval: float,
                        outputs: list[str], scratch: Path, rtol: float = 1e-8,
-                       on_step: Callable[[int, int], None] | None = None, method: str = "DOP853") -> np.ndarray:
-    """Rows of t_k = k ``interval`` (k = 1 ... N) and ``outputs`` (``"instance.variable"``) of the system
+                       on_step: Callable[[int, int], None] | None = None, method: str = "DOP853",
+                       initial: bool = False) -> np.ndarray:
+    """Rows of t_k = k ``interval`` (k = 1 ... N, from k = 0 with ``initial``) and ``outputs`` (``"instance.variable"``) of the system
     integrated by ``method`` (:data:`METHODS`; the implicit ones with :meth:`ModelExchangeSystem.jacobian`)
     at relative tolerance ``rtol``, step by step (``completedIntegratorStep`` after each), the rows from
     its dense output; ``on_step(k, N)`` after each integrator step with the rows done."""
@@ -374,8 +375,10 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
         if lacking:
             raise NotRunnable(f"{method} needs the system's Jacobian, and {', '.join(lacking)} "
                               f"{'gives' if len(lacking) == 1 else 'give'} no directional derivatives")
-        solver = METHODS[method](system.rates, 0.0, system.start(), times[-1], rtol=rtol, atol=ATOL, **exact)
+        start = system.start()
+        solver = METHODS[method](system.rates, 0.0, start, times[-1], rtol=rtol, atol=ATOL, **exact)
         rows: list[list[float]] = []
+        first = [[0.0, *system.outputs(0.0, start, ports)]] if initial else []
         while len(rows) < count:
             message = solver.step()
             if solver.status == "failed":
@@ -386,6 +389,6 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
             system.completed_step(end, solver.y)
             if on_step is not None:
                 on_step(len(rows), count)
-        return np.array(rows)
+        return np.array(first + rows)
     finally:
         system.close()

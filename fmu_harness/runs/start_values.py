@@ -9,13 +9,14 @@ catalog model of each FMU, whose checks (the spec's bounds and relations, then t
 the FMUs run, and stops with the first reason.
 
 Usage: ``driveline-fmus check TARGET [NAME=VALUE ...]``, TARGET an SSP package (its parameter
-bindings) or an FMU (the values given, ``beta=0.3``): prints what would be refused in one line
-and exits with 1, or prints that every start value is accepted.
+bindings) or an FMU (the values given, ``beta=0.3``): prints what would be refused in one line,
+``driveline-fmus check: refused: instance (Model): reason``, and exits with 1 (as ``driveline-fmus
+system`` does for the same values), or prints that every start value is accepted and the platforms
+whose binaries each FMU carries (the folders of its ``binaries/``).
 """
 
 from __future__ import annotations
 
-import argparse
 import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -29,7 +30,8 @@ from driveline.catalog import MODELS
 
 from .ssp import bindings
 from .ssp_package import read
-from ..console import summary
+from ..console import CommandParser, refused, summary
+from ..packaging.toolchain import platforms_sentence
 
 _KINDS = {"Real": float, "Integer": int, "Boolean": lambda text: str(text).lower() in ("true", "1"), "String": str}
 
@@ -54,8 +56,8 @@ def refusals(model: str, values: Mapping[str, Any], declared_only: bool = False)
     inputs' (an input's start value beyond its bounds or relations, ``beta`` above ``beta_max``, is
     refused at ``ExitInitializationMode`` too; an input left out is at its declared start); [] when
     it takes them or when the model is not in the catalog (nothing to check it with).
-    ``declared_only``: the spec's bounds and relations between parameters alone, not the model's
-    own checks (``CriticalSpeeds`` analyses the structure there, 0.04 to 0.5 s)."""
+    ``declared_only``: the spec's bounds and relations alone, of the parameters and then of the inputs,
+    not the model's own checks (``CriticalSpeeds`` analyses the structure there, 0.04 to 0.5 s)."""
     model_class = MODELS.get(model)
     if model_class is None:
         return []
@@ -68,7 +70,9 @@ def refusals(model: str, values: Mapping[str, Any], declared_only: bool = False)
             setattr(core, name, _KINDS[variable.type](value))
         except (TypeError, ValueError):
             return [f"{name} = {value!r} is not of type {variable.type}"]
-    return core.declared_parameter_errors() if declared_only else core.parameter_errors() + core.input_errors()
+    if declared_only:
+        return core.declared_parameter_errors() or core.declared_input_errors()
+    return core.parameter_errors() + core.input_errors()
 
 
 def check_start_values(instances: list[Instance]) -> None:
@@ -112,14 +116,14 @@ def _connected_inputs(instances: list[Instance], connections: list[tuple[tuple[s
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=summary(__doc__))
+    parser = CommandParser(description=summary(__doc__))
     parser.add_argument("target", type=Path, help="an SSP package or an FMU")
     parser.add_argument("values", nargs="*", metavar="NAME=VALUE", help="start values of an FMU")
     args = parser.parse_args(argv)
     if any("=" not in value for value in args.values) or (args.values and args.target.suffix.lower() == ".ssp"):
         parser.error("start values are NAME=VALUE, for an FMU (an SSP package brings its own)")
     if not args.target.is_file():
-        parser.exit(1, f"{args.target}: no such file\n")
+        parser.error(f"{args.target}: no such file")
     try:
         values = {f"{args.target.stem}.{value.partition('=')[0]}": value.partition("=")[2] for value in args.values}
         if args.target.suffix.lower() == ".ssp":
@@ -127,11 +131,26 @@ def main(argv: list[str] | None = None) -> None:
         else:
             instances = engine_instances({args.target.stem: args.target}, start_values=values)
         check_start_values(instances)
-    except StartValuesRefused as refused:
-        parser.exit(1, f"refused: {refused}\n")
+    except StartValuesRefused as refusal:
+        raise refused(parser.prog, str(refusal)) from None
     except (OSError, KeyError, ValueError, zipfile.BadZipFile, ET.ParseError) as error:
-        parser.exit(1, f"{args.target}: cannot be read ({type(error).__name__}: {error})\n")
+        parser.error(f"{args.target}: cannot be read ({type(error).__name__}: {error})")
     print(f"{args.target}: every start value accepted ({', '.join(i.name for i in instances)})")
+    for fmu, members in fmu_members(args.target).items():
+        print(f"{fmu}: {platforms_sentence(members)}")
+
+
+def fmu_members(target: Path) -> dict[str, list[str]]:
+    """The file names in each FMU of ``target``: an FMU's own, or those of every FMU an SSP package holds
+    (by its path in the package)."""
+    with zipfile.ZipFile(target) as archive:
+        if target.suffix.lower() != ".ssp":
+            return {target.name: archive.namelist()}
+        found = {}
+        for name in sorted(n for n in archive.namelist() if n.lower().endswith(".fmu")):
+            with archive.open(name) as data, zipfile.ZipFile(data) as fmu:
+                found[name] = fmu.namelist()
+        return found
 
 
 if __name__ == "__main__":

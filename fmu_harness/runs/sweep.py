@@ -57,7 +57,7 @@ from fmpy.model_description import ModelDescription
 
 from driveline.catalog import MODELS
 
-from ..console import CommandParser, Progress, optional, summary
+from ..console import CommandParser, Progress, optional, refused, summary
 from .runner import StepRefused, simulate
 from .start_values import refusals
 from .system_sweep import (
@@ -574,6 +574,19 @@ def check_scheduler(address: str, seconds: float = CONNECT_SECONDS) -> None:
         raise ValueError(f"--scheduler {address}: no scheduler answers there ({error.strerror or error})") from None
 
 
+TABLE_SUFFIXES = (".parquet", ".csv")
+
+
+def table_file(text: str) -> Path:
+    """An argparse type: the file a sweep's table goes to, Parquet or CSV by its suffix."""
+    path = Path(text)
+    if path.suffix.lower() not in TABLE_SUFFIXES:
+        raise argparse.ArgumentTypeError(f"{text}: write a .parquet or a .csv file")
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: a folder, not a file to write")
+    return path
+
+
 def workers_count(text: str) -> int:
     """An argparse type: the number of local workers, at least 1."""
     try:
@@ -607,8 +620,10 @@ def run_plan(plan: Plan, scheduler: str | None, workers: int) -> pa.Table:
     with progress; ends the command first when every point is refused (naming the reasons) or an
     optional package the run needs is missing."""
     if len(plan.refused) == len(plan.points):
-        print_reasons(Counter(plan.refused.values()))
-        sys.exit(f"{COMMAND}: every point refused, none run")
+        reasons = Counter(plan.refused.values())
+        more = len(reasons) - 1
+        raise refused(COMMAND, f"every point, none run: {reasons.most_common(1)[0][0]}"
+                               + (f" (and {more} more reason{'s' * (more > 1)})" if more else ""))
     optional("pyarrow", EXTRA, COMMAND)  # before the cluster starts
     if isinstance(plan.fmu, ShippedSystem) and plan.fmu.master == "libcosim":
         optional("libcosimpy", "interop", f"{COMMAND} --master libcosim")
@@ -635,7 +650,7 @@ def main(argv: list[str] | None = None) -> None:
     swept.add_argument("--system", type=Path, help="an SSP package: names are component.variable, joined by +")
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
     parser.add_argument("--turns", type=int, default=1, help=f"run length in turns of {SPEED} (default 1)")
-    parser.add_argument("--steps-per-turn", type=int, default=360)
+    parser.add_argument("--steps-per-turn", type=int, default=360, help="steps of one turn of the run")
     parser.add_argument("--duration", type=float,
                         help="run length [s] instead of whole turns (of a system: instead of its stop time)")
     parser.add_argument("--step", type=float, help="communication step size [s] (needed by a system)")
@@ -646,7 +661,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--layout", default="", help="driveline of the critical-speed margin: TOML file or shipped name"
     )
-    parser.add_argument("--out", type=Path, default=Path("results/sweep.parquet"), help=".parquet or .csv")
+    parser.add_argument("--out", type=table_file, default=Path("results/sweep.parquet"), help=".parquet or .csv")
     args = parser.parse_args(argv)
 
     try:

@@ -315,10 +315,10 @@ def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, o
                connections: Collection[tuple[Port, Port]], stop_time: float, step_size: float,
                outputs: list[str], on_step: Callable[[int, int], None] | None = None,
                order: Sequence[str] | None = None,
-               unpacked: Mapping[str, tuple[str, ModelDescription]] | None = None) -> np.ndarray:
+               unpacked: Mapping[str, tuple[str, ModelDescription]] | None = None, initial: bool = False) -> np.ndarray:
     """The fixed-step Jacobi master: instances ``{name: FMU}`` with their start values, connections
     ``((instance, output), (instance, input))``; rows of t_k and ``outputs`` (``"instance.variable"``)
-    for t_1 ... t_N. ``on_step(k, N)`` is called after each step. A refused step or initialisation
+    for t_1 ... t_N, from t_0 = 0 (the outputs after initialisation) with ``initial``. ``on_step(k, N)`` is called after each step. A refused step or initialisation
     raises :class:`StepRefused` with the instance's name before its reasons. With ``order`` (every instance's
     name) it is a Gauss-Seidel master instead: the instances step one after the other in that order,
     each with its inputs set just before from the outputs as they are then (those of the instances
@@ -345,7 +345,7 @@ def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, o
         steps = int(round(stop_time / step_size))
         groups = [list(instances)] if order is None else [[name] for name in order]
         sweeps = [(group, Transfer(instances, [c for c in connections if c[1][0] in group])) for group in groups]
-        rows = []
+        rows = [record()] if initial else []
         for k in range(steps):
             for group, transfer in sweeps:
                 transfer()
@@ -353,8 +353,8 @@ def run_jacobi(fmus: Mapping[str, Path], parameters: Mapping[str, Mapping[str, o
             rows.append(record())
             if on_step is not None:
                 on_step(k + 1, steps)
-        times = (np.arange(steps) + 1.0) * step_size
-        return np.column_stack([times, np.array(rows, dtype=float).reshape(steps, len(outputs))[:, columns]])
+        times = (np.arange(len(rows)) + (0.0 if initial else 1.0)) * step_size
+        return np.column_stack([times, np.array(rows, dtype=float).reshape(len(rows), len(outputs))[:, columns]])
     finally:
         for instance in instances.values():
             instance.close()

@@ -46,7 +46,8 @@ COUPLINGS = (
 
 
 def fluctuation_and_order(omega_out: np.ndarray) -> tuple[float, int | None]:
-    """(max - min) / mean of a speed sampled uniformly over one input turn, and its dominant order."""
+    """(max - min) / mean of a speed sampled uniformly over one input turn, and its dominant order
+    (None under :data:`NO_ORDER_BELOW`, written 0 in the CSV file: a constant speed)."""
     mean = float(np.mean(omega_out))
     fluctuation = float((omega_out.max() - omega_out.min()) / mean)
     if fluctuation < NO_ORDER_BELOW:
@@ -79,8 +80,8 @@ def write(models: Path, out: Path, betas_deg: list[float] | None = None) -> list
     betas_deg = betas_deg or [5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 45.0]
     rows = speed_fluctuation_table(models, betas_deg)
     out.mkdir(parents=True, exist_ok=True)
-    table = write_csv(out / "coupling_comparison.csv", ("beta [deg]", "coupling [name]", "fluctuation [1]", "order [1]"),
-                      ((r["beta_deg"], r["coupling"], r["fluctuation"], r["order"] or "") for r in rows))
+    table = write_csv(out / "coupling_comparison.csv", ("beta [deg]", "coupling", "fluctuation [1]", "order [1]"),
+                      ((r["beta_deg"], r["coupling"], r["fluctuation"], r["order"] or 0) for r in rows))
     markdown = out / "coupling_comparison.md"
     lines = ["| beta [deg] | " + " | ".join(c.name for c in COUPLINGS) + " |", "|---" * (len(COUPLINGS) + 1) + "|"]
     for beta_deg in betas_deg:

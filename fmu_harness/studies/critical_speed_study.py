@@ -19,7 +19,7 @@ from driveline.rotor.model import SHAFT_PARAMETERS, build_driveline
 from driveline.rotor.spec import SPEC
 
 from ..runs.runner import FmuInstance
-from .figures import figure, save
+from .figures import BLUE, ORANGE, VERMILLION, clear_of_lines, figure, save
 from .result_table import column, write_csv
 
 RPM = 30.0 / math.pi
@@ -31,13 +31,13 @@ STEPS = 300
 #: Relative detunings sampled on both sides of each critical speed besides the ramp's equal steps:
 #: the unbalance response's peak at the first critical is 0.4 % wide at half its height.
 DETUNINGS = np.geomspace(1e-5, 0.03, 30)
-SENSES = {"forward": ("tab:blue", "-", "o"), "backward": ("tab:orange", "--", "s")}  # colour, line, marker
+SENSES = {"forward": (BLUE, "-", "o"), "backward": (ORANGE, "--", "s")}  # colour, line, marker
 #: Crossing marks, nested where they meet: a backward crossing's filled square on top, inside a
 #: forward crossing's ring or a critical speed's larger red ring (the backward 1x crossings lie
 #: within 3 % of the critical speeds).
-MARKS = {"critical": {"marker": "o", "ms": 12, "mfc": "none", "mec": "red", "mew": 2.0, "zorder": 5},
-         "forward": {"marker": "o", "ms": 8, "mfc": "none", "mec": "tab:blue", "mew": 1.4, "zorder": 6},
-         "backward": {"marker": "s", "ms": 5, "mfc": "tab:orange", "mec": "tab:orange", "zorder": 7}}
+MARKS = {"critical": {"marker": "o", "ms": 12, "mfc": "none", "mec": VERMILLION, "mew": 2.0, "zorder": 5},
+         "forward": {"marker": "o", "ms": 8, "mfc": "none", "mec": BLUE, "mew": 1.4, "zorder": 6},
+         "backward": {"marker": "s", "ms": 5, "mfc": ORANGE, "mec": ORANGE, "zorder": 7}}
 
 
 def critical_speeds(fmu: Path) -> tuple[float, ...]:
@@ -100,7 +100,7 @@ def write(fmu: Path, out: Path) -> list[Path]:
     result = ramp(fmu, ramp_speeds(BEYOND * max(criticals), criticals))
     table = write_csv(out / "critical_speeds.csv",
                       ("mode [1]", "critical speed [rad/s]", "critical speed [rpm]"),
-                      ((k, f"{w:.6g}", f"{w * RPM:.6g}") for k, w in enumerate(criticals, start=1)))
+                      ((k, float(f"{w:.6g}"), float(f"{w * RPM:.6g}")) for k, w in enumerate(criticals, start=1)))
     names = result.dtype.names
     ramp_csv = write_csv(out / "critical_speeds_ramp.csv", ("time [s]", *(column(SPEC, n) for n in names[1:])),
                          result.tolist())
@@ -122,6 +122,7 @@ def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray]
         label = {1: f"{sense} whirl, modes 1-{MODES} (FMU)", MODES + 1: f"{sense} whirl, mode {mode} (rotor core)"}
         ax.plot(spins * RPM, values * RPM, style, color=color, lw=1.6 if from_fmu else 1.1,
                 alpha=1.0 if from_fmu else 0.75, label=label.get(mode, f"_{sense} whirl, mode {mode}"))
+    labels = []
     for (sense, mode), values in whirl.items():
         color = SENSES[sense][0]
         for order in ORDERS:
@@ -129,10 +130,10 @@ def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray]
                 critical = order == 1 and sense == "forward"
                 ax.plot(speed * RPM, order * speed * RPM, ls="none", **MARKS["critical" if critical else sense],
                         label=f"_{'critical speed' if critical else sense} {order}x, mode {mode}")  # not in the legend
-                ax.annotate(f"{speed * RPM:.0f}", (speed * RPM, order * speed * RPM),
-                            xytext=(5, -11) if sense == "forward" else (-5, 4), textcoords="offset points",
-                            ha="left" if sense == "forward" else "right", fontsize=7.5,
-                            color="red" if critical else color, fontweight="bold" if critical else "normal")
+                labels.append((ax.annotate(f"{speed * RPM:.0f}", (speed * RPM, order * speed * RPM),
+                                           xytext=(0, 0), textcoords="offset points", ha="center", va="center",
+                                           fontsize=7.5, color=VERMILLION if critical else color,
+                                           fontweight="bold" if critical else "normal"), sense))
     for mark, label in (("critical", "critical speed (1x, forward) [rpm]"), ("forward", "order resonance, forward [rpm]"),
                         ("backward", "order resonance, backward [rpm]")):
         ax.plot([], [], ls="none", **MARKS[mark], label=label)
@@ -152,4 +153,9 @@ def campbell_figure(result: np.ndarray, whirl: dict[tuple[str, int], np.ndarray]
         angle = ax.transData.transform_angles(np.array([math.degrees(math.atan(order))]), at[None, :])[0]
         ax.annotate(f"{order}x", at, xytext=(-4, 4), textcoords="offset points", fontsize=10, color="0.2",
                     ha="right", va="bottom", rotation=angle, rotation_mode="anchor")
+    fig.canvas.draw()
+    for label, sense in labels:  # each crossing's speed beside its mark, where no line crosses it
+        below, above = (-1, 1) if sense == "forward" else (1, -1)  # forward speeds first below, backward above
+        clear_of_lines(ax, label, [{"xyann": (x, y)} for y in (12 * below, 12 * above, 22 * below, 22 * above)
+                                   for x in (24, -24, 40, -40)])
     return fig

@@ -34,7 +34,7 @@ from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody, modes
 from ..runs import ssp_package
 from ..runs.system import LAUNCH_ORDER, run_jacobi
 from . import order_tracking
-from .figures import figure, save
+from .figures import BLUE, ORANGE, PALETTE, SKY, YELLOW, clear_of_lines, figure, save
 from .result_table import write_csv
 
 TORQUE = 20.0  # motor torque after the ramp [N.m]
@@ -90,7 +90,8 @@ def run(package: Path, torque: float = TORQUE, stop_time: float = STOP_TIME, ste
         with zipfile.ZipFile(package) as archive:
             archive.extractall(scratch)
         fmus = {c.name: Path(scratch) / c.source for c in system.components}
-        rows = run_jacobi(fmus, parameters, system.connections, stop_time, step, outputs, order=LAUNCH_ORDER)
+        rows = run_jacobi(fmus, parameters, system.connections, stop_time, step, outputs, order=LAUNCH_ORDER,
+                          initial=True)
     return Launch(rows[:, 0], {name: rows[:, k + 1] for k, name in enumerate(outputs)})
 
 
@@ -169,15 +170,41 @@ def third_order_peaks(launch: Launch) -> tuple[list[Peak], np.ndarray, np.ndarra
     return peaks, speeds, amplitudes
 
 
+PEAK_COLUMNS = ("mode [1]", "f_mode [Hz]", "dominant", "damping_ratio [1]", "crossing_speed [rad/s]", "crossing",
+                "peak_speed [rad/s]", "difference [%]", "swept_peak_speed [rad/s]", "peak_amplitude [m/s2 or rad/s2]")
+"""launch_shudder_peaks.csv: ``crossing`` says whether the launch reaches the mode's crossing; where it
+does not, the peak's columns hold the launch's end (its last tracked speed and the amplitude there)."""
+
+
+def peak_row(peak: Peak, end_speed: float, end_amplitude: float) -> tuple:
+    """A row of :data:`PEAK_COLUMNS`: ``end_speed`` [rad/s] and ``end_amplitude``, the order tracking's last
+    speed and the mode's amplitude there, stand for a peak the launch does not reach."""
+    if peak.measured is not None:
+        return (peak.mode, peak.frequency, peak.coordinate, peak.damping, peak.crossing, "reached",
+                peak.measured[1], peak.difference, peak.swept, peak.measured[0])
+    return (peak.mode, peak.frequency, peak.coordinate, peak.damping, peak.crossing,
+            f"not reached: the launch ends at {end_speed:.1f} rad/s", end_speed,
+            100.0 * (end_speed / peak.crossing - 1.0), end_speed, end_amplitude)
+
+
+TAKE_OFF = 2.0  # the torque panel's span [s]: the ramp and the halfshafts' wind-up, then the torques hold
+
+
 def speed_torque_figure(launch: Launch) -> Figure:
-    """Vehicle speed and both halfshaft torques over time."""
-    fig, (speed, torque) = figure(2, 1, figsize=(8, 6), sharex=True)
-    speed.plot(launch.time, launch.values["drive.v_x"] * KMH, color="tab:blue", label="vehicle speed")
+    """Vehicle speed over the launch; both halfshaft torques over the take-off, where they change."""
+    fig, (speed, torque) = figure(2, 1, figsize=(8, 6.4))
+    speed.plot(launch.time, launch.values["drive.v_x"] * KMH, color=BLUE, label="vehicle speed")
     speed.set_ylabel("vehicle speed [km/h]")
+    speed.set_xlabel("time [s]")
+    speed.set_xlim(launch.time[0], launch.time[-1])
     speed.set_title(f"Launch from standstill, motor torque ramped to {TORQUE:g} N.m: vehicle speed", fontsize=10)
-    for side, color in (("left", "tab:red"), ("right", "tab:green")):
-        torque.plot(launch.time, launch.values[f"drive.T_load_{side}"], color=color, lw=0.8, label=f"{side} halfshaft")
-    torque.set_title("Halfshaft torques, each in its joint's frame (the right one turns negatively)", fontsize=10)
+    early = launch.time <= min(TAKE_OFF, launch.time[-1])
+    for side, color, style in (("left", BLUE, "-"), ("right", ORANGE, "--")):
+        torque.plot(launch.time[early], launch.values[f"drive.T_load_{side}"][early], style, color=color, lw=1.0,
+                    label=f"{side} halfshaft")
+    torque.set_xlim(launch.time[0], launch.time[early][-1])
+    torque.set_title(f"Halfshaft torques over the first {launch.time[early][-1]:.3g} s (held after), each in its "
+                     "joint's frame: the right one turns negatively", fontsize=9)
     torque.set_ylabel("T_load [N.m]")
     torque.set_xlabel("time [s]")
     torque.legend(loc="center right")
@@ -188,21 +215,33 @@ def speed_torque_figure(launch: Launch) -> Figure:
 
 
 def axial_force_figure(launch: Launch) -> Figure:
-    """Both joints' generated axial force -Rz_in over the halfshaft speed, with its third-order amplitude."""
-    fig, axes = figure(2, 1, figsize=(8, 6), sharex=True)
+    """Both joints' generated axial force -Rz_in: its third-order amplitude over the halfshaft speed, and
+    its shape over the launch's last turn."""
+    fig, (orders, turn) = figure(2, 1, figsize=(8, 6.4))
     omega = order_tracking.shaft_speed(launch.time, launch.shaft_angle)
-    for ax, side, color in zip(axes, ("left", "right"), ("tab:red", "tab:green")):
+    top = 0.0
+    for side, color, style in (("left", BLUE, "-"), ("right", ORANGE, "--")):
         force = -launch.values[f"joint_{side}.Rz_in"]
-        ax.plot(omega, force, color=color, lw=0.4, label=f"-Rz_in, {side} joint")
         speeds, amplitude = order_tracking.order_track(launch.time, launch.shaft_angle, force, 3)
-        ax.plot(speeds, amplitude, color="black", lw=1.6, label="its third-order amplitude")
-        ax.set_ylim(-1.5 * amplitude.max(), 1.6 * amplitude.max())
-        ax.set_ylabel("generated axial force [N]")
-        ax.set_title(f"Generated axial force of the {side} joint (friction's sign follows the sliding: "
-                     "its third order is 4/pi of its peak)", fontsize=9)
-        ax.legend(loc="upper center", ncols=2, fontsize=8)
+        orders.plot(speeds, amplitude, style, color=color, lw=1.4, label=f"{side} joint")
+        top = max(top, amplitude.max())
+        angle = np.abs(launch.values[f"joint_{side}.phi_out"])
+        last = angle >= angle[-1] - 2.0 * np.pi
+        turn.plot(np.degrees(angle[last] - angle[last][0]), force[last], style, color=color, lw=1.2,
+                  label=f"{side} joint")
+    orders.set_xlim(speeds[0], speeds[-1])
+    orders.set_ylim(0.0, 1.15 * top)
+    orders.set_xlabel("left halfshaft speed [rad/s] (the right one turns as fast, negatively)")
+    orders.set_ylabel("third-order amplitude [N]")
+    orders.set_title("Generated axial force -Rz_in, third order (friction's sign follows the sliding: 4/pi of "
+                     "its peak)", fontsize=9)
+    turn.set_xlim(0.0, 360.0)
+    turn.set_xlabel("shaft angle over the launch's last turn [deg]")
+    turn.set_ylabel("-Rz_in [N]")
+    turn.set_title(f"Its shape over the last turn, at {omega[-1]:.1f} rad/s", fontsize=9)
+    orders.legend(loc="lower right", fontsize=8)  # one legend: both panels draw the joints alike
+    for ax in (orders, turn):
         ax.grid(alpha=0.3)
-    axes[-1].set_xlabel("left halfshaft speed [rad/s] (the right one turns as fast, negatively)")
     fig.tight_layout()
     return fig
 
@@ -222,26 +261,30 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
     line = np.array([left, right])
     for order, style in ((1, ":"), (3, "--")):
         top.plot(line, order * line / (2.0 * np.pi), style, color="white", lw=1.2, label=f"order {order}")
-    for peak in peaks:
-        top.plot(line, [peak.frequency] * 2, color="cyan", lw=0.7, ls="-.", label=f"_mode {peak.mode}")
-        top.annotate(f"mode {peak.mode} ({peak.coordinate}) {peak.frequency:.2f} Hz", (left, peak.frequency),
-                     xytext=(3, 2), textcoords="offset points", color="cyan", fontsize=7)
-    reached = [peak for peak in peaks if peak.measured is not None]
-    ring = {"ls": "none", "marker": "o", "ms": 13, "mfc": "none", "mec": "cyan", "mew": 1.6}
-    dot = {"ls": "none", "marker": "o", "ms": 5, "color": "lime", "zorder": 4}
-    top.plot([p.crossing for p in reached], [p.frequency for p in reached], **ring, label="3 x f_shaft = f_mode")
-    top.plot([p.measured[1] for p in reached], [3.0 * p.measured[1] / (2.0 * np.pi) for p in reached], **dot,
-             label="measured third-order peak")
     top.set_facecolor("black")  # where no window is centred, as where the spectrum is 0
-    top.set_xlim(left, right)
-    top.set_ylim(0.0, SPECTRUM_TOP)
     top.set_ylabel("frequency [Hz]")
     top.set_title("Powertrain pitch acceleration at its centre of gravity over the halfshaft speed:\n"
                   "orders 1 and 3, mount modes, their crossings with the 3rd order and the measured peaks",
                   fontsize=10)
+    top.set_xlim(left, right)
+    top.set_ylim(0.0, SPECTRUM_TOP)
+    fig.canvas.draw()
+    for peak in peaks:  # each mode's label on its line's height, at the end the order lines leave clear
+        label = top.annotate(f"mode {peak.mode} ({peak.coordinate}) {peak.frequency:.2f} Hz", (left, peak.frequency),
+                             xytext=(3, 0), textcoords="offset points", color=SKY, fontsize=7, va="center")
+        box = clear_of_lines(top, label, [{"xy": (left, peak.frequency), "xyann": (3, 0), "ha": "left"},
+                                          {"xy": (right, peak.frequency), "xyann": (-3, 0), "ha": "right"}])
+        span = [box.x1, right] if label.get_horizontalalignment() == "left" else [left, box.x0]
+        top.plot(span, [peak.frequency] * 2, color=SKY, lw=0.7, ls="-.", label=f"_mode {peak.mode}")
+    reached = [peak for peak in peaks if peak.measured is not None]
+    ring = {"ls": "none", "marker": "o", "ms": 13, "mfc": "none", "mec": SKY, "mew": 1.6}
+    dot = {"ls": "none", "marker": "o", "ms": 5, "color": YELLOW, "zorder": 4}
+    top.plot([p.crossing for p in reached], [p.frequency for p in reached], **ring, label="3 x f_shaft = f_mode")
+    top.plot([p.measured[1] for p in reached], [3.0 * p.measured[1] / (2.0 * np.pi) for p in reached], **dot,
+             label="measured third-order peak")
     top.legend(loc="upper left", fontsize=8)
     inside = (speeds >= left) & (speeds <= right)
-    colors = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    colors = PALETTE[:6]
     for peak, amplitude in zip(peaks, amplitudes):
         if peak.measured is None:
             continue
@@ -269,17 +312,12 @@ def write(package: Path, out: Path) -> list[Path]:
     units = {name: MODELS[model].spec[variable].unit
              for name, model, variable in _column_models(package)}
     header = ["time [s]", *(f"{csv_name} [{units[name]}]" for name, csv_name in COLUMNS)]
-    kept = slice(EVERY - 1, None, EVERY)
+    kept = slice(0, None, EVERY)  # from t = 0
     table = np.column_stack([launch.time[kept], *(launch.values[name][kept] for name, _ in COLUMNS)])
     run_csv = write_csv(out / "vehicle_launch.csv", header, table.tolist())
     peaks, speeds, amplitudes = third_order_peaks(launch)
-    peaks_csv = write_csv(out / "launch_shudder_peaks.csv",
-                          ("mode [1]", "f_mode [Hz]", "dominant [1]", "damping_ratio [1]", "crossing_speed [rad/s]",
-                           "peak_speed [rad/s]", "difference [%]", "swept_peak_speed [rad/s]",
-                           "peak_amplitude [m/s2 or rad/s2]"),
-                          ((p.mode, p.frequency, p.coordinate, p.damping, p.crossing,
-                            np.nan if p.measured is None else p.measured[1], p.difference, p.swept,
-                            np.nan if p.measured is None else p.measured[0]) for p in peaks))
+    peaks_csv = write_csv(out / "launch_shudder_peaks.csv", PEAK_COLUMNS,
+                          (peak_row(p, speeds[-1], amplitudes[p.mode - 1][-1]) for p in peaks))
     return [run_csv, peaks_csv,
             save(speed_torque_figure(launch), out / "launch_speed_torque.png"),
             save(axial_force_figure(launch), out / "launch_axial_force.png"),

@@ -57,7 +57,7 @@ def write(fmu: Path, out: Path) -> list[Path]:
     shares) and ``powertrain_decoupling.png`` into ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     frequencies, shares, axis = modal_table(fmu)
-    header = ["mode [1]", column(SPEC, "f_mode_1").replace("f_mode_1", "f_mode"), "dominant [1]",
+    header = ["mode [1]", column(SPEC, "f_mode_1").replace("f_mode_1", "f_mode"), "dominant",
               "dominant_share [1]", *(f"share_{name} [1]" for name in COORDINATES)]
     rows = [(j + 1, float(frequencies[j]), COORDINATES[int(np.argmax(shares[j]))], float(np.max(shares[j])),
              *(float(v) for v in shares[j])) for j in range(6)]

@@ -23,7 +23,7 @@ from driveline.tripod.spec import DOUBLE_ROLLER, PLAIN_TRIPOD, SINGLE_ROLLER, SP
 
 from ..runs.runner import simulate
 from . import result_table
-from .figures import by_scale, figure, save, span
+from .figures import BLUE, GREEN, VERMILLION, blank, by_scale, figure, ordered, save, span
 
 SPEED = 2000.0 * math.pi / 30.0  # rad/s, the seed's 2000 rpm
 BETAS_DEG = (5, 10, 15, 20, 25, 30, 35, 40, 45)
@@ -41,15 +41,14 @@ FRICTION_BETAS = tuple(range(5, 46, 5))
 FRICTION_LOADS = (250.0, 500.0)
 FRICTION_MU = 0.05  # the friction coefficient of the figure against beta
 #: How each reaction's curves are told apart: one colour per bend angle, the smallest drawn last.
-BETA_COLOURS = dict(zip(BETAS_DEG, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
-                                    "tab:pink", "tab:gray", "tab:olive")))
+BETA_COLOURS = dict(zip(BETAS_DEG, ordered(len(BETAS_DEG))))  # dark to light as beta grows
 #: The joints of the roller tripods' figure (tripod_type), the bend angles and loads it runs, its friction
 JOINTS = {PLAIN_TRIPOD: "plain tripod", SINGLE_ROLLER: "single roller", DOUBLE_ROLLER: "double roller"}
 ROLLER_BETAS = (2, 4, 8, 12, 16, 20)
 ROLLER_LOADS = (100.0, 300.0, 500.0)
 JOINTS_LOAD, JOINTS_BETA = 300.0, 12  # the figure's load against the angle, and angle against the load
 #: The CSV's ``reactions`` column: which reactions a row holds, a label rather than a number.
-REACTIONS_COLUMN = "reactions [label]"
+REACTIONS_COLUMN = "reactions"
 
 
 @dataclass(frozen=True)
@@ -146,10 +145,10 @@ def _beta_curves(ax: Axes, results: dict[float, np.ndarray], values, betas: list
                 label=f"beta = {beta} deg")
 
 
-def _beta_legend(fig: Figure, betas) -> None:
+def _beta_legend(fig: Figure, betas, loc: str = "lower center") -> None:
     """One legend for the whole figure: the colour of each bend angle."""
     handles = [Line2D([], [], color=BETA_COLOURS[beta], label=f"beta = {beta} deg") for beta in betas]
-    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8)
+    fig.legend(handles=handles, loc=loc, ncol=len(handles), fontsize=8)
 
 
 def _panels_by_scale(axes_row, results: dict[float, np.ndarray], values, ylabel: str, title: str) -> None:
@@ -185,13 +184,13 @@ def seed_figure(seed: dict[float, np.ndarray], loaded: dict[float, np.ndarray], 
     rows = [(seed, f"seed's {SEED[column]} as printed (seed fig. {number})"),
             (loaded, f"force balance, T_load = {LOADS[-1]:.0f} N.m")]
     panels = [len(by_scale({b: np.abs(values(r)).max() for b, r in results.items()})) for results, _ in rows]
-    fig, axes = figure(2, max(panels), figsize=(4.2 * max(panels), 8.4), squeeze=False)
-    for axes_row, (results, title) in zip(axes, rows):
-        _panels_by_scale(axes_row, results, values, f"{symbol} [N]", title)
+    fig = blank(figsize=(4.2 * max(panels), 8.4), layout="constrained")
+    for subfigure, count, (results, title) in zip(fig.subfigures(len(rows), 1), panels, rows):
+        # each row as many panels as its scales need, spread over the whole width: no empty panel
+        _panels_by_scale(subfigure.subplots(1, count, squeeze=False)[0], results, values, f"{symbol} [N]", title)
     fig.suptitle(f"{symbol}: 2000 rpm, r = 26 mm, l = 700 mm, m = 0.2 kg, exact kinematics; one scale per panel",
                  fontsize=10)
-    _beta_legend(fig, BETAS_DEG)
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    _beta_legend(fig, BETAS_DEG, "outside lower center")
     return fig
 
 
@@ -226,22 +225,22 @@ def beta_figure(runs: dict[tuple[float, float], np.ndarray], seed: dict[float, n
     line = np.linspace(0.0, 45.0, 91)
     ry.plot(line, -LOADS[-1] * np.tan(np.radians(line) / 2) / 0.7, "k-", lw=0.8,
             label=f"-T tan(beta/2) / l, T = {LOADS[-1]:.0f} N.m")
-    ry.plot(betas, [runs[beta, LOADS[-1]]["Ry_in"].mean() for beta in BETAS_DEG], "o", color="tab:blue",
+    ry.plot(betas, [runs[beta, LOADS[-1]]["Ry_in"].mean() for beta in BETAS_DEG], "o", color=BLUE,
             label=f"force balance, T = {LOADS[-1]:.0f} N.m")
-    ry.plot(betas, [runs[beta, 0.0]["Ry_in"].mean() for beta in BETAS_DEG], "s", ms=5, color="tab:blue",
+    ry.plot(betas, [runs[beta, 0.0]["Ry_in"].mean() for beta in BETAS_DEG], "s", ms=5, color=BLUE,
             label="force balance, T = 0 N.m")
     ry.plot(betas, [seed[beta]["Ry_in"].mean() for beta in BETAS_DEG], "o", ms=12, mfc="none", mec="0.3", mew=1.5,
             label="seed's eq 34: mean 0 at every load")
     ry.set_title("Mean Ry_in: the force balance carries the load, the seed's eq 34 does not")
     rx.plot(betas, [runs[beta, 0.0]["Rx_in"].mean() for beta in BETAS_DEG], "s", ms=11, mfc="none",
-            color="tab:green", label="force balance, T = 0 N.m")
-    rx.plot(betas, [runs[beta, LOADS[-1]]["Rx_in"].mean() for beta in BETAS_DEG], "o-", ms=5, color="tab:green",
+            color=GREEN, label="force balance, T = 0 N.m")
+    rx.plot(betas, [runs[beta, LOADS[-1]]["Rx_in"].mean() for beta in BETAS_DEG], "o-", ms=5, color=GREEN,
             label=f"force balance, T = {LOADS[-1]:.0f} N.m")
     rx.plot(betas[[0, -1]], (0.0, 0.0), ":", color="0.3", label="seed's eq 33: mean 0 at every load")
     rx.set_title("Mean Rx_in: the same at both loads")
     for ax in (ry, rx):
         ax.set_ylabel("mean force [N]")
-    for ax, column, color in zip(amplitudes, ("Rx_in", "Ry_in", "Rz_out"), ("tab:green", "tab:blue", "tab:red")):
+    for ax, column, color in zip(amplitudes, ("Rx_in", "Ry_in", "Rz_out"), (GREEN, BLUE, VERMILLION)):
         for load, marker in zip(LOADS, ("s", "o")):
             amplitude = [order_amplitude(runs[beta, load][column]) for beta in BETAS_DEG]
             ax.semilogy(betas, amplitude, marker + "-", color=color, label=f"force balance, T = {load:.0f} N.m")

@@ -21,6 +21,7 @@ from fmu_harness.checks import python_fmu_check
 from fmu_harness.runs.runner import FmuInstance
 from fmu_harness.runs import system
 from fmu_harness.studies import critical_speed_study, launch_study, order_tracking
+from fmu_harness.studies.result_table import table_errors
 from fmu_harness.packaging import native
 
 FIRST_COLUMNS = {"time [s]", "beta [deg]", "mode [1]"}  # time, the swept bend angle, the mode number
@@ -47,10 +48,13 @@ def results(models, tmp_path_factory) -> Path:
                           capture_output=True, text=True, timeout=900)
     assert done.returncode == 0, done.stderr
     assert {Path(line).name for line in done.stdout.split()} == {path.name for path in out.iterdir()}
+    shown = done.stderr.splitlines()  # each study's start shown before its end
+    assert shown.index("main job [1/6] tripod coupling ...") < shown.index("main job [1/6] tripod coupling done")
+    assert "main job [5/6] launch shudder ..." in shown and "beta_rate" not in done.stderr  # no notice of a default
     return out
 
 
-def test_every_csv_starts_with_time_or_the_swept_variable_with_units_and_no_repeated_row(results):
+def test_every_csv_starts_with_time_at_0_or_the_swept_variable_with_units_and_no_repeated_row_nor_empty_cell(results):
     tables = sorted(results.glob("*.csv"))
     assert [t.name for t in tables] == ["coupling_comparison.csv", "critical_speeds.csv", "critical_speeds_ramp.csv",
                                         "launch_shudder_peaks.csv", "powertrain_modes.csv", "tripod_coupling.csv",
@@ -60,8 +64,16 @@ def test_every_csv_starts_with_time_or_the_swept_variable_with_units_and_no_repe
         assert header[0] in FIRST_COLUMNS, table.name
         assert rows and all(len(row) == len(header) for row in rows), table.name
         assert len(set(map(tuple, rows))) == len(rows), f"{table.name} repeats a row"
-        for name in header:  # a column of labels too: reactions [label], coupling [name]
-            assert HEADED.match(name), f"{table.name}: column {name!r} has no unit"
+        cells = [[float(cell) if HEADED.match(name) else cell for name, cell in zip(header, row)] for row in rows]
+        assert table_errors(header, cells) == [], table.name  # a number under name [unit], a text under name
+        if header[0] == "time [s]":
+            assert float(rows[0][0]) == 0.0, f"{table.name} starts at {rows[0][0]} s"
+
+
+def test_every_figure_is_named_in_the_docs_page_it_belongs_to(results):
+    pages = " ".join(page.read_text() for page in (Path(__file__).resolve().parents[2] / "docs").glob("*.md"))
+    figures = sorted(path.name for path in results.glob("*.png"))
+    assert len(figures) == 15 and [name for name in figures if name not in pages] == []
 
 
 def test_ramp_rows_belong_to_their_own_speed_and_pass_every_critical_speed(results):
@@ -161,7 +173,7 @@ def test_the_launchs_third_order_peaks_lie_at_the_mount_modes_crossings_delayed_
             assert peak[1] == pytest.approx(crossings[j], rel=3e-2), f"mode {j + 1}"
             checked.append(j + 1)
     assert checked == [3, 4, 5]
-    table = np.genfromtxt(results / "launch_shudder_peaks.csv", delimiter=",", skip_header=1, usecols=(1, 4, 5))
+    table = np.genfromtxt(results / "launch_shudder_peaks.csv", delimiter=",", skip_header=1, usecols=(1, 4, 6))
     np.testing.assert_allclose(table[:, 0], found.frequencies, rtol=1e-9)
     for name in ("launch_speed_torque.png", "launch_axial_force.png", "launch_shudder_orders.png"):
         assert (results / name).stat().st_size > 30_000

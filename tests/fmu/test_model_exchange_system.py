@@ -210,5 +210,5 @@ def test_the_command_writes_the_engines_rows(launch, fmi2_dir, native_dir, tmp_p
     package, fmus = launch
     outputs = [column.split(" [")[0] for column in header[1:]]
     expected = run_model_exchange(fmus, {c.name: c.parameters for c in package.components}, package.connections,
-                                  0.01, 1e-3, outputs, tmp_path / "engine", rtol=1e-9)
+                                  0.01, 1e-3, outputs, tmp_path / "engine", rtol=1e-9, initial=True)
     np.testing.assert_array_equal(np.array(rows, dtype=float), expected)

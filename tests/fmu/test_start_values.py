@@ -66,7 +66,8 @@ def test_an_ssp_package_is_checked_by_its_bindings(fmi2_dir, capsys):
     with pytest.raises(SystemExit) as exited:
         start_values.main([str(bad)])
     assert exited.value.code == 1
-    assert capsys.readouterr().err == "refused: coupling (TripodCoupling): parameter r = -1000 mm must be positive\n"
+    assert capsys.readouterr().err.endswith(": refused: coupling (TripodCoupling): parameter r = -1000 mm must be "
+                                            "positive\n")
     with pytest.raises(start_values.StartValuesRefused):
         importers.cosim_session(1e-3, ssp=bad)
 
@@ -75,8 +76,8 @@ def test_an_fmu_is_checked_with_the_values_given(fmi2_dir, capsys):
     with pytest.raises(SystemExit) as exited:
         start_values.main([str(fmi2_dir / "CriticalSpeeds.fmu"), "omega_in_max=1e-300", "omega_in=0"])
     assert exited.value.code == 1
-    assert capsys.readouterr().err == ("refused: CriticalSpeeds (CriticalSpeeds): parameter omega_in_max = 1e-300 "
-                                       "rad/s is below its minimum 0.001 rad/s\n")
+    assert capsys.readouterr().err.endswith(": refused: CriticalSpeeds (CriticalSpeeds): parameter omega_in_max = "
+                                            "1e-300 rad/s is below its minimum 0.001 rad/s\n")
 
 
 def test_the_system_master_refuses_before_loading_an_fmu(tmp_path):
@@ -87,11 +88,11 @@ def test_the_system_master_refuses_before_loading_an_fmu(tmp_path):
 def test_a_sweep_whose_every_point_is_refused_exits_before_any_worker(fmi2_dir, capsys):
     with pytest.raises(SystemExit) as exited:
         sweep.main(["--grid", "r=-1,-2", "--models", str(fmi2_dir)])
-    assert capsys.readouterr().err.splitlines() == ["  1 failed: parameter r = -1000 mm must be positive",
-                                                    "  1 failed: parameter r = -2000 mm must be positive"]
-    assert exited.value.code == "driveline-fmus sweep: every point refused, none run"  # printed, exit status 1
-    assert sweep.refused_points("TripodCoupling", [{"r": 0.03}, {"r": -1.0}]) == {
-        1: "parameter r = -1000 mm must be positive"}
+    assert capsys.readouterr().err == ("driveline-fmus sweep: refused: every point, none run: parameter r = -1000 mm "
+                                       "must be positive (and 1 more reason)\n")
+    assert exited.value.code == 1
+    assert sweep.refused_points("TripodCoupling", [{"r": 0.03}, {"r": -1.0}, {"beta": 0.9}]) == {
+        1: "parameter r = -1000 mm must be positive", 2: "input beta = 51.5662 deg must not exceed beta_max = 45 deg"}
 
 
 def test_a_connected_input_is_checked_at_the_start_of_the_output_feeding_it(fmi2_dir, capsys):
@@ -104,5 +105,5 @@ def test_a_connected_input_is_checked_at_the_start_of_the_output_feeding_it(fmi2
     with pytest.raises(SystemExit) as exited:
         start_values.main([str(system.write_ssp(_changed_system("OverBent", "coupling", beta=1.0), fmi2_dir))])
     assert exited.value.code == 1
-    assert capsys.readouterr().err == ("refused: coupling (TripodCoupling): input beta = 57.2958 deg must not "
-                                       "exceed beta_max = 45 deg\n")
+    assert capsys.readouterr().err.endswith(": refused: coupling (TripodCoupling): input beta = 57.2958 deg must not "
+                                            "exceed beta_max = 45 deg\n")

@@ -1,6 +1,7 @@
 """The main job's figures show what their titles claim, measured on the matplotlib figures the
 studies return (``support.figure_checks``): no curve drawn under others, overlapping markers
-nested, every sample inside its axes, no log axis over a zero, no legend repeated; and, figure by
+nested, every sample inside its axes, no log axis over a zero, no legend repeated, no empty panel,
+no text beyond the canvas or crossed by a line, only colour-blind-safe colours; and, figure by
 figure, that each case the title names is drawn. The checks themselves are shown to catch the
 defects they were written for, on figures drawn here."""
 
@@ -13,6 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
+from fmu_harness import shudder_map  # noqa: E402
 from fmu_harness.packaging import native  # noqa: E402
 from fmu_harness.runs import system  # noqa: E402
 from fmu_harness.studies import coupling_comparison, critical_speed_study, launch_study, tripod_study  # noqa: E402
@@ -26,6 +28,10 @@ def assert_clean(fig, name: str = "") -> None:
     assert figure_checks.beyond_limits(fig) == [], name
     assert figure_checks.log_over_zero(fig) == [], name
     assert figure_checks.repeated_legends(fig) == [], name
+    assert figure_checks.empty_axes(fig) == [], name
+    assert figure_checks.texts_outside_canvas(fig) == [], name
+    assert figure_checks.texts_on_lines(fig) == [], name
+    assert figure_checks.unsafe_colours(fig) == [], name
 
 
 @pytest.fixture(scope="module")
@@ -151,8 +157,7 @@ def test_the_launch_figures_show_each_curve_and_what_their_titles_name(launch_fi
     for name, fig in figures.items():
         assert_clean(fig, name)
     assert drawn_labels(figures["speed_torque"]) == ["vehicle speed", "left halfshaft", "right halfshaft"]
-    assert drawn_labels(figures["axial_force"]) == [f"{label}" for side in ("left", "right") for label in
-                                                   (f"-Rz_in, {side} joint", "its third-order amplitude")]
+    assert drawn_labels(figures["axial_force"]) == ["left joint", "right joint"] * 2
     top, bottom = figures["orders"].axes[:2]
     labels = [line.get_label() for line in top.get_lines()]
     assert labels[:2] == ["order 1", "order 3"] and labels.count("_mode 1") == 1
@@ -199,3 +204,38 @@ def test_the_checks_catch_what_the_old_figures_drew():
     assert figure_checks.beyond_limits(fig) == [": tripod", ": reducer"]
     for figure in (hidden, split, fig):
         plt.close(figure)
+
+
+def test_the_checks_catch_what_a_report_cannot_show():
+    """The defects an NVH engineer met in the figures before: an empty panel left over (figs 12, 13), a
+    mode's label struck through by the next mode's line, an axis label cut at the canvas's edge (the
+    shudder map of two values), red against green (the launch's halfshafts)."""
+    fig, (drawn, empty) = plt.subplots(1, 2, figsize=(6, 3))
+    drawn.plot([0, 1], [8.45, 8.45], color="#56B4E9", label="mode 3")
+    drawn.plot([0, 1], [9.11, 9.11], color="tab:red", label="mode 4")
+    drawn.annotate("mode 3 (x) 8.45 Hz", (0.0, 8.45), xytext=(3, 2), textcoords="offset points", fontsize=7)
+    drawn.set_ylim(0.0, 25.0)  # as the spectrogram: the two lines 0.66 Hz, a few pixels, apart
+    drawn.set_xlabel("a label\n" * 12)  # pushed below the canvas
+    assert figure_checks.empty_axes(fig) == ["axes 1"]
+    assert figure_checks.texts_on_lines(fig) == [": mode 3 (x) 8.45 Hz"]
+    assert figure_checks.texts_outside_canvas(fig) == ["axes"]
+    assert figure_checks.unsafe_colours(fig) == [": mode 4 in tab:red"]
+    plt.close(fig)
+
+
+def test_the_shudder_map_of_two_values_per_axis_stays_within_its_grid(tmp_path):
+    """``map --count 2``: two bend angles, two torques, two friction coefficients; each panel's axes span
+    the grid (5 to 20 deg, 20 to 100 % of the motor's peak), every label on the canvas."""
+    pa = pytest.importorskip("pyarrow")
+    rows = [{shudder_map.BETA: beta, shudder_map.TORQUE: torque, shudder_map.MU: mu, "status": "ok",
+             shudder_map.PEAK: 1.0 + beta + torque / 100.0 + mu}
+            for beta in shudder_map.BETA_RANGE for torque in shudder_map.TORQUE_RANGE for mu in shudder_map.MU_RANGE]
+    with pytest.MonkeyPatch.context() as patch:  # the figure kept open instead of saved and closed
+        kept = []
+        patch.setattr("fmu_harness.studies.figures.save", lambda fig, path: kept.append(fig) or path)
+        shudder_map.draw(pa.Table.from_pylist(rows), tmp_path / "map.png")
+    (fig,) = kept
+    assert figure_checks.texts_outside_canvas(fig) == [] and figure_checks.empty_axes(fig) == []
+    for panel in fig.axes[:2]:
+        assert panel.get_xlim() == pytest.approx((5.0, 20.0)) and panel.get_ylim() == pytest.approx((20.0, 100.0))
+    plt.close(fig)

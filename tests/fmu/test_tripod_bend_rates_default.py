@@ -8,12 +8,16 @@ is tested against the multibody model in test_tripod_moving_bearing.py."""
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from driveline.tripod.model import RATES_ESTIMATED
 from driveline.tripod.spec import RATES_AUTOMATIC, RATES_FROM_INPUTS, SPEC
+from fmu_harness.packaging import native
 from support import tripod_multibody
 
 RPM = math.pi / 30.0
@@ -58,17 +62,17 @@ def test_the_default_is_automatic():
 
 
 @pytest.mark.parametrize("kinematics", [0, 1])
-def test_a_host_setting_only_beta_gets_the_rates_and_one_warning(family, fmi, kinematics):
+def test_a_host_setting_only_beta_gets_the_rates_and_one_information_line(family, fmi, kinematics):
     """Measured (both families, both versions, both kinematics): the plungers' axial forces within
     0.012 N of the exact rates' over the whole ramp (peak 136 N), where the former default,
-    beta_rate = 0 with the rates unset, was quasi-static and 21.1 N off; the log holds one warning,
+    beta_rate = 0 with the rates unset, was quasi-static and 21.1 N off; the log holds one information line,
     at initialisation, saying so."""
     reference, quiet = run(family, fmi, smooth, {"kinematics": kinematics, "beta_rate": RATES_FROM_INPUTS}, True)
     default, log = run(family, fmi, smooth, {"kinematics": kinematics}, False)
     quasi_static, _ = run(family, fmi, smooth, {"kinematics": kinematics, "beta_rate": RATES_FROM_INPUTS}, False)
     assert np.abs(default - reference).max() < 0.02
     assert 19.0 < np.abs(quasi_static - reference).max() < 23.0
-    assert log == [("Warning", RATES_ESTIMATED)] and quiet == []
+    assert log == [("OK", RATES_ESTIMATED)] and quiet == []  # information (a default in use), not a warning
 
 
 @pytest.mark.parametrize("bend", [smooth, linear], ids=["smooth", "linear"])
@@ -79,7 +83,7 @@ def test_a_host_setting_the_rates_gets_them_bit_for_bit(family, fmi, bend):
     given, log = run(family, fmi, bend, {"kinematics": 1}, True)
     inputs, _ = run(family, fmi, bend, {"kinematics": 1, "beta_rate": RATES_FROM_INPUTS}, True)
     np.testing.assert_array_equal(given, inputs)
-    assert log == ([] if bend is linear else [("Warning", RATES_ESTIMATED)])
+    assert log == ([] if bend is linear else [("OK", RATES_ESTIMATED)])
 
 
 def test_the_start_of_a_ramp_without_its_rates_is_the_samples_lead_in(family, fmi):
@@ -93,3 +97,16 @@ def test_the_start_of_a_ramp_without_its_rates_is_the_samples_lead_in(family, fm
     np.testing.assert_array_equal(default[:2], quasi_static[:2])
     assert np.abs(default[2:] - reference[2:]).max() < 1e-6
     assert np.abs(default[:2] - reference[:2]).max() > 1.0
+
+
+def test_the_default_is_said_only_to_a_host_that_asks_for_logging(native_dir, fmi, tmp_path):
+    """fmpy's command line on the native FMU, only beta set: silent by default; with --debug-logging
+    (loggingOn) the one information line, status OK."""
+    fmu = native.fmu_path(native_dir, "TripodCoupling", fmi)
+    command = [str(Path(sys.executable).with_name("fmpy")), "simulate", str(fmu), "--stop-time", "0.01",
+               "--start-values", "beta", "0.2", "--output-file", str(tmp_path / "run.csv")]
+    quiet = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    logged = subprocess.run([*command, "--debug-logging"], capture_output=True, text=True, timeout=120)
+    assert quiet.returncode == 0 and logged.returncode == 0
+    assert "beta_rate" not in quiet.stdout + quiet.stderr
+    assert [line for line in logged.stdout.splitlines() if "beta_rate" in line] == [f"[OK] {RATES_ESTIMATED}"]

@@ -85,12 +85,14 @@ def _assert_like_the_master(master: tuple[list[str], np.ndarray], run: tuple[lis
     of its terms' magnitude."""
     header, reference = master
     assert run[0] == header
+    # libcosim's rows from t_1 (it initialises in its first step), the others' from t = 0
+    reference, values = reference[reference[:, 0] > 0.0], run[1][run[1][:, 0] > 0.0]
     scale = np.maximum(np.abs(reference).max(axis=0), 1e-300)
     mass = system.vehicle_launch().component("joint_left").spec["m_plunger"].start
     for side in system.SIDES:
         terms = np.abs(reference[:, header.index(f"joint_{side}.F_plunger1 [N]")]).max() / mass
         scale[header.index(f"joint_{side}.a_plunger_sum [m/s2]")] = terms
-    assert (np.abs(run[1] - reference).max(axis=0) / scale).max() <= 1e-9
+    assert (np.abs(values - reference).max(axis=0) / scale).max() <= 1e-9
 
 
 def test_without_friction_the_joints_generate_no_axial_force(launch_ssp, master, tmp_path):

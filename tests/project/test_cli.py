@@ -41,6 +41,10 @@ def assert_one_line_mistake(run: subprocess.CompletedProcess, *words: str) -> No
     (["sweep", "--grid", "beta"], ["expected name=v1,v2"]),
     (["sweep", "--grid", "beta=0.1", "--models", "nowhere"], ["no folder nowhere", "driveline-fmus build"]),
     (["interop", "--models", "nowhere"], ["no built FMU in nowhere", "driveline-fmus build"]),
+    (["sweep", "--grid", "beta=0.1", "--step", "-2e-4"], ["the step must be a finite positive", "got -0.0002"]),
+    (["sweep", "--grid", "beta=0.1", "--out", "x.xlsx"], ["--out", "x.xlsx: write a .parquet or a .csv file"]),
+    (["map", "--out", "map.xlsx"], ["--out", "map.xlsx: write a .parquet or a .csv file"]),
+    (["map", "--duration", "1"], ["--duration 1 s", "less than the 2 revolutions", "at least 1.4 s"]),
 ])
 def test_a_mistake_is_one_line_and_a_non_zero_exit(arguments, words, tmp_path):
     assert_one_line_mistake(driveline_fmus(*arguments, cwd=tmp_path), *words)
@@ -51,11 +55,28 @@ def test_a_mistake_is_one_line_and_a_non_zero_exit(arguments, words, tmp_path):
     (["--layout", "nope.toml"], ["nope.toml", "No such file"]),
     (["--grid", "phi_out=1"], ["phi_out: no parameter or input of TripodCoupling"]),
     (["--grid", "beta=0:1:0"], ["no points"]),
+    (["--grid", "beta=0.9,1.0"], ["sweep: refused: every point, none run: input beta = 51.5662 deg must not exceed "
+                                  "beta_max = 45 deg (and 1 more reason)"]),
 ])
 def test_a_sweep_is_refused_before_its_cluster_starts(arguments, words, tripod_fmu, tmp_path):
     arguments = ["--grid", "beta=0.1", *arguments] if "--grid" not in arguments else arguments
     run = driveline_fmus("sweep", *arguments, "--models", str(tripod_fmu.parent), cwd=tmp_path)
     assert_one_line_mistake(run, *words)
+
+
+def test_check_refuses_in_the_words_and_status_of_system(tripod_fmu, tmp_path):
+    """The words and status ``driveline-fmus system`` ends with for the same value
+    (tests/fmu/test_system_command.py): ``refused:``, status 1."""
+    run = driveline_fmus("check", str(tripod_fmu), "beta=0.9", cwd=tmp_path)
+    assert_one_line_mistake(run, "driveline-fmus check: refused: TripodCoupling (TripodCoupling): input beta = 51.5662 "
+                                 "deg must not exceed beta_max = 45 deg")
+    assert run.returncode == 1
+
+
+def test_help_shows_the_defaults(tmp_path):
+    shown = " ".join(driveline_fmus("sweep", "--help", cwd=tmp_path).stdout.split())
+    assert "steps of one turn of the run (default 360)" in shown and "local cluster size (default" in shown
+    assert "folder of built FMUs (default models)" in shown
 
 
 def test_run_outside_a_built_folder_tells_a_wheel_user_what_to_do(tmp_path):

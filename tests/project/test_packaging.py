@@ -173,3 +173,34 @@ def test_doc_page_rendering():
         '<h2 id="variables">Variables</h2>', '<p>See <a href="https://fmi-standard.org">the web</a>.</p>',
     ]
     assert "<title>Model — a title</title>" in rendered
+
+
+@pytest.mark.parametrize("folders, words", [
+    (["linux64"], "binaries for x86_64 Linux (glibc 2.17 or newer) only; `python build_fmu.py --all-platforms` adds "
+                  "x86_64 Windows, aarch64 Linux, x86_64 macOS and aarch64 macOS"),
+    ([p.fmi2 for p in toolchain.PLATFORMS], "binaries for x86_64 Linux (glibc 2.17 or newer), x86_64 Windows (Windows "
+                                            "10 or newer), aarch64 Linux (glibc 2.17 or newer), x86_64 macOS (macOS 11 "
+                                            "or newer) and aarch64 macOS (macOS 11 or newer)"),
+    (["x86_64-windows", "riscv64-linux"], "binaries for x86_64 Windows (Windows 10 or newer) and riscv64-linux only; "),
+])
+def test_the_platforms_a_native_fmu_carries_are_named_from_its_binaries(folders, words):
+    names = ["modelDescription.xml", "sources/model.c", *(f"binaries/{folder}/Model.so" for folder in folders)]
+    assert toolchain.platforms_sentence(names).startswith(words)
+
+
+def test_a_python_fmu_names_what_its_host_needs():
+    names = ["resources/model.py", "binaries/win64/Model.dll", "binaries/linux64/Model.so"]
+    assert toolchain.platforms_sentence(names) == ("binaries for x86_64 Linux and x86_64 Windows; a Python FMU: the host "
+                                                   "needs Python with numpy and scipy")
+
+
+def test_check_names_the_platforms_each_fmu_carries(native_dir, tmp_path):
+    """The host-only build the README's set-up makes: this machine's binary alone, and the release command."""
+    fmu = native.fmu_path(native_dir, "SpeedSource")
+    done = subprocess.run([str(Path(sys.executable).with_name("driveline-fmus")), "check", str(fmu)],
+                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    host = toolchain.host_platform()
+    assert done.returncode == 0 and done.stdout.splitlines()[1] == (
+        f"SpeedSource.fmu: binaries for {host.name} ({host.oldest} or newer) only; "
+        f"`python build_fmu.py --all-platforms` adds "
+        f"{toolchain._joined([p.name for p in toolchain.PLATFORMS if p is not host])}")

@@ -151,3 +151,94 @@ def repeated_legends(fig: Figure) -> list[list[str]]:
     """The entries of every legend that repeats another one of the figure."""
     entries = [[text.get_text() for text in legend.get_texts()] for legend in _legends(fig)]
     return [labels for k, labels in enumerate(entries) if labels in entries[:k]]
+
+
+def empty_axes(fig: Figure) -> list[str]:
+    """Visible axes that draw nothing: no line, collection, image or patch with data."""
+    return [ax.get_title() or f"axes {k}" for k, ax in enumerate(_drawn(fig)) if ax.get_visible() and not ax.has_data()]
+
+
+def texts_outside_canvas(fig: Figure) -> list[str]:
+    """Axes whose drawn texts (title, axis labels, tick labels, annotations, legend) and the figure's own
+    texts and legends that reach beyond the figure's edges, cut off in the saved file (by more than half
+    a pixel)."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    width, height = fig.canvas.get_width_height()
+    boxes = [(ax.get_title() or ax.get_ylabel() or "axes", ax.get_tightbbox(renderer)) for ax in fig.axes
+             if ax.get_visible()]
+    texts = [*fig.texts, *([fig._suptitle] if getattr(fig, "_suptitle", None) is not None else [])]
+    boxes += [(text.get_text(), text.get_window_extent(renderer)) for text in texts if text.get_text().strip()]
+    boxes += [("figure legend", legend.get_window_extent(renderer)) for legend in fig.legends]
+    return [name for name, box in boxes
+            if box.x0 < -0.5 or box.y0 < -0.5 or box.x1 > width + 0.5 or box.y1 > height + 0.5]
+
+
+def texts_on_lines(fig: Figure) -> list[str]:
+    """Annotations and texts written inside an axes that a visible curve of the axes crosses (the curve
+    sampled every pixel along its polyline, the text's box shrunk by a pixel)."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    found = []
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        curves = [_dense(_pixels(line)) for line in _curves(ax)]
+        for text in ax.texts:
+            if not (text.get_visible() and text.get_text().strip()):
+                continue
+            box = text.get_window_extent(renderer).expanded(1.0, 1.0)
+            x0, y0, x1, y1 = box.x0 + 1, box.y0 + 1, box.x1 - 1, box.y1 - 1
+            for points in curves:
+                if np.any((points[:, 0] > x0) & (points[:, 0] < x1) & (points[:, 1] > y0) & (points[:, 1] < y1)):
+                    found.append(f"{ax.get_title()}: {text.get_text()}")
+                    break
+    return found
+
+
+def _dense(points: np.ndarray) -> np.ndarray:
+    """The polyline through ``points`` sampled at least every pixel."""
+    if len(points) < 2:
+        return points
+    pieces = [points[:1]]
+    for start, end in zip(points[:-1], points[1:]):
+        count = max(1, int(np.ceil(np.linalg.norm(end - start))))
+        pieces.append(start + np.outer(np.arange(1, count + 1) / count, end - start))
+    return np.vstack(pieces)
+
+
+#: Colours a figure may draw its curves and markers in: the Okabe-Ito palette (safe for the common
+#: colour-vision deficiencies), black, white and greys; a colour map's colours (viridis, cividis,
+#: magma: perceptually ordered, readable without hue) are images and collections, not lines.
+SAFE_COLOURS = ("#0072b2", "#e69f00", "#009e73", "#d55e00", "#cc79a7", "#56b4e9", "#f0e442", "#000000", "#ffffff")
+
+
+def _safe(colour) -> bool:
+    red, green, blue, _ = to_rgba(colour)
+    grey = abs(red - green) < 1e-6 and abs(green - blue) < 1e-6
+    return grey or any(np.allclose((red, green, blue), to_rgba(safe)[:3], atol=2e-3) for safe in SAFE_COLOURS)
+
+
+def unsafe_colours(fig: Figure, ordered: tuple[str, ...] = ("viridis", "cividis")) -> list[str]:
+    """Curves and markers drawn in a colour outside :data:`SAFE_COLOURS` and the ``ordered`` colour maps
+    (a series of bend angles, say, coloured by a map's evenly spaced colours)."""
+    import matplotlib
+
+    maps = [matplotlib.colormaps[name] for name in ordered]
+    samples = np.vstack([cmap(np.linspace(0.0, 1.0, 1025))[:, :3] for cmap in maps])
+
+    def allowed(colour) -> bool:
+        if colour in ("none", "None") or to_rgba(colour)[3] == 0.0:
+            return True
+        rgb = np.array(to_rgba(colour)[:3])
+        return _safe(colour) or bool(np.any(np.abs(samples - rgb).max(axis=1) < 2e-3))
+
+    found = []
+    for ax in _drawn(fig):
+        for line in ax.get_lines():
+            if not line.get_visible():
+                continue
+            colours = [line.get_color()] + ([line.get_markerfacecolor(), line.get_markeredgecolor()]
+                                            if line.get_marker() not in ("None", "", None) else [])
+            found += [f"{ax.get_title()}: {line.get_label()} in {colour}" for colour in colours if not allowed(colour)]
+    return found

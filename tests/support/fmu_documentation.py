@@ -1,14 +1,18 @@
 """What an FMU's ``documentation/`` must hold, Python or native: ``index.html`` rendered from the
 model's doc page, the page, the licence, and no other page of the repository anywhere in the FMU;
-every link of ``index.html`` leads to a section of it or to the web."""
+every link of ``index.html`` leads to a section of it or to the web; a native FMU's page names the
+platforms whose binaries it carries."""
 
 from __future__ import annotations
 
+import html
+import re
 import zipfile
 from html.parser import HTMLParser
 from pathlib import Path
 
 from fmu_harness.packaging.documentation import snake_case
+from fmu_harness.packaging.toolchain import PLATFORMS, platforms_sentence
 
 ROOT = Path(__file__).resolve().parents[2]
 VOID = {"meta", "br", "hr", "img"}
@@ -63,3 +67,18 @@ def assert_documentation(fmu: Path, model: str) -> None:
     assert "variables" in parsed.ids
     for link in parsed.links:
         assert link.startswith(("https://", "http://")) or link[1:] in parsed.ids, link
+    if any(name.startswith("sources/") and name.endswith(".c") for name in names):
+        assert_platforms_named(index, names)
+
+
+def assert_platforms_named(index: str, names: list[str]) -> None:
+    """The native FMU's page says, after its title, which platforms it carries binaries for: those of
+    its ``binaries/`` folders, each named, and none it lacks named as carried."""
+    text = html.unescape(re.sub(r"<[^>]+>", "", index))
+    sentence = platforms_sentence(names).replace("`", "")
+    assert f"This FMU carries {sentence}." in text
+    carried = sentence.split(" only;")[0]
+    for platform in PLATFORMS:
+        inside = any(name.startswith(f"binaries/{folder}/") for name in names
+                     for folder in (platform.fmi2, platform.tuple))
+        assert (platform.name in carried) == inside, platform.name

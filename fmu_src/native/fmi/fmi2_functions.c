@@ -43,7 +43,7 @@ const char *fmi2GetVersion(void)
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
-                              fmi2Boolean visible UNUSED, fmi2Boolean loggingOn UNUSED)
+                              fmi2Boolean visible UNUSED, fmi2Boolean loggingOn)
 {
     void (*logger)(void) = functions != NULL ? (void (*)(void))functions->logger : NULL;
     void *environment = functions != NULL ? functions->componentEnvironment : NULL;
@@ -63,6 +63,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     free(resources);
     if (instance != NULL) {
         instance->model_exchange = fmuType == fmi2ModelExchange;
+        instance->logging_on = loggingOn != fmi2False;
     }
     return instance;
 }
@@ -72,9 +73,10 @@ void fmi2FreeInstance(fmi2Component c)
     instance_free((Instance *)c);
 }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn UNUSED, size_t nCategories,
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[])
-ON_INSTANCE(fmi2, instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories))
+ON_INSTANCE(fmi2, instance_set_debug_logging(instance, "SetDebugLogging", loggingOn != fmi2False, nCategories,
+                                             categories))
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined UNUSED, fmi2Real tolerance UNUSED,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined UNUSED, fmi2Real stopTime UNUSED)

@@ -38,13 +38,14 @@ const char *fmi3GetVersion(void)
     return fmi3Version;
 }
 
-fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean loggingOn UNUSED, size_t nCategories,
+fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean loggingOn, size_t nCategories,
                                const fmi3String categories[])
-ON_INSTANCE(fmi3, instance_set_debug_logging(instance, "SetDebugLogging", nCategories, categories))
+ON_INSTANCE(fmi3, instance_set_debug_logging(instance, "SetDebugLogging", loggingOn != fmi3False, nCategories,
+                                             categories))
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
                                           fmi3String resourcePath, fmi3Boolean visible UNUSED,
-                                          fmi3Boolean loggingOn UNUSED,
+                                          fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment,
                                           fmi3LogMessageCallback logMessage)
 {
@@ -52,13 +53,14 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                       instanceEnvironment, resourcePath);
     if (instance != NULL) {
         instance->model_exchange = 1;
+        instance->logging_on = loggingOn != fmi3False;
     }
     return instance;
 }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
                                          fmi3String resourcePath, fmi3Boolean visible UNUSED,
-                                         fmi3Boolean loggingOn UNUSED,
+                                         fmi3Boolean loggingOn,
                                          fmi3Boolean eventModeUsed UNUSED, fmi3Boolean earlyReturnAllowed UNUSED,
                                          const fmi3ValueReference requiredIntermediateVariables[] UNUSED,
                                          size_t nRequiredIntermediateVariables UNUSED,
@@ -67,9 +69,14 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3IntermediateUpdateCallback intermediateUpdate UNUSED)
 {
     /* resourcePath: the resources folder (a path; NULL: none); eventModeUsed: these models have no
-     * clocks or events; loggingOn: every message has status Error and is always logged */
-    return instance_new(instanceName, instantiationToken, "fmi3", emit, (void (*)(void))logMessage,
-                        instanceEnvironment, resourcePath);
+     * clocks or events; loggingOn: a message of status OK (information) is logged only with it, the others
+     * always */
+    Instance *instance = instance_new(instanceName, instantiationToken, "fmi3", emit, (void (*)(void))logMessage,
+                                      instanceEnvironment, resourcePath);
+    if (instance != NULL) {
+        instance->logging_on = loggingOn != fmi3False;
+    }
+    return instance;
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName UNUSED, fmi3String instantiationToken UNUSED,

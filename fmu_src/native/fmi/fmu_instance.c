@@ -131,7 +131,9 @@ void instance_log(Instance *instance, Status status, const char *first, ...)
     va_start(pieces, first);
     append_pieces(message, sizeof message, first, pieces);
     va_end(pieces);
-    instance->emit(instance, status, category_of(status), message);
+    if (status != STATUS_OK || instance->logging_on) { /* information only when the host asked for logging */
+        instance->emit(instance, status, category_of(status), message);
+    }
 }
 
 void instance_log_messages(Instance *instance, Status status)
@@ -291,8 +293,8 @@ Status instance_exit_initialization(Instance *instance)
     }
     if (model_hooks.start_notice != NULL) {
         const char *notice = model_hooks.start_notice(&instance->data);
-        if (notice != NULL) {
-            instance_log(instance, STATUS_WARNING, notice, (const char *)NULL);
+        if (notice != NULL) { /* a default in use: an information line (status OK, category logAll) */
+            instance_log(instance, STATUS_OK, notice, (const char *)NULL);
         }
     }
     instance->mode = MODE_STEP;

@@ -157,6 +157,7 @@ struct Instance {
     char refusal[FMU_MESSAGE_SIZE]; /* the first reason of the last refusal or misuse: a repeat is not logged */
     char notice[FMU_MESSAGE_SIZE];  /* the model's last step notice (ModelHooks.step_notice): a repeat is not logged */
     int model_exchange; /* instantiated for Model Exchange (fmu_model_exchange.c) */
+    int logging_on;     /* the host's loggingOn: an information line (status OK) is logged only then */
     int event_mode;     /* Model Exchange after initialisation: event mode, else continuous-time mode */
     int stale;          /* a time, state, input or parameter was set since the outputs were evaluated (Model
                          * Exchange) or the values read in Initialization Mode computed (``initial``) */
@@ -303,7 +304,8 @@ Status instance_fail(Instance *instance, const char *first, ...);
 Status instance_no_variables_of(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                                 const char *type, int setting);
 /* Checks the categories; messages (all of status Error) are logged whether debug logging is on or not. */
-Status instance_set_debug_logging(Instance *instance, const char *function, size_t n, const char *const categories[]);
+Status instance_set_debug_logging(Instance *instance, const char *function, int logging_on, size_t n,
+                                  const char *const categories[]);
 /* A function of an interface type or capability these FMUs do not offer. */
 Status instance_unsupported(Instance *instance, const char *function);
 

@@ -335,7 +335,8 @@ Status instance_no_variables_of(Instance *instance, const char *function, const 
 static const char *const LOG_CATEGORIES[] = {"logStatusWarning", "logStatusDiscard", "logStatusError",
                                              "logStatusFatal", "logAll"};
 
-Status instance_set_debug_logging(Instance *instance, const char *function, size_t n, const char *const categories[])
+Status instance_set_debug_logging(Instance *instance, const char *function, int logging_on, size_t n,
+                                  const char *const categories[])
 {
     size_t i, j;
     if (n > 0 && categories == NULL) {
@@ -352,6 +353,7 @@ Status instance_set_debug_logging(Instance *instance, const char *function, size
                                  categories[i] ? categories[i] : "(null)", "'", (const char *)NULL);
         }
     }
+    instance->logging_on = logging_on;
     return STATUS_OK;
 }
 
