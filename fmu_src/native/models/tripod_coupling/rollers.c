@@ -1,0 +1,303 @@
+/* The roller tripods' balance (driveline/tripod/rollers.py; eqs R1-R15 of docs/tripod_coupling.md): each
+ * roller's contacts with its trunnion and its track, the single roller's contact normal by the Illinois method
+ * on its bracket, the balance by successive substitution from the plain tripod's frictionless forces. Every
+ * expression keeps the Python core's order of operations. */
+#include "step.h"
+
+#include "driveline_constants.h"
+
+static const double PI = 3.141592653589793; /* math.pi */
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double out[3])
+{
+    double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+    out[0] = x;
+    out[1] = y;
+    out[2] = z;
+}
+
+/* a / |a| into out (a zero vector stays zero), and |a| (rollers._unit) */
+static double unit3(Guard *guard, const double a[3], double out[3])
+{
+    double size = root(guard, dot3(a, a)), by = size > 0.0 ? size : 1.0;
+    out[0] = a[0] / by;
+    out[1] = a[1] / by;
+    out[2] = a[2] / by;
+    return size;
+}
+
+/* numpy's remainder: the sign of the divisor */
+static double remainder_of(double a, double b)
+{
+    double mod = fmod(a, b);
+    if (mod != 0.0) {
+        if ((b < 0.0) != (mod < 0.0)) {
+            mod += b;
+        }
+    } else {
+        mod = copysign(0.0, b);
+    }
+    return mod;
+}
+
+/* One arm's track contact (rollers.RollerContacts, the parts the balance needs). */
+typedef struct {
+    double k[3], N, u[3], across, s[3], v_roll, v_skew, F_roll, F_skew, miss, pushed[3];
+} Contact;
+
+/* The single roller on its track with contact normal at ``angle`` (rollers._skewed_slips and the
+ * Illinois method's function in rollers._skewed_contact): slips, g's share and the miss of H's direction. */
+static void skewed_slips(Guard *guard, const Load *load, const double axis[3], double zdot, const double spin[3],
+                         double angle, double target, Contact *c)
+{
+    double R = load->roller_radius, along[3], turn[3], v0[3], g[3];
+    int i;
+    c->k[0] = cos(angle);
+    c->k[1] = sin(angle);
+    c->k[2] = 0.0;
+    cross3(axis, c->k, along);
+    c->across = unit3(guard, along, c->u);
+    cross3(c->k, c->u, c->s);
+    cross3(spin, c->k, turn);
+    for (i = 0; i < 3; i++) {
+        v0[i] = zdot * (i == 2 ? 1.0 : 0.0) - R * turn[i];
+    }
+    c->v_roll = dot3(v0, c->u) + R * c->across * dot3(spin, axis);
+    c->v_skew = dot3(v0, c->s);
+    for (i = 0; i < 3; i++) {
+        g[i] = -load->mu_roll * slip_sign(guard, c->v_roll, load->slip_speed) * c->u[i]
+               - load->friction * slip_sign(guard, c->v_skew, load->slip_speed) * c->s[i];
+        c->pushed[i] = c->k[i] + g[i] * (i == 2 ? 0.0 : 1.0);
+    }
+    c->miss = remainder_of(atan2(c->pushed[1], c->pushed[0]) - target + PI, 2.0 * PI) - PI;
+}
+
+static double sign_of(double a)
+{
+    return a > 0.0 ? 1.0 : (a < 0.0 ? -1.0 : 0.0);
+}
+
+/* The three single rollers' track contacts under the horizontal forces H (rollers._skewed_contact): the
+ * normal's angle by the Illinois method on the bracket within asin(mu + mu_roll) of H's, all arms together. */
+static void skewed_contacts(Guard *guard, const Load *load, const double H[3][3], const double axis[3][3],
+                            const double zdot[3], const double spin[3], Contact c[3])
+{
+    double target[3], size[3], low[3], high[3], f_low[3], f_high[3], angle[3];
+    double share = load->friction + load->mu_roll;
+    double spread = asin(share < TRIPOD_ROLLERS_FRICTION_SHARE_CAP ? share : TRIPOD_ROLLERS_FRICTION_SHARE_CAP)
+                    + TRIPOD_ROLLERS_BRACKET_MARGIN;
+    int side[3] = {0, 0, 0}, iteration, j;
+    Contact probe;
+    for (j = 0; j < 3; j++) {
+        target[j] = atan2(H[j][1], H[j][0]);
+        size[j] = root(guard, dot3(H[j], H[j]));
+        low[j] = target[j] - spread;
+        high[j] = target[j] + spread;
+        skewed_slips(guard, load, axis[j], zdot[j], spin, low[j], target[j], &probe);
+        f_low[j] = probe.miss;
+        skewed_slips(guard, load, axis[j], zdot[j], spin, high[j], target[j], &probe);
+        f_high[j] = probe.miss;
+    }
+    for (iteration = 0; iteration < TRIPOD_ROLLERS_CONTACT_ITERATIONS; iteration++) {
+        int done = 1;
+        for (j = 0; j < 3; j++) {
+            double least = fabs(f_low[j]) < fabs(f_high[j]) ? fabs(f_low[j]) : fabs(f_high[j]);
+            done = done && (fabs(high[j] - low[j]) <= TRIPOD_ROLLERS_CONTACT_TOLERANCE
+                            || least <= TRIPOD_ROLLERS_CONTACT_TOLERANCE);
+        }
+        if (done) {
+            break;
+        }
+        for (j = 0; j < 3; j++) {
+            double a = f_high[j] != f_low[j] ? (low[j] * f_high[j] - high[j] * f_low[j]) / (f_high[j] - f_low[j])
+                                             : 0.5 * (low[j] + high[j]);
+            double f_mid, new_low, new_high;
+            int lower;
+            skewed_slips(guard, load, axis[j], zdot[j], spin, a, target[j], &probe);
+            f_mid = probe.miss;
+            lower = sign_of(f_mid) == sign_of(f_low[j]);
+            new_low = lower ? f_mid : f_low[j];
+            new_high = lower ? f_high[j] : f_mid;
+            if (lower) {
+                low[j] = a;
+            } else {
+                high[j] = a;
+            }
+            /* Illinois: halve the value at the end that stays twice in a row */
+            if (lower && side[j] == 1) {
+                new_high = 0.5 * new_high;
+            }
+            if (!lower && side[j] == -1) {
+                new_low = 0.5 * new_low;
+            }
+            side[j] = lower ? 1 : -1;
+            f_low[j] = new_low;
+            f_high[j] = new_high;
+        }
+    }
+    for (j = 0; j < 3; j++) {
+        angle[j] = fabs(f_low[j]) <= fabs(f_high[j]) ? low[j] : high[j];
+        skewed_slips(guard, load, axis[j], zdot[j], spin, angle[j], target[j], &c[j]);
+        c[j].N = size[j] / root(guard, dot3(c[j].pushed, c[j].pushed));
+        c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
+        c[j].F_skew = -load->friction * c[j].N * slip_sign(guard, c[j].v_skew, load->slip_speed);
+    }
+}
+
+
+/* rollers.roller_reactions: the roller tripods' balance by successive substitution from the frictionless
+ * lambda_j, mu_j (R5-R13), then the reactions (R14) and the dissipation (R15). */
+void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], double inv_det,
+                             const Load *load, const Shaft *shaft, double lam[3], double mu_q[3], Reactions *out)
+{
+    const double m = load->m, R = load->roller_radius, mu = load->friction;
+    double centre[3][3], e[3][3], d[3][3], n[3][3], q[3][3], axis[3][3], length[3], groove_acc[3][3];
+    double zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], spin[3], load_moment[3], friction_h[3][3];
+    double N_trunnion[3], phi[3], force[3][3], friction[3][3], couple[3][3], H[3][3];
+    double R_out[3] = {0.0, 0.0, 0.0}, R_in[3] = {0.0, 0.0, 0.0}, L[3] = {0.0, 0.0, 0.0}, power = 0.0;
+    Contact c[3];
+    int iteration, i, j;
+    for (j = 0; j < 3; j++) {
+        const Arm *a = &arm[j];
+        centre[j][0] = a->gx;
+        centre[j][1] = a->gy;
+        centre[j][2] = a->bz;
+        e[j][0] = a->ex;
+        e[j][1] = a->ey;
+        e[j][2] = a->ez;
+        d[j][0] = a->dx;
+        d[j][1] = a->dy;
+        d[j][2] = a->dz;
+        n[j][0] = a->ey;
+        n[j][1] = -a->ex;
+        n[j][2] = 0.0;
+        cross3(e[j], n[j], q[j]);
+        length[j] = unit3(guard, e[j], axis[j]);
+        groove_acc[j][0] = a->ax;
+        groove_acc[j][1] = a->ay;
+        groove_acc[j][2] = 0.0;
+        zdot[j] = a->zdot;
+        zddot[j] = a->zddot;
+        v_trunnion[j] = a->sigma * length[j];
+        trunnion_sign[j] = slip_sign(guard, v_trunnion[j], load->slip_speed);
+        friction_h[j][0] = friction_h[j][1] = friction_h[j][2] = 0.0;
+    }
+    for (i = 0; i < 3; i++) {
+        spin[i] = shaft->W[i] - load->omega * (i == 2 ? 1.0 : 0.0);
+        load_moment[i] = load->T_load * shaft->U[i];
+    }
+    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE;
+         iteration++) {
+        double new_lam[3], new_mu[3], moment[3], sums[3][3], change = 0.0, scale = 0.0;
+        for (j = 0; j < 3; j++) {
+            N_trunnion[j] = root(guard, arm[j].exy2 * (lam[j] * lam[j] + mu_q[j] * mu_q[j] * length[j] * length[j]));
+            phi[j] = divide(guard, mu * N_trunnion[j] * trunnion_sign[j], length[j]);
+            for (i = 0; i < 3; i++) {
+                force[j][i] = lam[j] * n[j][i] + mu_q[j] * q[j][i] + phi[j] * e[j][i];
+                H[j][i] = m * groove_acc[j][i] + force[j][i] * (i == 2 ? 0.0 : 1.0);
+            }
+        }
+        if (load->tripod_type == TRIPOD_SPEC_SINGLE_ROLLER) {
+            skewed_contacts(guard, load, (const double(*)[3])H, (const double(*)[3])axis, zdot, spin, c);
+            for (j = 0; j < 3; j++) {
+                double arm_k[3];
+                for (i = 0; i < 3; i++) {
+                    friction[j][i] = c[j].F_roll * c[j].u[i] + c[j].F_skew * c[j].s[i];
+                    arm_k[i] = -R * c[j].k[i];
+                }
+                cross3(arm_k, friction[j], couple[j]);
+                for (i = 0; i < 3; i++) {
+                    couple[j][i] = couple[j][i] + R * c[j].F_roll * c[j].across * axis[j][i];
+                }
+            }
+        } else {
+            for (j = 0; j < 3; j++) {
+                c[j].N = unit3(guard, H[j], c[j].k);
+                c[j].v_roll = zdot[j];
+                c[j].v_skew = 0.0;
+                c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
+                c[j].F_skew = 0.0;
+                for (i = 0; i < 3; i++) {
+                    friction[j][i] = c[j].F_roll * (i == 2 ? 1.0 : 0.0);
+                    couple[j][i] = 0.0;
+                }
+            }
+        }
+        for (j = 0; j < 3; j++) {
+            double lever_q[3], lever_e[3];
+            new_mu[j] = divide(guard, m * zddot[j] - friction[j][2] + phi[j] * e[j][2], arm[j].exy2);
+            cross3(d[j], q[j], lever_q);
+            cross3(d[j], e[j], lever_e);
+            for (i = 0; i < 3; i++) {
+                sums[0][i] = j ? sums[0][i] + new_mu[j] * lever_q[i] : new_mu[j] * lever_q[i];
+                sums[1][i] = j ? sums[1][i] + phi[j] * lever_e[i] : phi[j] * lever_e[i];
+                sums[2][i] = j ? sums[2][i] + couple[j][i] : couple[j][i];
+            }
+        }
+        for (i = 0; i < 3; i++) {
+            moment[i] = load_moment[i] - sums[0][i] - sums[1][i] - sums[2][i];
+        }
+        for (j = 0; j < 3; j++) {
+            double change_h[3];
+            new_lam[j] = dot3(moment, adj[j]) * inv_det;
+            for (i = 0; i < 3; i++) {
+                double h = friction[j][i] * (i == 2 ? 0.0 : 1.0);
+                change_h[i] = h - friction_h[j][i];
+                friction_h[j][i] = h;
+            }
+            change = change + (fabs(new_lam[j] - lam[j]) * root(guard, arm[j].exy2)
+                               + fabs(new_mu[j] - mu_q[j]) * root(guard, arm[j].exy2) * length[j]
+                               + root(guard, dot3(change_h, change_h)));
+            scale = scale + (N_trunnion[j] + c[j].N);
+        }
+        for (j = 0; j < 3; j++) {
+            lam[j] = new_lam[j];
+            mu_q[j] = new_mu[j];
+        }
+        if (change <= TRIPOD_REACTIONS_FRICTION_TOLERANCE * scale) {
+            break;
+        }
+    }
+    if (iteration == TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS) {
+        refuse(guard, ERROR_ARITHMETIC, ROLLERS_NOT_CONVERGED);
+    }
+    /* R14, R15: the track's force on roller j, T_j = m bddot_j + F_j, its moment about O with the couple */
+    for (j = 0; j < 3; j++) {
+        double track[3], moment_O[3], t[3], P;
+        N_trunnion[j] = root(guard, arm[j].exy2 * (lam[j] * lam[j] + mu_q[j] * mu_q[j] * length[j] * length[j]));
+        phi[j] = divide(guard, mu * N_trunnion[j] * trunnion_sign[j], length[j]);
+        for (i = 0; i < 3; i++) {
+            force[j][i] = lam[j] * n[j][i] + mu_q[j] * q[j][i] + phi[j] * e[j][i];
+            track[i] = m * (groove_acc[j][i] + zddot[j] * (i == 2 ? 1.0 : 0.0)) + force[j][i];
+        }
+        cross3(centre[j], track, moment_O);
+        cross3(shaft->U, e[j], t);
+        for (i = 0; i < 3; i++) {
+            R_out[i] = j ? R_out[i] - force[j][i] : -force[j][i];
+            R_in[i] = j ? R_in[i] + track[i] : track[i];
+            L[i] = j ? L[i] + (moment_O[i] + couple[j][i]) : moment_O[i] + couple[j][i];
+        }
+        out->F_arm[j] = divide(guard, dot3(force[j], t), root(guard, dot3(t, t)));
+        out->F_plunger[j] = m * zddot[j];
+        P = phi[j] * length[j] * v_trunnion[j] + -c[j].F_roll * c[j].v_roll + -c[j].F_skew * c[j].v_skew;
+        power = j ? power + P : P;
+    }
+    out->Rx_in = R_in[0];
+    out->Ry_in = R_in[1];
+    out->Mx_in = L[0];
+    out->My_in = L[1];
+    out->T_in = L[2];
+    out->Rx_out = dot3(R_out, shaft->E1);
+    out->Ry_out = dot3(R_out, shaft->E2);
+    out->Rz_out = dot3(R_out, shaft->U);
+    out->a_plunger_sum = zddot[0] + zddot[1] + zddot[2];
+    out->omega_spin = dot3(shaft->W, shaft->U);
+    out->Rz_in = R_in[2];
+    out->P_friction = power;
+}
+
