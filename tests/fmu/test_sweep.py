@@ -99,7 +99,7 @@ def test_failed_points_are_reported_with_their_reason(client, tripod_fmu):
     rows = sweep(client, tripod_fmu, points, TIMING).to_pylist()
     assert [row["status"] for row in rows] == ["ok", "failed", "ok", "failed", "failed"]
     assert rows[4]["reason"] == "parameter r = -1000 mm must be positive"  # checked, not run
-    assert "beta_max" in rows[1]["reason"] and "Discard" in rows[1]["reason"]
+    assert rows[1]["reason"] == "input beta = 51.5662 deg must not exceed beta_max = 45 deg"  # checked, not run
     assert rows[3]["reason"].startswith("ValueError: a run of whole input turns needs a finite non-zero omega_in")
     assert rows[1]["T_in_mean"] is None and rows[3]["T_in_mean"] is None
     assert rows[0]["T_in_mean"] == pytest.approx(100.0, rel=1e-4) and rows[2]["delta_phi_peak_abs"] > 0.0
