@@ -120,7 +120,8 @@ class SystemInterface:
         missing = sorted({name for metrics in derived for name in metrics.outputs} - set(outputs))
         if missing:
             raise ValueError(f"{', '.join(missing)}: no Real output of {package.name}")
-        units = {f"{c.name}.{v.name}": unit_of(v) for c in package.components for v in descriptions[c.name].modelVariables}
+        units = {f"{c.name}.{v.name}": unit_of(v)
+                 for c in package.components for v in descriptions[c.name].modelVariables}
         return cls(package.name, {c.name: descriptions[c.name].modelName for c in package.components},
                    settable, package, outputs, tuple(derived), units)
 
