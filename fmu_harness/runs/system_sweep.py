@@ -76,6 +76,11 @@ class DerivedMetrics:
     compute: Callable[[np.ndarray, dict[str, np.ndarray]], Sequence[float]]
     units: tuple[str, ...]
 
+    def __post_init__(self) -> None:
+        if len(self.units) != len(self.columns):
+            raise ValueError(f"{len(self.columns)} derived metrics {', '.join(self.columns)} with "
+                             f"{len(self.units)} units: give each one")
+
 
 def targets(name: str) -> list[Target]:
     """``a.x+b.y`` -> ``[("a", "x"), ("b", "y")]``; ValueError for a part that is no ``component.variable``."""

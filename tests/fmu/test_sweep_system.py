@@ -237,3 +237,5 @@ def test_a_derived_metric_needs_outputs_the_system_has(launch_ssp):
     nowhere = DerivedMetrics(("mounts.nope",), ("nope_peak",), shudder_map.pitch_third_order, ("rad/s2",))
     with pytest.raises(ValueError, match="mounts.nope: no Real output of VehicleLaunch"):
         Plan.of_system(launch_ssp, POINTS, STOP, STEP, "gauss-seidel", (nowhere,))
+    with pytest.raises(ValueError, match="2 derived metrics a, b with 1 units"):
+        DerivedMetrics(("mounts.pitch_ddot",), ("a", "b"), shudder_map.pitch_third_order, ("rad/s2",))
