@@ -37,10 +37,7 @@ def over_budget(results: dict[str, dict]) -> list[str]:
 
 
 def main() -> None:
-    arguments = report.parser(summary(__doc__))
-    arguments.add_argument("fmu", nargs="?", type=Path, default=Path("models/native/CriticalSpeeds.fmu"),
-                           help="the native CriticalSpeeds FMU")
-    args = arguments.parse_args()
+    args = report.critical_speeds_parser(summary(__doc__)).parse_args()
     measurement = report.Measurement()
     with tempfile.TemporaryDirectory() as folder:
         results = measure(Path(folder), args.fmu if args.fmu.exists() else None)

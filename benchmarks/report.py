@@ -43,6 +43,14 @@ def parser(description: str) -> argparse.ArgumentParser:
     return result
 
 
+
+def critical_speeds_parser(description: str) -> argparse.ArgumentParser:
+    """:func:`parser` with the native CriticalSpeeds FMU as an optional argument."""
+    result = parser(description)
+    result.add_argument("fmu", nargs="?", type=Path, default=Path("models/native/CriticalSpeeds.fmu"),
+                        help="the native CriticalSpeeds FMU")
+    return result
+
 def page_of(name: str, docs: Path = DOCS) -> Path:
     """The one docs page holding the section ``name``."""
     pages = [page for page in sorted(docs.glob("*.md")) if markers(name)[0] in page.read_text()]

@@ -59,7 +59,7 @@ def pitch_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tu
     return third_order_peak(time, outputs[SHAFT], outputs[SIGNAL])
 
 
-THIRD_ORDER = DerivedMetrics((SHAFT, SIGNAL), (PEAK, f"{SIGNAL}_order3_speed"), pitch_third_order)
+THIRD_ORDER = DerivedMetrics((SHAFT, SIGNAL), (PEAK, f"{SIGNAL}_order3_speed"), pitch_third_order, ("rad/s2", "rad/s"))
 
 
 def shortest_duration(torque: float = TORQUE_RANGE[1], revolutions: float = REVOLUTIONS) -> float:

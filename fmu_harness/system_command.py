@@ -34,7 +34,7 @@ from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
 from .runs.start_values import StartValuesRefused, check_start_values, engine_instances
 from .runs.system import run_jacobi, step_limit_error
-from .studies.result_table import write_csv
+from .studies.result_table import headed, unit_of, write_csv
 
 ENGINES = ("master", "gauss-seidel", "libcosim", "ecos", "model-exchange")
 ENGINE_EXTRAS = {"libcosim": "libcosimpy", "ecos": "ecospy"}  # the module of the interop extra each engine needs
@@ -53,11 +53,6 @@ def _description(path: Path) -> ModelDescription:
         return read_model_description(str(path))
     except Exception as error:  # noqa: BLE001 - fmpy raises many kinds for an unreadable FMU
         raise PackageError(f"{path.name}: no readable FMU ({type(error).__name__}: {error})") from None
-
-
-def _unit(variable) -> str:
-    unit = variable.unit or (variable.declaredType.unit if variable.declaredType is not None else None)
-    return unit or "1"
 
 
 def _parse_value(kind: str, text: str) -> float | int | bool | str:
@@ -106,7 +101,7 @@ def output_columns(system: SspSystem, descriptions: dict[str, ModelDescription])
         for variable in descriptions[component.name].modelVariables:
             if variable.causality == "output" and variable.type == "Real":
                 names.append(f"{component.name}.{variable.name}")
-                headers.append(f"{component.name}.{variable.name} [{_unit(variable)}]")
+                headers.append(headed(f"{component.name}.{variable.name}", unit_of(variable)))
     return names, headers
 
 

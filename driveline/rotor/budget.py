@@ -23,15 +23,19 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 
+from .unit_rates import NATIVE_SECONDS_PER_UNIT, PYTHON_SECONDS_PER_UNIT
+
 #: Units of one step of an anisotropic chain (measured 6 to 8 times an isotropic step, both cores).
 ANISOTROPIC_STEP = 8
-#: Native CPU seconds of one unit at most: measured 40 to 75 ns (isotropic), 28 to 52 ns (anisotropic,
-#: per unit) on the project's machine; the Python core's batches take 85 to 270 ns (2026-11-27).
+#: Native CPU seconds the finite-element stages' estimates (:mod:`.work`) convert to one unit at: the
+#: rate their fits assumed (2026-11-27), not a measured one (:mod:`.unit_rates` holds those).
 SECONDS_PER_UNIT = 75e-9
-#: Native CPU seconds one analysis may spend at ``SECONDS_PER_UNIT`` (budget 5 s native, 30 s Python).
-SECONDS = 2.5
 #: The budget in units.
-UNITS = math.floor(SECONDS / SECONDS_PER_UNIT)
+UNITS = 33_333_333
+#: Native and Python CPU seconds of the whole budget at the measured rates: within the limits of 5 s
+#: and 30 s (tests/core/test_budget_rates.py).
+SECONDS = UNITS * NATIVE_SECONDS_PER_UNIT
+PYTHON_SECONDS = UNITS * PYTHON_SECONDS_PER_UNIT
 
 
 class BudgetSpent(ValueError):
@@ -53,9 +57,9 @@ class Budget:
         self.left -= units
 
 
-def refusal(stage: str) -> str:
-    """The refusal of an analysis whose budget ``stage`` exhausted."""
-    return (f"the analysis would exceed its work budget (about {SECONDS:g} s) in the {stage} "
+def refusal(stage: str, seconds: float = SECONDS) -> str:
+    """The refusal of an analysis whose budget ``stage`` exhausted, the budget taking about ``seconds``."""
+    return (f"the analysis would exceed its work budget (about {seconds:.1f} s) in the {stage} "
             "(fewer stations or segments, fewer or lower orders, or a smaller omega_in_max)")
 
 

@@ -47,7 +47,7 @@ import zipfile
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -58,6 +58,7 @@ from fmpy.model_description import ModelDescription
 from driveline.catalog import MODELS
 
 from ..console import CommandParser, Progress, optional, refused, summary
+from ..studies.result_table import headed, unheaded, unit_of
 from .runner import StepRefused, simulate
 from .start_values import refusals
 from .system_sweep import (
@@ -195,6 +196,8 @@ class Interface:
     speed_start: float | None
     """Start value of the ``omega_in`` input; None without one."""
     default_experiment: tuple[float, float] | None
+    units: dict[str, str] = field(default_factory=dict)
+    """The unit of every settable variable and Real output (``1`` without one)."""
 
     @classmethod
     def of(cls, path: Path) -> Interface:
@@ -214,6 +217,7 @@ class Interface:
                 if experiment and experiment.stopTime and experiment.stepSize
                 else None
             ),
+            units={v.name: unit_of(v) for v in variables},
         )
 
     def split(self, point: Point) -> tuple[Point, Point]:
@@ -238,6 +242,14 @@ class Interface:
 
     def metric_columns(self) -> list[str]:
         return [f"{output}_{statistic}" for output, statistic in self.statistics()]
+
+    def metric_units(self) -> list[str]:
+        """The unit of each of :meth:`metric_columns`: its output's (every statistic keeps it)."""
+        return [self.units[output] for output, _ in self.statistics()]
+
+    def unit(self, name: str) -> str:
+        """The unit of a point's name."""
+        return self.units[name]
 
     def run(
         self,
@@ -471,7 +483,8 @@ def run(client: Client, plan: Plan, show_progress: bool = False) -> pa.Table:
 
     Columns: the points' names, ``status`` (ok/failed), ``reason`` (null when ok), the
     metrics of :meth:`Interface.statistics` (null when failed) and, when available,
-    ``critical_speed_margin`` (see :func:`critical_speed_margins`).
+    ``critical_speed_margin`` (see :func:`critical_speed_margins`; null without one). Every numeric column carries its
+    unit as the field's metadata :data:`UNIT_KEY` (:func:`with_units`).
     """
     pa = optional("pyarrow", EXTRA, COMMAND)
     distributed = optional("distributed", EXTRA, COMMAND)
@@ -490,10 +503,30 @@ def run(client: Client, plan: Plan, show_progress: bool = False) -> pa.Table:
     types = {"status": pa.string(), "reason": pa.string(), **{m: pa.float64() for m in metrics}}
     columns = [*names, "status", "reason", *metrics]
     table = pa.table({c: pa.array([row.get(c) for row in rows], types.get(c)) for c in columns})
-    if plan.critical is None:
-        return table
-    margins = critical_speed_margins([interface.speed(point) for point in points], plan.critical)
-    return table.append_column(MARGIN, pa.array(margins, pa.float64()))
+    units = {**{name: interface.unit(name) for name in names}, **dict(zip(metrics, interface.metric_units()))}
+    if plan.critical is not None:
+        margins = critical_speed_margins([interface.speed(point) for point in points], plan.critical)
+        table = table.append_column(MARGIN, pa.array(margins, pa.float64(), from_pandas=True))  # NaN: null
+        units[MARGIN] = "1"
+    return with_units(table, units)
+
+
+UNIT_KEY = b"unit"
+"""The key of a numeric column's unit in its Parquet field's metadata."""
+
+
+def with_units(table: pa.Table, units: Mapping[str, str]) -> pa.Table:
+    """``table`` with each numeric column's unit of ``units`` as its field's metadata :data:`UNIT_KEY`; a
+    text column (a point's text values, ``status``, ``reason``) carries none."""
+    pa = optional("pyarrow", EXTRA, COMMAND)
+    fields = [f.with_metadata({UNIT_KEY: units[f.name].encode()})
+              if pa.types.is_integer(f.type) or pa.types.is_floating(f.type) else f for f in table.schema]
+    return table.cast(pa.schema(fields))
+
+
+def units_of(table: pa.Table) -> dict[str, str]:
+    """``{column: unit}`` of a table's numeric columns (:func:`with_units`)."""
+    return {f.name: f.metadata[UNIT_KEY].decode() for f in table.schema if f.metadata and UNIT_KEY in f.metadata}
 
 
 def sweep(
@@ -517,10 +550,13 @@ def refused_points(model: str, points: Sequence[Point]) -> dict[int, str]:
 
 
 def write_table(table: pa.Table, path: Path) -> None:
-    """Parquet, or CSV when ``path`` ends in ``.csv``."""
+    """Parquet, the units in the fields' metadata, or CSV when ``path`` ends in ``.csv``, each numeric
+    column headed ``name [unit]`` (:func:`fmu_harness.studies.result_table.headed`), a text column ``name``."""
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".csv":
-        optional("pyarrow.csv", EXTRA, COMMAND).write_csv(table, path)
+        units = units_of(table)
+        headers = [headed(name, units[name]) if name in units else name for name in table.column_names]
+        optional("pyarrow.csv", EXTRA, COMMAND).write_csv(table.rename_columns(headers), path)
     else:
         optional("pyarrow.parquet", EXTRA, COMMAND).write_table(table, path)
 
@@ -634,9 +670,11 @@ def run_plan(plan: Plan, scheduler: str | None, workers: int) -> pa.Table:
 
 
 def read_table(path: Path) -> pa.Table:
-    """A table :func:`write_table` wrote."""
+    """A table :func:`write_table` wrote, its columns by name and their units in the fields' metadata."""
     if path.suffix.lower() == ".csv":
-        return optional("pyarrow.csv", EXTRA, COMMAND).read_csv(path)
+        table = optional("pyarrow.csv", EXTRA, COMMAND).read_csv(path)
+        names, units = zip(*map(unheaded, table.column_names))
+        return with_units(table.rename_columns(list(names)), {n: u for n, u in zip(names, units) if u is not None})
     return optional("pyarrow.parquet", EXTRA, COMMAND).read_table(path)
 
 

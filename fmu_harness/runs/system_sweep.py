@@ -25,7 +25,7 @@ import math
 import tempfile
 import zipfile
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +35,7 @@ from fmpy.model_description import ModelDescription
 
 from . import container, ssp_package
 from .libcosim_run import cosim_run
+from ..studies.result_table import unit_of
 from .ssp_package import SspSystem
 from .start_values import refusals
 from .system import run_jacobi, step_limit_error
@@ -67,12 +68,18 @@ GENERIC = ("min", "max", "mean")
 class DerivedMetrics:
     """Metric columns a study computes from a run's recorded outputs on the worker (the shudder map's
     third-order peak, :mod:`fmu_harness.shudder_map`): ``compute(time, {output: values})`` gives the
-    values of ``columns`` from the ``outputs`` it names. ``compute`` travels to the workers by
-    reference: a module-level function of an importable module."""
+    values of ``columns``, in ``units``, from the ``outputs`` it names. ``compute`` travels to the workers
+    by reference: a module-level function of an importable module."""
 
     outputs: tuple[str, ...]
     columns: tuple[str, ...]
     compute: Callable[[np.ndarray, dict[str, np.ndarray]], Sequence[float]]
+    units: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        if len(self.units) != len(self.columns):
+            raise ValueError(f"{len(self.columns)} derived metrics {', '.join(self.columns)} with "
+                             f"{len(self.units)} units: give each one")
 
 
 def targets(name: str) -> list[Target]:
@@ -100,6 +107,8 @@ class SystemInterface:
     outputs: tuple[str, ...]
     """Every Real output as ``component.variable``."""
     derived: tuple[DerivedMetrics, ...] = ()
+    units: dict[str, str] = field(default_factory=dict)
+    """The unit of every settable variable and Real output, by ``component.variable`` (``1`` without one)."""
 
     @classmethod
     def of(cls, path: Path, derived: Sequence[DerivedMetrics] = ()) -> SystemInterface:
@@ -116,8 +125,10 @@ class SystemInterface:
         missing = sorted({name for metrics in derived for name in metrics.outputs} - set(outputs))
         if missing:
             raise ValueError(f"{', '.join(missing)}: no Real output of {package.name}")
+        units = {f"{c.name}.{v.name}": unit_of(v)
+                 for c in package.components for v in descriptions[c.name].modelVariables}
         return cls(package.name, {c.name: descriptions[c.name].modelName for c in package.components},
-                   settable, package, outputs, tuple(derived))
+                   settable, package, outputs, tuple(derived), units)
 
     def changes(self, point: Point) -> dict[Target, tuple[str, Value]]:
         """``{(component, variable): (type, value)}`` of a point; ValueError for a name the system cannot set."""
@@ -150,6 +161,15 @@ class SystemInterface:
     def metric_columns(self) -> list[str]:
         return [f"{output}_{statistic}" for output, statistic in self.statistics()] + [
             column for metrics in self.derived for column in metrics.columns]
+
+    def metric_units(self) -> list[str]:
+        """The unit of each of :meth:`metric_columns`: its output's, a derived metric's its own."""
+        return [self.units[output] for output, _ in self.statistics()] + [
+            unit for metrics in self.derived for unit in metrics.units]
+
+    def unit(self, name: str) -> str:
+        """The unit of a point's name: its first target's (all take the same value)."""
+        return self.units[".".join(targets(name)[0])]
 
     def recorded(self) -> list[str]:
         """The outputs a run records: those of the metrics."""

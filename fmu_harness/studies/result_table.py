@@ -17,10 +17,26 @@ UNIT = re.compile(r" \[[^\[\]]+\]$")
 """A header's unit: `` [unit]`` at its end."""
 
 
+def headed(name: str, unit: str | None) -> str:
+    """``name [unit]``; a quantity without a unit (an integer, a flag, a ratio) counts in ``1``."""
+    return f"{name} [{unit or '1'}]"
+
+
+def unheaded(header: str) -> tuple[str, str | None]:
+    """(name, unit) of a header :func:`headed` wrote, (header, None) of a text column's."""
+    found = UNIT.search(header)
+    return (header, None) if found is None else (header[:found.start()], found.group()[2:-1])
+
+
 def column(spec: ModelSpec, name: str) -> str:
-    """``name [unit]`` of one variable of ``spec``; a variable without a unit (an integer,
-    a flag) counts in ``1``."""
-    return f"{name} [{spec[name].unit or '1'}]"
+    """``name [unit]`` of one variable of ``spec``."""
+    return headed(name, spec[name].unit)
+
+
+def unit_of(variable) -> str:
+    """The unit of a model description's variable (fmpy's), its own or its declared type's; ``1``
+    without one."""
+    return variable.unit or (variable.declaredType.unit if variable.declaredType is not None else None) or "1"
 
 
 def table_errors(header: Sequence[str], rows: Sequence[Sequence[object]]) -> list[str]:

@@ -13,7 +13,19 @@ import pytest
 from driveline.catalog import MODELS
 from fmu_harness.runs import sweep as sweep_module
 from fmu_harness.runs.runner import simulate
-from fmu_harness.runs.sweep import MARGIN, Timing, grid, main, open_client, parse_axis, sweep, write_table
+from fmu_harness.runs.system_sweep import STATISTICS
+from fmu_harness.runs.sweep import (
+    MARGIN,
+    Timing,
+    grid,
+    main,
+    open_client,
+    parse_axis,
+    read_table,
+    sweep,
+    units_of,
+    write_table,
+)
 
 STEPS = 36
 TIMING = Timing(steps_per_turn=STEPS)
@@ -63,7 +75,22 @@ def test_sweep_matches_direct_runs_and_writes_parquet(client, tripod_fmu, tmp_pa
         assert not off, f"{point}: {off}"
     assert rows[-1]["delta_phi_peak_abs"] > rows[0]["delta_phi_peak_abs"] > 0.0
     write_table(table, tmp_path / "sweep.parquet")
-    assert pyarrow.parquet.read_table(tmp_path / "sweep.parquet").equals(table)
+    written = pyarrow.parquet.read_table(tmp_path / "sweep.parquet")
+    assert written.equals(table) and units_of(written) == spec_units(table.column_names)
+
+
+def spec_units(columns: list[str]) -> dict[str, str]:
+    """The unit of each numeric column of a TripodCoupling sweep from the model's spec (not the FMU's model
+    description the sweep reads): a point's variable's, a statistic's output's, the margin's 1."""
+    spec = MODELS["TripodCoupling"].spec
+    names = {variable.name for variable in spec.variables}
+    found = {}
+    for name in columns:
+        variable = name if name in names else next((v for v in names if name.startswith(f"{v}_")
+                                                    and name[len(v) + 1:] in STATISTICS), None)
+        if variable is not None:
+            found[name] = spec[variable].unit or "1"
+    return found | ({MARGIN: "1"} if MARGIN in columns else {})
 
 
 def test_failed_points_are_reported_with_their_reason(client, tripod_fmu):
@@ -72,7 +99,7 @@ def test_failed_points_are_reported_with_their_reason(client, tripod_fmu):
     rows = sweep(client, tripod_fmu, points, TIMING).to_pylist()
     assert [row["status"] for row in rows] == ["ok", "failed", "ok", "failed", "failed"]
     assert rows[4]["reason"] == "parameter r = -1000 mm must be positive"  # checked, not run
-    assert "beta_max" in rows[1]["reason"] and "Discard" in rows[1]["reason"]
+    assert rows[1]["reason"] == "input beta = 51.5662 deg must not exceed beta_max = 45 deg"  # checked, not run
     assert rows[3]["reason"].startswith("ValueError: a run of whole input turns needs a finite non-zero omega_in")
     assert rows[1]["T_in_mean"] is None and rows[3]["T_in_mean"] is None
     assert rows[0]["T_in_mean"] == pytest.approx(100.0, rel=1e-4) and rows[2]["delta_phi_peak_abs"] > 0.0
@@ -92,14 +119,24 @@ def test_grid_axes():
 
 
 def test_cli_with_points_file_on_a_running_scheduler(client, fmi2_dir, tmp_path):
+    """A CSV table heads every numeric column ``name [unit]`` with the spec's unit, the text columns
+    ``status`` and ``reason`` bare; read back, it is the table with its units."""
     points = tmp_path / "points.json"
-    points.write_text(json.dumps([{"beta": 0.2, "omega_in": 300.0}, {"beta": 0.4, "omega_in": 300.0}]))
+    points.write_text(json.dumps([{"beta": 0.2, "omega_in": 300.0, "kinematics": 1},
+                                  {"beta": 0.4, "omega_in": 0.0, "kinematics": 1}]))
     out = tmp_path / "sweep.csv"
     main(["--points", str(points), "--models", str(fmi2_dir), "--scheduler", client.scheduler.address,
           "--steps-per-turn", str(STEPS), "--out", str(out)])
     table = pyarrow.csv.read_csv(out)
-    assert table.column("status").to_pylist() == ["ok", "ok"]
-    assert table.column("beta").to_pylist() == [0.2, 0.4]
+    assert table.column("status").to_pylist() == ["ok", "failed"]
+    assert table.column("beta [rad]").to_pylist() == [0.2, 0.4]
+    back = read_table(out)
+    units = spec_units(back.column_names)
+    assert table.column_names == [f"{name} [{units[name]}]" if name in units else name for name in back.column_names]
+    assert units_of(back) == units and {"omega_in", "kinematics", "Rz_out_p2p", MARGIN} <= set(units)
+    assert set(back.column_names) - set(units) == {"status", "reason"}
+    assert back.column(MARGIN).to_pylist()[1] is None  # no margin at omega_in = 0, an empty cell
+    assert "nan" not in out.read_text()
 
 
 def test_critical_speed_margin_of_the_critical_speeds_model(client, tripod_fmu, monkeypatch):

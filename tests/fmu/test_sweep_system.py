@@ -17,9 +17,10 @@ import numpy as np
 import pyarrow.csv
 import pytest
 
+from driveline.catalog import MODELS
 from fmu_harness import shudder_map
 from fmu_harness.runs import system
-from fmu_harness.runs.sweep import Plan, main, run
+from fmu_harness.runs.sweep import Plan, main, read_table, run, units_of
 from fmu_harness.runs.system_sweep import STATISTICS, SYSTEM_METRICS, DerivedMetrics
 from fmu_harness.studies.order_tracking import third_order_peak
 
@@ -127,8 +128,14 @@ def test_a_tiny_shudder_map_on_a_local_cluster(launch_ssp, tmp_path, capsys):
     out, figure = tmp_path / "map.csv", tmp_path / "map.png"
     shudder_map.main(["--package", str(launch_ssp), "--count", "2", "--duration", str(STOP), "--step", str(STEP),
                       "--workers", "1", "--out", str(out), "--figure", str(figure)])
-    rows = pyarrow.csv.read_csv(out).to_pylist()
+    table = read_table(out)
+    rows = table.to_pylist()
     assert len(rows) == 8 and figure.stat().st_size > 10_000
+    units = {column: unit_of_metric(column) for column in table.column_names
+             if column not in ("status", "reason")}
+    assert units_of(table) == units and units[shudder_map.PEAK] == "rad/s2" and units[shudder_map.TORQUE] == "N.m"
+    assert pyarrow.csv.read_csv(out).column_names == [
+        f"{name} [{units[name]}]" if name in units else name for name in table.column_names]
     low = [row for row in rows if row[shudder_map.TORQUE] < 100.0]
     full = {(row[shudder_map.BETA], row[shudder_map.MU]): row[shudder_map.PEAK] for row in rows if row not in low}
     assert {row["reason"] for row in low} == {
@@ -139,6 +146,26 @@ def test_a_tiny_shudder_map_on_a_local_cluster(launch_ssp, tmp_path, capsys):
     assert "8 launches, 4 failed" in captured.out and "sweep [8/8]" in captured.err
     shudder_map.main(["--figure-only", "--out", str(out), "--figure", str(tmp_path / "again.png")])
     assert (tmp_path / "again.png").read_bytes() == figure.read_bytes()
+
+
+def unit_of_metric(column: str) -> str:
+    """The unit of a launch map's numeric column from the components' specs (not the FMUs' model descriptions
+    the sweep reads): a point's name its first target's, a statistic its output's, the third-order peak its
+    signal's and the speed there the shaft angle's per second."""
+    models = {component.name: component.model for component in system.vehicle_launch().components}
+
+    def unit(name: str) -> str:
+        component, variable = name.split(".")
+        return MODELS[models[component]].spec[variable].unit or "1"
+
+    if column == shudder_map.PEAK:
+        return unit(shudder_map.SIGNAL)
+    if column == f"{shudder_map.SIGNAL}_order3_speed":
+        return f"{unit(shudder_map.SHAFT)}/s"
+    for output, statistic in SYSTEM_METRICS["VehicleLaunch"]:
+        if column == f"{output}_{statistic}":
+            return unit(output)
+    return unit(column.split("+")[0])
 
 
 def test_refused_points_are_not_run_and_carry_their_reason(launch_ssp):
@@ -207,6 +234,8 @@ def test_grid_values_reach_every_joined_target(launch_ssp):
 
 def test_a_derived_metric_needs_outputs_the_system_has(launch_ssp):
     """A study's metric naming an output the package has not is refused before anything runs."""
-    nowhere = DerivedMetrics(("mounts.nope",), ("nope_peak",), shudder_map.pitch_third_order)
+    nowhere = DerivedMetrics(("mounts.nope",), ("nope_peak",), shudder_map.pitch_third_order, ("rad/s2",))
     with pytest.raises(ValueError, match="mounts.nope: no Real output of VehicleLaunch"):
         Plan.of_system(launch_ssp, POINTS, STOP, STEP, "gauss-seidel", (nowhere,))
+    with pytest.raises(ValueError, match="2 derived metrics a, b with 1 units"):
+        DerivedMetrics(("mounts.pitch_ddot",), ("a", "b"), shudder_map.pitch_third_order, ("rad/s2",))

@@ -4,6 +4,7 @@ every run failed says why and fails, long work shows its progress."""
 
 from __future__ import annotations
 
+import csv
 import os
 import shutil
 import subprocess
@@ -92,6 +93,8 @@ def test_a_sweep_whose_every_run_failed_names_the_reasons_and_fails(tripod_fmu, 
                          "--workers", "1", "--steps-per-turn", "4", "--out", "sweep.csv", cwd=tmp_path)
     assert run.returncode == 1 and "Traceback" not in run.stderr
     assert "3 runs, 3 failed" in run.stdout and (tmp_path / "sweep.csv").is_file()
+    with (tmp_path / "sweep.csv").open(newline="") as table:  # the units of the points' variables, none on text
+        assert next(csv.reader(table))[:5] == ["r [m]", "omega_in [rad/s]", "status", "reason", "phi_in_min [rad]"]
     reasons = [line for line in run.stderr.splitlines() if " failed: " in line]
     assert reasons[0].startswith("  2 failed: ValueError: a run of whole input turns needs a finite non-zero omega_in")
     assert reasons[1] == "  1 failed: parameter r = -10 mm must be positive" and len(reasons) == 2
