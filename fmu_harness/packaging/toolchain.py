@@ -26,7 +26,7 @@ from ..console import Progress
 
 # -ffp-contract=off: no fused multiply-add (clang fuses by default where the CPU has it, aarch64), so
 # every platform rounds as the Python core does, operation by operation
-CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", "-ffp-contract=off", "-fvisibility=hidden")
+CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-O2", "-ffp-contract=off", "-fvisibility=hidden")
 GLIBC = "2.17"  # manylinux2014
 MACOS = "11.0"  # Big Sur, the first with Apple silicon
 NO_COMPILER = ("no C compiler for the native FMUs: `pip install ziglang` (or install one, e.g. "

@@ -23,12 +23,12 @@
 /* The row of value reference ``reference`` (an unknown), or -1. */
 static int row_of(const Instance *instance, uint32_t reference)
 {
-    uint32_t first = MODEL_VARIABLE_COUNT + (instance->fmi_prefix[3] == '3' ? 1u : 0u); /* der(<state 0>) */
+    int state;
     if (reference < MODEL_VARIABLE_COUNT) {
         return model_jacobian_rows[reference];
     }
-    return reference >= first && reference - first < (uint32_t)MODEL_STATE_COUNT
-               ? MODEL_OUTPUT_ROWS + (int)(reference - first) : -1;
+    state = instance_derivative_of(instance, reference);
+    return state >= 0 ? MODEL_OUTPUT_ROWS + state : -1;
 }
 
 static int column_of(uint32_t reference)

@@ -284,6 +284,8 @@ Status instance_set_integer(Instance *instance, const char *function, const uint
  * SetRealInputDerivatives); Error, setting none, if one has no such input. */
 Status instance_set_input_derivatives(Instance *instance, const char *function, const uint32_t vr[], size_t n,
                                       const int32_t order[], const double value[]);
+/* The state whose derivative has value reference ``reference`` (FMI 3.0: after time), or -1. */
+int instance_derivative_of(const Instance *instance, uint32_t reference);
 Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[]);
 Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[]);
 /* Booleans as the FMI version's type of ``size`` bytes (fmi2Boolean: int, fmi3Boolean: bool):

@@ -29,11 +29,17 @@ static int is_time(const Instance *instance, uint32_t reference)
 #endif
 
 /* The state k whose derivative der(<state>) has value reference ``reference`` (after the spec's
- * variables and FMI 3.0's time), or -1. */
-static int derivative_of(const Instance *instance, uint32_t reference)
+ * variables and FMI 3.0's time), or -1; a model without states has none (no comparison with a count 0). */
+int instance_derivative_of(const Instance *instance, uint32_t reference)
 {
+#if MODEL_STATE_COUNT > 0
     uint32_t first = MODEL_VARIABLE_COUNT + (instance->fmi_prefix[3] == '3' ? 1u : 0u);
     return reference >= first && reference - first < (uint32_t)MODEL_STATE_COUNT ? (int)(reference - first) : -1;
+#else
+    (void)instance;
+    (void)reference;
+    return -1;
+#endif
 }
 
 /* 1 when ``reference`` names a variable of ``type`` that may be got (``setting`` 0) or set now;
@@ -49,7 +55,7 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
     }
     if (is_time(instance, reference)) {
         problem = type == VAR_REAL && !setting ? NULL : " is the independent variable time, a Real that cannot be set";
-    } else if (derivative_of(instance, reference) >= 0) {
+    } else if (instance_derivative_of(instance, reference) >= 0) {
         problem = type == VAR_REAL && !setting ? NULL : " is a state derivative, a Real that cannot be set";
     } else if (v == NULL) {
         problem = " is unknown";
@@ -172,7 +178,7 @@ Status instance_get_real(Instance *instance, const char *function, const uint32_
     status = model_exchange_update(instance);
     values = instance_readable(instance, &initial);
     for (i = 0; i < n; i++) {
-        k = vr[i] < MODEL_VARIABLE_COUNT ? -1 : derivative_of(instance, vr[i]);
+        k = vr[i] < MODEL_VARIABLE_COUNT ? -1 : instance_derivative_of(instance, vr[i]);
         value[i] = vr[i] < MODEL_VARIABLE_COUNT ? values->real_value[vr[i]]
                    : k >= 0                     ? DERIVATIVE_VALUE(k)
                                                 : values->time;

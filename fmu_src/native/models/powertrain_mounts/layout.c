@@ -34,7 +34,8 @@ static ErrorKind vector3(const Loader *loader, const char *where, const char *ke
     return ERROR_NONE;
 }
 
-static double det3(const double a[3][3])
+/* not const: C99 passes no double[3][3] for a const one (nor in state_and_inputs) */
+static double det3(double a[3][3])
 {
     return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
            a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);

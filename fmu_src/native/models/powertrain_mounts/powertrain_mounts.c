@@ -244,7 +244,7 @@ static void modes(System *s)
 }
 
 /* exact_step.state_matrices and system.input_map */
-static int state_and_inputs(System *s, const double centres[2][3], const double frames[2][3][3])
+static int state_and_inputs(System *s, double centres[2][3], double frames[2][3][3])
 {
     double inverse[6][6], identity[6][6] = {{0}}, product[6][6], mass[6][6];
     int i, j, side, k;

@@ -300,7 +300,10 @@ static double step_limit(const ModelData *data, int jacobi)
     return limit;
 }
 
-/* modes_text, in ``text`` (at least 160 characters) */
+/* modes_text's four numbers (39 characters at most) and its words, never cut (gcc's -Wformat-truncation) */
+#define MODES_TEXT_SIZE 256
+
+/* modes_text, in ``text`` (MODES_TEXT_SIZE characters) */
 static void modes_text(const ModelData *data, char *text, size_t size)
 {
     char shown[4][40];
@@ -318,7 +321,7 @@ static void modes_text(const ModelData *data, char *text, size_t size)
 /* step_limit_notice: a step above the Jacobi limit */
 static void step_notice(const ModelData *data, double step_size, Messages *out)
 {
-    char modes[200], limit[40], omega_step[40], damping_step[40], divergence[40], divergence_step[40];
+    char modes[MODES_TEXT_SIZE], limit[40], omega_step[40], damping_step[40], divergence[40], divergence_step[40];
     double jacobi = step_limit(data, 1);
     if (!(step_size > jacobi)) {
         return;
@@ -338,7 +341,7 @@ static void step_notice(const ModelData *data, double step_size, Messages *out)
 /* step_limit_errors: a step at which the coupled drive diverges in any master's order */
 static void step_size_errors(const ModelData *data, double step_size, Messages *out)
 {
-    char modes[200], step[40], limit[40], divergence_step[40], jacobi[40];
+    char modes[MODES_TEXT_SIZE], step[40], limit[40], divergence_step[40], jacobi[40];
     double longest = step_limit(data, 0);
     if (!(step_size > longest)) {
         return;
