@@ -662,8 +662,8 @@ def _pack(name: str, fmi: str, files: dict[str, bytes], binaries: dict[toolchain
         **carried,
         **{f"sources/{source}": data for source, data in sources.items()},
         **{f"resources/{resource}": data for resource, data in resource_files(name).items()},
-        **documentation.members(name, toolchain.platforms_sentence(carried)),
     }
+    members |= documentation.members(name, toolchain.platforms_sentence(members))
     if fmi == "3":
         members["sources/buildDescription.xml"] = build_description(name, compiled)
     write_zip(target, members)

@@ -73,7 +73,7 @@ def test_every_csv_starts_with_time_at_0_or_the_swept_variable_with_units_and_no
 def test_every_figure_is_named_in_the_docs_page_it_belongs_to(results):
     pages = " ".join(page.read_text() for page in (Path(__file__).resolve().parents[2] / "docs").glob("*.md"))
     figures = sorted(path.name for path in results.glob("*.png"))
-    assert len(figures) == 15 and [name for name in figures if name not in pages] == []
+    assert len(figures) == 16 and [name for name in figures if name not in pages] == []
 
 
 def test_ramp_rows_belong_to_their_own_speed_and_pass_every_critical_speed(results):
