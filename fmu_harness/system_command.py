@@ -34,7 +34,7 @@ from .runs.runner import StepRefused
 from .runs.ssp_package import PackageError, SspSystem
 from .runs.start_values import StartValuesRefused, check_start_values, engine_instances
 from .runs.system import run_jacobi, step_limit_error
-from .studies.result_table import headed, unit_of, write_csv
+from .runs.result_table import headed, unit_of, write_csv
 
 ENGINES = ("master", "gauss-seidel", "libcosim", "ecos", "model-exchange")
 ENGINE_EXTRAS = {"libcosim": "libcosimpy", "ecos": "ecospy"}  # the module of the interop extra each engine needs

@@ -58,7 +58,7 @@ from fmpy.model_description import ModelDescription
 from driveline.catalog import MODELS
 
 from ..console import CommandParser, Progress, optional, refused, summary
-from ..studies.result_table import headed, unheaded, unit_of
+from .result_table import headed, unheaded, unit_of
 from .runner import StepRefused, simulate
 from .start_values import refusals
 from .system_sweep import (
@@ -551,7 +551,7 @@ def refused_points(model: str, points: Sequence[Point]) -> dict[int, str]:
 
 def write_table(table: pa.Table, path: Path) -> None:
     """Parquet, the units in the fields' metadata, or CSV when ``path`` ends in ``.csv``, each numeric
-    column headed ``name [unit]`` (:func:`fmu_harness.studies.result_table.headed`), a text column ``name``."""
+    column headed ``name [unit]`` (:func:`fmu_harness.runs.result_table.headed`), a text column ``name``."""
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".csv":
         units = units_of(table)

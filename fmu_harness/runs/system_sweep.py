@@ -35,7 +35,7 @@ from fmpy.model_description import ModelDescription
 
 from . import container, ssp_package
 from .libcosim_run import cosim_run
-from ..studies.result_table import unit_of
+from .result_table import unit_of
 from .ssp_package import SspSystem
 from .start_values import refusals
 from .system import run_jacobi, step_limit_error

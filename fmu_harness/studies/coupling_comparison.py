@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 
 from ..runs.runner import FmuInstance, simulate
 from .figures import figure, save
-from .result_table import write_csv
+from ..runs.result_table import write_csv
 
 SPEED = 1500.0 * math.pi / 30.0  # rad/s
 SAMPLES_PER_TURN = 360

@@ -20,7 +20,7 @@ from driveline.rotor.spec import SPEC
 
 from ..runs.runner import FmuInstance
 from .figures import BLUE, ORANGE, VERMILLION, clear_of_lines, figure, save
-from .result_table import column, write_csv
+from ..runs.result_table import column, write_csv
 
 RPM = 30.0 / math.pi
 ORDERS = (1, 2, 3)  # unbalance; Cardan joints; the tripod coupling (docs/tripod_coupling.md)

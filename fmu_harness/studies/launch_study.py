@@ -35,7 +35,7 @@ from ..runs import ssp_package
 from ..runs.system import LAUNCH_ORDER, run_jacobi
 from . import order_tracking
 from .figures import BLUE, ORANGE, PALETTE, SKY, YELLOW, clear_of_lines, figure, save
-from .result_table import write_csv
+from ..runs.result_table import write_csv
 
 TORQUE = 20.0  # motor torque after the ramp [N.m]
 STOP_TIME = 40.0  # [s]

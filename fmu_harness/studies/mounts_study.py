@@ -16,7 +16,7 @@ from driveline.mounts.rigid_body import COORDINATES  # noqa: E402
 from driveline.mounts.spec import AXES, SPEC  # noqa: E402
 
 from ..runs.runner import FmuInstance  # noqa: E402
-from .result_table import column, write_csv  # noqa: E402
+from ..runs.result_table import column, write_csv  # noqa: E402
 
 MODES = range(1, 7)
 SHARES = tuple(f"share_{j}_{name}" for j in MODES for name in COORDINATES)

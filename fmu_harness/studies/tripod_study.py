@@ -22,7 +22,7 @@ from driveline.tripod.exact import exact_pose
 from driveline.tripod.spec import DOUBLE_ROLLER, PLAIN_TRIPOD, SINGLE_ROLLER, SPEC
 
 from ..runs.runner import simulate
-from . import result_table
+from ..runs import result_table
 from .figures import BLUE, GREEN, VERMILLION, blank, by_scale, figure, ordered, save, span
 
 SPEED = 2000.0 * math.pi / 30.0  # rad/s, the seed's 2000 rpm

@@ -21,7 +21,7 @@ from fmu_harness.checks import python_fmu_check
 from fmu_harness.runs.runner import FmuInstance
 from fmu_harness.runs import system
 from fmu_harness.studies import critical_speed_study, launch_study, order_tracking
-from fmu_harness.studies.result_table import table_errors
+from fmu_harness.runs.result_table import table_errors
 from fmu_harness.packaging import native
 
 FIRST_COLUMNS = {"time [s]", "beta [deg]", "mode [1]"}  # time, the swept bend angle, the mode number

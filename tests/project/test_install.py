@@ -80,6 +80,7 @@ def test_installed_wheel_builds_every_fmu_and_both_systems(wheel, tmp_path):
     models = work / "models"
     expected = {fmu_path(models, name, fmi) for name in MODELS for fmi in ("2", "3")}
     expected |= {native.fmu_path(models, name, fmi) for name in native.native_models() for fmi in ("2", "3")}
+    expected |= {system.container_path(s, models, fmi) for s in system.systems() for fmi in ("2", "3")}
     assert set(models.rglob("*.fmu")) == expected
     packages = {path.relative_to(models).as_posix() for path in models.rglob("*.ssp")}
     assert {f"{s.name}.ssp" for s in system.systems()} | {"native/Driveline.ssp"} <= packages

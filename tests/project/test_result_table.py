@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from fmu_harness.studies.result_table import write_csv
+from fmu_harness.runs.result_table import write_csv
 
 
 @pytest.mark.parametrize("header, row, words", [

@@ -1,6 +1,6 @@
-"""The main job's CSV files: the time (or the swept variable) first, every numeric column headed
-``name [unit]`` and every text column ``name`` alone, every cell a finite number or a text, no row
-written twice."""
+"""The result tables of the main job, the sweeps and the system command: the time (or the swept
+variable) first, every numeric column headed ``name [unit]`` and every text column ``name`` alone,
+every cell a finite number or a text, no row written twice."""
 
 from __future__ import annotations
 
