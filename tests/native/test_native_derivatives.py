@@ -50,7 +50,16 @@ SHIFT = 0.4  # rad: the states moved from their start, away from the joints' sym
 #: and towards the saturation (-0.15: the slope 2 % of C_slip), the car reversing and within the rolling
 #: resistance's regularisation (v_x / v_low = 0.5).
 STATES = {"VehicleDriveline": ({"v_x": -2.0, "slip_left": 0.02, "slip_right": -0.05},
-                               {"v_x": 0.05, "slip_left": 0.05, "slip_right": -0.15})}
+                               {"v_x": 0.05, "slip_left": 0.05, "slip_right": -0.15}),
+          #: PowertrainMounts moved by SHIFT would carry each wheel's joint 0.4 m away, beyond its halfshaft's reach
+          #: (the geometry outputs refuse it): a displacement and a velocity off every axis, a few mm and mrad, the
+          #: launch's size
+          "PowertrainMounts": tuple({**dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), np.array(q) * scale)),
+                                     **dict(zip(("x_dot", "y_dot", "z_dot", "roll_dot", "pitch_dot", "yaw_dot"),
+                                                np.array(v) * scale))}
+                                    for scale in (1.0, -0.7)
+                                    for q, v in [((2e-3, -1.5e-3, 3e-3, 4e-3, -3e-3, 5e-3),
+                                                  (0.05, -0.04, 0.03, 0.2, -0.3, 0.25))])}
 
 
 #: Points of a model's derivatives beyond its dependency points (which the dependency tests pay for at every

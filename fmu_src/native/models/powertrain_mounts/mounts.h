@@ -2,6 +2,7 @@
  * system.py, exact_step.py and model.py are in the model file next to this folder):
  *   layout.c     the layouts (layout.py), read by the shared layout reader (lib/toml.h)
  *   dense.c      small dense linear algebra: products, solutions, symmetric eigenvalues, the matrix exponential
+ *   halfshaft.c  the halfshafts' geometry on the moving powertrain (halfshaft/geometry.py, halfshafts.py)
  */
 #ifndef MOUNTS_H
 #define MOUNTS_H
@@ -42,5 +43,26 @@ void dense_symmetric_eigen(double *a, double *vectors, int n);
  * after ``count`` halvings, squared ``count`` times (Higham 2005); 0 without memory or for a singular
  * denominator. */
 int dense_exponential(double *z, int count, double *out);
+
+/* ---- halfshaft.c -------------------------------------------------------------------------------- */
+
+#define HALFSHAFT_VALUES 9 /* halfshafts.GEOMETRY: beta, its rates, psi, its rates, the plunge, its rates */
+#define HALFSHAFT_MOTION 18 /* q, q', q'' */
+#define HALFSHAFT_JET 9     /* a, a', a'': the wheel centre in the housing frame and its rates */
+
+/* halfshafts.Halfshaft: the housing's design frame (columns X', Y', Z') and centre O, the wheel centre W, the
+ * shaft's length, T(W) and the design geometry (in the order of HALFSHAFT_VALUES) */
+typedef struct {
+    double frame[3][3], centre[3], wheel[3], length, wheel_map[3][6], design[HALFSHAFT_VALUES];
+} Halfshaft;
+
+/* Halfshaft.of: W from the design bend, plane angle and plunge, T(W) about the centre of gravity */
+void halfshaft_place(Halfshaft *shaft, const double frame[3][3], const double centre[3], const double gravity[3],
+                     double length, double beta, double psi, double plunge);
+/* Halfshaft.geometry: the values and, unless ``partial`` is NULL, their partial derivatives by (q, q', q''); 0
+ * when the wheel centre lies beyond the shaft's reach from the housing's axis, its distance in ``reach`` */
+int halfshaft_geometry(const Halfshaft *shaft, const double q[6], const double velocity[6],
+                       const double acceleration[6], double values[HALFSHAFT_VALUES],
+                       double partial[HALFSHAFT_VALUES][HALFSHAFT_MOTION], double *reach);
 
 #endif

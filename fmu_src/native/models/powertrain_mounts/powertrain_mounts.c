@@ -47,6 +47,7 @@ typedef struct {
     int dominant[6];
     int has_propagator;
     Propagator propagator;
+    Halfshaft shafts[2];
     char failure[ERROR_SIZE];
 } System;
 
@@ -345,6 +346,83 @@ static int restrained(const System *s, char *error)
     return 0;
 }
 
+/* ---- the halfshafts (model.py: extra_parameter_errors' Halfshaft.of, _show_halfshafts, _limit_error) ------- */
+
+static const char *const SIDES[2] = {"left", "right"};
+/* the first of each side's geometry outputs, the rest following in the order of HALFSHAFT_VALUES */
+static const int GEOMETRY_VARIABLES[2] = {V_beta_left, V_beta_right};
+
+static void place_halfshafts(System *s, const ModelData *data, double centres[2][3], double frames[2][3][3])
+{
+    static const int design[2][4] = {{V_l_left, V_beta_design_left, V_psi_design_left, V_plunge_design_left},
+                                     {V_l_right, V_beta_design_right, V_psi_design_right, V_plunge_design_right}};
+    int side;
+    for (side = 0; side < 2; side++) {
+        const double *value = data->real_value;
+        halfshaft_place(&s->shafts[side], frames[side], centres[side], s->layout.centre, value[design[side][0]],
+                        value[design[side][1]], value[design[side][2]], value[design[side][3]]);
+    }
+}
+
+/* Halfshaft.geometry at the motion shown (the states and the accelerations' outputs), or the design */
+static Failure show_halfshafts(System *s, ModelData *data)
+{
+    double q[6], velocity[6], acceleration[6], values[HALFSHAFT_VALUES], reach;
+    int side, i;
+    for (i = 0; i < 6; i++) {
+        q[i] = data->real_value[STATE_VARIABLES[i]];
+        velocity[i] = data->real_value[STATE_VARIABLES[6 + i]];
+        acceleration[i] = data->real_value[ACCELERATION_VARIABLES[i]];
+    }
+    for (side = 0; side < 2; side++) {
+        const Halfshaft *shaft = &s->shafts[side];
+        if (!data->int_value[V_housing_motion]) {
+            memcpy(values, shaft->design, sizeof values);
+        } else if (!halfshaft_geometry(shaft, q, velocity, acceleration, values, NULL, &reach)) {
+            char distance[40], length[40];
+            python_format_g(reach, 6, distance, sizeof distance);
+            python_format_g(shaft->length, 6, length, sizeof length);
+            snprintf(s->failure, ERROR_SIZE, "the %s joint: the wheel centre lies %s m from the housing's axis, "
+                     "beyond the halfshaft's length %s m", SIDES[side], distance, length);
+            return FAILURE(ERROR_VALUE, s->failure);
+        }
+        for (i = 0; i < HALFSHAFT_VALUES; i++) {
+            data->real_value[GEOMETRY_VARIABLES[side] + i] = values[i];
+        }
+    }
+    return NO_FAILURE;
+}
+
+/* PowertrainMountsModel._limit_error of each side at the start: the bend and the plunge within the joint's */
+static Failure limit_error(System *s, const ModelData *data)
+{
+    static const int limits[2][3] = {{V_beta_max_left, V_plunge_min_left, V_plunge_max_left},
+                                     {V_beta_max_right, V_plunge_min_right, V_plunge_max_right}};
+    const double *value = data->real_value;
+    char shown[40], bound[40];
+    int side;
+    for (side = 0; side < 2; side++) {
+        double beta = value[GEOMETRY_VARIABLES[side]], plunge = value[GEOMETRY_VARIABLES[side] + 6];
+        double low = value[limits[side][1]], high = value[limits[side][2]], limit = value[limits[side][0]];
+        if (beta > limit) {
+            python_format_g(180.0 / FMU_PI * beta + 0.0, 6, shown, sizeof shown);
+            python_format_g(180.0 / FMU_PI * limit + 0.0, 6, bound, sizeof bound);
+            snprintf(s->failure, ERROR_SIZE, "the %s joint's bend at the start, %s deg, exceeds beta_max_%s = %s deg",
+                     SIDES[side], shown, SIDES[side], bound);
+            return FAILURE(ERROR_VALUE, s->failure);
+        }
+        if (!(low <= plunge && plunge <= high)) {
+            python_format_g(1e3 * plunge + 0.0, 6, shown, sizeof shown);
+            python_format_g(1e3 * (plunge < low ? low : high) + 0.0, 6, bound, sizeof bound);
+            snprintf(s->failure, ERROR_SIZE, "the %s joint's plunge at the start, %s mm, lies beyond plunge_%s_%s = "
+                     "%s mm (the joint's stroke)", SIDES[side], shown, plunge < low ? "min" : "max", SIDES[side],
+                     bound);
+            return FAILURE(ERROR_VALUE, s->failure);
+        }
+    }
+    return NO_FAILURE;
+}
+
 /* ---- building the system (MountSystem.build, model.extra_parameter_errors) -------------------------- */
 
 static void vector_of(const ModelData *data, const int variables[3], double out[3])
@@ -407,6 +485,7 @@ static int build(System *s, const ModelData *data, char *error)
         return 0;
     }
     torque_roll_axis(s);
+    place_halfshafts(s, data, centre, frames);
     return 1;
 }
 
@@ -653,6 +732,7 @@ static Failure start(ModelData *data, double start_time UNUSED)
 {
     System *s = data->cache->derived;
     double force[6], state[12] = {0};
+    Failure failure;
     if (s == NULL) { /* the parameter check builds it before every initialisation */
         return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
     }
@@ -661,7 +741,11 @@ static Failure start(ModelData *data, double start_time UNUSED)
         return FAILURE(ERROR_VALUE, "Singular matrix");
     }
     show(s, data, state, force);
-    return show_analysis(s, data);
+    failure = show_halfshafts(s, data);
+    if (failure.kind == ERROR_NONE) {
+        failure = limit_error(s, data);
+    }
+    return failure.kind == ERROR_NONE ? show_analysis(s, data) : failure;
 }
 
 static Failure advance(ModelData *data, double current_time UNUSED, double step_size)
@@ -694,7 +778,7 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
         force[i] = held[i] + rates[i] * step_size;
     }
     show(s, data, next, force);
-    return NO_FAILURE;
+    return show_halfshafts(s, data);
 }
 
 /* Model Exchange: the accelerations (the velocities' derivatives) and mount forces at the solver's state
@@ -713,6 +797,58 @@ static Failure evaluate(ModelData *data, double time UNUSED)
         state[i] = data->real_value[STATE_VARIABLES[i]];
     }
     show(s, data, state, force);
+    return show_halfshafts(s, data);
+}
+
+/* The halfshafts' rows: d/d(q, q') directly and through q'' = (A s + B G u)[6:], d/du through q'' alone; none
+ * with the housings held (their outputs are the parameters' design) */
+static Failure halfshaft_partials(const System *s, const ModelData *data, double partial[])
+{
+    double state[12], force[6], acceleration[6], values[HALFSHAFT_VALUES], found[HALFSHAFT_VALUES][HALFSHAFT_MOTION];
+    double reach;
+    int side, i, j, k;
+    if (!data->int_value[V_housing_motion]) {
+        return NO_FAILURE;
+    }
+    generalised(s, data, 0, force);
+    for (i = 0; i < 12; i++) {
+        state[i] = data->real_value[STATE_VARIABLES[i]];
+    }
+    for (i = 0; i < 6; i++) {
+        double sum = 0.0;
+        for (k = 0; k < 12; k++) {
+            sum += s->a[6 + i][k] * state[k];
+        }
+        for (k = 0; k < 6; k++) {
+            sum += s->b[6 + i][k] * force[k];
+        }
+        acceleration[i] = sum;
+    }
+    for (side = 0; side < 2; side++) {
+        if (!halfshaft_geometry(&s->shafts[side], state, state + 6, acceleration, values, found, &reach)) {
+            return FAILURE(ERROR_VALUE, "the wheel centre lies beyond the halfshaft's reach");
+        }
+        for (j = 0; j < HALFSHAFT_VALUES; j++) {
+            double *row = partial + model_jacobian_rows[GEOMETRY_VARIABLES[side] + j] * MODEL_COLUMN_COUNT;
+            for (k = 0; k < 12; k++) {
+                double sum = found[j][k];
+                for (i = 0; i < 6; i++) {
+                    sum += found[j][12 + i] * s->a[6 + i][k];
+                }
+                row[model_jacobian_columns[STATE_VARIABLES[k]]] = sum;
+            }
+            for (k = 0; k < N_INPUTS; k++) {
+                double sum = 0.0;
+                for (i = 0; i < 6; i++) {
+                    int m;
+                    for (m = 0; m < 6; m++) {
+                        sum += found[j][12 + i] * s->b[6 + i][m] * s->inputs[m][k];
+                    }
+                }
+                row[model_jacobian_columns[model_input_derivatives[k].input]] = sum;
+            }
+        }
+    }
     return NO_FAILURE;
 }
 
@@ -754,7 +890,7 @@ static Failure jacobian(const ModelData *data, double partial[])
             }
         }
     }
-    return NO_FAILURE;
+    return halfshaft_partials(s, data, partial);
 }
 
 const ModelHooks model_hooks = {.start = start, .advance = advance, .evaluate = evaluate,
