@@ -173,8 +173,7 @@ def vehicle_launch(housing_motion: bool = True) -> System:
         connections += [Connection(("drive", f"{name}_{side}"), (joint, name)) for name in JOINT_DRIVE]
         connections += [Connection((joint, name), ("drive", f"{name}_{side}")) for name in JOINT_FEEDBACK]
     if MOUNTS in MODELS:
-        components.append(Component("mounts", MOUNTS, {"g": dynamics.GRAVITY,
-                                                       **({"housing_motion": 1} if moving else {})}))
+        components.append(Component("mounts", MOUNTS, {"g": dynamics.GRAVITY, "housing_motion": int(moving)}))
         connections += [Connection((f"joint_{side}", name), ("mounts", f"{name}_{side}"))
                         for side in SIDES for name in HOUSING_LOADS]
         connections.append(Connection(("drive", "T_reaction"), ("mounts", "M_y")))

@@ -4,6 +4,7 @@ joints with direct feedthrough, run by ``driveline-fmus system`` in the project'
 from __future__ import annotations
 
 import csv
+import dataclasses
 import importlib.util
 import math
 import zipfile
@@ -93,6 +94,27 @@ def _assert_like_the_master(master: tuple[list[str], np.ndarray], run: tuple[lis
         terms = np.abs(reference[:, header.index(f"joint_{side}.F_plunger1 [N]")]).max() / mass
         scale[header.index(f"joint_{side}.a_plunger_sum [m/s2]")] = terms
     assert (np.abs(values - reference).max(axis=0) / scale).max() <= 1e-9
+
+
+def test_with_the_housings_held_the_launch_is_the_fixed_bend_launch_bit_for_bit(fmi2_dir, native_dir, launch_ssp,
+                                                                              master, tmp_path):
+    """``mounts.housing_motion`` = 0: every output of the package equal bit for bit to the package whose joints
+    have their bends bound and take nothing from PowertrainMounts (the package of before the housings moved);
+    with the switch on (the package's default), the joints' bend follows the powertrain: the left one moves
+    off its 8 deg within 50 ms and its bend plane turns."""
+    held = system.write_ssp(dataclasses.replace(system.vehicle_launch(housing_motion=False), name="VehicleLaunchHeld"),
+                            fmi2_dir, native_dir)
+    header, fixed = _run_with(held, tmp_path / "fixed.csv", [])
+    switched_header, switched = _run_with(launch_ssp, tmp_path / "held.csv", ["mounts.housing_motion=0"])
+    assert header == switched_header and np.array_equal(fixed, switched)
+    moving_header, moving = master
+    assert moving_header == header
+    assert np.all(fixed[:, header.index("mounts.beta_left [rad]")] == math.radians(8.0))
+    bend = moving[:, header.index("mounts.beta_left [rad]")]
+    assert np.abs(bend - math.radians(8.0)).max() > 1e-4
+    assert np.abs(moving[:, header.index("mounts.psi_left [rad]")]).max() > 1e-3
+    connected = {(c.start, c.end) for c in system.vehicle_launch().connections}
+    assert (("mounts", "beta_left"), ("joint_left", "beta")) in connected
 
 
 def test_without_friction_the_joints_generate_no_axial_force(launch_ssp, master, tmp_path):
