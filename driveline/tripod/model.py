@@ -118,10 +118,11 @@ class TripodCouplingModel(DrivenShaftModel):
         beta = self.beta + (beta_dot + 0.5 * beta_ddot * elapsed) * elapsed
         if not 0.0 <= beta <= self.beta_max:
             raise ValueError(BETA_LEAVES_RANGE)
+        psi = self.psi + (self.psi_dot + 0.5 * self.psi_ddot * elapsed) * elapsed
         values, self._solution = coupling_outputs(
             self.phi_in, beta, self.omega_in + self.alpha_in * elapsed, self.T_load,
             self.r, self.l, self.m_plunger, self.kinematics, self._solution, self.alpha_in, self.seed_reactions,
             self.mu, self.v_slip, beta_dot + beta_ddot * elapsed, beta_ddot, self.tripod_type, self.mu_roll,
-            self.roller_radius,
+            self.roller_radius, psi, self.psi_dot + self.psi_ddot * elapsed, self.psi_ddot, self.plunge_dot,
         )
         self.__dict__.update(values)
