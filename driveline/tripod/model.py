@@ -47,6 +47,10 @@ class TripodCouplingModel(DrivenShaftModel):
          "phi_in_start": 0.2},
         {"kinematics": EXACT, "mu": 0.05, "tripod_type": DOUBLE_ROLLER, "T_load": -300.0, "beta_rate": RATES_FROM_INPUTS,
          "beta_ddot": 3.0, "phi_in_start": 0.4},
+        # the moving housing: the bend plane turned and turning, the spider plunging (groove slips of 20 mm/s
+        # and more), with the seed's eqs turned into the housing's frame
+        {"kinematics": EXACT, "mu": 0.05, "seed_reactions": 1, "alpha_in": 30.0, "beta_dot": 0.5, "beta_ddot": 3.0,
+         "phi_in_start": 0.4, "psi": 0.7, "psi_dot": 4.0, "psi_ddot": 25.0, "plunge_dot": 0.02},
     )
 
     def reset_internal_state(self) -> None:
