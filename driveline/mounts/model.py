@@ -9,6 +9,7 @@ the step's end, under the inputs moved on by their rates.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -180,14 +181,21 @@ class PowertrainMountsModel(SteppedModel):
                 setattr(self, f"F_{axis}_mount{i + 1}", float(forces[i, k]) if i < len(forces) else 0.0)
 
     def _show_halfshafts(self) -> None:
-        """Each side's geometry at the motion shown (:mod:`.halfshafts`), or its design with the housings held."""
+        """Each side's geometry at the motion shown (:mod:`.halfshafts`), or its design with the housings held; not
+        a number where the motion is none (the motion's outputs then refuse the step)."""
         motion = [self._values(names) for names in (COORDINATES, VELOCITIES, ACCELERATIONS)]
+        finite = all(np.isfinite(part).all() for part in motion)
         for side, shaft in self._shafts.items():
-            try:
-                found = shaft.geometry(*motion) if self.housing_motion else shaft.design
-            except GeometryError as error:
-                raise ValueError(f"the {side} joint: {error}") from None
-            for name, value in zip(GEOMETRY, values(found)):
+            if not self.housing_motion:
+                found = values(shaft.design)
+            elif not finite:
+                found = (math.nan,) * len(GEOMETRY)
+            else:
+                try:
+                    found = values(shaft.geometry(*motion))
+                except GeometryError as error:
+                    raise ValueError(f"the {side} joint: {error}") from None
+            for name, value in zip(GEOMETRY, found):
                 setattr(self, f"{name}_{side}", value)
 
     def _show_analysis(self) -> None:

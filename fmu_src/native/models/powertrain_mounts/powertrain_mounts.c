@@ -364,20 +364,26 @@ static void place_halfshafts(System *s, const ModelData *data, double centres[2]
     }
 }
 
-/* Halfshaft.geometry at the motion shown (the states and the accelerations' outputs), or the design */
+/* Halfshaft.geometry at the motion shown (the states and the accelerations' outputs), or the design; not a
+ * number where the motion is none (the motion's outputs then refuse the step) */
 static Failure show_halfshafts(System *s, ModelData *data)
 {
     double q[6], velocity[6], acceleration[6], values[HALFSHAFT_VALUES], reach;
-    int side, i;
+    int side, i, finite = 1;
     for (i = 0; i < 6; i++) {
         q[i] = data->real_value[STATE_VARIABLES[i]];
         velocity[i] = data->real_value[STATE_VARIABLES[6 + i]];
         acceleration[i] = data->real_value[ACCELERATION_VARIABLES[i]];
+        finite = finite && isfinite(q[i]) && isfinite(velocity[i]) && isfinite(acceleration[i]);
     }
     for (side = 0; side < 2; side++) {
         const Halfshaft *shaft = &s->shafts[side];
         if (!data->int_value[V_housing_motion]) {
             memcpy(values, shaft->design, sizeof values);
+        } else if (!finite) {
+            for (i = 0; i < HALFSHAFT_VALUES; i++) {
+                values[i] = NAN;
+            }
         } else if (!halfshaft_geometry(shaft, q, velocity, acceleration, values, NULL, &reach)) {
             char distance[40], length[40];
             python_format_g(reach, 6, distance, sizeof distance);
