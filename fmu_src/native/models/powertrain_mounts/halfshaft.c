@@ -112,7 +112,7 @@ static Jet angle(Jet y, Jet x)
 
 /* mounts/halfshafts.Halfshaft.of with geometry.design_wheel: W = O + F (-L sin beta cos psi, -L sin beta sin psi,
  * plunge + L cos beta), T(W) = [I, -(W - c)x] */
-void halfshaft_place(Halfshaft *shaft, const double frame[3][3], const double centre[3], const double gravity[3],
+void halfshaft_place(Halfshaft *shaft, const double *frame, const double centre[3], const double gravity[3],
                      double length, double beta, double psi, double plunge)
 {
     double rho = length * sin(beta), h = length * cos(beta), local[3], r[3];
@@ -123,13 +123,13 @@ void halfshaft_place(Halfshaft *shaft, const double frame[3][3], const double ce
     for (i = 0; i < 3; i++) {
         double sum = 0.0;
         for (k = 0; k < 3; k++) {
-            sum += frame[i][k] * local[k];
+            sum += frame[3 * i + k] * local[k];
         }
         shaft->wheel[i] = centre[i] + sum;
         shaft->centre[i] = centre[i];
         r[i] = shaft->wheel[i] - gravity[i];
         for (k = 0; k < 3; k++) {
-            shaft->frame[i][k] = frame[i][k];
+            shaft->frame[i][k] = frame[3 * i + k];
             shaft->wheel_map[i][k] = i == k ? 1.0 : 0.0;
         }
     }

@@ -346,89 +346,6 @@ static int restrained(const System *s, char *error)
     return 0;
 }
 
-/* ---- the halfshafts (model.py: extra_parameter_errors' Halfshaft.of, _show_halfshafts, _limit_error) ------- */
-
-static const char *const SIDES[2] = {"left", "right"};
-/* the first of each side's geometry outputs, the rest following in the order of HALFSHAFT_VALUES */
-static const int GEOMETRY_VARIABLES[2] = {V_beta_left, V_beta_right};
-
-static void place_halfshafts(System *s, const ModelData *data, double centres[2][3], double frames[2][3][3])
-{
-    static const int design[2][4] = {{V_l_left, V_beta_design_left, V_psi_design_left, V_plunge_design_left},
-                                     {V_l_right, V_beta_design_right, V_psi_design_right, V_plunge_design_right}};
-    int side;
-    for (side = 0; side < 2; side++) {
-        const double *value = data->real_value;
-        halfshaft_place(&s->shafts[side], frames[side], centres[side], s->layout.centre, value[design[side][0]],
-                        value[design[side][1]], value[design[side][2]], value[design[side][3]]);
-    }
-}
-
-/* Halfshaft.geometry at the motion shown (the states and the accelerations' outputs), or the design; not a
- * number where the motion is none (the motion's outputs then refuse the step) */
-static Failure show_halfshafts(System *s, ModelData *data)
-{
-    double q[6], velocity[6], acceleration[6], values[HALFSHAFT_VALUES], reach;
-    int side, i, finite = 1;
-    for (i = 0; i < 6; i++) {
-        q[i] = data->real_value[STATE_VARIABLES[i]];
-        velocity[i] = data->real_value[STATE_VARIABLES[6 + i]];
-        acceleration[i] = data->real_value[ACCELERATION_VARIABLES[i]];
-        finite = finite && isfinite(q[i]) && isfinite(velocity[i]) && isfinite(acceleration[i]);
-    }
-    for (side = 0; side < 2; side++) {
-        const Halfshaft *shaft = &s->shafts[side];
-        if (!data->int_value[V_housing_motion]) {
-            memcpy(values, shaft->design, sizeof values);
-        } else if (!finite) {
-            for (i = 0; i < HALFSHAFT_VALUES; i++) {
-                values[i] = NAN;
-            }
-        } else if (!halfshaft_geometry(shaft, q, velocity, acceleration, values, NULL, &reach)) {
-            char distance[40], length[40];
-            python_format_g(reach, 6, distance, sizeof distance);
-            python_format_g(shaft->length, 6, length, sizeof length);
-            snprintf(s->failure, ERROR_SIZE, "the %s joint: the wheel centre lies %s m from the housing's axis, "
-                     "beyond the halfshaft's length %s m", SIDES[side], distance, length);
-            return FAILURE(ERROR_VALUE, s->failure);
-        }
-        for (i = 0; i < HALFSHAFT_VALUES; i++) {
-            data->real_value[GEOMETRY_VARIABLES[side] + i] = values[i];
-        }
-    }
-    return NO_FAILURE;
-}
-
-/* PowertrainMountsModel._limit_error of each side at the start: the bend and the plunge within the joint's */
-static Failure limit_error(System *s, const ModelData *data)
-{
-    static const int limits[2][3] = {{V_beta_max_left, V_plunge_min_left, V_plunge_max_left},
-                                     {V_beta_max_right, V_plunge_min_right, V_plunge_max_right}};
-    const double *value = data->real_value;
-    char shown[40], bound[40];
-    int side;
-    for (side = 0; side < 2; side++) {
-        double beta = value[GEOMETRY_VARIABLES[side]], plunge = value[GEOMETRY_VARIABLES[side] + 6];
-        double low = value[limits[side][1]], high = value[limits[side][2]], limit = value[limits[side][0]];
-        if (beta > limit) {
-            python_format_g(180.0 / FMU_PI * beta + 0.0, 6, shown, sizeof shown);
-            python_format_g(180.0 / FMU_PI * limit + 0.0, 6, bound, sizeof bound);
-            snprintf(s->failure, ERROR_SIZE, "the %s joint's bend at the start, %s deg, exceeds beta_max_%s = %s deg",
-                     SIDES[side], shown, SIDES[side], bound);
-            return FAILURE(ERROR_VALUE, s->failure);
-        }
-        if (!(low <= plunge && plunge <= high)) {
-            python_format_g(1e3 * plunge + 0.0, 6, shown, sizeof shown);
-            python_format_g(1e3 * (plunge < low ? low : high) + 0.0, 6, bound, sizeof bound);
-            snprintf(s->failure, ERROR_SIZE, "the %s joint's plunge at the start, %s mm, lies beyond plunge_%s_%s = "
-                     "%s mm (the joint's stroke)", SIDES[side], shown, plunge < low ? "min" : "max", SIDES[side],
-                     bound);
-            return FAILURE(ERROR_VALUE, s->failure);
-        }
-    }
-    return NO_FAILURE;
-}
-
 /* ---- building the system (MountSystem.build, model.extra_parameter_errors) -------------------------- */
 
 static void vector_of(const ModelData *data, const int variables[3], double out[3])
@@ -451,14 +368,13 @@ static int build(System *s, const ModelData *data, char *error)
     static const int bends[2][3] = {{V_bend_x_left, V_bend_y_left, V_bend_z_left},
                                     {V_bend_x_right, V_bend_y_right, V_bend_z_right}};
     static const int motor[3] = {V_motor_axis_x, V_motor_axis_y, V_motor_axis_z};
-    static const char *const sides[2] = {"left", "right"};
     double centre[2][3], shaft[3], bend[3], frames[2][3][3], axis[3], length, gravity[6] = {0};
     int side, k;
     for (side = 0; side < 2; side++) {
         vector_of(data, centres[side], centre[side]);
         vector_of(data, shafts[side], shaft);
         vector_of(data, bends[side], bend);
-        if (!joint_frame(shaft, bend, sides[side], frames[side], error)) {
+        if (!joint_frame(shaft, bend, mounts_sides[side], frames[side], error)) {
             return 0;
         }
     }
@@ -491,7 +407,7 @@ static int build(System *s, const ModelData *data, char *error)
         return 0;
     }
     torque_roll_axis(s);
-    place_halfshafts(s, data, centre, frames);
+    halfshafts_place(s->shafts, data, &centre[0][0], &frames[0][0][0], s->layout.centre);
     return 1;
 }
 
@@ -747,9 +663,9 @@ static Failure start(ModelData *data, double start_time UNUSED)
         return FAILURE(ERROR_VALUE, "Singular matrix");
     }
     show(s, data, state, force);
-    failure = show_halfshafts(s, data);
+    failure = halfshafts_show(s->shafts, data, s->failure);
     if (failure.kind == ERROR_NONE) {
-        failure = limit_error(s, data);
+        failure = halfshafts_limits(data, s->failure);
     }
     return failure.kind == ERROR_NONE ? show_analysis(s, data) : failure;
 }
@@ -784,7 +700,7 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
         force[i] = held[i] + rates[i] * step_size;
     }
     show(s, data, next, force);
-    return show_halfshafts(s, data);
+    return halfshafts_show(s->shafts, data, s->failure);
 }
 
 /* Model Exchange: the accelerations (the velocities' derivatives) and mount forces at the solver's state
@@ -803,19 +719,14 @@ static Failure evaluate(ModelData *data, double time UNUSED)
         state[i] = data->real_value[STATE_VARIABLES[i]];
     }
     show(s, data, state, force);
-    return show_halfshafts(s, data);
+    return halfshafts_show(s->shafts, data, s->failure);
 }
 
-/* The halfshafts' rows: d/d(q, q') directly and through q'' = (A s + B G u)[6:], d/du through q'' alone; none
- * with the housings held (their outputs are the parameters' design) */
+/* The halfshafts' rows (halfshaft_outputs.c) from the accelerations' partials: A's rows and B G */
 static Failure halfshaft_partials(const System *s, const ModelData *data, double partial[])
 {
-    double state[12], force[6], acceleration[6], values[HALFSHAFT_VALUES], found[HALFSHAFT_VALUES][HALFSHAFT_MOTION];
-    double reach;
-    int side, i, j, k;
-    if (!data->int_value[V_housing_motion]) {
-        return NO_FAILURE;
-    }
+    double state[12], force[6], acceleration[6], loads[6][N_INPUTS];
+    int i, j, k;
     generalised(s, data, 0, force);
     for (i = 0; i < 12; i++) {
         state[i] = data->real_value[STATE_VARIABLES[i]];
@@ -829,33 +740,14 @@ static Failure halfshaft_partials(const System *s, const ModelData *data, double
             sum += s->b[6 + i][k] * force[k];
         }
         acceleration[i] = sum;
-    }
-    for (side = 0; side < 2; side++) {
-        if (!halfshaft_geometry(&s->shafts[side], state, state + 6, acceleration, values, found, &reach)) {
-            return FAILURE(ERROR_VALUE, "the wheel centre lies beyond the halfshaft's reach");
-        }
-        for (j = 0; j < HALFSHAFT_VALUES; j++) {
-            double *row = partial + model_jacobian_rows[GEOMETRY_VARIABLES[side] + j] * MODEL_COLUMN_COUNT;
-            for (k = 0; k < 12; k++) {
-                double sum = found[j][k];
-                for (i = 0; i < 6; i++) {
-                    sum += found[j][12 + i] * s->a[6 + i][k];
-                }
-                row[model_jacobian_columns[STATE_VARIABLES[k]]] = sum;
-            }
-            for (k = 0; k < N_INPUTS; k++) {
-                double sum = 0.0;
-                for (i = 0; i < 6; i++) {
-                    int m;
-                    for (m = 0; m < 6; m++) {
-                        sum += found[j][12 + i] * s->b[6 + i][m] * s->inputs[m][k];
-                    }
-                }
-                row[model_jacobian_columns[model_input_derivatives[k].input]] = sum;
+        for (k = 0; k < N_INPUTS; k++) {
+            loads[i][k] = 0.0;
+            for (j = 0; j < 6; j++) {
+                loads[i][k] += s->b[6 + i][j] * s->inputs[j][k];
             }
         }
     }
-    return NO_FAILURE;
+    return halfshafts_partials(s->shafts, data, acceleration, &s->a[6][0], &loads[0][0], partial);
 }
 
 /* Directional derivatives: the model is linear, its partials constant. The accelerations (A s + B G u)[6:]
