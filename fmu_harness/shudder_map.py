@@ -10,7 +10,8 @@ Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
         [--out results/shudder_map.parquet] [--figure results/shudder_map.png]
     driveline-fmus map --figure-only [--out ...] [--figure ...]
 
-The grid: ``--count`` values each of both joints' ``beta`` (5 to 20 deg), ``motor.T_level`` (20 to
+The grid: ``--count`` values each of both halfshafts' design bend (``mounts.beta_design_*``, the joints'
+bends following the powertrain from there; 5 to 20 deg), ``motor.T_level`` (20 to
 100 % of the default car's motor peak, :data:`driveline.vehicle.compact_car.MOTOR_PEAK_TORQUE`) and
 both joints' ``mu`` (0.02 to 0.1), the cartesian product (512 launches at the default 8), each one
 launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and :data:`THIRD_ORDER`:
@@ -45,7 +46,7 @@ if TYPE_CHECKING:
 
 COMMAND = "driveline-fmus map"
 SHAFT, SIGNAL = "joint_left.phi_in", "mounts.pitch_ddot"
-BETA = "joint_left.beta+joint_right.beta"
+BETA = "mounts.beta_design_left+mounts.beta_design_right"
 TORQUE = "motor.T_level"
 MU = "joint_left.mu+joint_right.mu"
 PEAK = f"{SIGNAL}_order3_peak"

@@ -27,7 +27,7 @@ from fmu_harness.studies.order_tracking import third_order_peak
 STOP, STEP = 2.0, 8e-4
 """Short launches: 2 s, in which the left joint turns 2.8 (200 N.m) to 4.0 (280 N.m) revolutions, more than
 the order tracking's window of 2, in 2500 steps of the Gauss-Seidel master at 8e-4 s (its stability limit)."""
-BOTH_BETA = "joint_left.beta+joint_right.beta"
+BOTH_BETA = "mounts.beta_design_left+mounts.beta_design_right"
 POINTS = [{BOTH_BETA: 0.1, "motor.T_level": 280.0, "joint_left.mu": 0.08},
           {BOTH_BETA: 0.3, "motor.T_level": 200.0, "joint_left.mu": 0.02}]
 
@@ -86,18 +86,18 @@ def master_metrics(fmi2_dir: Path, native_dir: Path, point: dict, order: tuple[s
 def test_a_system_sweep_on_a_scheduler_gives_the_masters_runs(launch_ssp, scheduler, fmi2_dir, native_dir):
     """Gauss-Seidel in the package's order (the launch's order) on the scheduler's worker: each row's
     metrics, the third-order peak of the pitch acceleration among them, are those of the master run here
-    with both joints' beta bound, bit for bit. A bend beyond
+    with both halfshafts' design bend bound, bit for bit. A bend beyond
     the joint's beta_max, which the FMU would refuse at initialisation, fails its row with the model's
     reason, not run."""
     from distributed import Client
 
-    plan = Plan.of_system(launch_ssp, [*POINTS, {"joint_right.beta": 1.0}], STOP, STEP, "gauss-seidel",
+    plan = Plan.of_system(launch_ssp, [*POINTS, {"mounts.beta_design_right": 1.0}], STOP, STEP, "gauss-seidel",
                           (shudder_map.THIRD_ORDER,))
     with Client(scheduler) as client:
         *rows, beyond = run(client, plan).to_pylist()
     assert [row["status"] for row in rows] == ["ok", "ok"] and beyond["status"] == "failed"
-    assert beyond["reason"] == ("joint_right (TripodCoupling): input beta = 57.2958 deg must not exceed "
-                                "beta_max = 45 deg")
+    assert beyond["reason"] == ("mounts (PowertrainMounts): parameter beta_design_right = 57.2958 deg must not "
+                                "exceed beta_max_right = 45 deg (the right joint's largest bend)")
     for point, row in zip(POINTS, rows):
         expected = master_metrics(fmi2_dir, native_dir, point, system.LAUNCH_ORDER)
         assert {name: row[name] for name in expected} == expected
