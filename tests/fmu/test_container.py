@@ -79,10 +79,10 @@ def test_the_driveline_container_runs_as_the_master(packages, tmp_path):
 
 
 def test_a_hosts_values_replace_the_packages_bindings(packages, tmp_path):
-    """A host sets the launch's torque, a joint's bend (an input the package binds) and friction: the run is
-    the master's with those bindings (the toolbox re-applied a bound input's start value on entering
-    initialisation, which undid the host's bend)."""
-    changes = {("motor", "T_level"): 200.0, ("joint_left", "beta"): 0.25, ("joint_right", "mu"): 0.09}
+    """A host sets the launch's torque, a halfshaft's design bend and a joint's friction: the run is the master's
+    with those bindings (the toolbox re-applied a bound input's start value on entering initialisation, which
+    undid a host's value: the joints' bends were such inputs before PowertrainMounts fed them)."""
+    changes = {("motor", "T_level"): 200.0, ("mounts", "beta_design_left"): 0.25, ("joint_right", "mu"): 0.09}
     _compare(packages["VehicleLaunch"], tmp_path, 1e-4, False, changes)
 
 

@@ -229,7 +229,7 @@ def _without_derivatives(fmu: bytes, folder: Path) -> bytes:
     return (folder / "out.fmu").read_bytes()
 
 
-def test_the_command_writes_the_engines_rows(launch, fmi2_dir, native_dir, tmp_path):
+def test_the_command_writes_the_engines_rows(moving, fmi2_dir, native_dir, tmp_path):
     """``driveline-fmus system VehicleLaunch.ssp --engine model-exchange``: the CSV file holds the
     engine's rows for every Real output, bit for bit."""
     package_path = system.write_ssp(system.vehicle_launch(), fmi2_dir, native_dir)
@@ -237,7 +237,7 @@ def test_the_command_writes_the_engines_rows(launch, fmi2_dir, native_dir, tmp_p
                          "--rtol", "1e-9", "--out", str(tmp_path / "run.csv")])
     with (tmp_path / "run.csv").open() as handle:
         header, *rows = list(csv.reader(handle))
-    package, fmus = launch
+    package, fmus = moving
     outputs = [column.split(" [")[0] for column in header[1:]]
     expected = run_model_exchange(fmus, {c.name: c.parameters for c in package.components}, package.connections,
                                   0.01, 1e-3, outputs, tmp_path / "engine", rtol=1e-9, initial=True)
