@@ -28,9 +28,9 @@ STOP, STEP = 2.0, 8e-4
 """Short launches: 2 s, in which the left joint turns 2.8 (200 N.m) to 4.0 (280 N.m) revolutions, more than
 the order tracking's window of 2, in 2500 steps of the Gauss-Seidel master at 8e-4 s (its stability limit)."""
 BOTH_BETA = "mounts.beta_design_left+mounts.beta_design_right"
-#: The housings held (``mounts.housing_motion`` 0): the masters' runs are compared bit for bit, and with the
-#: housings moving the loop through the mounts leaves the container's and the project's master a last-bit apart
-#: after a few steps, which the friction's sign amplifies over a launch (measured 5e-8 of a metric after 2 s)
+#: The housings held (``mounts.housing_motion`` 0): with the housings moving, the loop through the mounts lets
+#: the last bits by which the container and the project's master differ grow over a launch (measured 5e-8 of a
+#: metric after 2 s; 2e-8 between libcosim and the Jacobi master at 4e-4 s)
 POINTS = [{BOTH_BETA: 0.1, "motor.T_level": 280.0, "joint_left.mu": 0.08, "mounts.housing_motion": 0},
           {BOTH_BETA: 0.3, "motor.T_level": 200.0, "joint_left.mu": 0.02, "mounts.housing_motion": 0}]
 
@@ -89,7 +89,9 @@ def master_metrics(fmi2_dir: Path, native_dir: Path, point: dict, order: tuple[s
 def test_a_system_sweep_on_a_scheduler_gives_the_masters_runs(launch_ssp, scheduler, fmi2_dir, native_dir):
     """Gauss-Seidel in the package's order (the launch's order) on the scheduler's worker: each row's
     metrics, the third-order peak of the pitch acceleration among them, are those of the master run here
-    with both halfshafts' design bend bound, bit for bit. A bend beyond
+    with both halfshafts' design bend bound, to the last bits (the worker runs the package as one FMU, which
+    tests/fmu/test_container.py holds within 1e-9; measured up to 1.2e-14 since the drive's T_reaction loads the
+    powertrain, bit for bit before), within 1e-12. A bend beyond
     the joint's beta_max, which the FMU would refuse at initialisation, fails its row with the model's
     reason, not run."""
     from distributed import Client
@@ -103,7 +105,7 @@ def test_a_system_sweep_on_a_scheduler_gives_the_masters_runs(launch_ssp, schedu
                                 "exceed beta_max_right = 45 deg (the right joint's largest bend)")
     for point, row in zip(POINTS, rows):
         expected = master_metrics(fmi2_dir, native_dir, point, system.LAUNCH_ORDER)
-        assert {name: row[name] for name in expected} == expected
+        assert all(math.isclose(row[name], value, rel_tol=1e-12) for name, value in expected.items()), point
         assert all(row[name] == value for name, value in point.items())
     assert rows[0]["joint_right.Rz_in_peak_abs"] != rows[1]["joint_right.Rz_in_peak_abs"]
 
