@@ -114,13 +114,11 @@ def test_the_work_fuzzer_names_each_case_on_which_the_families_verdicts_differ()
         f"case 2: python accepted, budget ({budget[1]}); native accepted, other ({dips[1]})"]
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "issue 45, defect 6: the native FMU refuses the six-segment layout (more than 512 dips on one line), the "
-    "Python FMU accepts it: the determinant's rounding level misses the propagation's round-off"))
 def test_the_work_fuzzer_finds_the_families_agree_on_the_six_segment_layout(fmu_dir: Path, native_dir: Path,
                                                                             fmi_versions: list[str]):
-    """Both families' CriticalSpeeds FMUs on the layout where their verdicts differed (issue 45, defect 6),
-    each in a process under its family's limits: the same verdict."""
+    """Both families' CriticalSpeeds FMUs on the layout where their verdicts differed (issue 45, defect 6: the
+    native FMU refused it, more than 512 dips on one line, the Python FMU accepted it), each in a process under
+    its family's limits: both accept it."""
     fmi = fmi_versions[0]
     case = {"layout": SIX_SEGMENT_LAYOUT, "start": dict(ROUND_OFF_PARAMETERS), "changes": []}
     fmus = {"python": packaging.fmu_path(fmu_dir, "CriticalSpeeds", fmi),
@@ -129,6 +127,7 @@ def test_the_work_fuzzer_finds_the_families_agree_on_the_six_segment_layout(fmu_
                                  for family, path in fmus.items()}}]
     assert work_fuzzer.over_budget(results) == []
     assert work_fuzzer.disagreements(results) == []
+    assert work_fuzzer.verdicts(results[0]["native"]) == ["accepted"]
 
 
 def test_a_case_whose_process_dies_or_outlives_its_limit_is_a_crash_or_a_hang(monkeypatch, tmp_path):
