@@ -313,6 +313,9 @@ ARITHMETIC_FAILURES = [  # where the Python core fails arithmetically, the C por
     ("TripodCoupling", {"T_load": 1e307}),
     ("TripodCoupling", {"T_load": 1e307, "kinematics": 1}),
     ("TripodCoupling", {"T_load": 1e306}),
+    ("TripodCoupling", {"psi": 1e308}),  # the bend plane's angle: the pose at phi_in - psi
+    ("TripodCoupling", {"psi": -1e308, "kinematics": 1}),
+    ("TripodCoupling", {"psi_dot": 1e200, "kinematics": 1, "mu": 0.05}),  # the speed relative to the plane
 ]
 
 
