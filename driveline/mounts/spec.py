@@ -14,6 +14,8 @@ LOAD_INPUTS = ("F_x", "F_y", "F_z", "M_x", "M_y", "M_z")
 #: Every load input in the order of the input map: the load at the centre of gravity, the joints', the motor's.
 INPUTS = LOAD_INPUTS + tuple(f"{name}_{side}" for side in SIDES for name in REACTIONS) + ("T_motor",)
 SHARED_LAYOUT = "transverse_fwd_powertrain"
+#: The same powertrain on rubber mounts (progressive characteristics, Maxwell branches), shipped beside it
+RUBBER_LAYOUT = "transverse_fwd_powertrain_rubber"
 COORDINATE_INDEX = ", ".join(f"{i} {name}" for i, name in enumerate(COORDINATES, 1))
 # What the outputs are computed from (``depends_on``): the parameters placing the loads (the
 # joints' frames and centres, the motor axis), the inputs' generalised force, the motion (states)
