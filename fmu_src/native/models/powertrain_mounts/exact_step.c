@@ -11,7 +11,7 @@
 
 #define MAX_STATE MOUNTS_MAX_STATE
 
-int exact_state_matrices(const double mass[6][6], const double stiffness[6][6], const double damping[6][6],
+int exact_state_matrices(double mass[6][6], double stiffness[6][6], double damping[6][6],
                          const Branches *branches, double (*a)[MAX_STATE], double (*b)[6])
 {
     double inverse[6][6] = {{0}}, product[6][6], copy[6][6];

@@ -112,7 +112,7 @@ typedef struct {
 } Propagator;
 
 /* exact_step.state_matrices: A (n x n) and B (n x 6), n = 12 + the branches; 0 for a singular mass matrix */
-int exact_state_matrices(const double mass[6][6], const double stiffness[6][6], const double damping[6][6],
+int exact_state_matrices(double mass[6][6], double stiffness[6][6], double damping[6][6],
                          const Branches *branches, double (*a)[MOUNTS_MAX_STATE], double (*b)[6]);
 /* exact_step.work_error and Propagator.build; 0 with the message in ``failure`` */
 int exact_propagator(const double (*a)[MOUNTS_MAX_STATE], const double (*b)[6], int n, double h, Propagator *p,

@@ -152,7 +152,7 @@ static void matrices(System *s)
 
 /* K phi = w^2 M phi through M = L L^T (Cholesky) and Jacobi on L^-1 K L^-T (scipy.linalg.eigh's part): the
  * eigenvalues ascending, the mass-normalised shapes in the columns */
-static void eigen(const double mass[6][6], const double stiffness[6][6], double values[6], double shapes[6][6])
+static void eigen(double mass[6][6], double stiffness[6][6], double values[6], double shapes[6][6])
 {
     double l[6][6] = {{0}}, c[36], vectors[36], w2[6];
     int order[6], i, j, k;
@@ -219,7 +219,7 @@ static void eigen(const double mass[6][6], const double stiffness[6][6], double 
 }
 
 /* phi_j^T a phi_j */
-static double modal(const double a[6][6], const double shapes[6][6], int j)
+static double modal(double a[6][6], double shapes[6][6], int j)
 {
     double total = 0.0;
     int i, k;
@@ -236,7 +236,7 @@ static double modal(const double a[6][6], const double shapes[6][6], int j)
 /* Mode j's fixed point (K + K_s(f_j)) phi_j = (2 pi f_j)^2 M phi_j, the branches' storage at its own frequency
  * (rigid_body.modes), from ``frequency``: the frequency, its shape into column j of ``shapes``, the branches'
  * stiffness there into ``storage`` (K + K_s), ``loss``, ``slope`` */
-static double fixed_point(const System *s, const double stiffness[6][6], int j, double frequency,
+static double fixed_point(System *s, double stiffness[6][6], int j, double frequency,
                           double shapes[6][6], double storage[6][6], double loss[6][6], double slope[6][6])
 {
     double values[6], vectors[6][6] = {{0}};
@@ -270,7 +270,7 @@ static double fixed_point(const System *s, const double stiffness[6][6], int j, 
 /* rigid_body.modes about an operating point of tangent stiffness ``stiffness``, with the Maxwell branches
  * (``with_branches``): the damping ratios of the modal strain energy, phi^T K_l phi / (2 phi^T K_s phi -
  * phi^T w dK_s/dw phi), K_l = 2 pi f C + the branches' loss stiffness */
-static void modes(System *s, const double stiffness[6][6], int with_branches)
+static void modes(System *s, double stiffness[6][6], int with_branches)
 {
     double shapes[6][6], momenta[6], w2[6], storage[6][6], loss[6][6], slope[6][6];
     int i, j, k;
@@ -434,7 +434,7 @@ static int operating_point(System *s, const ModelData *data, double centres[2][3
     } else {
         memcpy(tangent, s->stiffness, sizeof tangent);
     }
-    modes(s, (const double(*)[6])tangent, s->branches.count > 0);
+    modes(s, tangent, s->branches.count > 0);
     torque_roll_axis(s);
     return 1;
 }

@@ -59,7 +59,7 @@ static double fit_frequency(int i)
 
 /* The least-squares solution of a[:, passive] s = b (a: ROWS x COLUMNS, row-major) by Householder QR; 0 when
  * the passive columns are dependent. */
-static int least_squares(const double a[ROWS][COLUMNS], const double b[ROWS], const int passive[COLUMNS],
+static int least_squares(double a[ROWS][COLUMNS], const double b[ROWS], const int passive[COLUMNS],
                          double s[COLUMNS])
 {
     double q[ROWS][COLUMNS], r[ROWS];
@@ -118,7 +118,7 @@ static int least_squares(const double a[ROWS][COLUMNS], const double b[ROWS], co
 }
 
 /* scipy.optimize.nnls of the ROWS x COLUMNS system: Lawson and Hanson's active set */
-static void nnls(const double a[ROWS][COLUMNS], const double b[ROWS], double x[COLUMNS])
+static void nnls(double a[ROWS][COLUMNS], const double b[ROWS], double x[COLUMNS])
 {
     int passive[COLUMNS] = {0}, iteration, i, j;
     double tolerance = 10.0 * DBL_EPSILON * ROWS, s[COLUMNS];
