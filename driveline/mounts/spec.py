@@ -146,7 +146,9 @@ def _mounts() -> tuple[Variable, ...]:
 
 
 def _statics_and_modes() -> tuple[Variable, ...]:
-    """Static sag, modes and torque roll axis: functions of the parameters alone."""
+    """Static sag, modes and torque roll axis: functions of the parameters alone (the modes those of the
+    operating point under the weight and T_mean about motor_axis: the tangent rates of progressive mounts
+    and the rubber's branches there)."""
     found = []
     for name in COORDINATES:
         unit, display = _unit(name, 0)
@@ -159,22 +161,22 @@ def _statics_and_modes() -> tuple[Variable, ...]:
                           depends_on=STATICS))
     found += [Variable(f"f_mode_{j}", "output", 0.0,
                        f"Natural frequency of mode {j} (ascending) at the static equilibrium under the weight and "
-                       "T_mean, with the rubber's storage stiffness at that frequency", "Hz", depends_on=("layout",))
+                       "T_mean, with the rubber's storage stiffness at that frequency", "Hz", depends_on=STATICS)
               for j in range(1, 7)]
     found += [Variable(f"zeta_mode_{j}", "output", 0.0,
                        f"Damping ratio of mode {j} (modal strain energy: loss over twice the storage stiffness "
-                       "at its frequency)", "1", depends_on=("layout",))
+                       "at its frequency)", "1", depends_on=STATICS)
               for j in range(1, 7)]
     for j in range(1, 7):
         found.append(Variable(f"mode_{j}_coordinate", "output", 0,
                               f"Coordinate with the largest kinetic-energy share of mode {j}: {COORDINATE_INDEX}",
-                              type="Integer", depends_on=("layout",)))
+                              type="Integer", depends_on=STATICS))
         found.append(Variable(f"mode_{j}_share", "output", 0.0,
                               f"Kinetic-energy share of mode {j} in its dominant coordinate", "1",
-                              depends_on=("layout",)))
+                              depends_on=STATICS))
     found += [Variable(f"share_{j}_{name}", "output", 0.0,
                        f"Kinetic-energy share of coordinate {name} in mode {j} (each mode's shares sum to 1)", "1",
-                       depends_on=("layout",))
+                       depends_on=STATICS)
               for j in range(1, 7) for name in COORDINATES]
     found += [Variable(f"torque_roll_axis_{axis}", "output", 0.0,
                        f"Torque roll axis (unit vector, vehicle {axis} component): the free powertrain's "
