@@ -22,6 +22,17 @@ void dense_multiply(const double *a, const double *b, double *c, int n, int m, i
     }
 }
 
+/* max |v_i| of the ``n`` numbers of ``v`` */
+double dense_largest(const double *v, int n)
+{
+    double found = 0.0;
+    int i;
+    for (i = 0; i < n; i++) {
+        found = fmax(found, fabs(v[i]));
+    }
+    return found;
+}
+
 /* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) by Gaussian
  * elimination with partial pivoting (a overwritten); 0 if a is singular. */
 int dense_solve(double *a, double *b, int n, int columns)

@@ -110,16 +110,6 @@ void forces_mean_elastic_load(const Layout *layout, const double maps[][3][6], c
     congruence(layout, maps, slopes, jacobian);
 }
 
-static double largest(const double v[6])
-{
-    double found = 0.0;
-    int i;
-    for (i = 0; i < 6; i++) {
-        found = fmax(found, fabs(v[i]));
-    }
-    return found;
-}
-
 static double norm6(const double v[6])
 {
     double sum = 0.0;
@@ -178,7 +168,7 @@ ErrorKind forces_equilibrium(const Layout *layout, const double maps[][3][6], co
         for (i = 0; i < 6; i++) {
             moved = fmax(moved, fabs(size * step[i]));
         }
-        if (moved <= MOUNTS_FORCES_NEWTON_STEP * fmax(largest(q), 1e-300)) {
+        if (moved <= MOUNTS_FORCES_NEWTON_STEP * fmax(dense_largest(q, 6), 1e-300)) {
             return ERROR_NONE;
         }
     }

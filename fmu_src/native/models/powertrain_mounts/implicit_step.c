@@ -7,16 +7,6 @@
 #include <math.h>
 #include <string.h>
 
-static double largest(const double v[6])
-{
-    double found = 0.0;
-    int i;
-    for (i = 0; i < 6; i++) {
-        found = fmax(found, fabs(v[i]));
-    }
-    return found;
-}
-
 /* z1 = z_keep + z_gain (R dq) */
 static void branch_forces(const Branches *b, const double *keep, const double *gain, const double dq[6], double *z1)
 {
@@ -85,7 +75,7 @@ ErrorKind implicit_step(const StepSystem *s, const double *state, const double f
             dq[i] += correction[i];
             moved[i] = big_q0[i] + dq[i];
         }
-        if (largest(correction) <= MOUNTS_FORCES_NEWTON_STEP * fmax(largest(moved), 1e-300)) {
+        if (dense_largest(correction, 6) <= MOUNTS_FORCES_NEWTON_STEP * fmax(dense_largest(moved, 6), 1e-300)) {
             branch_forces(b, keep, gain, dq, z1);
             for (i = 0; i < 6; i++) {
                 next[i] = q0[i] + dq[i];

@@ -138,6 +138,8 @@ ErrorKind implicit_step(const StepSystem *s, const double *state, const double f
 
 /* ---- dense.c ----------------------------------------------------------------------------------- */
 
+/* max |v_i| of the ``n`` numbers of ``v`` */
+double dense_largest(const double *v, int n);
 /* c = a b: (n x m) (m x p) */
 void dense_multiply(const double *a, const double *b, double *c, int n, int m, int p);
 /* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) by Gaussian
