@@ -17,12 +17,9 @@ HOST_SOURCE = Path(__file__).with_name("native_host.c")
 
 # The standard scenario of every native model, and the modes it leaves out (its parameters
 # are the spec's start values); CriticalSpeeds' String and Boolean parameters, a shipped layout
-# found in the resources folder the host hands over (PowertrainMounts' too).
+# found in the resources folder the host hands over.
 MODES = {"TripodCoupling": [{"kinematics": 1, "mu": 0.05}, {"kinematics": 1, "seed_reactions": 1}],
-         "CriticalSpeeds": [{"layout": "two_piece_propshaft"}, {"orders": "1,2,3,6", "shear": False}],
-         # the rubber layout under the drive reaction: the fit, the equilibrium on the stops, the modes' fixed
-         # point, the implicit steps
-         "PowertrainMounts": [{"layout": "transverse_fwd_powertrain_rubber", "T_mean": 1100.0}]}
+         "CriticalSpeeds": [{"layout": "two_piece_propshaft"}, {"orders": "1,2,3,6", "shear": False}]}
 #: Largest deviation from the Python FMU, relative to each output's largest magnitude: the damping
 #: ratio's eigenvalue real part and the response near a resonance, 1e-9 (why: SIGNAL_TOLERANCE of
 #: tests/native/test_native_fmus.py).
