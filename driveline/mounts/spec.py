@@ -132,8 +132,9 @@ def _motion() -> tuple[Variable, ...]:
 
 
 def _states() -> tuple[State, ...]:
-    """Displacements starting in the equilibrium under the start inputs, velocities at rest."""
-    return (*(State(name, LOADS, f"{name}_dot", NOMINALS[name]) for name in COORDINATES),
+    """Displacements starting in the equilibrium under the start inputs, velocities at rest (on progressive
+    mounts that equilibrium's displacement from the weight's depends on the weight: g)."""
+    return (*(State(name, (*LOADS, "g"), f"{name}_dot", NOMINALS[name]) for name in COORDINATES),
             *(State(f"{name}_dot", (), f"{name}_ddot", NOMINALS[name] * NOMINAL_RATE) for name in COORDINATES))
 
 
