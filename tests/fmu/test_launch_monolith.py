@@ -77,7 +77,8 @@ def test_with_the_housings_held_the_packages_peaks_are_the_monolithic_models(pac
 def test_at_60_deg_the_housings_motion_cuts_the_lateral_peak_as_in_the_monolithic_model(package):
     """The issue's check: at 60 deg the package's third-order lateral peak with the housings moving at least
     2 times below the same launch with them held, and within :data:`FACTOR` of the monolithic model with the
-    housings moving (measured there: 18.0 to 2.9 m/s2; the package 16.0 to 2.07)."""
+    housings moving (measured 2026-12-07: the model 17.98 m/s2 held, 2.18 moving; the package with the
+    joints following the powertrain 16.0 held, 2.07 moving)."""
     phase = math.radians(60.0)
     held, moving = (package_peaks(package, phase, flag)["lateral"] for flag in (False, True))
     expected = monolith_peaks(phase, True)["lateral"]
@@ -87,7 +88,8 @@ def test_at_60_deg_the_housings_motion_cuts_the_lateral_peak_as_in_the_monolithi
 
 def test_the_housings_motion_cuts_the_monolithic_models_lateral_response():
     """The issue's measurement, in the model alone: at 60 deg the groove friction on the sliding speed
-    relative to the moving housing cuts the third-order lateral peak at least 2 times."""
+    relative to the moving housing cuts the third-order lateral peak at least 2 times (measured 8.2 times,
+    17.98 to 2.18 m/s2)."""
     phase = math.radians(60.0)
     held, moving = (monolith_peaks(phase, flag)["lateral"] for flag in (False, True))
     assert moving < held / 2.0
