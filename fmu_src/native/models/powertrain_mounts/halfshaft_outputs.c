@@ -93,17 +93,13 @@ Failure halfshafts_limits(const ModelData *data, char *failure)
     return NO_FAILURE;
 }
 
-Failure halfshafts_partials(const Halfshaft shafts[2], const ModelData *data, const double acceleration[6],
-                            const double *by_state, const double *by_load, double partial[])
+Failure halfshafts_partials(const Halfshaft shafts[2], const ModelData *data, double partial[])
 {
-    double q[6], velocity[6], values[HALFSHAFT_VALUES], found[HALFSHAFT_VALUES][HALFSHAFT_MOTION], reach;
-    int side, i, j, k;
-    if (!data->int_value[V_housing_motion]) {
+    double q[6], velocity[6], acceleration[6], values[HALFSHAFT_VALUES], found[HALFSHAFT_VALUES][HALFSHAFT_MOTION];
+    double reach;
+    int side, i, j, c;
+    if (!data->int_value[V_housing_motion] || !motion_of(data, q, velocity, acceleration)) {
         return NO_FAILURE;
-    }
-    for (i = 0; i < 6; i++) {
-        q[i] = data->real_value[model_states[i]];
-        velocity[i] = data->real_value[model_states[6 + i]];
     }
     for (side = 0; side < 2; side++) {
         if (!halfshaft_geometry(&shafts[side], q, velocity, acceleration, values, found, &reach)) {
@@ -111,19 +107,16 @@ Failure halfshafts_partials(const Halfshaft shafts[2], const ModelData *data, co
         }
         for (j = 0; j < HALFSHAFT_VALUES; j++) {
             double *row = partial + model_jacobian_rows[GEOMETRY_VARIABLES[side] + j] * MODEL_COLUMN_COUNT;
-            for (k = 0; k < 12; k++) { /* directly and through q'' */
-                double sum = found[j][k];
-                for (i = 0; i < 6; i++) {
-                    sum += found[j][12 + i] * by_state[12 * i + k];
-                }
-                row[model_jacobian_columns[model_states[k]]] = sum;
-            }
-            for (k = 0; k < MODEL_INPUT_DERIVATIVE_COUNT; k++) { /* through q'' alone */
+            for (c = 0; c < MODEL_COLUMN_COUNT; c++) { /* through q'' */
                 double sum = 0.0;
                 for (i = 0; i < 6; i++) {
-                    sum += found[j][12 + i] * by_load[MODEL_INPUT_DERIVATIVE_COUNT * i + k];
+                    sum += found[j][12 + i] *
+                           partial[model_jacobian_rows[model_state_derivatives[6 + i]] * MODEL_COLUMN_COUNT + c];
                 }
-                row[model_jacobian_columns[model_input_derivatives[k].input]] = sum;
+                row[c] = sum;
+            }
+            for (i = 0; i < 12; i++) { /* and by the displacements and velocities directly */
+                row[model_jacobian_columns[model_states[i]]] += found[j][i];
             }
         }
     }
