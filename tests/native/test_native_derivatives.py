@@ -54,12 +54,16 @@ STATES = {"VehicleDriveline": ({"v_x": -2.0, "slip_left": 0.02, "slip_right": -0
           #: PowertrainMounts moved by SHIFT would carry each wheel's joint 0.4 m away, beyond its halfshaft's reach
           #: (the geometry outputs refuse it): a displacement and a velocity off every axis, a few mm and mrad, the
           #: launch's size
-          "PowertrainMounts": tuple({**dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), np.array(q) * scale)),
+          "PowertrainMounts": (*({**dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), np.array(q) * scale)),
                                      **dict(zip(("x_dot", "y_dot", "z_dot", "roll_dot", "pitch_dot", "yaw_dot"),
                                                 np.array(v) * scale))}
                                     for scale in (1.0, -0.7)
                                     for q, v in [((2e-3, -1.5e-3, 3e-3, 4e-3, -3e-3, 5e-3),
-                                                  (0.05, -0.04, 0.03, 0.2, -0.3, 0.25))])}
+                                                  (0.05, -0.04, 0.03, 0.2, -0.3, 0.25))]),
+                               # the snubbed layout's point: every mount 28 mm or more onto its stop, beyond the blend
+                               {"x": 0.03, "y": -0.03, "z": 0.03, "roll": 0.005, "pitch": -0.004, "yaw": 0.003,
+                                "x_dot": 0.1, "y_dot": -0.1, "z_dot": 0.1, "roll_dot": 0.2, "pitch_dot": -0.2,
+                                "yaw_dot": 0.2})}
 
 
 #: Points of a model's derivatives beyond its dependency points (which the dependency tests pay for at every
