@@ -278,6 +278,7 @@ class ModelExchangeSystem:
                                       "it gives no directional derivatives to solve it with")
         self.stages = self._stages(after)
         carried = self.blocks + [stage for stage in self.stages if stage is not None]
+        self._loop_columns = {id(block): self._columns(block) for block, loop in zip(self.blocks, self.loops) if loop}
         self._reads = {id(block): self._grouped(block, 0) for block in carried}
         self._writes = {id(block): self._grouped(block, 1) for block in carried}
         sizes = [instance.size for instance in self.instances.values()]
@@ -304,6 +305,16 @@ class ModelExchangeSystem:
             else:
                 stages.append(list(block))
         return stages
+
+    def _columns(self, block: list[int]) -> list[tuple[ModelExchangeInstance, list[str], list[int], str]]:
+        """Per connection of the loop ``block``: the instance it feeds, that instance's outputs in the loop, their
+        rows in the block, and the input it feeds."""
+        found = []
+        for k in block:
+            _, (target, input_) = self.connections[k]
+            rows = [row for row, j in enumerate(block) if self.connections[j][0][0] == target]
+            found.append((self.instances[target], [self.connections[block[row]][0][1] for row in rows], rows, input_))
+        return found
 
     def loop_name(self, block: list[int]) -> str:
         return ", ".join(f"{s}.{o}" for (s, o), _ in (self.connections[k] for k in block))
@@ -332,19 +343,26 @@ class ModelExchangeSystem:
             values[positions] = instance.get(outputs)
         return values
 
+    def _loop_jacobian(self, block: list[int]) -> np.ndarray:
+        """I - dy/dv of the loop ``block`` at the present point: a directional derivative of the outputs of the
+        loop that each input feeds, per input."""
+        jacobian = np.eye(len(block))
+        for column, (instance, outputs, rows, input_) in enumerate(self._loop_columns[id(block)]):
+            jacobian[rows, column] -= instance.directional(outputs, input_)
+        return jacobian
+
     def _solve_loop(self, block: list[int]) -> None:
         """The loop's values v = y(v) by Newton's method, (I - dy/dv) dv = y(v) - v, the Jacobian from the
-        directional derivatives of each output with respect to the inputs of the loop it depends on."""
+        directional derivatives of each output with respect to the inputs of the loop it depends on, taken at
+        the first iteration and kept (the loop is nearly linear: the second update is 1e-12 of the first, and
+        ends it)."""
         values = self._outputs(block)
+        jacobian = None
         for _ in range(MAX_LOOP_ITERATIONS):
             self._carry(block, values)
             residual = self._outputs(block) - values
-            jacobian = np.eye(len(block))
-            for column, k in enumerate(block):
-                _, (target, input_) = self.connections[k]
-                rows = [row for row, j in enumerate(block) if self.connections[j][0][0] == target]
-                outputs = [self.connections[block[row]][0][1] for row in rows]
-                jacobian[rows, column] -= self.instances[target].directional(outputs, input_)
+            if jacobian is None:
+                jacobian = self._loop_jacobian(block)
             update = np.linalg.solve(jacobian, residual)
             values = values + update
             if np.all(np.abs(update) <= LOOP_TOLERANCE * np.maximum(1.0, np.abs(values))):
