@@ -282,6 +282,7 @@ class ModelExchangeSystem:
         self._reads = {id(block): self._grouped(block, 0) for block in carried}
         self._writes = {id(block): self._grouped(block, 1) for block in carried}
         sizes = [instance.size for instance in self.instances.values()]
+        self.evaluations = 0  # of :meth:`rates`, the integrator's right-hand sides
         self.slices = dict(zip(self.instances, (slice(a, b) for a, b in zip(np.cumsum([0, *sizes]), np.cumsum(sizes)))))
 
     def _order(self) -> dict[int, list[int]]:
@@ -389,6 +390,7 @@ class ModelExchangeSystem:
             instance.completed_step()
 
     def rates(self, time: float, states: np.ndarray) -> np.ndarray:
+        self.evaluations += 1
         self.settle(time, states)
         return np.concatenate([instance.derivatives() for instance in self.instances.values()])
 
@@ -434,11 +436,12 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
                        connections: Sequence[tuple[Port, Port]], stop_time: float, interval: float,
                        outputs: list[str], scratch: Path, rtol: float = 1e-8,
                        on_step: Callable[[int, int], None] | None = None, method: str = "DOP853",
-                       initial: bool = False) -> np.ndarray:
+                       initial: bool = False, counts: dict[str, int] | None = None) -> np.ndarray:
     """Rows of t_k = k ``interval`` (k = 1 ... N, from k = 0 with ``initial``) and ``outputs`` (``"instance.variable"``) of the system
     integrated by ``method`` (:data:`METHODS`; the implicit ones with :meth:`ModelExchangeSystem.jacobian`)
     at relative tolerance ``rtol``, step by step (``completedIntegratorStep`` after each), the rows from
-    its dense output; ``on_step(k, N)`` after each integrator step with the rows done."""
+    its dense output; ``on_step(k, N)`` after each integrator step with the rows done. ``counts``, when given, gets
+    the run's integrator steps, right-hand sides and Jacobians (what its cost is made of)."""
     system = ModelExchangeSystem(fmus, parameters, connections, scratch)
     try:
         count = int(round(stop_time / interval))
@@ -453,8 +456,10 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
         solver = METHODS[method](system.rates, 0.0, start, times[-1], rtol=rtol, atol=ATOL, **exact)
         rows: list[list[float]] = []
         first = [[0.0, *system.outputs(0.0, start, ports)]] if initial else []
+        steps = 0
         while len(rows) < count:
             message = solver.step()
+            steps += 1
             if solver.status == "failed":
                 raise StepRefused(method, "Discard", solver.t, [message])
             end, interpolant = solver.t, solver.dense_output()
@@ -463,6 +468,8 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
             system.completed_step(end, solver.y)
             if on_step is not None:
                 on_step(len(rows), count)
+        if counts is not None:
+            counts.update({"steps": steps, "right-hand sides": system.evaluations, "Jacobians": solver.njev})
         return np.array(first + rows)
     finally:
         system.close()
