@@ -13,7 +13,8 @@ Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
         [--figure results/shudder_map.png]
     driveline-fmus map --figure-only [--out ...] [--envelope ...] [--figure ...]
 
-The grid: ``--count`` values each of both joints' ``beta`` (5 to 20 deg), ``motor.T_level`` (20 to
+The grid: ``--count`` values each of both halfshafts' design bend (``mounts.beta_design_*``, the joints'
+bends following the powertrain from there; 5 to 20 deg), ``motor.T_level`` (20 to
 100 % of the default car's motor peak, :data:`driveline.vehicle.compact_car.MOTOR_PEAK_TORQUE`) and
 both joints' ``mu`` (0.02 to 0.1), and ``--phases`` values of the right joint's ``phi_in_start`` (the left
 joint's stays 0) spread over the third of a turn after which a tripod joint repeats itself
@@ -55,7 +56,7 @@ if TYPE_CHECKING:
 COMMAND = "driveline-fmus map"
 SHAFT, SIGNAL = "joint_left.phi_in", "mounts.pitch_ddot"
 LATERAL, YAW = "mounts.y_ddot", "mounts.yaw_ddot"
-BETA = "joint_left.beta+joint_right.beta"
+BETA = "mounts.beta_design_left+mounts.beta_design_right"
 TORQUE = "motor.T_level"
 MU = "joint_left.mu+joint_right.mu"
 PHASE = "joint_right.phi_in_start"

@@ -9,12 +9,15 @@ the step's end, under the inputs moved on by their rates.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
 
 from ..model import SteppedModel
+from ..halfshaft.geometry import GeometryError
 from .exact_step import Propagator, work_error
+from .halfshafts import GEOMETRY, Halfshaft, values
 from .implicit_step import implicit_step
 from .layout import MAX_MOUNTS, Layout, load_layout, shipped_layout
 from .rigid_body import COORDINATES
@@ -40,7 +43,7 @@ class PowertrainMountsModel(SteppedModel):
                           "shaft_x_left": 0.1, "shaft_z_left": -0.05, "bend_x_left": 0.2, "shaft_x_right": -0.08,
                           "shaft_z_right": 0.04, "bend_y_right": 0.15, "motor_axis_x": 0.1, "motor_axis_z": 0.2,
                           "T_mean": 150.0},)
-    derived_state = ("_system", "_built_for", "_propagator")
+    derived_state = ("_system", "_built_for", "_propagator", "_shafts")
     #: the Maxwell branches' forces [N] (:mod:`.rubber`), a tuple of floats: part of the saved state
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml" for name in (SHARED_LAYOUT, RUBBER_LAYOUT))
 
@@ -48,6 +51,7 @@ class PowertrainMountsModel(SteppedModel):
         self._system: MountSystem | None = None
         self._built_for: tuple | None = None
         self._propagator: Propagator | None = None
+        self._shafts: dict[str, Halfshaft] = {}
         self._branch_forces: tuple[float, ...] = ()
 
     def _vector(self, template: str, side: str = "") -> np.ndarray:
@@ -69,6 +73,11 @@ class PowertrainMountsModel(SteppedModel):
         except (ValueError, ArithmeticError) as error:
             return [f"powertrain: {error}"]
         self._system, self._built_for, self._propagator = system, key, None
+        self._shafts = {side: Halfshaft.of(placement.frames[side], placement.centres[side],
+                                           system.body.layout.centre_of_gravity, getattr(self, f"l_{side}"),
+                                           getattr(self, f"beta_design_{side}"), getattr(self, f"psi_design_{side}"),
+                                           getattr(self, f"plunge_design_{side}"))
+                        for side in SIDES}
         return []
 
     def _values(self, names: tuple[str, ...]) -> np.ndarray:
@@ -95,13 +104,42 @@ class PowertrainMountsModel(SteppedModel):
             sag = system.body.static_displacement(force)
         state = np.concatenate([sag, np.zeros(system.size - 6)])
         self._show(state, force)
+        for side in SIDES:
+            reason = self._limit_error(side)
+            if reason is not None:
+                raise ValueError(reason)
         self._show_analysis()
 
+    def _limit_error(self, side: str) -> str | None:
+        """Why the ``side`` joint's start position lies beyond its bend or its stroke (the design geometry's
+        own limits are the spec's relations)."""
+        beta, plunge = getattr(self, f"beta_{side}"), getattr(self, f"plunge_{side}")
+        low, high = getattr(self, f"plunge_min_{side}"), getattr(self, f"plunge_max_{side}")
+        limit = getattr(self, f"beta_max_{side}")
+        angle, length = SPEC[f"beta_max_{side}"], SPEC[f"plunge_max_{side}"]
+        if beta > limit:
+            return (f"the {side} joint's bend at the start, {angle.shown(beta)}, exceeds beta_max_{side} = "
+                    f"{angle.shown(limit)}")
+        if not low <= plunge <= high:
+            bound, limit = ("min", low) if plunge < low else ("max", high)
+            return (f"the {side} joint's plunge at the start, {length.shown(plunge)}, lies beyond "
+                    f"plunge_{bound}_{side} = {length.shown(limit)} (the joint's stroke)")
+        return None
+
     def rounding_scales(self) -> dict[str, float]:
-        """The accelerations: zero in the equilibrium the model starts in, up to rounding."""
+        """The accelerations: zero in the equilibrium the model starts in, up to rounding; so are the halfshafts'
+        rates, the second ones linear in the accelerations there (the first rates all zero): their scale is
+        the sum over the accelerations of each one's scale times its partial derivative."""
         system = self._system
         scales = system.acceleration_scales(self._state(), system.inputs @ self._values(INPUTS))
-        return dict(zip(ACCELERATIONS, (float(scale) for scale in scales)))
+        found = dict(zip(ACCELERATIONS, (float(scale) for scale in scales)))
+        if self.housing_motion:
+            q, zero = self._values(COORDINATES), np.zeros(6)
+            for side, shaft in self._shafts.items():
+                partials = np.array([values(shaft.geometry(q, zero, unit)) for unit in np.eye(6)])
+                for name, column in zip(GEOMETRY, partials.T):
+                    found[f"{name}_{side}"] = float(np.abs(column) @ scales)
+        return found
 
     def advance(self, current_time: float, step_size: float) -> None:
         system = self._system
@@ -136,10 +174,29 @@ class PowertrainMountsModel(SteppedModel):
                                np.concatenate([state[:12], system.accelerations(state, force)])):
             setattr(self, name, float(value))
         self._branch_forces = tuple(float(value) for value in state[12:])
+        self._show_halfshafts()
         forces = system.mount_forces(state)
         for i in range(MAX_MOUNTS):
             for k, axis in enumerate(AXES):
                 setattr(self, f"F_{axis}_mount{i + 1}", float(forces[i, k]) if i < len(forces) else 0.0)
+
+    def _show_halfshafts(self) -> None:
+        """Each side's geometry at the motion shown (:mod:`.halfshafts`), or its design with the housings held; not
+        a number where the motion is none (the motion's outputs then refuse the step)."""
+        motion = [self._values(names) for names in (COORDINATES, VELOCITIES, ACCELERATIONS)]
+        finite = all(np.isfinite(part).all() for part in motion)
+        for side, shaft in self._shafts.items():
+            if not self.housing_motion:
+                found = values(shaft.design)
+            elif not finite:
+                found = (math.nan,) * len(GEOMETRY)
+            else:
+                try:
+                    found = values(shaft.geometry(*motion))
+                except GeometryError as error:
+                    raise ValueError(f"the {side} joint: {error}") from None
+            for name, value in zip(GEOMETRY, found):
+                setattr(self, f"{name}_{side}", value)
 
     def _show_analysis(self) -> None:
         """Static sag, modal table and torque roll axis (fixed by the parameters)."""

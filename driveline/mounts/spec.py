@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-from ..variables import DefaultExperiment, ModelSpec, State, Variable
+import math
+
+from ..tripod.spec import BETA_LIMIT
+from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
+from .halfshafts import GEOMETRY
 from .layout import MAX_MOUNTS
 from .rigid_body import COORDINATES
 
@@ -188,6 +192,85 @@ def _statics_and_modes() -> tuple[Variable, ...]:
     return tuple(found)
 
 
+#: Each side's halfshaft in the package's design position: the left joint bent 8 deg on the 0.45 m shaft, the
+#: right one 6 deg on the 0.70 m one, both in the vertical plane (psi 0: the bend plane X'Z' holds bend_*)
+DESIGN = {"left": (0.45, math.radians(8.0)), "right": (0.70, math.radians(6.0))}
+#: The plunge each joint allows from its housing's reference point O, both ways [m]
+PLUNGE_TRAVEL = 0.025
+HOUSING_MOTION = "housing_motion"
+
+
+def _shaft_placement(side: str) -> tuple[str, ...]:
+    """The parameters that place one side's halfshaft: its joint's centre and frame, its wheel."""
+    return ("layout", *(f"{axis}_joint_{side}" for axis in AXES),
+            *(f"{kind}_{axis}_{side}" for kind in ("shaft", "bend") for axis in AXES),
+            f"l_{side}", f"beta_design_{side}", f"psi_design_{side}", f"plunge_design_{side}", HOUSING_MOTION)
+
+
+def _halfshafts() -> tuple[Variable, ...]:
+    """The wheels' places (by the design geometry), the joints' limits, the switch, and each side's
+    geometry (:mod:`.halfshafts`): its angles and plunge from the motion, their rates from the velocities
+    too, the second rates from the accelerations, so from the loads as well (direct feedthrough)."""
+    found = [Variable(HOUSING_MOTION, "parameter", 1,
+                      "1 = the halfshaft outputs (beta_left ... plunge_ddot_right) follow the powertrain's motion; "
+                      "0 = they hold the design geometry (beta_design_*, psi_design_*, plunge_design_*; rates 0): "
+                      "the joints' housings as if fixed", type="Integer", min=0, max=1)]
+    for side in SIDES:
+        length, beta = DESIGN[side]
+        found += [
+            Variable(f"l_{side}", "parameter", length,
+                     f"Length L of the {side} halfshaft between its joints' centres (TripodCoupling's l)", "m", "mm",
+                     min=0.0, min_exclusive=True),
+            Variable(f"beta_design_{side}", "parameter", beta,
+                     f"Bend angle of the {side} halfshaft with the powertrain at rest at q = 0 (the static "
+                     "equilibrium under the weight): with psi_design, plunge_design and l it places the wheel's "
+                     "joint centre, fixed to the body", "rad", "deg", min=0.0, max=BETA_LIMIT),
+            Variable(f"psi_design_{side}", "parameter", 0.0,
+                     f"Bend-plane angle of the {side} halfshaft about the housing's axis Z' at q = 0, from X' "
+                     "(bend_*) towards Y' (0: the output shaft leans towards -X')", "rad", "deg",
+                     min=-math.pi, max=math.pi),
+            Variable(f"plunge_design_{side}", "parameter", 0.0,
+                     f"Plunge of the {side} joint at q = 0: the spider's centre along Z' from the housing's "
+                     "point O (x_joint_*)", "m", "mm"),
+            Variable(f"beta_max_{side}", "parameter", math.radians(45.0),
+                     f"Largest bend angle of the {side} joint (its TripodCoupling's beta_max)", "rad", "deg",
+                     min=0.0, max=BETA_LIMIT),
+            Variable(f"plunge_min_{side}", "parameter", -PLUNGE_TRAVEL,
+                     f"Shortest plunge the {side} joint's housing allows (the spider towards the housing's bottom)",
+                     "m", "mm"),
+            Variable(f"plunge_max_{side}", "parameter", PLUNGE_TRAVEL,
+                     f"Longest plunge the {side} joint's housing allows (the spider towards its mouth)", "m", "mm"),
+        ]
+    texts = {"beta": "Bend angle of the {side} halfshaft at its inboard joint",
+             "psi": "Bend-plane angle of the {side} halfshaft about its housing's axis Z', from X' towards Y'",
+             "plunge": "Plunge of the {side} joint: the spider's centre along Z' from the housing's point O"}
+    units = {"beta": ("rad", "deg"), "psi": ("rad", "deg"), "plunge": ("m", "mm")}
+    for side in SIDES:
+        placed = _shaft_placement(side)
+        for name in GEOMETRY:
+            base = name.split("_")[0]
+            order = {"": 0, "dot": 1, "ddot": 2}[name[len(base) + 1:]]
+            unit, display = units[base]
+            unit = unit if order == 0 else f"{unit}/s" if order == 1 else f"{unit}/s2"
+            text = texts[base].format(side=side)
+            if order:
+                text = f"{('First', 'Second')[order - 1]} time derivative of the {text[0].lower()}{text[1:]}"
+            depends = (*placed, *COORDINATES) if order == 0 else (*placed, *MOTION) if order == 1 else \
+                (*placed, *PLACEMENT, *INPUTS, *MOTION)
+            found.append(Variable(f"{name}_{side}", "output", 0.0, text, unit, display if order == 0 else None,
+                                  depends_on=tuple(dict.fromkeys(depends)),
+                                  **({"initial_depends_on": ()} if order else {})))
+    return tuple(found)
+
+
+RELATIONS = tuple(
+    relation for side in SIDES for relation in (
+        Relation(f"beta_design_{side}", "<=", f"beta_max_{side}", reason=f"the {side} joint's largest bend"),
+        Relation(f"plunge_design_{side}", ">=", f"plunge_min_{side}", reason=f"the {side} joint's stroke"),
+        Relation(f"plunge_design_{side}", "<=", f"plunge_max_{side}", reason=f"the {side} joint's stroke"),
+    ))
+
+
 SPEC = ModelSpec(
     name="PowertrainMounts",
     description=(
@@ -210,7 +293,10 @@ SPEC = ModelSpec(
         *_motion(),
         *_mounts(),
         *_statics_and_modes(),
+        # appended after every other variable: value references are positions
+        *_halfshafts(),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-3),
+    relations=RELATIONS,
     states=_states(),
 )

@@ -5,7 +5,8 @@ The motor's work goes into the kinetic energy of the drive's rotating parts, the
 relaxation, eq V6, stores ``sigma (L^2 / C) ln cosh(C s / L)`` with ``F = L tanh(C s / L)``), and is
 dissipated by the halfshafts' damping, the joints' friction (``P_friction``), the tyres' slip
 (``F (|v| + v_low) s``) and the road load. The powertrain on its mounts has its own balance: the
-work of the joints' housing loads goes into its kinetic and elastic energy and the mounts' damping.
+work of the joints' housing loads and of the drive's reaction torque (``T_reaction``) goes into its
+kinetic and elastic energy and the mounts' damping.
 The dissipated powers are integrated with the state (quadrature states), so the balance holds to the
 integration's tolerance, not a quadrature rule's.
 """
@@ -132,7 +133,7 @@ def _cosimulation_state(equations: LaunchEquations, row: dict[str, float]) -> tu
     y[dynamics.SPEED] = row["drive.v_x"]
     y[MOUNTS_STATE] = [row[f"mounts.{name}"] for name in (*COORDINATES, *(f"{c}_dot" for c in COORDINATES))]
     found = {"placed": placed, "T_motor": row["motor.T_motor"], "joints": sides, "omega_in": omega,
-             "force": equations.mounts.inputs @ equations.mount_loads(sides)}
+             "force": equations.mounts.inputs @ equations.mount_loads(sides, row["drive.T_reaction"])}
     return y, found
 
 
@@ -141,7 +142,7 @@ def cosimulation_balance(models: Path, natives: Path | None, step: float, stop_t
     the outputs at ``stop_time``, the powers from the outputs at each communication point integrated by
     the trapezoidal rule (from the start, at rest)."""
     equations = LaunchEquations(launch_parameters())
-    launch = system.vehicle_launch()
+    launch = system.vehicle_launch(housing_motion=False)
     launch = system.System(launch.name, launch.components, launch.connections, stop_time, step)
     outputs = launch.outputs()
     rows = system.simulate(launch, models, outputs, natives=natives)

@@ -30,7 +30,6 @@ from scipy.integrate import solve_ivp
 from driveline.mounts.model import PowertrainMountsModel
 from driveline.mounts.rigid_body import COORDINATES
 from driveline.mounts.spec import INPUTS as MOUNT_INPUTS
-from driveline.mounts.spec import REACTIONS
 from driveline.torque.model import TorqueSourceModel
 from driveline.tripod.outputs import coupling_outputs
 from driveline.tripod import plane_solver
@@ -133,20 +132,23 @@ class LaunchEquations:
         else:
             raise ArithmeticError("the joints' algebraic loop did not converge")
         self._alpha = alpha
-        force = self.mounts.inputs @ self.mount_loads(joints)
-        mount_state = np.asarray(y[MOUNTS_STATE], dtype=float)
         placed = placed._replace(T_in_left=joints[0]["T_in"], T_in_right=-joints[1]["T_in"])
+        reaction = dynamics.reaction_torque(self.drive, placed, rates[dynamics.CASE])
+        force = self.mounts.inputs @ self.mount_loads(joints, reaction)
+        mount_state = np.asarray(y[MOUNTS_STATE], dtype=float)
         return {"drive_rates": rates, "omega_in": omega, "joints": joints, "T_motor": T_motor, "loads": loads,
-                "placed": placed, "force": force,
+                "placed": placed, "force": force, "reaction": reaction,
                 "mount_rates": self.mounts.a @ mount_state + self.mounts.b @ force,
                 "mount_accelerations": self.mounts.accelerations(mount_state, force)}
 
     @staticmethod
-    def mount_loads(joints: list[dict]) -> np.ndarray:
-        """PowertrainMounts' inputs: both joints' housing reactions (its own T_motor and load inputs 0)."""
+    def mount_loads(joints: list[dict], reaction: float) -> np.ndarray:
+        """PowertrainMounts' inputs: both joints' housing forces and bending moments, the drive's ``reaction``
+        (its T_reaction) about y (its own T_motor and the other load inputs 0)."""
         values = dict.fromkeys(MOUNT_INPUTS, 0.0)
         for side, joint in zip(system.SIDES, joints):
-            values.update({f"{name}_{side}": joint[name] for name in REACTIONS})
+            values.update({f"{name}_{side}": joint[name] for name in system.HOUSING_LOADS})
+        values["M_y"] = reaction
         return np.array([values[name] for name in MOUNT_INPUTS])
 
     def rates(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -160,7 +162,7 @@ class LaunchEquations:
         drive = dynamics.start_state(self.drive, self.v_start, placed)
         y = np.concatenate([drive, phi, np.zeros(12)])
         found = self.evaluate(0.0, y)
-        force = self.mounts.inputs @ self.mount_loads(found["joints"])
+        force = self.mounts.inputs @ self.mount_loads(found["joints"], found["reaction"])
         y[MOUNTS_STATE.start:MOUNTS_STATE.start + 6] = self.mounts.body.static_displacement(force)
         return y
 
@@ -174,8 +176,9 @@ class LaunchEquations:
 
 
 def launch_parameters(overrides: Mapping[str, Mapping[str, object]] | None = None) -> dict[str, dict[str, object]]:
-    """The component parameters of :func:`.system.vehicle_launch`, with ``overrides`` on top."""
-    parameters = {c.name: dict(c.parameters) for c in system.vehicle_launch().components}
+    """The component parameters of :func:`.system.vehicle_launch` without the housings' motion (the joints'
+    bends bound), with ``overrides`` on top."""
+    parameters = {c.name: dict(c.parameters) for c in system.vehicle_launch(housing_motion=False).components}
     parameters.setdefault("mounts", {})
     for name, values in (overrides or {}).items():
         parameters[name].update(values)
@@ -208,8 +211,9 @@ def errors(cosimulation: Mapping[str, np.ndarray], times: np.ndarray, monolithic
 def cosimulate(models: Path, natives: Path | None, step: float, stop_time: float,
                order: tuple[str, ...] | None = None) -> dict[str, np.ndarray]:
     """The launch in the project's master at ``step`` (:func:`.system.component_fmus` of ``models`` and
-    ``natives``), Jacobi or Gauss-Seidel in ``order``: ``"t"`` and :data:`SIGNALS`."""
-    launch = system.vehicle_launch()
+    ``natives``), Jacobi or Gauss-Seidel in ``order``: ``"t"`` and :data:`SIGNALS`; the package without the
+    housings' motion, as the reference."""
+    launch = system.vehicle_launch(housing_motion=False)
     launch = system.System(launch.name, launch.components, launch.connections, stop_time, step)
     rows = system.simulate(launch, models, list(SIGNALS), natives=natives, order=order)
     return {"t": rows[:, 0], **{name: rows[:, i + 1] for i, name in enumerate(SIGNALS)}}

@@ -6,7 +6,7 @@ Usage::
     python -m fmu_harness.runs.sweep --model CardanJoint --points points.csv --out cardan.parquet
     python -m fmu_harness.runs.sweep --grid beta=0.1,0.3 --scheduler tcp://host:8786
     python -m fmu_harness.runs.sweep --system models/native/VehicleLaunch.ssp --step 4e-4 \
-        --grid joint_left.beta+joint_right.beta=0.1,0.2 motor.T_level=100,200
+        --grid mounts.beta_design_left+mounts.beta_design_right=0.1,0.2 motor.T_level=100,200
 
 A grid axis is ``name=v1,v2,...`` or ``name=start:stop:count`` (``count`` values, both ends
 included); the grid is the cartesian product of its axes. A points file is CSV (a header of

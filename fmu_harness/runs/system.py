@@ -33,6 +33,8 @@ import numpy as np
 from fmpy.model_description import ModelDescription
 
 from driveline.catalog import MODELS
+from driveline.mounts.halfshafts import GEOMETRY
+from driveline.mounts.spec import DESIGN as MOUNTS_DESIGN
 from driveline.vehicle import dynamics
 from driveline.vehicle.dynamics import Drive
 from driveline.variables import UNITS, ModelSpec, Variable
@@ -123,8 +125,16 @@ SIDES = ("left", "right")
 JOINT_FEEDBACK = ("T_in", "phi_out", "omega_out")
 #: What the drive feeds each joint.
 JOINT_DRIVE = ("omega_in", "alpha_in", "T_load")
-#: The joints' housing loads PowertrainMounts takes per side, under the joint's own names.
-HOUSING_LOADS = ("Rx_in", "Ry_in", "Rz_in", "Mx_in", "My_in", "T_in")
+#: The joints' housing loads PowertrainMounts takes per side, under the joint's own names: the forces and the
+#: bending moments; the moment about the housing's axis reaches the powertrain through the gears, with the
+#: rotating parts' inertia, as the drive's ``T_reaction`` (about y, into the mounts' ``M_y``).
+HOUSING_LOADS = ("Rx_in", "Ry_in", "Rz_in", "Mx_in", "My_in")
+#: What PowertrainMounts feeds each joint: its halfshaft's geometry on the moving powertrain (the output
+#: ``<name>_<side>`` into the joint's input ``<name>``), each that the joint takes as an input.
+HALFSHAFT_GEOMETRY = GEOMETRY
+#: The package's halfshafts (PowertrainMounts' defaults, the joints' l and beta_max the same): the left
+#: joint bent 8 deg on the 0.45 m shaft, the right one 6 deg on the 0.70 m one, in the vertical plane.
+HALFSHAFTS = MOUNTS_DESIGN
 
 
 #: The joints' connected inputs at the launch's consistent start (the drive at rest, the halfshafts untwisted):
@@ -134,29 +144,39 @@ HOUSING_LOADS = ("Rx_in", "Ry_in", "Rz_in", "Mx_in", "My_in", "T_in")
 JOINT_AT_REST = {"omega_in": 0.0, "alpha_in": 0.0, "T_load": 0.0}
 
 
-def vehicle_launch() -> System:
+def vehicle_launch(housing_motion: bool = True) -> System:
     """A launch of a front-wheel-drive car from standstill: ``TorqueSource`` ramps the motor to 140 N.m
     (half its peak) in 0.3 s into ``VehicleDriveline``, whose side gears drive two ``TripodCoupling`` s
     (exact kinematics, friction 0.05; left 8 deg on the 0.45 m shaft, right 6 deg on the 0.70 m one)
     that twist the halfshafts; ``PowertrainMounts``, when the catalog has it, takes both joints' housing
-    loads (its ``g`` the drive's standard gravity: one value across the models). Communication step 0.1 ms (the differential's internal mode, 670 rad/s, needs it)."""
+    loads and the drive's ``T_reaction`` (its ``g`` the drive's standard gravity: one value across the models)
+    and gives each joint its halfshaft's geometry on the moving powertrain (:data:`HALFSHAFT_GEOMETRY`; its
+    ``housing_motion`` 0 holds the design geometry, the housings as if fixed). Without ``housing_motion``
+    the package of before: the joints' bends bound, PowertrainMounts feeding them nothing. Communication step
+    0.1 ms (the differential's internal mode, 670 rad/s, needs it)."""
+    moving = housing_motion and MOUNTS in MODELS
+    joints = {side: {**JOINT_AT_REST, "kinematics": 1, "mu": 0.05, "l": HALFSHAFTS[side][0],
+                     **({"beta_rate": 0} if moving else {"beta": HALFSHAFTS[side][1]}), "phi_in_start": 0.0}
+              for side in SIDES}
     components = [
         Component("motor", "TorqueSource", {"T_level": 140.0, "ramp_time": 0.3}),
         Component("drive", "VehicleDriveline", {}),
-        Component("joint_left", "TripodCoupling", {**JOINT_AT_REST, "kinematics": 1, "mu": 0.05, "l": 0.45,
-                                                   "beta": math.radians(8.0), "phi_in_start": 0.0}),
-        Component("joint_right", "TripodCoupling", {**JOINT_AT_REST, "kinematics": 1, "mu": 0.05, "l": 0.70,
-                                                    "beta": math.radians(6.0), "phi_in_start": 0.0}),
+        *(Component(f"joint_{side}", "TripodCoupling", joints[side]) for side in SIDES),
     ]
     connections = [Connection(("motor", "T_motor"), ("drive", "T_motor"))]
+    if moving:  # first: the initialisation exchange hands the joints their bend before they report phi_out
+        joint_inputs = {v.name for v in MODELS["TripodCoupling"].spec.of("input")}
+        connections += [Connection(("mounts", f"{name}_{side}"), (f"joint_{side}", name))
+                        for side in SIDES for name in HALFSHAFT_GEOMETRY if name in joint_inputs]
     for side in SIDES:
         joint = f"joint_{side}"
         connections += [Connection(("drive", f"{name}_{side}"), (joint, name)) for name in JOINT_DRIVE]
         connections += [Connection((joint, name), ("drive", f"{name}_{side}")) for name in JOINT_FEEDBACK]
     if MOUNTS in MODELS:
-        components.append(Component("mounts", MOUNTS, {"g": dynamics.GRAVITY}))
+        components.append(Component("mounts", MOUNTS, {"g": dynamics.GRAVITY, "housing_motion": int(moving)}))
         connections += [Connection((f"joint_{side}", name), ("mounts", f"{name}_{side}"))
                         for side in SIDES for name in HOUSING_LOADS]
+        connections.append(Connection(("drive", "T_reaction"), ("mounts", "M_y")))
     return System("VehicleLaunch", tuple(components), tuple(connections), 4.0, 1e-4)
 
 

@@ -3,7 +3,7 @@ per point, its components' parameters set from the point.
 
 A point's names are ``component.variable``: a parameter of the component's FMU or an input no
 connection feeds. One name may join several with ``+`` and set them all to its value:
-``joint_left.beta+joint_right.beta=0.1,0.2`` bends both joints alike. The package's own bindings hold
+``mounts.beta_design_left+mounts.beta_design_right=0.1,0.2`` bends both halfshafts alike. The package's own bindings hold
 for everything a point leaves alone.
 
 Masters (``--master``): ``jacobi``, the project's fixed-step Jacobi master

@@ -65,7 +65,7 @@ def _compare(package: Path, tmp_path: Path, step: float, sequential: bool,
 
 @pytest.mark.parametrize("sequential", [False, True], ids=["jacobi", "gauss-seidel"])
 def test_the_launch_container_runs_as_the_master(packages, tmp_path, sequential):
-    """All 176 outputs of the launch over 0.1 s at 1e-4 s, Jacobi and Gauss-Seidel in the package's order."""
+    """All 200 outputs of the launch over 0.1 s at 1e-4 s, Jacobi and Gauss-Seidel in the package's order."""
     _compare(packages["VehicleLaunch"], tmp_path, 1e-4, sequential)
 
 
@@ -79,10 +79,10 @@ def test_the_driveline_container_runs_as_the_master(packages, tmp_path):
 
 
 def test_a_hosts_values_replace_the_packages_bindings(packages, tmp_path):
-    """A host sets the launch's torque, a joint's bend (an input the package binds) and friction: the run is
-    the master's with those bindings (the toolbox re-applied a bound input's start value on entering
-    initialisation, which undid the host's bend)."""
-    changes = {("motor", "T_level"): 200.0, ("joint_left", "beta"): 0.25, ("joint_right", "mu"): 0.09}
+    """A host sets the launch's torque, a halfshaft's design bend and a joint's friction: the run is the master's
+    with those bindings (the toolbox re-applied a bound input's start value on entering initialisation, which
+    undid a host's value: the joints' bends were such inputs before PowertrainMounts fed them)."""
+    changes = {("motor", "T_level"): 200.0, ("mounts", "beta_design_left"): 0.25, ("joint_right", "mu"): 0.09}
     _compare(packages["VehicleLaunch"], tmp_path, 1e-4, False, changes)
 
 
@@ -112,9 +112,9 @@ def test_the_container_is_a_valid_fmu_and_the_same_bytes_again(packages, tmp_pat
     from fmpy import read_model_description
 
     variables = {v.name: v for v in read_model_description(str(first)).modelVariables}
-    assert variables["drive.v_x"].unit == "m/s" and variables["joint_left.beta"].unit == "rad"
+    assert variables["drive.v_x"].unit == "m/s" and variables["mounts.beta_design_left"].unit == "rad"
     assert float(variables["motor.T_level"].start) == 140.0
-    assert float(variables["joint_left.beta"].start) == pytest.approx(math.radians(8.0), rel=1e-15)
+    assert float(variables["mounts.beta_design_left"].start) == pytest.approx(math.radians(8.0), rel=1e-15)
     assert not [v for v in variables.values() if v.causality == "local"]
 
 

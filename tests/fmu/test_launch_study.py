@@ -12,7 +12,8 @@ from fmu_harness.studies import launch_study, order_tracking
 
 CASES = {"friction": {},
          "no friction": {f"joint_{side}": {"mu": 0.0} for side in system.SIDES},
-         "no friction, straight": {f"joint_{side}": {"mu": 0.0, "beta": 0.0} for side in system.SIDES}}
+         "no friction, straight": {**{f"joint_{side}": {"mu": 0.0} for side in system.SIDES},
+                                   "mounts": {"housing_motion": 0, "beta_design_left": 0.0, "beta_design_right": 0.0}}}
 
 
 @pytest.fixture(scope="module")

@@ -27,9 +27,12 @@ from fmu_harness.studies.order_tracking import third_order_peak
 STOP, STEP = 2.0, 8e-4
 """Short launches: 2 s, in which the left joint turns 2.8 (200 N.m) to 4.0 (280 N.m) revolutions, more than
 the order tracking's window of 2, in 2500 steps of the Gauss-Seidel master at 8e-4 s (its stability limit)."""
-BOTH_BETA = "joint_left.beta+joint_right.beta"
-POINTS = [{BOTH_BETA: 0.1, "motor.T_level": 280.0, "joint_left.mu": 0.08},
-          {BOTH_BETA: 0.3, "motor.T_level": 200.0, "joint_left.mu": 0.02}]
+BOTH_BETA = "mounts.beta_design_left+mounts.beta_design_right"
+#: The housings held (``mounts.housing_motion`` 0): with the housings moving, the loop through the mounts lets
+#: the last bits by which the container and the project's master differ grow over a launch (measured 5e-8 of a
+#: metric after 2 s; 2e-8 between libcosim and the Jacobi master at 4e-4 s)
+POINTS = [{BOTH_BETA: 0.1, "motor.T_level": 280.0, "joint_left.mu": 0.08, "mounts.housing_motion": 0},
+          {BOTH_BETA: 0.3, "motor.T_level": 200.0, "joint_left.mu": 0.02, "mounts.housing_motion": 0}]
 
 
 @pytest.fixture(scope="module")
@@ -86,21 +89,23 @@ def master_metrics(fmi2_dir: Path, native_dir: Path, point: dict, order: tuple[s
 def test_a_system_sweep_on_a_scheduler_gives_the_masters_runs(launch_ssp, scheduler, fmi2_dir, native_dir):
     """Gauss-Seidel in the package's order (the launch's order) on the scheduler's worker: each row's
     metrics, the third-order peak of the pitch acceleration among them, are those of the master run here
-    with both joints' beta bound, bit for bit. A bend beyond
+    with both halfshafts' design bend bound, to the last bits (the worker runs the package as one FMU, which
+    tests/fmu/test_container.py holds within 1e-9; measured up to 1.2e-14 since the drive's T_reaction loads the
+    powertrain, bit for bit before), within 1e-12. A bend beyond
     the joint's beta_max, which the FMU would refuse at initialisation, fails its row with the model's
     reason, not run."""
     from distributed import Client
 
-    plan = Plan.of_system(launch_ssp, [*POINTS, {"joint_right.beta": 1.0}], STOP, STEP, "gauss-seidel",
+    plan = Plan.of_system(launch_ssp, [*POINTS, {"mounts.beta_design_right": 1.0}], STOP, STEP, "gauss-seidel",
                           (shudder_map.THIRD_ORDER,))
     with Client(scheduler) as client:
         *rows, beyond = run(client, plan).to_pylist()
     assert [row["status"] for row in rows] == ["ok", "ok"] and beyond["status"] == "failed"
-    assert beyond["reason"] == ("joint_right (TripodCoupling): input beta = 57.2958 deg must not exceed "
-                                "beta_max = 45 deg")
+    assert beyond["reason"] == ("mounts (PowertrainMounts): parameter beta_design_right = 57.2958 deg must not "
+                                "exceed beta_max_right = 45 deg (the right joint's largest bend)")
     for point, row in zip(POINTS, rows):
         expected = master_metrics(fmi2_dir, native_dir, point, system.LAUNCH_ORDER)
-        assert {name: row[name] for name in expected} == expected
+        assert all(math.isclose(row[name], value, rel_tol=1e-12) for name, value in expected.items()), point
         assert all(row[name] == value for name, value in point.items())
     assert rows[0]["joint_right.Rz_in_peak_abs"] != rows[1]["joint_right.Rz_in_peak_abs"]
 
@@ -260,7 +265,7 @@ def test_grid_values_reach_every_joined_target(launch_ssp):
     """One value of a joined name binds each of its targets; the others keep the package's bindings."""
     plan = Plan.of_system(launch_ssp, [{BOTH_BETA: 0.25}], STOP, STEP, "gauss-seidel")
     bound = {c.name: c.parameters for c in plan.fmu.interface.system({BOTH_BETA: 0.25}).components}
-    assert bound["joint_left"]["beta"] == bound["joint_right"]["beta"] == 0.25
+    assert bound["mounts"]["beta_design_left"] == bound["mounts"]["beta_design_right"] == 0.25
     assert bound["joint_left"]["l"] == 0.45 and bound["joint_right"]["l"] == 0.70
     assert np.isclose(bound["motor"]["T_level"], 140.0)
 

@@ -4,6 +4,7 @@ joints with direct feedthrough, run by ``driveline-fmus system`` in the project'
 from __future__ import annotations
 
 import csv
+import dataclasses
 import importlib.util
 import math
 import zipfile
@@ -95,6 +96,27 @@ def _assert_like_the_master(master: tuple[list[str], np.ndarray], run: tuple[lis
     assert (np.abs(values - reference).max(axis=0) / scale).max() <= 1e-9
 
 
+def test_with_the_housings_held_the_launch_is_the_fixed_bend_launch_bit_for_bit(fmi2_dir, native_dir, launch_ssp,
+                                                                              master, tmp_path):
+    """``mounts.housing_motion`` = 0: every output of the package equal bit for bit to the package whose joints
+    have their bends bound and take nothing from PowertrainMounts (the package of before the housings moved);
+    with the switch on (the package's default), the joints' bend follows the powertrain: the left one moves
+    off its 8 deg within 50 ms and its bend plane turns."""
+    held = system.write_ssp(dataclasses.replace(system.vehicle_launch(housing_motion=False), name="VehicleLaunchHeld"),
+                            fmi2_dir, native_dir)
+    header, fixed = _run_with(held, tmp_path / "fixed.csv", [])
+    switched_header, switched = _run_with(launch_ssp, tmp_path / "held.csv", ["mounts.housing_motion=0"])
+    assert header == switched_header and np.array_equal(fixed, switched)
+    moving_header, moving = master
+    assert moving_header == header
+    assert np.all(fixed[:, header.index("mounts.beta_left [rad]")] == math.radians(8.0))
+    bend = moving[:, header.index("mounts.beta_left [rad]")]
+    assert np.abs(bend - math.radians(8.0)).max() > 1e-4
+    assert np.abs(moving[:, header.index("mounts.psi_left [rad]")]).max() > 1e-3
+    connected = {(c.start, c.end) for c in system.vehicle_launch().connections}
+    assert (("mounts", "beta_left"), ("joint_left", "beta")) in connected
+
+
 def test_without_friction_the_joints_generate_no_axial_force(launch_ssp, master, tmp_path):
     """The generated axial force -Rz_in comes from friction alone: with mu = 0 on both joints it is 0
     over the run, where with the package's mu = 0.05 it reaches over 1 N within 50 ms."""
@@ -148,18 +170,15 @@ def test_a_joint_started_at_another_phase_starts_with_untwisted_halfshafts(joint
     assert phase == pytest.approx(math.radians(degrees), abs=0.01)
 
 
-def test_a_reversed_launch_is_the_mirror_image_of_the_forward_one(launch_ssp, master, tmp_path):
-    """Motor torque reversed (T_level = -140 N.m): the car launches backwards and each joint turns
-    through -phi_in(t), the mirror image about its bend plane of the forward launch. Sliding speeds
+def test_a_reversed_launch_is_the_mirror_image_of_the_forward_one(launch_ssp, tmp_path):
+    """Motor torque reversed (T_level = -140 N.m), the housings held: the car launches backwards and each joint
+    turns through -phi_in(t), the mirror image about its bend plane of the forward launch. Sliding speeds
     along the grooves are even under that mirror, so the friction forces and the generated axial force
     Rz_in are the forward run's (to 1e-12 of its largest value); the out-of-plane Ry_in, the torques
-    and the speeds flip (docs/vehicle_launch.md, "Torque reversal")."""
-    system_command.main([str(launch_ssp), "--stop-time", str(STOP), "--step", str(STEP), "--out",
-                         str(tmp_path / "run.csv"), "--set", "motor.T_level=-140"])
-    with (tmp_path / "run.csv").open() as handle:
-        rows = list(csv.reader(handle))
-    header, values = rows[0], np.array(rows[1:], dtype=float)
-    forward_header, forward = master
+    and the speeds flip (docs/vehicle_launch.md, "Torque reversal"). The housings' motion breaks the mirror:
+    the powertrain winds up the other way, and the bends it changes are not mirrored."""
+    header, values = _run_with(launch_ssp, tmp_path / "run.csv", ["mounts.housing_motion=0", "motor.T_level=-140"])
+    forward_header, forward = _run_with(launch_ssp, tmp_path / "forward.csv", ["mounts.housing_motion=0"])
     for name, sign in (("drive.v_x", -1.0), ("drive.T_load_left", -1.0), ("joint_left.phi_in", -1.0),
                        ("joint_left.Rz_in", 1.0), ("joint_right.Rz_in", 1.0), ("joint_left.Ry_in", -1.0)):
         column = next(i for i, label in enumerate(header) if label.split(" [")[0] == name)

@@ -50,7 +50,20 @@ SHIFT = 0.4  # rad: the states moved from their start, away from the joints' sym
 #: and towards the saturation (-0.15: the slope 2 % of C_slip), the car reversing and within the rolling
 #: resistance's regularisation (v_x / v_low = 0.5).
 STATES = {"VehicleDriveline": ({"v_x": -2.0, "slip_left": 0.02, "slip_right": -0.05},
-                               {"v_x": 0.05, "slip_left": 0.05, "slip_right": -0.15})}
+                               {"v_x": 0.05, "slip_left": 0.05, "slip_right": -0.15}),
+          #: PowertrainMounts moved by SHIFT would carry each wheel's joint 0.4 m away, beyond its halfshaft's reach
+          #: (the geometry outputs refuse it): a displacement and a velocity off every axis, a few mm and mrad, the
+          #: launch's size
+          "PowertrainMounts": (*({**dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), np.array(q) * scale)),
+                                     **dict(zip(("x_dot", "y_dot", "z_dot", "roll_dot", "pitch_dot", "yaw_dot"),
+                                                np.array(v) * scale))}
+                                    for scale in (1.0, -0.7)
+                                    for q, v in [((2e-3, -1.5e-3, 3e-3, 4e-3, -3e-3, 5e-3),
+                                                  (0.05, -0.04, 0.03, 0.2, -0.3, 0.25))]),
+                               # the snubbed layout's point: every mount 28 mm or more onto its stop, beyond the blend
+                               {"x": 0.03, "y": -0.03, "z": 0.03, "roll": 0.005, "pitch": -0.004, "yaw": 0.003,
+                                "x_dot": 0.1, "y_dot": -0.1, "z_dot": 0.1, "roll_dot": 0.2, "pitch_dot": -0.2,
+                                "yaw_dot": 0.2})}
 
 
 #: Points of a model's derivatives beyond its dependency points (which the dependency tests pay for at every

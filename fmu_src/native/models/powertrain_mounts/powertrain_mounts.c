@@ -49,6 +49,7 @@ typedef struct {
     Branches branches;
     int has_propagator;
     Propagator propagator;
+    Halfshaft shafts[2];
     char failure[ERROR_SIZE];
 } System;
 
@@ -459,14 +460,13 @@ static int build(System *s, const ModelData *data, char *error)
     static const int bends[2][3] = {{V_bend_x_left, V_bend_y_left, V_bend_z_left},
                                     {V_bend_x_right, V_bend_y_right, V_bend_z_right}};
     static const int motor[3] = {V_motor_axis_x, V_motor_axis_y, V_motor_axis_z};
-    static const char *const sides[2] = {"left", "right"};
     double centre[2][3], shaft[3], bend[3], frames[2][3][3], axis[3], length;
     int side, k;
     for (side = 0; side < 2; side++) {
         vector_of(data, centres[side], centre[side]);
         vector_of(data, shafts[side], shaft);
         vector_of(data, bends[side], bend);
-        if (!joint_frame(shaft, bend, sides[side], frames[side], error)) {
+        if (!joint_frame(shaft, bend, mounts_sides[side], frames[side], error)) {
             return 0;
         }
     }
@@ -493,6 +493,7 @@ static int build(System *s, const ModelData *data, char *error)
     if (!restrained(s, error)) {
         return 0;
     }
+    halfshafts_place(s->shafts, data, &centre[0][0], &frames[0][0][0], s->layout.centre);
     return operating_point(s, data, centre, frames, error);
 }
 
@@ -694,6 +695,7 @@ static Failure start(ModelData *data, double start_time UNUSED)
     double force[6], load[6], state[MAX_STATE] = {0};
     const char *message = NULL;
     ErrorKind failed;
+    Failure failure;
     int i;
     if (s == NULL) { /* the parameter check builds it before every initialisation */
         return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
@@ -713,7 +715,11 @@ static Failure start(ModelData *data, double start_time UNUSED)
         return FAILURE(ERROR_VALUE, "Singular matrix");
     }
     show(s, data, state, force);
-    return show_analysis(s, data);
+    failure = halfshafts_show(s->shafts, data, s->failure);
+    if (failure.kind == ERROR_NONE) {
+        failure = halfshafts_limits(data, s->failure);
+    }
+    return failure.kind == ERROR_NONE ? show_analysis(s, data) : failure;
 }
 
 /* The state (q, q', z) of the outputs and the internal state */
@@ -760,7 +766,7 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
         force[i] = held[i] + rates[i] * step_size;
     }
     show(s, data, next, force);
-    return NO_FAILURE;
+    return halfshafts_show(s->shafts, data, s->failure);
 }
 
 /* Model Exchange: the accelerations (the velocities' derivatives) and mount forces at the solver's state
@@ -784,7 +790,7 @@ static Failure evaluate(ModelData *data, double time UNUSED)
         state[i] = data->real_value[STATE_VARIABLES[i]];
     }
     show(s, data, state, force);
-    return NO_FAILURE;
+    return halfshafts_show(s->shafts, data, s->failure);
 }
 
 /* Directional derivatives: linear mounts' partials are constant, progressive ones' take the tangent rates
@@ -850,7 +856,7 @@ static Failure jacobian(const ModelData *data, double partial[])
             }
         }
     }
-    return NO_FAILURE;
+    return halfshafts_partials(s->shafts, data, partial); /* after the accelerations' rows, which it reads */
 }
 
 const ModelHooks model_hooks = {.start = start, .advance = advance, .evaluate = evaluate,
