@@ -122,6 +122,6 @@ class TripodCouplingModel(DrivenShaftModel):
             self.phi_in, beta, self.omega_in + self.alpha_in * elapsed, self.T_load,
             self.r, self.l, self.m_plunger, self.kinematics, self._solution, self.alpha_in, self.seed_reactions,
             self.mu, self.v_slip, beta_dot + beta_ddot * elapsed, beta_ddot, self.tripod_type, self.mu_roll,
-            self.roller_radius,
+            self.roller_radius, self.roller_bore_radius,
         )
         self.__dict__.update(values)

@@ -21,7 +21,8 @@ RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 # reactions (a_plunger_sum, Rz_out, Rx_in, Ry_in with the bend's rates, the load and friction) more.
 POSITION = ("phi_in", "beta", "r", "l", "kinematics")
 PLUNGERS = (*POSITION, "omega_in", "m_plunger", "alpha_in", "beta_dot", "beta_ddot", "beta_rate")
-FORCES = (*PLUNGERS, "T_load", "mu", "v_slip", "tripod_type", "mu_roll", "roller_radius")
+FORCES = (*PLUNGERS, "T_load", "mu", "v_slip", "tripod_type", "mu_roll", "roller_radius",
+          "roller_bore_radius")
 FRICTION = tuple(name for name in FORCES if name != "kinematics")  # zero without friction, which needs the exact
 ARM_OUTPUTS = tuple(
     Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N",
