@@ -5,25 +5,28 @@ launch torque and the joints' friction coefficient, each launch a run of the swe
 
 Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
 
-    driveline-fmus map [--package models/native/VehicleLaunch.ssp] [--count 8]
+    driveline-fmus map [--package models/native/VehicleLaunch.ssp] [--count 8] [--joints 0,1,2]
         [--duration 4] [--step 2e-4] [--master gauss-seidel] [--workers N | --scheduler tcp://host:8786]
         [--out results/shudder_map.parquet] [--figure results/shudder_map.png]
     driveline-fmus map --figure-only [--out ...] [--figure ...]
 
 The grid: ``--count`` values each of both joints' ``beta`` (5 to 20 deg), ``motor.T_level`` (20 to
 100 % of the default car's motor peak, :data:`driveline.vehicle.compact_car.MOTOR_PEAK_TORQUE`) and
-both joints' ``mu`` (0.02 to 0.1), the cartesian product (512 launches at the default 8), each one
+both joints' ``mu`` (0.02 to 0.1), the cartesian product (512 launches at the default 8), and with
+``--joints`` the joints' ``tripod_type`` too (``--joints 0,1,2``: plain, single and double roller, a
+dimension of its own, three times the launches; by default the plain tripod alone, no column), each one
 launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and :data:`THIRD_ORDER`:
 ``mounts.pitch_ddot_order3_peak``, the peak third-order amplitude of the powertrain's pitch
 acceleration over the left joint's turns (:func:`fmu_harness.studies.order_tracking.third_order_peak`;
 the right joint turns negatively in its own frame), and ``mounts.pitch_ddot_order3_speed``, the joint's
 speed there. A launch whose joint turns less than the order tracking's window fails with that
-reason. The table goes to ``--out``, the figure (a panel per friction coefficient: the peak over bend
-angle and torque) to ``--figure``; ``--figure-only`` draws the figure from a table written before.
+reason. The table goes to ``--out``, the figure (a panel per friction coefficient, a row of them per
+joint: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the figure from a table written before.
 """
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import math
 import sys
@@ -33,6 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from driveline.tripod.spec import DOUBLE_ROLLER, PLAIN_TRIPOD, SINGLE_ROLLER
 from driveline.vehicle.compact_car import MASS, MOTOR_PEAK_TORQUE, RATIO, WHEEL_RADIUS
 
 from .console import CommandParser, summary
@@ -42,12 +46,15 @@ from .studies.order_tracking import REVOLUTIONS, third_order_peak
 
 if TYPE_CHECKING:
     import pyarrow as pa
+    from matplotlib.figure import Figure
 
 COMMAND = "driveline-fmus map"
 SHAFT, SIGNAL = "joint_left.phi_in", "mounts.pitch_ddot"
 BETA = "joint_left.beta+joint_right.beta"
 TORQUE = "motor.T_level"
 MU = "joint_left.mu+joint_right.mu"
+JOINT = "joint_left.tripod_type+joint_right.tripod_type"
+JOINT_NAMES = {PLAIN_TRIPOD: "plain tripod", SINGLE_ROLLER: "single roller", DOUBLE_ROLLER: "double roller"}
 PEAK = f"{SIGNAL}_order3_peak"
 BETA_RANGE = (math.radians(5.0), math.radians(20.0))
 TORQUE_RANGE = (0.2 * MOTOR_PEAK_TORQUE, MOTOR_PEAK_TORQUE)
@@ -83,46 +90,73 @@ def duration_error(duration: float) -> str | None:
             f"{math.ceil(shortest * 10.0) / 10.0:g} s (default 4)")
 
 
-def axes(count: int) -> dict[str, list[float]]:
-    """The map's grid axes, ``count`` values each, both ends included."""
-    return {name: np.linspace(*bounds, count).tolist()
-            for name, bounds in ((BETA, BETA_RANGE), (TORQUE, TORQUE_RANGE), (MU, MU_RANGE))}
+def axes(count: int, joints: Sequence[int] = (PLAIN_TRIPOD,)) -> dict[str, list[float]]:
+    """The map's grid axes, ``count`` values each, both ends included; the joints' types ``joints`` a
+    first axis of their own unless the plain tripod alone."""
+    found = {} if tuple(joints) == (PLAIN_TRIPOD,) else {JOINT: list(joints)}
+    return found | {name: np.linspace(*bounds, count).tolist()
+                    for name, bounds in ((BETA, BETA_RANGE), (TORQUE, TORQUE_RANGE), (MU, MU_RANGE))}
+
+
+def joint_types(text: str) -> list[int]:
+    """``--joints``: tripod types (0 plain, 1 single roller, 2 double roller) separated by commas."""
+    try:
+        found = [int(part) for part in text.split(",")]
+    except ValueError:
+        found = []
+    if not found or any(joint not in JOINT_NAMES for joint in found) or len(set(found)) < len(found):
+        raise argparse.ArgumentTypeError(f"{text!r}: give distinct tripod types among 0, 1, 2, e.g. 0,1,2")
+    return found
 
 
 def draw(table: pa.Table, path: Path) -> Path:
-    """A panel per friction coefficient: the peak third-order pitch acceleration [rad/s2] over the bend
-    angle [deg] and the launch torque [% of the motor's peak], one colour scale for all panels; a
-    failed launch is left blank."""
+    """The map's figure (:func:`map_figure`) saved to ``path``."""
     from .studies import figures  # matplotlib, when a figure is drawn: a mistake is refused before it loads
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return figures.save(map_figure(table), path)
+
+
+def map_figure(table: pa.Table) -> Figure:
+    """A panel per friction coefficient, a row of them per joint: the peak third-order pitch acceleration
+    [rad/s2] over the bend angle [deg] and the launch torque [% of the motor's peak], one colour scale
+    for all panels; a failed launch is left blank."""
+    from .studies import figures
 
     rows = table.to_pylist()
     betas, torques, mus = (sorted({row[name] for row in rows}) for name in (BETA, TORQUE, MU))
-    peaks = np.full((len(mus), len(torques), len(betas)), np.nan)
+    joints = sorted({row[JOINT] for row in rows}) if JOINT in table.column_names else [PLAIN_TRIPOD]
+    cases = [(joint, mu) for joint in joints for mu in mus]  # a panel each, a row of them per joint
+    peaks = np.full((len(cases), len(torques), len(betas)), np.nan)
     for row in rows:
         if row["status"] == "ok":
-            peaks[mus.index(row[MU]), torques.index(row[TORQUE]), betas.index(row[BETA])] = row[PEAK]
+            case = cases.index((row.get(JOINT, PLAIN_TRIPOD), row[MU]))
+            peaks[case, torques.index(row[TORQUE]), betas.index(row[BETA])] = row[PEAK]
     columns = min(4, len(mus))
-    fig, panels = figures.figure(math.ceil(len(mus) / columns), columns, squeeze=False, sharex=True, sharey=True,
-                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6),
-                                 layout="constrained")
+    lines = len(joints) * math.ceil(len(mus) / columns)
+    fig, panels = figures.figure(lines, columns, squeeze=False, sharex=True, sharey=True,
+                                 figsize=(3.2 * columns + 1.2, 2.9 * lines + 0.6), layout="constrained")
     top = np.nanmax(peaks) if np.any(np.isfinite(peaks)) else 1.0
     x, y = np.degrees(betas), 100.0 * np.array(torques) / MOTOR_PEAK_TORQUE
+    per_joint = columns * math.ceil(len(mus) / columns)
     for k, panel in enumerate(panels.flat):
-        if k >= len(mus):
+        joint, place = divmod(k, per_joint)
+        if place >= len(mus):
             panel.set_visible(False)
             continue
-        image = panel.pcolormesh(x, y, peaks[k], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
+        case = joint * len(mus) + place
+        image = panel.pcolormesh(x, y, peaks[case], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
         panel.set_xlim(x[0], x[-1])  # the grid's range: its outer cells shown to their values, no further
         panel.set_ylim(y[0], y[-1])
-        panel.set_title(f"mu = {mus[k]:.3g}", fontsize=9)
+        title = f"mu = {mus[place]:.3g}"
+        panel.set_title(title if len(joints) == 1 else f"{JOINT_NAMES[joints[joint]]}, {title}", fontsize=9)
     for panel in panels[-1]:
         panel.set_xlabel("bend angle beta [deg]")
     for panel in panels[:, 0]:
         panel.set_ylabel("launch torque [% of peak]")
     fig.colorbar(image, ax=panels, label="peak 3rd-order pitch acceleration [rad/s2]")
     fig.suptitle(f"Launch shudder map: {len(rows)} launches of VehicleLaunch, both joints alike", fontsize=10)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return figures.save(fig, path)
+    return fig
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -130,6 +164,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp",
                         help="the launch's SSP package (default models/native/VehicleLaunch.ssp)")
     parser.add_argument("--count", type=int, default=8, help="values per axis (default 8: 512 launches)")
+    parser.add_argument("--joints", type=joint_types, default=[PLAIN_TRIPOD],
+                        help="tripod types swept, e.g. 0,1,2 (0 plain, 1 single, 2 double roller; default 0)")
     parser.add_argument("--duration", type=float, default=4.0, help="launch length [s] (default 4)")
     parser.add_argument("--step", type=float, default=2e-4, help="communication step [s] (default 2e-4)")
     parser.add_argument("--master", choices=sweep.MASTERS, default=sweep.DEFAULT_MASTER,
@@ -153,7 +189,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     if too_short:
         parser.error(too_short)
     try:
-        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count)), args.duration, args.step, args.master,
+        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count, args.joints)), args.duration, args.step, args.master,
                                     (THIRD_ORDER,))
         if args.scheduler:
             sweep.check_scheduler(args.scheduler)

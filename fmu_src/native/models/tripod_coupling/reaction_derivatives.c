@@ -330,11 +330,7 @@ static void skewed_contacts(const DualLoad *load, const Vec H[3], const Vec axis
         target_v[j] = target[j].v;
         zdot_v[j] = zdot[j].v;
     }
-    context.load = load;
-    context.axis = axis_v;
-    context.zdot = zdot_v;
-    context.target = target_v;
-    context.spin = spin_v;
+    context = (MissContext){load, axis_v, zdot_v, target_v, spin_v};
     illinois_angles(miss_at, &context, target_v, load->friction, load->mu_roll, angles);
     for (j = 0; j < 3; j++) {
         Dual theta, slope;

@@ -106,12 +106,7 @@ static void skewed_contacts(Guard *guard, const Load *load, const double H[3][3]
         target[j] = atan2(H[j][1], H[j][0]);
         size[j] = root(guard, dot3(H[j], H[j]));
     }
-    context.guard = guard;
-    context.load = load;
-    context.axis = axis;
-    context.zdot = zdot;
-    context.spin = spin;
-    context.target = target;
+    context = (MissContext){guard, load, axis, zdot, spin, target};
     illinois_angles(miss_at, &context, target, load->friction, load->mu_roll, angle);
     for (j = 0; j < 3; j++) {
         skewed_slips(guard, load, axis[j], zdot[j], spin, angle[j], target[j], &c[j]);
