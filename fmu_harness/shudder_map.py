@@ -21,7 +21,8 @@ acceleration over the left joint's turns (:func:`fmu_harness.studies.order_track
 the right joint turns negatively in its own frame), and ``mounts.pitch_ddot_order3_speed``, the joint's
 speed there. A launch whose joint turns less than the order tracking's window fails with that
 reason. The table goes to ``--out``, the figure (a panel per friction coefficient, a row of them per
-joint: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the figure from a table written before.
+joint: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the figure from a
+table written before.
 """
 
 from __future__ import annotations
@@ -189,8 +190,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     if too_short:
         parser.error(too_short)
     try:
-        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count, args.joints)), args.duration, args.step, args.master,
-                                    (THIRD_ORDER,))
+        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count, args.joints)), args.duration, args.step,
+                                    args.master, (THIRD_ORDER,))
         if args.scheduler:
             sweep.check_scheduler(args.scheduler)
     except (ValueError, OSError) as error:

@@ -56,7 +56,8 @@ def coupling_outputs(
     ``beta_dot``, ``beta_ddot``: rates of the bend angle (the output bearing moves with beta).
     ``tripod_type`` 1 (single roller) or 2 (double roller) with the exact kinematics: the roller
     tripods' contacts (:mod:`.rollers`), with rolling resistance ``mu_roll`` and the rollers' outer
-    and bore radii ``roller_radius``, ``roller_bore_radius`` [m]; without friction, and in the closed form, every type is the plain one.
+    and bore radii ``roller_radius``, ``roller_bore_radius`` [m]; without friction, and in the closed
+    form, every type is the plain one.
     """
     rho = orbit_radius(beta, r)
     pin = dynamics.pin_force(T_load, rho, r)

@@ -3,7 +3,7 @@
 The pose, velocities and accelerations are the plain tripod's (:func:`.reactions.mechanism`): the
 roller's centre ``b_j`` is where the arm meets the track's axis, the ball centre of the plain
 tripod, and carries the roller's mass m (``m_plunger``). What changes is each arm's contacts
-(docs/tripod_coupling.md, "Roller tripods", eqs R1-R14):
+(docs/tripod_coupling.md, "Roller tripods", eqs R1-R18):
 
 * trunnion: the roller (single roller) or the inner ring (double roller) slides along the arm at
   ``v_t = sigma_j |e_j|^2 / |e_j|`` with Coulomb friction ``mu`` on the normal force ``|F_perp|``

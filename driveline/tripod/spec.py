@@ -146,8 +146,8 @@ SPEC = ModelSpec(
         Variable("tripod_type", "parameter", PLAIN_TRIPOD,
                  "Joint: 0 = plain tripod (plungers sliding in the grooves, the seed's), 1 = single roller (a roller "
                  "turning and sliding on each trunnion, rolling and skewing on its track), 2 = double roller (outer "
-                 "roller kept parallel to its track, inner ring sliding on the trunnion); the rollers' friction needs "
-                 "the exact kinematics", type="Integer", min=PLAIN_TRIPOD, max=DOUBLE_ROLLER),
+                 "roller kept parallel to its track on needles, inner ring sliding on the trunnion); the rollers' "
+                 "friction needs the exact kinematics", type="Integer", min=PLAIN_TRIPOD, max=DOUBLE_ROLLER),
         Variable("mu_roll", "parameter", ROLLING_RESISTANCE,
                  "Rolling resistance of each roller on its track, tangential over normal force (roller tripods; "
                  "their sliding contacts take mu)", "1", min=0.0),
@@ -155,8 +155,9 @@ SPEC = ModelSpec(
                  "Outer radius R of the rollers: the track contact lies R from the roller's centre (roller tripods)",
                  "m", "mm", min=0.0, min_exclusive=True),
         Variable("roller_bore_radius", "parameter", 0.0115,
-                 "Bore radius of the roller (single) or inner ring (double) on the trunnion, needles included "
-                 "(assembly check)", "m", "mm", min=0.0, min_exclusive=True),
+                 "Bore radius of the roller: the single roller's on the trunnion, needles included; the double "
+                 "roller's outer roller's, on which the needles of its inner ring run (assembly check)", "m", "mm",
+                 min=0.0, min_exclusive=True),
         Variable("trunnion_radius", "parameter", 0.009,
                  "Radius of the trunnions (tripod arms) that carry the rollers (assembly check)", "m", "mm",
                  min=0.0, min_exclusive=True),

@@ -1,4 +1,4 @@
-/* The roller tripods' balance (driveline/tripod/rollers.py; eqs R1-R15 of docs/tripod_coupling.md): each
+/* The roller tripods' balance (driveline/tripod/rollers.py; eqs R1-R18 of docs/tripod_coupling.md): each
  * roller's contacts with its trunnion and its track, the single roller's contact normal by the Illinois method
  * on its bracket, the balance by successive substitution from the plain tripod's frictionless forces. Every
  * expression keeps the Python core's order of operations. */
