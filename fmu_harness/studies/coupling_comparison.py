@@ -1,7 +1,7 @@
 """Side-by-side comparison of the coupling FMUs, and the two-joint Cardan shaft.
 
-* :func:`speed_fluctuation_table` runs TripodCoupling, CardanJoint and UniversalReducer at the
-  same input speed over a sweep of bend angles and measures the output-speed fluctuation
+* :func:`speed_fluctuation_table` runs TripodCoupling (plain, single and double roller), CardanJoint
+  and UniversalReducer at the same input speed over a sweep of bend angles and measures the output-speed fluctuation
   (peak-to-peak / mean over one input turn) and its dominant order.
 * :func:`cardan_shaft` co-simulates two CardanJoint instances in one process, the first one's
   output speed feeding the second one's input, to show phasing cancel or double the fluctuation.
@@ -34,10 +34,18 @@ class Coupling:
     to_input: float  # offset: input = offset + sign * beta
     sign: float
     parameters: dict[str, float]
+    fmu: str = ""  # the FMU's model name, when not the name
+    style: str = "o-"  # its line in the figure
 
 
+TRIPOD = {"kinematics": 1, "beta_max": math.radians(60.0)}
 COUPLINGS = (
-    Coupling("TripodCoupling", "beta", 0.0, 1.0, {"kinematics": 1, "beta_max": math.radians(60.0)}),
+    Coupling("TripodCoupling", "beta", 0.0, 1.0, TRIPOD),
+    # The roller tripods (tripod_type 1, 2) with friction: the plain tripod's closure, so its output speed
+    Coupling("TripodCoupling single roller", "beta", 0.0, 1.0, {**TRIPOD, "tripod_type": 1, "mu": 0.05},
+             "TripodCoupling", "s--"),
+    Coupling("TripodCoupling double roller", "beta", 0.0, 1.0, {**TRIPOD, "tripod_type": 2, "mu": 0.05},
+             "TripodCoupling", "^:"),
     Coupling("CardanJoint", "beta", 0.0, 1.0, {"beta_max": math.radians(80.0)}),
     # The reducer's intersection angle is 180 deg for in-line shafts.
     Coupling("UniversalReducer", "intersection_angle", math.pi, -1.0,
@@ -59,7 +67,7 @@ def fluctuation_and_order(omega_out: np.ndarray) -> tuple[float, int | None]:
 def one_turn(models: Path, coupling: Coupling, beta: float) -> np.ndarray:
     period = 2 * math.pi / SPEED
     result = simulate(
-        models / f"{coupling.name}.fmu", period, period / SAMPLES_PER_TURN,
+        models / f"{coupling.fmu or coupling.name}.fmu", period, period / SAMPLES_PER_TURN,
         inputs={"omega_in": SPEED, coupling.angle_input: coupling.to_input + coupling.sign * beta},
         start_values=coupling.parameters, outputs=["omega_out"],
     )
@@ -102,7 +110,7 @@ def comparison_figure(rows: list[dict[str, object]], betas_deg: list[float]) -> 
     for k, coupling in enumerate(COUPLINGS):
         values = [row["fluctuation"] for row in rows if row["coupling"] == coupling.name]
         if max(values) >= NO_ORDER_BELOW:
-            ax.semilogy(betas_deg, values, "o-", color=f"C{k}", label=coupling.name)
+            ax.semilogy(betas_deg, values, coupling.style, color=f"C{k}", label=coupling.name)
         else:
             ax.text(0.98, 0.04 + 0.07 * len(ax.texts), f"{coupling.name}: {max(values):.2g} at every bend angle (constant speed "
                     "ratio), no point on a log scale", transform=ax.transAxes, ha="right", va="bottom", fontsize=8)
