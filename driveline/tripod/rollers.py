@@ -120,6 +120,8 @@ def roller_reactions(
     friction_h = np.zeros_like(arm)  # horizontal part of the track's friction on the roller
     R = roller_radius
     needle_share = roller_bore_radius / R  # r_b / R
+    relax, last_lam, last_mu = np.ones(shape), np.zeros_like(lam), np.zeros_like(mu_q)  # the double roller's damping
+    length2 = arm_length * arm_length
     for _ in range(MAX_FRICTION_ITERATIONS):
         N_trunnion = np.sqrt(exy2 * (lam * lam + mu_q * mu_q * arm_length * arm_length))
         phi = mu * N_trunnion * trunnion_sign / arm_length  # F = lam n + mu q + phi e (R5)
@@ -147,6 +149,14 @@ def roller_reactions(
         change = np.sum(np.abs(new_lam - lam) * np.sqrt(exy2) + np.abs(new_mu_q - mu_q) * np.sqrt(exy2) * arm_length
                         + np.sqrt(_dot(new_friction_h - friction_h, new_friction_h - friction_h)), -1)
         scale = np.sum(N_trunnion + N_track, -1)
+        if tripod_type != SINGLE_ROLLER:
+            # the needles' steep regularised sign can make the substitution swing between two states: each
+            # reversal of the forces' change (its scalar product with the last one) halves the steps from then on
+            step_lam, step_mu = new_lam - lam, new_mu_q - mu_q
+            turned = np.sum(exy2 * (step_lam * last_lam + length2 * step_mu * last_mu), -1) < 0.0
+            relax = np.where(turned, 0.5 * relax, relax)
+            last_lam, last_mu = step_lam, step_mu
+            new_lam, new_mu_q = lam + relax[..., None] * step_lam, mu_q + relax[..., None] * step_mu
         lam, mu_q, friction_h = new_lam, new_mu_q, new_friction_h
         if np.all(change <= FRICTION_TOLERANCE * scale):
             break

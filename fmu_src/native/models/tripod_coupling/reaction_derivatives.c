@@ -366,7 +366,9 @@ static int roller_reactions(const DualArm arm[3], Dual adj[3][3], Dual inv_det, 
     Dual F_skew[3], v_roll[3], v_skew[3], zero = dual_constant(0.0), power = zero;
     Vec R_out = vec(zero, zero, zero), R_in = R_out, L = R_out;
     DualContact c[3];
+    Dual step_lam[3], step_mu[3], next_lam[3], next_mu[3];
     double change[DUAL_SIZE + 1], scale[DUAL_SIZE + 1];
+    double relax = 1.0, last_lam[3] = {0.0, 0.0, 0.0}, last_mu[3] = {0.0, 0.0, 0.0};
     int iteration, i, j, col, settled = 0;
     for (j = 0; j < 3; j++) {
         const DualArm *a = &arm[j];
@@ -435,13 +437,33 @@ static int roller_reactions(const DualArm arm[3], Dual adj[3][3], Dual inv_det, 
                 tally(h.v[i], 1.0, scale);
             }
             friction_h[j] = h;
-            mu_q[j] = new_mu;
+            step_mu[j] = dual_sub(new_mu, mu_q[j]);
+            next_mu[j] = new_mu;
         }
         for (j = 0; j < 3; j++) {
             Dual new_lam = dual_mul(vdot(moment, vec(adj[j][0], adj[j][1], adj[j][2])), inv_det);
             tally(dual_sub(new_lam, lam[j]), sqrt(arm[j].exy2.v), change);
             tally(new_lam, sqrt(arm[j].exy2.v), scale);
-            lam[j] = new_lam;
+            step_lam[j] = dual_sub(new_lam, lam[j]);
+            next_lam[j] = new_lam;
+        }
+        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's damping, on the values */
+            double turned = 0.0;
+            for (j = 0; j < 3; j++) {
+                turned = turned + arm[j].exy2.v * (step_lam[j].v * last_lam[j] + length[j].v * length[j].v
+                                                   * step_mu[j].v * last_mu[j]);
+                last_lam[j] = step_lam[j].v;
+                last_mu[j] = step_mu[j].v;
+            }
+            relax = turned < 0.0 ? 0.5 * relax : relax;
+            for (j = 0; j < 3; j++) {
+                next_lam[j] = dual_add(lam[j], dual_scale(step_lam[j], relax));
+                next_mu[j] = dual_add(mu_q[j], dual_scale(step_mu[j], relax));
+            }
+        }
+        for (j = 0; j < 3; j++) {
+            lam[j] = next_lam[j];
+            mu_q[j] = next_mu[j];
         }
         settled = iteration > 0;
         for (col = 0; col <= DUAL_SIZE; col++) {

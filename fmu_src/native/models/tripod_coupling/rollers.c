@@ -128,6 +128,7 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
     double zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], spin[3], load_moment[3], friction_h[3][3];
     double N_trunnion[3], phi[3], force[3][3], friction[3][3], couple[3][3], H[3][3];
     double R_out[3] = {0.0, 0.0, 0.0}, R_in[3] = {0.0, 0.0, 0.0}, L[3] = {0.0, 0.0, 0.0}, power = 0.0;
+    double relax = 1.0, last_lam[3] = {0.0, 0.0, 0.0}, last_mu[3] = {0.0, 0.0, 0.0};
     Contact c[3];
     int iteration, i, j;
     for (j = 0; j < 3; j++) {
@@ -224,6 +225,21 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                                + fabs(new_mu[j] - mu_q[j]) * root(guard, arm[j].exy2) * length[j]
                                + root(guard, dot3(change_h, change_h)));
             scale = scale + (N_trunnion[j] + c[j].N);
+        }
+        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's damping (rollers.py) */
+            double turned = 0.0;
+            for (j = 0; j < 3; j++) {
+                double step_lam = new_lam[j] - lam[j], step_mu = new_mu[j] - mu_q[j];
+                turned = turned + arm[j].exy2 * (step_lam * last_lam[j]
+                                                 + length[j] * length[j] * step_mu * last_mu[j]);
+                last_lam[j] = step_lam;
+                last_mu[j] = step_mu;
+            }
+            relax = turned < 0.0 ? 0.5 * relax : relax;
+            for (j = 0; j < 3; j++) {
+                new_lam[j] = lam[j] + relax * last_lam[j];
+                new_mu[j] = mu_q[j] + relax * last_mu[j];
+            }
         }
         for (j = 0; j < 3; j++) {
             lam[j] = new_lam[j];
