@@ -150,11 +150,16 @@ def roller_reactions(
                         + np.sqrt(_dot(new_friction_h - friction_h, new_friction_h - friction_h)), -1)
         scale = np.sum(N_trunnion + N_track, -1)
         if tripod_type != SINGLE_ROLLER:
-            # the needles' steep regularised sign can make the substitution swing between two states: each
-            # reversal of the forces' change (its scalar product with the last one) halves the steps from then on
+            # the needles' steep regularised sign can make the substitution swing between two states: the
+            # steps' ratio rho to the last ones (projected, in forces) estimates the map's gain g = 1 + (rho - 1)
+            # / relax, and the steps take the share relax = 1 / (1 - g) that cancels it, at most 1 (Irons-Tuck)
             step_lam, step_mu = new_lam - lam, new_mu_q - mu_q
-            turned = np.sum(exy2 * (step_lam * last_lam + length2 * step_mu * last_mu), -1) < 0.0
-            relax = np.where(turned, 0.5 * relax, relax)
+            last = np.sum(exy2 * (last_lam * last_lam + length2 * last_mu * last_mu), -1)
+            ratio = (np.sum(exy2 * (step_lam * last_lam + length2 * step_mu * last_mu), -1)
+                     / np.where(last > 0.0, last, 1.0))
+            shared = relax / np.where(ratio < 1.0, 1.0 - ratio, 1.0)
+            shared = np.where(ratio < 1.0, np.minimum(1.0, shared), 0.5 * relax)
+            relax = np.where(last > 0.0, shared, relax)
             last_lam, last_mu = step_lam, step_mu
             new_lam, new_mu_q = lam + relax[..., None] * step_lam, mu_q + relax[..., None] * step_mu
         lam, mu_q, friction_h = new_lam, new_mu_q, new_friction_h

@@ -447,15 +447,19 @@ static int roller_reactions(const DualArm arm[3], Dual adj[3][3], Dual inv_det, 
             step_lam[j] = dual_sub(new_lam, lam[j]);
             next_lam[j] = new_lam;
         }
-        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's damping, on the values */
-            double turned = 0.0;
+        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's relaxation, on the values */
+            double last = 0.0, along = 0.0, ratio, shared;
             for (j = 0; j < 3; j++) {
-                turned = turned + arm[j].exy2.v * (step_lam[j].v * last_lam[j] + length[j].v * length[j].v
-                                                   * step_mu[j].v * last_mu[j]);
+                double length2 = length[j].v * length[j].v;
+                last = last + arm[j].exy2.v * (last_lam[j] * last_lam[j] + length2 * last_mu[j] * last_mu[j]);
+                along = along + arm[j].exy2.v * (step_lam[j].v * last_lam[j] + length2 * step_mu[j].v * last_mu[j]);
                 last_lam[j] = step_lam[j].v;
                 last_mu[j] = step_mu[j].v;
             }
-            relax = turned < 0.0 ? 0.5 * relax : relax;
+            ratio = along / (last > 0.0 ? last : 1.0);
+            shared = relax / (ratio < 1.0 ? 1.0 - ratio : 1.0);
+            shared = ratio < 1.0 ? (1.0 < shared ? 1.0 : shared) : 0.5 * relax;
+            relax = last > 0.0 ? shared : relax;
             for (j = 0; j < 3; j++) {
                 next_lam[j] = dual_add(lam[j], dual_scale(step_lam[j], relax));
                 next_mu[j] = dual_add(mu_q[j], dual_scale(step_mu[j], relax));

@@ -226,16 +226,20 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                                + root(guard, dot3(change_h, change_h)));
             scale = scale + (N_trunnion[j] + c[j].N);
         }
-        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's damping (rollers.py) */
-            double turned = 0.0;
+        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's relaxation (rollers.py) */
+            double last = 0.0, along = 0.0, ratio, shared;
             for (j = 0; j < 3; j++) {
                 double step_lam = new_lam[j] - lam[j], step_mu = new_mu[j] - mu_q[j];
-                turned = turned + arm[j].exy2 * (step_lam * last_lam[j]
-                                                 + length[j] * length[j] * step_mu * last_mu[j]);
+                double length2 = length[j] * length[j];
+                last = last + arm[j].exy2 * (last_lam[j] * last_lam[j] + length2 * last_mu[j] * last_mu[j]);
+                along = along + arm[j].exy2 * (step_lam * last_lam[j] + length2 * step_mu * last_mu[j]);
                 last_lam[j] = step_lam;
                 last_mu[j] = step_mu;
             }
-            relax = turned < 0.0 ? 0.5 * relax : relax;
+            ratio = along / (last > 0.0 ? last : 1.0);
+            shared = relax / (ratio < 1.0 ? 1.0 - ratio : 1.0);
+            shared = ratio < 1.0 ? (1.0 < shared ? 1.0 : shared) : 0.5 * relax;
+            relax = last > 0.0 ? shared : relax;
             for (j = 0; j < 3; j++) {
                 new_lam[j] = lam[j] + relax * last_lam[j];
                 new_mu[j] = mu_q[j] + relax * last_mu[j];
