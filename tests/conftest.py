@@ -78,8 +78,9 @@ FAMILY_IDS = (PythonFamily.name, NativeFamily.name)
 DURATIONS = Path(__file__).with_name("durations.json")
 SLOW_SECONDS = 0.5  # CPU seconds of a test at which it is slow
 RELEASE_FIXTURE = "release_dir"  # the five-platform build: its cost depends on ziglang's cache
-#: The session's FMU builds, which every FMU test shares: charged to no test when measuring.
-SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "tripod_fmu", "native_dir", "family"}
+#: The session's FMU builds, which every FMU test shares, and the sanitized builds of the native FMUs that a
+#: module's tests share: charged to no test when measuring.
+SHARED_BUILDS = {"fmu_store", "fmu_path", "fmu_dir", "tripod_fmu", "native_dir", "family", "sanitized"}
 
 
 QUICK_VERSIONS = ["2"]

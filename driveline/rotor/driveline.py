@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import transfer
 from .elements import Bearing, ConcentratedMass, EndCondition, PointElement, ShaftSegment, Unbalance
-from .roots import find_roots_batch
+from .roots import IntArray, find_roots_batch
 
 FloatArray = NDArray[np.float64]
 Whirl = Literal["forward", "backward"]
@@ -270,8 +270,10 @@ class Driveline:
     def _batch(self, lines: FloatArray, grids: list[FloatArray]) -> list[FloatArray]:
         """Roots of the determinant along ``lines`` (rows ``(w_k, s_k, o_k)``) on their ``grids``, one batch."""
         w_k, s_k, o_k = lines.T
-        return find_roots_batch(
-            lambda x, k: transfer.determinant_and_rounding(self._chain, w_k[k] * x, s_k[k] * x + o_k[k]), grids).roots
+        def f(x: FloatArray, k: IntArray, extra_pieces: int = 0) -> tuple[FloatArray, FloatArray]:
+            return transfer.determinant_and_rounding(self._chain, w_k[k] * x, s_k[k] * x + o_k[k], extra_pieces)
+
+        return find_roots_batch(f, grids, again=lambda x, k: f(x, k, 1)[0]).roots
 
     @staticmethod
     def _take(roots: FloatArray, n: int | None) -> FloatArray:

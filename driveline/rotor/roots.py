@@ -23,6 +23,14 @@ times its rounding level of zero is as deep as ``f`` resolves, a double root, no
 re-scanned; any other dip no deeper than ``ROUNDING`` times the rounding levels of
 its three points is ripple and is dropped. At most ``MAX_DIPS`` dips of one
 function are re-scanned; a function with more is refused (ArithmeticError).
+
+Where ``f`` can also be evaluated ``again`` another way that is exact in exact
+arithmetic (the determinant with every segment cut into one more piece), the
+three points of every dip are evaluated again and their rounding levels raised
+to at least the difference: a sample of the round-off ``f`` accumulates before
+its last step, which its own rounding level does not see (issue 45: a layout
+whose determinant is noise of 5e10 where that level says 1.5e-4, and whose dips
+then depended on each core's round-off).
 """
 
 from __future__ import annotations
@@ -37,6 +45,8 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 #: ``f(x, k)``: the ``k[i]``-th function of a batch at ``x[i]``, or that and its rounding level there.
 BatchFunc = Callable[[FloatArray, IntArray], FloatArray | tuple[FloatArray, FloatArray]]
+#: ``again(x, k)``: the ``k[i]``-th function at ``x[i]`` evaluated another way, equal in exact arithmetic.
+AgainFunc = Callable[[FloatArray, IntArray], FloatArray]
 
 SUBGRID = 24
 #: Sub-grid levels: each divides the dip's width by SUBGRID / 2 (16 levels span 1e17).
@@ -67,7 +77,7 @@ class BatchReport:
 
 
 def find_roots_batch(
-    f: BatchFunc, grids: Sequence[FloatArray], xtol: float = XTOL, rtol: float = RTOL
+    f: BatchFunc, grids: Sequence[FloatArray], xtol: float = XTOL, rtol: float = RTOL, again: AgainFunc | None = None
 ) -> BatchReport:
     """Roots of the functions ``f(., k)`` inside ``[grids[k][0], grids[k][-1]]``, all searched together.
 
@@ -79,7 +89,7 @@ def find_roots_batch(
     for x in xs:
         if x.ndim != 1 or x.size < 3 or np.any(np.diff(x) <= 0):
             raise ValueError("grid must be a strictly increasing 1-D array of at least 3 points")
-    st = _Search(f, xtol, rtol)
+    st = _Search(f, xtol, rtol, again)
     x = np.concatenate(xs)
     line = np.repeat(np.arange(len(xs)), [g.size for g in xs])
     seq, (fx, rx) = line.copy(), st.eval(x, line)
@@ -98,8 +108,8 @@ def find_roots_batch(
 class _Search:
     """Evaluation counter, collected brackets and roots of one batch search."""
 
-    def __init__(self, f: BatchFunc, xtol: float, rtol: float) -> None:
-        self.f, self.xtol, self.rtol = f, xtol, rtol
+    def __init__(self, f: BatchFunc, xtol: float, rtol: float, again: AgainFunc | None = None) -> None:
+        self.f, self.xtol, self.rtol, self.again = f, xtol, rtol, again
         self.evaluations = self.poles = self.dips = self.doubles = 0
         self.roots: list[FloatArray] = [np.empty(0)]
         self.lines: list[IntArray] = [np.empty(0, dtype=np.intp)]
@@ -115,6 +125,14 @@ class _Search:
         if isinstance(values, tuple):
             return np.asarray(values[0], dtype=float), np.asarray(values[1], dtype=float)
         return np.asarray(values, dtype=float), np.zeros(x.size)
+
+    def rounding(self, x: FloatArray, fx: FloatArray, rx: FloatArray, line: IntArray) -> FloatArray:
+        """The rounding levels ``rx`` of ``f`` (``fx``) at ``x`` raised to the difference from an evaluation
+        ``again`` (unchanged without one)."""
+        if self.again is None or not x.size:
+            return rx
+        self.evaluations += x.size
+        return np.maximum(rx, np.abs(fx - np.asarray(self.again(x, line), dtype=float)))
 
     def found(self, x: FloatArray, line: IntArray) -> None:
         self.roots.append(x)
@@ -139,6 +157,10 @@ def _scan(st: _Search, x: FloatArray, fx: FloatArray, rx: FloatArray, line: IntA
     # has at most 1/9 of its larger neighbour's |f|. Shallow dips (round-off ripple
     # on a flat stretch) are not examined.
     dip &= af[1:-1] <= DIP_RATIO * np.maximum(af[:-2], af[2:])
+    # the propagation's round-off at the dips' points, which the rounding levels of f do not see
+    at = np.unique(np.flatnonzero(dip)[:, None] + np.arange(3)[None, :])
+    rx = rx.copy()
+    rx[at] = st.rounding(x[at], fx[at], rx[at], line[at])
     # a dip whose bottom f does not resolve from zero is kept (a double root, below); one whose depth
     # the rounding of its points explains is ripple
     unresolved = af[1:-1] <= ROUNDING * rx[1:-1]

@@ -164,9 +164,13 @@ class _Trace:
 
 
 def _propagate(
-    chain: Chain, w: FloatArray, spin: FloatArray, min_pieces: int = 1, trace: _Trace | None = None
+    chain: Chain, w: FloatArray, spin: FloatArray, min_pieces: int = 1, trace: _Trace | None = None,
+    extra_pieces: int = 0
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Propagate the left-end basis through every element: ``Y_N``, its log scale and sign.
+
+    ``extra_pieces`` cuts every segment into that many more pieces than it needs: the same result in exact
+    arithmetic (``H(l) = H(l/p)^p``), other round-off.
 
     ``Y_N`` is orthonormal; the classical ``C_R P B_L`` equals ``sign * C_R Y_N``
     times ``exp(log_scale + sum(beta1 l))``; ``log_scale`` already holds
@@ -208,8 +212,8 @@ def _propagate(
             backward = seg.beta1(-w, spin)
             log_scale -= backward * seg.length
             growth = np.maximum(growth, backward)
-        budget.charge(per_step * int(np.maximum(_pieces(growth, seg.length), min_pieces).sum()))
-        p = max(_segment_pieces(growth, seg.length), min_pieces)
+        budget.charge(per_step * int((np.maximum(_pieces(growth, seg.length), min_pieces) + extra_pieces).sum()))
+        p = max(_segment_pieces(growth, seg.length), min_pieces) + extra_pieces
         piece = seg.length / p
         H = fields.get((seg, piece))
         if H is None:  # equal segments (a tube cut into equal pieces) share one field matrix
@@ -248,17 +252,24 @@ def determinant(chain: Chain, w: ArrayLike, spin: ArrayLike) -> FloatArray:
     return determinant_and_rounding(chain, w, spin)[0]
 
 
-def determinant_and_rounding(chain: Chain, w: ArrayLike, spin: ArrayLike) -> tuple[FloatArray, FloatArray]:
+def determinant_and_rounding(
+    chain: Chain, w: ArrayLike, spin: ArrayLike, extra_pieces: int = 0
+) -> tuple[FloatArray, FloatArray]:
     """:func:`determinant` and its rounding level: ``eps`` times the sum of the magnitudes of the terms
     of the end determinant (``|a d| + |b c|`` of the 2x2, the 24 products of the 4x4) times the same
     smooth factor. Near a root the terms cancel and ``f`` is their rounding: a dip of ``f`` as deep as
-    this level is no evidence of a root (a layout of extreme materials ripples there by about one level)."""
+    this level is no evidence of a root (a layout of extreme materials ripples there by about one level).
+
+    The level does not see the propagation's round-off, which stiffnesses far apart amplify (issue 45:
+    noise of 5e10 where the level says 1.5e-4). With ``extra_pieces`` every segment is cut into that many
+    more pieces: the same ``f`` in exact arithmetic, other round-off, so the difference of two evaluations
+    samples the propagation's round-off (:func:`driveline.rotor.roots.find_roots_batch` asks it at dips)."""
     w_arr, s_arr = np.broadcast_arrays(np.atleast_1d(np.asarray(w, float)), np.atleast_1d(np.asarray(spin, float)))
     w_flat, s_flat = w_arr.ravel(), s_arr.ravel()
     f, rounding = np.empty(w_flat.size), np.empty(w_flat.size)
     for start in range(0, w_flat.size, BATCH):  # memory bounded by BATCH points, whatever the grid
         part = slice(start, start + BATCH)
-        f[part], rounding[part] = _determinant(chain, w_flat[part].copy(), s_flat[part].copy())
+        f[part], rounding[part] = _determinant(chain, w_flat[part].copy(), s_flat[part].copy(), extra_pieces)
     return f.reshape(w_arr.shape), rounding.reshape(w_arr.shape)
 
 
@@ -272,9 +283,9 @@ BATCH = 4096
 _PERMUTATIONS = np.array(list(itertools.permutations(range(4))))
 
 
-def _determinant(chain: Chain, w: FloatArray, spin: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _determinant(chain: Chain, w: FloatArray, spin: FloatArray, extra_pieces: int = 0) -> tuple[FloatArray, FloatArray]:
     """:func:`determinant_and_rounding` at the points ``w``, ``spin`` (1-D, equal sizes)."""
-    Y, log_scale, sign = _propagate(chain, w, spin)
+    Y, log_scale, sign = _propagate(chain, w, spin, extra_pieces=extra_pieces)
     sub = Y[:, _final_rows(chain), :]
     if chain.isotropic:
         f = sub[:, 0, 0] * sub[:, 1, 1] - sub[:, 0, 1] * sub[:, 1, 0]

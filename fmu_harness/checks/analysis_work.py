@@ -67,6 +67,20 @@ position = 1.440681430980566
 amount = 8.265024109038702e-08
 """
 ROUND_OFF_PARAMETERS = {"omega_in_max": 2.07419590242784, "omega_in": 2.07419590242784, "band": 0.1, "orders": "89"}
+
+
+def _segments_repeated(layout: str, times: int) -> str:
+    """``layout`` (its segments before its bearings) with its segments repeated ``times`` times, its point
+    elements where they were."""
+    head, rest = layout.split("[[segments]]", 1)
+    segments, points = rest.split("[[bearings]]", 1)
+    return head + times * ("[[segments]]" + segments) + "[[bearings]]" + points
+
+
+#: ROUND_OFF_LAYOUT with its three segments repeated (six), the bearings where they were: with
+#: ROUND_OFF_PARAMETERS refused natively ("more than 512 dips on one line") and accepted by the Python core (at
+#: most 24 dips re-scanned on a line), the families' verdicts differing (issue 45, defect 6).
+SIX_SEGMENT_LAYOUT = _segments_repeated(ROUND_OFF_LAYOUT, 2)
 #: A layout the work estimate accepts (0.2 s) whose anisotropic Campbell table exceeds the analysis's budget
 #: (driveline/rotor/budget.py) with ``BUDGET_PARAMETERS``: refused naming the Campbell table, natively
 #: after 1.7 s of CPU time (found by a work fuzzer's layout with two masses and a bearing added).

@@ -8,8 +8,9 @@ the edge the work estimate accepts, then tunable changes mid-run (``omega_in_max
 bearing damping, the response position). Every case runs in a process of its own under a limit of
 CPU time and address space (``resource.setrlimit``): the FMU is initialised, stepped, changed and
 stepped again, and the CPU seconds of each analysis (initialisation or a changed step) are measured,
-with the process's peak memory. ``benchmarks/work_fuzzer.py`` runs many cases, the robustness suite
-(tests/fmu/test_robustness.py) a few and the issue's layout.
+with the process's peak memory. Run on both families, every case's verdicts (accepted, or refused by the
+estimate, the budget or otherwise, analysis by analysis) must be the same in both. ``benchmarks/work_fuzzer.py``
+runs many cases, the robustness suite (tests/fmu/test_robustness.py) a few and the issue's layout.
 """
 
 from __future__ import annotations
@@ -243,12 +244,38 @@ def over_budget(results: list[dict]) -> list[str]:
     return found
 
 
-def exit_over_budget(results: list[dict]) -> None:
-    """Name every analysis beyond its budget (:func:`over_budget`) and exit, 1 if there is any."""
-    over = over_budget(results)
+def verdicts(run: dict) -> list[str]:
+    """The verdict of each analysis of a family's run (:func:`kind`), in order."""
+    return [kind(analysis) for analysis in run["analyses"]]
+
+
+def disagreements(results: list[dict]) -> list[str]:
+    """Every case whose families' verdicts differ: an analysis that one family accepts and the other refuses, or
+    refuses for another reason (the estimate, the budget, any other), with the first refusal of each; the cases
+    only one family ran, or on which a family's process did not end (:func:`over_budget`), are not compared."""
+    found = []
+    for number, result in enumerate(results):
+        runs = [result.get(family) for family in BUDGETS]
+        if any(run is None or "failed" in run for run in runs):
+            continue
+        given = [verdicts(run) for run in runs]
+        if given[0] != given[1]:
+            said = [next((a["message"] for a in run["analyses"] if a["status"] != "OK"), "") for run in runs]
+            found.append(f"case {number}: " + "; ".join(
+                f"{family} {', '.join(kinds)}" + (f" ({message})" if message else "")
+                for family, kinds, message in zip(BUDGETS, given, said)))
+    return found
+
+
+def exit_on_findings(results: list[dict]) -> None:
+    """Name every analysis beyond its budget (:func:`over_budget`) and every case on which the families'
+    verdicts differ (:func:`disagreements`), and exit, 1 if there is any."""
+    over, differing = over_budget(results), disagreements(results)
     for line in over:
         print(f"over budget: {line}")
-    sys.exit(1 if over else 0)
+    for line in differing:
+        print(f"verdicts differ: {line}")
+    sys.exit(1 if over or differing else 0)
 
 
 def summary(results: list[dict]) -> str:
@@ -285,7 +312,7 @@ def main(argv: list[str] | None = None) -> None:
                        "(python build_fmu.py CriticalSpeeds)\n")
     results = fuzz(fmus, args.cases, args.seed, lambda done, total: print(f"case {done}/{total}", file=sys.stderr))
     print(summary(results))
-    exit_over_budget(results)
+    exit_on_findings(results)
 
 
 if __name__ == "__main__":

@@ -165,6 +165,22 @@ def test_a_dip_at_the_rounding_level_is_a_double_root_not_a_chase():
         find_roots(f, GRID - 0.0123)
 
 
+def test_a_second_evaluation_tells_the_rounding_the_first_does_not_see():
+    """The ripple above with no rounding level given (as the end determinant's level misses the round-off
+    of the propagation before it, issue 45), but evaluated ``again`` another way that rounds otherwise: the
+    difference raises the level of the dip's three points (three evaluations more), so the search stops at
+    the ripple's depth with the double root, as when told the level; without it, the cap (above)."""
+    def f(x):
+        return (x - 0.5) ** 2 + 1e-9 * (0.5 + np.sin(1e13 * x))
+
+    def again(x, k):
+        return (x - 0.5) ** 2 + 1e-9 * (0.5 + np.cos(3e12 * x))
+
+    report = find_roots_batch(lambda x, k: (f(x), np.zeros(x.size)), [GRID - 0.0123], again=again)
+    assert report.double_roots == 1 and report.evaluations == GRID.size + 3
+    assert np.allclose(report.roots[0], 0.5, rtol=0, atol=1e-4)
+
+
 def test_ripple_as_deep_as_the_rounding_is_not_examined():
     """Dips of 1e-6 +- 1e-7 with a rounding level of 2e-8 at every point: resolved from zero, but no
     deeper than 8 times the rounding of their three points, so dropped; told no rounding, the same

@@ -17,6 +17,7 @@ import pytest
 from driveline.catalog import MODELS
 from fmu_harness import packaging
 from fmu_harness.checks import robustness, robustness_probe, work_fuzzer
+from fmu_harness.checks.analysis_work import ROUND_OFF_PARAMETERS, SIX_SEGMENT_LAYOUT
 from fmu_harness.packaging import native
 from fmu_harness.checks.failing_model import FailingModel
 
@@ -92,6 +93,41 @@ def test_the_work_fuzzer_finds_no_analysis_beyond_its_budget(paths: robustness.F
     results = work_fuzzer.fuzz({family: paths("CriticalSpeeds", fmi_versions[0])}, 3, seed=3)
     assert work_fuzzer.over_budget(results) == []
     assert [analysis["status"] for analysis in results[0][family]["analyses"]] == ["OK"] * 3
+
+
+def test_the_work_fuzzer_names_each_case_on_which_the_families_verdicts_differ():
+    """A case whose analyses one family accepts and the other refuses, or refuses for another reason, is named
+    with the first refusal of each; equal verdicts, one family's run and a run that did not end are not."""
+    def run(*outcomes):
+        return {"analyses": [{"seconds": 0.1, "status": status, "message": message} for status, message in outcomes],
+                "peak": 0}
+
+    accepted, dips = ("OK", ""), ("Error", "driveline: the root search met more than 512 dips on one line")
+    budget = ("Error", "driveline: the analysis would exceed its work budget (about 5 s)")
+    results = [{"python": run(accepted, accepted), "native": run(accepted, accepted)},
+               {"python": run(accepted), "native": run(dips)},
+               {"python": run(accepted, budget), "native": run(accepted, dips)},
+               {"native": run(dips)},
+               {"python": run(accepted), "native": {"failed": "no end in time"}}]
+    assert work_fuzzer.disagreements(results) == [
+        f"case 1: python accepted; native other ({dips[1]})",
+        f"case 2: python accepted, budget ({budget[1]}); native accepted, other ({dips[1]})"]
+
+
+def test_the_work_fuzzer_finds_the_families_agree_on_the_six_segment_layout(fmu_dir: Path, native_dir: Path,
+                                                                            fmi_versions: list[str]):
+    """Both families' CriticalSpeeds FMUs on the layout where their verdicts differed (issue 45, defect 6: the
+    native FMU refused it, more than 512 dips on one line, the Python FMU accepted it), each in a process under
+    its family's limits: both accept it."""
+    fmi = fmi_versions[0]
+    case = {"layout": SIX_SEGMENT_LAYOUT, "start": dict(ROUND_OFF_PARAMETERS), "changes": []}
+    fmus = {"python": packaging.fmu_path(fmu_dir, "CriticalSpeeds", fmi),
+            "native": native.fmu_path(native_dir, "CriticalSpeeds", fmi)}
+    results = [{"case": case, **{family: work_fuzzer.run_limited(path, case, work_fuzzer.BUDGETS[family])
+                                 for family, path in fmus.items()}}]
+    assert work_fuzzer.over_budget(results) == []
+    assert work_fuzzer.disagreements(results) == []
+    assert work_fuzzer.verdicts(results[0]["native"]) == ["accepted"]
 
 
 def test_a_case_whose_process_dies_or_outlives_its_limit_is_a_crash_or_a_hang(monkeypatch, tmp_path):

@@ -9,6 +9,12 @@
  *   MODE "states": every function in every state of both interfaces' state machines (Instantiated,
  *        Initialization Mode, Event Mode, Continuous-Time Mode, Step Mode, Terminated, Error), each on a
  *        fresh instance driven there, with the start values' arguments (SEED and CASES unused);
+ *   MODE "targets": a fuzz target for each entry point the layer added or hardened (TARGETS: the Model
+ *        Exchange functions, the directional and adjoint derivatives, DoStep, the saved states): CASES cases
+ *        each, a fresh instance driven into a random state of its interface's state machine, then TARGET_CALLS
+ *        calls, every other one the target's, with hostile arguments; a target the standard forbids in the
+ *        state its calls' statuses left the instance in must be refused with Error. A line "target NAME
+ *        cases N" for each;
  *   MODE "instantiate": CASES instantiations and frees.
  * It exits 1 naming the first broken promise: a status outside OK, Warning, Discard and Error; an output,
  * state derivative, state or sensitivity got with OK or Warning that is not finite; a function the standard
@@ -717,6 +723,67 @@ static void states(void)
     }
 }
 
+/* The entry points the layer added or hardened (issue 45): each is a fuzz target of MODE "targets". */
+static const Action TARGETS[] = {A_SET_TIME, A_SET_STATES, A_GET_STATES, A_GET_DERIVATIVES, A_GET_NOMINALS,
+                                 A_GET_INDICATORS, A_ENTER_EVENT, A_ENTER_CONTINUOUS, A_DISCRETE, A_COMPLETED,
+                                 A_DIRECTIONAL, A_ADJOINT, A_DO_STEP, A_GET_STATE, A_SET_STATE, A_SAVED_BYTES};
+#define TARGET_COUNT ((int)(sizeof TARGETS / sizeof TARGETS[0]))
+#define TARGET_CALLS 8
+
+static void follow(Host *host, Action action, int status, Where *phase);
+
+/* 1 when ``a`` belongs to the Model Exchange interface only */
+static int model_exchange_only(Action a)
+{
+    return a == A_SET_TIME || a == A_SET_STATES || a == A_GET_STATES || a == A_GET_DERIVATIVES ||
+           a == A_GET_NOMINALS || a == A_GET_INDICATORS || a == A_ENTER_CONTINUOUS || a == A_COMPLETED ||
+           (FMI_VERSION == 2 && (a == A_ENTER_EVENT || a == A_DISCRETE));
+}
+
+static void targets(unsigned long cases)
+{
+    static const Where me_states[] = {S_INSTANTIATED, S_INITIALIZATION, S_EVENT, S_CONTINUOUS, S_TERMINATED, S_ERROR};
+    static const Where cs_states[] = {S_INSTANTIATED, S_INITIALIZATION, S_STEP, S_TERMINATED, S_ERROR};
+    Host host;
+    Where phase;
+    Action action;
+    unsigned long c;
+    int t, i, me, status, k, known;
+    for (t = 0; t < TARGET_COUNT; t++) {
+        for (c = 0; c < cases; c++) {
+            me = model_exchange_only(TARGETS[t]) || TARGETS[t] == A_ADJOINT ? 1 : TARGETS[t] == A_DO_STEP ? 0 : below(2);
+            if (!instantiate(&host, me)) {
+                if (me) {
+                    break; /* a co-simulation-only model */
+                }
+                broken("Instantiate", "refused the model's own token");
+            }
+            phase = me ? me_states[below(6)] : cs_states[below(5)];
+            if (!drive(&host, phase)) {
+                printf("%s: cannot reach %s\n", me ? "ModelExchange" : "CoSimulation", WHERE[phase]);
+                exit(1);
+            }
+            for (k = 0; k < KEPT && (TARGETS[t] == A_SET_STATE || TARGETS[t] == A_SAVED_BYTES); k++) {
+                act(&host, A_GET_STATE); /* a state to set or to corrupt */
+            }
+            for (i = 0, known = 1; i < TARGET_CALLS; i++) {
+                action = i % 2 == 0 ? TARGETS[t] : (Action)below(A_COUNT);
+                host.hostile = 1;
+                status = act(&host, action);
+                if (known && action == TARGETS[t] && status >= 0 && status != 3 && forbidden(action, phase, me)) {
+                    printf("%s in %s of %s: status %d\n", ACTION[action], WHERE[phase],
+                           me ? "ModelExchange" : "CoSimulation", status);
+                    broken(ACTION[action], "is forbidden there and was not refused with Error");
+                }
+                follow(&host, action, status, &phase);
+                known = known && action != A_SET_STATE && action != A_SAVED_BYTES; /* a saved state's mode */
+            }
+            release(&host);
+        }
+        printf("target %s cases %lu\n", ACTION[TARGETS[t]], c);
+    }
+}
+
 /* The next call of a host that mostly goes on as a solver or a master would, from the phase its calls' statuses
  * left the instance in. */
 static Action next_action(const Host *host, Where *phase)
@@ -792,7 +859,7 @@ int main(int argc, char **argv)
     unsigned long cases, c;
     Host host;
     if (argc != 5) {
-        fprintf(stderr, "usage: %s sequences|states|instantiate SEED CASES RESOURCES\n", argv[0]);
+        fprintf(stderr, "usage: %s sequences|states|targets|instantiate SEED CASES RESOURCES\n", argv[0]);
         return 2;
     }
     rng_state ^= strtoull(argv[2], NULL, 10) * 0x9E3779B97F4A7C15ull;
@@ -809,6 +876,8 @@ int main(int argc, char **argv)
         states();
     } else if (strcmp(argv[1], "sequences") == 0) {
         sequences(cases);
+    } else if (strcmp(argv[1], "targets") == 0) {
+        targets(cases);
     } else {
         for (c = 0; c < cases; c++) {
             if (instantiate(&host, 0)) {

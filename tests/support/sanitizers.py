@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import functools
 import os
+import re
 import subprocess
 import tempfile
 from pathlib import Path
@@ -57,7 +58,7 @@ def build(fmu: Path, fmi: str, folder: Path) -> tuple[Path, Path]:
 
 def run(executable: Path, resources: Path, mode: str, seed: int = 0, cases: int = 0) -> tuple[int, str, dict[str, int]]:
     """A run of the fuzzing host: its exit code, what it and the sanitizers printed, and its counts of calls and
-    cases (empty if it did not end normally)."""
+    cases (empty if it did not end normally); with mode "targets", each target's cases as "target <function>"."""
     command = [str(executable), mode, str(seed), str(cases), str(resources)]
     try:
         done = subprocess.run(command, capture_output=True, text=True, timeout=TIME_LIMIT,
@@ -68,4 +69,6 @@ def run(executable: Path, resources: Path, mode: str, seed: int = 0, cases: int 
     counts = {}
     if done.returncode == 0 and words[-4:-3] == ["calls"]:
         counts = {"calls": int(words[-3]), "cases": int(words[-1])}
+        counts.update((f"target {name}", int(n)) for name, n in re.findall(r"^target (\w+) cases (\d+)$",
+                                                                           done.stdout, re.MULTILINE))
     return done.returncode, done.stdout[-3000:] + done.stderr[-6000:], counts

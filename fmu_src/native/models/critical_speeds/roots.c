@@ -53,6 +53,21 @@ static double line_f(const Search *st, double x, double *rounding)
     return f;
 }
 
+/* roots._Search.rounding at point j of a sampled sequence: its rounding level rx[j] raised to the difference
+ * from the determinant with every segment cut into one more piece (the propagation's round-off), once per
+ * point: level[j] < 0 until then */
+static double raised_rounding(const Search *st, const double *x, const double *fx, const double *rx, double *level,
+                              int j)
+{
+    if (level[j] < 0.0) {
+        double w = st->w * x[j], spin = st->s * x[j] + st->o, again, difference;
+        chain_determinant_cut(st->chain, 1, &w, &spin, 1, &again, NULL);
+        difference = fabs(fx[j] - again);
+        level[j] = rx[j] > difference ? rx[j] : difference; /* numpy.maximum */
+    }
+    return level[j];
+}
+
 /* ERROR_NONE, or ERROR_VALUE with ROTOR_BUDGET_SPENT once the chain's budget is spent (every search stops
  * at its next evaluation; the model names the stage) */
 static ErrorKind budget_left(const Chain *chain, char *error, size_t size)
@@ -141,12 +156,11 @@ static ErrorKind refine(Search *st, double a, double b, double fa, double fb)
     return ERROR_ARITHMETIC;
 }
 
-/* roots._scan for one sampled sequence (f fx, rounding levels rx): its zeros and sign changes, then its
- * dips re-scanned on sub-grids of SUBGRID steps (a dip that persists down to the root tolerance or to the
- * rounding of f is a double root, one that the rounding of its points explains is dropped; more than
- * MAX_DIPS re-scans on the line are refused). ERROR_NONE, or the failure's kind with the message in
- * st->error. */
-static ErrorKind scan(Search *st, const double *x, const double *fx, const double *rx, int n, int depth)
+static ErrorKind scan(Search *st, const double *x, const double *fx, const double *rx, int n, int depth);
+
+/* scan with the rounding levels of the sequence's points (level, n entries, < 0: not raised yet) */
+static ErrorKind scan_levels(Search *st, const double *x, const double *fx, const double *rx, double *level, int n,
+                             int depth)
 {
     int i, j;
     ErrorKind failed;
@@ -164,15 +178,23 @@ static ErrorKind scan(Search *st, const double *x, const double *fx, const doubl
     for (i = 1; i + 1 < n; i++) {
         double s = sign_of(fx[i]), lo = x[i - 1], hi = x[i + 1], mid = x[i];
         double a0 = fabs(fx[i - 1]), a1 = fabs(fx[i]), a2 = fabs(fx[i + 1]), larger = a0 > a2 ? a0 : a2;
-        double sx[ROTOR_ROOTS_SUBGRID + 1], sf[ROTOR_ROOTS_SUBGRID + 1], sr[ROTOR_ROOTS_SUBGRID + 1];
-        int unresolved = a1 <= ROTOR_ROOTS_ROUNDING * rx[i];
+        double sx[ROTOR_ROOTS_SUBGRID + 1], sf[ROTOR_ROOTS_SUBGRID + 1], sr[ROTOR_ROOTS_SUBGRID + 1], r0, r1, r2;
+        int unresolved;
         if (!(sign_of(fx[i - 1]) == s && s == sign_of(fx[i + 1]) && s != 0.0)) {
             continue;
         }
         if (!(a1 < a0 && a1 <= a2 && a1 <= ROTOR_ROOTS_DIP_RATIO * larger)) {
             continue;
         }
-        if (!unresolved && !(larger - a1 > ROTOR_ROOTS_ROUNDING * (rx[i - 1] + rx[i] + rx[i + 1]))) {
+        /* the propagation's round-off at the dip's points, which the rounding levels of f do not see */
+        r0 = raised_rounding(st, x, fx, rx, level, i - 1);
+        r1 = raised_rounding(st, x, fx, rx, level, i);
+        r2 = raised_rounding(st, x, fx, rx, level, i + 1);
+        if ((failed = budget_left(st->chain, st->error, st->size)) != ERROR_NONE) {
+            return failed;
+        }
+        unresolved = a1 <= ROTOR_ROOTS_ROUNDING * r1;
+        if (!unresolved && !(larger - a1 > ROTOR_ROOTS_ROUNDING * (r0 + r1 + r2))) {
             continue; /* ripple */
         }
         if (hi - lo <= 2.0 * (ROTOR_ROOTS_XTOL + ROTOR_ROOTS_RTOL * fabs(mid)) || depth >= ROTOR_ROOTS_MAX_DEPTH ||
@@ -192,7 +214,7 @@ static ErrorKind scan(Search *st, const double *x, const double *fx, const doubl
         }
         sx[0] = lo;
         sf[0] = fx[i - 1];
-        sr[0] = rx[i - 1];
+        sr[0] = r0;
         for (j = 1; j < ROTOR_ROOTS_SUBGRID; j++) {
             sx[j] = lo + (hi - lo) * (j * (1.0 / ROTOR_ROOTS_SUBGRID)); /* numpy.linspace(0, 1, SUBGRID + 1) */
             sf[j] = line_f(st, sx[j], &sr[j]);
@@ -202,12 +224,34 @@ static ErrorKind scan(Search *st, const double *x, const double *fx, const doubl
         }
         sx[ROTOR_ROOTS_SUBGRID] = hi;
         sf[ROTOR_ROOTS_SUBGRID] = fx[i + 1];
-        sr[ROTOR_ROOTS_SUBGRID] = rx[i + 1];
+        sr[ROTOR_ROOTS_SUBGRID] = r2;
         if ((failed = scan(st, sx, sf, sr, ROTOR_ROOTS_SUBGRID + 1, depth + 1)) != ERROR_NONE) {
             return failed;
         }
     }
     return ERROR_NONE;
+}
+
+/* roots._scan for one sampled sequence (f fx, rounding levels rx): its zeros and sign changes, then its
+ * dips re-scanned on sub-grids of SUBGRID steps (a dip that persists down to the root tolerance or to the
+ * rounding of f is a double root, one that the rounding of its points explains is dropped; the rounding of
+ * a dip's points raised to the propagation's round-off, raised_rounding; more than MAX_DIPS re-scans on the
+ * line are refused). ERROR_NONE, or the failure's kind with the message in st->error. */
+static ErrorKind scan(Search *st, const double *x, const double *fx, const double *rx, int n, int depth)
+{
+    double *level = malloc((size_t)n * sizeof *level);
+    int i;
+    ErrorKind status;
+    if (level == NULL) {
+        ROTOR_ERROR(st->error, st->size, ROTOR_OUT_OF_MEMORY);
+        return ERROR_VALUE;
+    }
+    for (i = 0; i < n; i++) {
+        level[i] = -1.0;
+    }
+    status = scan_levels(st, x, fx, rx, level, n, depth);
+    free(level);
+    return status;
 }
 
 static int compare_doubles(const void *a, const void *b)

@@ -140,6 +140,9 @@ void chain_determinant(const Chain *chain, size_t n, const double *w, const doub
 /* transfer.determinant_and_rounding: f and its rounding level at ``n`` points (rounding NULL: f alone) */
 void chain_determinant_rounding(const Chain *chain, size_t n, const double *w, const double *spin, double *f,
                                 double *rounding);
+/* transfer.determinant_and_rounding(..., extra_pieces): every segment cut into extra_pieces more pieces */
+void chain_determinant_cut(const Chain *chain, size_t n, const double *w, const double *spin, int extra_pieces,
+                           double *f, double *rounding);
 /* the budget every propagation on the chain pays from (NULL: none), and whether it is spent */
 void chain_set_budget(Chain *chain, Budget *budget);
 int chain_budget_spent(const Chain *chain);

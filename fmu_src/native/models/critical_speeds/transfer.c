@@ -525,9 +525,10 @@ static void field_product(double Hf[4][4], double Hb[4][4], Basis *Y)
     }
 }
 
-/* transfer._propagate for one (w, spin): the orthonormal Y_N, its log scale and sign */
-static void propagate(const Chain *chain, double w, double spin, int min_pieces, Basis *Y, double *log_scale,
-                      double *sign, Gram *trace)
+/* transfer._propagate for one (w, spin): the orthonormal Y_N, its log scale and sign; every segment cut into
+ * extra_pieces more pieces than it needs (the same in exact arithmetic, other round-off) */
+static void propagate(const Chain *chain, double w, double spin, int min_pieces, int extra_pieces, Basis *Y,
+                      double *log_scale, double *sign, Gram *trace)
 {
     int pair = !chain->isotropic, k, i, j, piece_count, per_step = pair ? ROTOR_BUDGET_ANISOTROPIC_STEP : 1;
     const int *free_rows = FREE_COMPONENTS[chain->left];
@@ -563,6 +564,7 @@ static void propagate(const Chain *chain, double w, double spin, int min_pieces,
         if (piece_count < min_pieces) {
             piece_count = min_pieces;
         }
+        piece_count += extra_pieces;
         budget_charge(chain->budget, (long long)per_step * piece_count);
         piece = seg->length / piece_count;
         field_matrix(chain, seg, w, spin, piece, Hf);
@@ -614,9 +616,9 @@ static double determinant_terms(double S[4][4])
     return ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
 }
 
-/* transfer.determinant_and_rounding (rounding NULL: transfer.determinant) */
-void chain_determinant_rounding(const Chain *chain, size_t n, const double *w, const double *spin, double *f,
-                                double *rounding)
+/* transfer.determinant_and_rounding with extra_pieces (rounding NULL: transfer.determinant) */
+void chain_determinant_cut(const Chain *chain, size_t n, const double *w, const double *spin, int extra_pieces,
+                           double *f, double *rounding)
 {
     size_t i;
     for (i = 0; i < n; i++) {
@@ -629,7 +631,7 @@ void chain_determinant_rounding(const Chain *chain, size_t n, const double *w, c
             }
             continue;
         }
-        propagate(chain, w[i], spin[i], 1, &Y, &log_scale, &sign, NULL);
+        propagate(chain, w[i], spin[i], 1, extra_pieces, &Y, &log_scale, &sign, NULL);
         final_rows(chain, &Y, S);
         if (chain->isotropic) {
             d = S[0][0] * S[1][1] - S[0][1] * S[1][0];
@@ -651,10 +653,17 @@ void chain_determinant_rounding(const Chain *chain, size_t n, const double *w, c
     }
 }
 
+/* transfer.determinant_and_rounding (rounding NULL: transfer.determinant) */
+void chain_determinant_rounding(const Chain *chain, size_t n, const double *w, const double *spin, double *f,
+                                double *rounding)
+{
+    chain_determinant_cut(chain, n, w, spin, 0, f, rounding);
+}
+
 /* transfer.determinant */
 void chain_determinant(const Chain *chain, size_t n, const double *w, const double *spin, double *f)
 {
-    chain_determinant_rounding(chain, n, w, spin, f, NULL);
+    chain_determinant_cut(chain, n, w, spin, 0, f, NULL);
 }
 
 /* The right singular vector of the smallest singular value of the n x n matrix A (one-sided Jacobi). */
@@ -733,7 +742,7 @@ double chain_forward_fraction(const Chain *chain, double w, double spin)
     Basis Y;
     Gram g = {0, {{0.0}}, {{0.0}}};
     double log_scale, sign, S[4][4], q[4], ef, eb;
-    propagate(chain, w, spin, ROTOR_DRIVELINE_DIRECTION_POINTS, &Y, &log_scale, &sign, &g);
+    propagate(chain, w, spin, ROTOR_DRIVELINE_DIRECTION_POINTS, 0, &Y, &log_scale, &sign, &g);
     final_rows(chain, &Y, S);
     null_vector(Y.cols, S, q);
     ef = quadratic_form(Y.cols, g.forward, q);
