@@ -1,33 +1,38 @@
-"""The launch shudder map: peak third-order powertrain acceleration over bend angle, torque and friction.
+"""The launch shudder map: peak third-order powertrain acceleration over bend angle, torque, friction and phase.
 
 The peak third-order powertrain acceleration of the vehicle launch over the joints' bend angle, the
-launch torque and the joints' friction coefficient, each launch a run of the sweep layer.
+launch torque, the joints' friction coefficient and the right joint's phase against the left's, each
+launch a run of the sweep layer; for each bend, torque and friction the worst phase and the envelope
+over the phases.
 
 Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
 
-    driveline-fmus map [--package models/native/VehicleLaunch.ssp] [--count 8] [--joints 0,1,2]
-        [--duration 4] [--step 2e-4] [--master gauss-seidel] [--workers N | --scheduler tcp://host:8786]
-        [--out results/shudder_map.parquet] [--figure results/shudder_map.png]
-    driveline-fmus map --figure-only [--out ...] [--figure ...]
+    driveline-fmus map [--package models/native/VehicleLaunch.ssp] [--count 8]
+        [--phases 4] [--duration 4] [--step 2e-4] [--master gauss-seidel] [--workers N | --scheduler tcp://host:8786]
+        [--out results/shudder_map.parquet] [--envelope results/shudder_map_envelope.csv]
+        [--figure results/shudder_map.png]
+    driveline-fmus map --figure-only [--out ...] [--envelope ...] [--figure ...]
 
 The grid: ``--count`` values each of both joints' ``beta`` (5 to 20 deg), ``motor.T_level`` (20 to
 100 % of the default car's motor peak, :data:`driveline.vehicle.compact_car.MOTOR_PEAK_TORQUE`) and
-both joints' ``mu`` (0.02 to 0.1), the cartesian product (512 launches at the default 8), and with
-``--joints`` the joints' ``tripod_type`` too (``--joints 0,1,2``: plain, single and double roller, a
-dimension of its own, three times the launches; by default the plain tripod alone, no column), each one
-launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and :data:`THIRD_ORDER`:
-``mounts.pitch_ddot_order3_peak``, the peak third-order amplitude of the powertrain's pitch
-acceleration over the left joint's turns (:func:`fmu_harness.studies.order_tracking.third_order_peak`;
-the right joint turns negatively in its own frame), and ``mounts.pitch_ddot_order3_speed``, the joint's
-speed there. A launch whose joint turns less than the order tracking's window fails with that
-reason. The table goes to ``--out``, the figure (a panel per friction coefficient, a row of them per
-joint: the peak over bend angle and torque) to ``--figure``; ``--figure-only`` draws the figure from a
-table written before.
+both joints' ``mu`` (0.02 to 0.1), and ``--phases`` values of the right joint's ``phi_in_start`` (the left
+joint's stays 0) spread over the third of a turn after which a tripod joint repeats itself
+(:data:`PHASE_PERIOD`; 0, 30, 60, 90 deg at the default 4), the cartesian product (2,048 launches at the
+defaults), each one launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and
+:data:`THIRD_ORDERS`: for the powertrain's pitch, lateral and yaw accelerations at its centre of gravity
+(``mounts.pitch_ddot``, ``mounts.y_ddot``, ``mounts.yaw_ddot``) the peak third-order amplitude over the
+left joint's turns (``..._order3_peak``, :func:`fmu_harness.studies.order_tracking.third_order_peak`; the
+right joint turns negatively in its own frame) and the joint's speed there (``..._order3_speed``). A
+launch whose joint turns less than the order tracking's window fails with that reason. The table goes
+to ``--out``; the envelope over the phases (:func:`envelope`: for each bend, torque and friction each
+peak's largest and smallest value over the phases and the phase of the largest, the worst) to
+``--envelope``; the figure (a panel per friction coefficient: the worst phase's pitch peak over bend
+angle and torque, each cell labelled with its worst phase) to ``--figure``; ``--figure-only`` draws the
+figure from a table written before.
 """
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import math
 import sys
@@ -37,7 +42,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from driveline.tripod.spec import DOUBLE_ROLLER, PLAIN_TRIPOD, SINGLE_ROLLER
 from driveline.vehicle.compact_car import MASS, MOTOR_PEAK_TORQUE, RATIO, WHEEL_RADIUS
 
 from .console import CommandParser, summary
@@ -47,19 +51,20 @@ from .studies.order_tracking import REVOLUTIONS, third_order_peak
 
 if TYPE_CHECKING:
     import pyarrow as pa
-    from matplotlib.figure import Figure
 
 COMMAND = "driveline-fmus map"
 SHAFT, SIGNAL = "joint_left.phi_in", "mounts.pitch_ddot"
+LATERAL, YAW = "mounts.y_ddot", "mounts.yaw_ddot"
 BETA = "joint_left.beta+joint_right.beta"
 TORQUE = "motor.T_level"
 MU = "joint_left.mu+joint_right.mu"
-JOINT = "joint_left.tripod_type+joint_right.tripod_type"
-JOINT_NAMES = {PLAIN_TRIPOD: "plain tripod", SINGLE_ROLLER: "single roller", DOUBLE_ROLLER: "double roller"}
+PHASE = "joint_right.phi_in_start"
 PEAK = f"{SIGNAL}_order3_peak"
 BETA_RANGE = (math.radians(5.0), math.radians(20.0))
 TORQUE_RANGE = (0.2 * MOTOR_PEAK_TORQUE, MOTOR_PEAK_TORQUE)
 MU_RANGE = (0.02, 0.1)
+PHASE_PERIOD = 2.0 * math.pi / 3.0
+"""A tripod joint turned by a third of a turn is the same joint: the relative phase repeats after it [rad]."""
 
 
 def pitch_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tuple[float, float]:
@@ -67,7 +72,25 @@ def pitch_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tu
     return third_order_peak(time, outputs[SHAFT], outputs[SIGNAL])
 
 
+def lateral_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tuple[float, float]:
+    """The peak third-order lateral acceleration [m/s2] over the left joint's turns and its speed there [rad/s]."""
+    return third_order_peak(time, outputs[SHAFT], outputs[LATERAL])
+
+
+def yaw_third_order(time: np.ndarray, outputs: Mapping[str, np.ndarray]) -> tuple[float, float]:
+    """The peak third-order yaw acceleration [rad/s2] over the left joint's turns and its speed there [rad/s]."""
+    return third_order_peak(time, outputs[SHAFT], outputs[YAW])
+
+
 THIRD_ORDER = DerivedMetrics((SHAFT, SIGNAL), (PEAK, f"{SIGNAL}_order3_speed"), pitch_third_order, ("rad/s2", "rad/s"))
+THIRD_ORDERS = (
+    THIRD_ORDER,
+    DerivedMetrics((SHAFT, LATERAL), (f"{LATERAL}_order3_peak", f"{LATERAL}_order3_speed"), lateral_third_order,
+                   ("m/s2", "rad/s")),
+    DerivedMetrics((SHAFT, YAW), (f"{YAW}_order3_peak", f"{YAW}_order3_speed"), yaw_third_order, ("rad/s2", "rad/s")),
+)
+PEAKS = tuple(metric.columns[0] for metric in THIRD_ORDERS)
+"""The peak columns the envelope over the phases reports."""
 
 
 def shortest_duration(torque: float = TORQUE_RANGE[1], revolutions: float = REVOLUTIONS) -> float:
@@ -91,82 +114,107 @@ def duration_error(duration: float) -> str | None:
             f"{math.ceil(shortest * 10.0) / 10.0:g} s (default 4)")
 
 
-def axes(count: int, joints: Sequence[int] = (PLAIN_TRIPOD,)) -> dict[str, list[float]]:
-    """The map's grid axes, ``count`` values each, both ends included; the joints' types ``joints`` a
-    first axis of their own unless the plain tripod alone."""
-    found = {} if tuple(joints) == (PLAIN_TRIPOD,) else {JOINT: list(joints)}
-    return found | {name: np.linspace(*bounds, count).tolist()
-                    for name, bounds in ((BETA, BETA_RANGE), (TORQUE, TORQUE_RANGE), (MU, MU_RANGE))}
+def phases(count: int) -> list[float]:
+    """``count`` phases [rad] of the right joint against the left, evenly over :data:`PHASE_PERIOD` from 0."""
+    return (np.arange(count) * (PHASE_PERIOD / count)).tolist()
 
 
-def joint_types(text: str) -> list[int]:
-    """``--joints``: tripod types (0 plain, 1 single roller, 2 double roller) separated by commas."""
-    try:
-        found = [int(part) for part in text.split(",")]
-    except ValueError:
-        found = []
-    if not found or any(joint not in JOINT_NAMES for joint in found) or len(set(found)) < len(found):
-        raise argparse.ArgumentTypeError(f"{text!r}: give distinct tripod types among 0, 1, 2, e.g. 0,1,2")
-    return found
+def axes(count: int, phase_count: int = 1) -> dict[str, list[float]]:
+    """The map's grid axes, ``count`` values each (both ends included) of bend, torque and friction and
+    ``phase_count`` phases (:func:`phases`)."""
+    found = {name: np.linspace(*bounds, count).tolist()
+             for name, bounds in ((BETA, BETA_RANGE), (TORQUE, TORQUE_RANGE), (MU, MU_RANGE))}
+    return found | {PHASE: phases(phase_count)}
+
+
+def envelope(table: pa.Table) -> pa.Table:
+    """For each bend, torque and friction of a map's ``table``: how many phases ran (``phases``), and for
+    each peak of :data:`PEAKS` its largest value over them (``..._max``), the phase there
+    (``..._worst_phase`` [rad]) and its smallest value (``..._min``); a combination whose every launch
+    failed has no row. The units those of the map's columns."""
+    import pyarrow as pa  # the sweep extra, as the map's own table
+
+    units = sweep.units_of(table)
+    groups: dict[tuple[float, float, float], list[dict]] = {}
+    for row in table.to_pylist():
+        if row["status"] == "ok":
+            groups.setdefault((row[BETA], row[TORQUE], row[MU]), []).append(row)
+    columns: dict[str, list[float]] = {BETA: [], TORQUE: [], MU: [], "phases": []}
+    found_units = {BETA: units[BETA], TORQUE: units[TORQUE], MU: units[MU], "phases": "1"}
+    for peak in PEAKS:
+        for suffix, unit in (("max", units[peak]), ("worst_phase", units[PHASE]), ("min", units[peak])):
+            columns[f"{peak}_{suffix}"] = []
+            found_units[f"{peak}_{suffix}"] = unit
+    for (beta, torque, mu), rows in sorted(groups.items()):
+        columns[BETA].append(beta)
+        columns[TORQUE].append(torque)
+        columns[MU].append(mu)
+        columns["phases"].append(len(rows))
+        for peak in PEAKS:
+            worst = max(rows, key=lambda row: row[peak])
+            columns[f"{peak}_max"].append(worst[peak])
+            columns[f"{peak}_worst_phase"].append(worst[PHASE])
+            columns[f"{peak}_min"].append(min(row[peak] for row in rows))
+    found = pa.table({name: pa.array(values, type=pa.int64() if name == "phases" else pa.float64())
+                      for name, values in columns.items()})
+    return sweep.with_units(found, found_units)
 
 
 def draw(table: pa.Table, path: Path) -> Path:
-    """The map's figure (:func:`map_figure`) saved to ``path``."""
+    """A panel per friction coefficient: the peak third-order pitch acceleration [rad/s2] of the worst
+    phase (:func:`envelope`) over the bend angle [deg] and the launch torque [% of the motor's peak], one
+    colour scale for all panels, each cell labelled with its worst phase [deg] when the map has several;
+    a combination whose every launch failed is left blank."""
     from .studies import figures  # matplotlib, when a figure is drawn: a mistake is refused before it loads
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return figures.save(map_figure(table), path)
-
-
-def map_figure(table: pa.Table) -> Figure:
-    """A panel per friction coefficient, a row of them per joint: the peak third-order pitch acceleration
-    [rad/s2] over the bend angle [deg] and the launch torque [% of the motor's peak], one colour scale
-    for all panels; a failed launch is left blank."""
-    from .studies import figures
-
-    rows = table.to_pylist()
-    betas, torques, mus = (sorted({row[name] for row in rows}) for name in (BETA, TORQUE, MU))
-    joints = sorted({row[JOINT] for row in rows}) if JOINT in table.column_names else [PLAIN_TRIPOD]
-    cases = [(joint, mu) for joint in joints for mu in mus]  # a panel each, a row of them per joint
-    peaks = np.full((len(cases), len(torques), len(betas)), np.nan)
+    rows = envelope(table).to_pylist()
+    betas, torques, mus = (sorted({row[name] for row in table.to_pylist()}) for name in (BETA, TORQUE, MU))
+    several = len({row[PHASE] for row in table.to_pylist()}) > 1
+    peaks = np.full((len(mus), len(torques), len(betas)), np.nan)
+    worst = np.full_like(peaks, np.nan)
     for row in rows:
-        if row["status"] == "ok":
-            case = cases.index((row.get(JOINT, PLAIN_TRIPOD), row[MU]))
-            peaks[case, torques.index(row[TORQUE]), betas.index(row[BETA])] = row[PEAK]
+        cell = mus.index(row[MU]), torques.index(row[TORQUE]), betas.index(row[BETA])
+        peaks[cell], worst[cell] = row[f"{PEAK}_max"], row[f"{PEAK}_worst_phase"]
     columns = min(4, len(mus))
-    lines = len(joints) * math.ceil(len(mus) / columns)
-    fig, panels = figures.figure(lines, columns, squeeze=False, sharex=True, sharey=True,
-                                 figsize=(3.2 * columns + 1.2, 2.9 * lines + 0.6), layout="constrained")
+    fig, panels = figures.figure(math.ceil(len(mus) / columns), columns, squeeze=False, sharex=True, sharey=True,
+                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6),
+                                 layout="constrained")
     top = np.nanmax(peaks) if np.any(np.isfinite(peaks)) else 1.0
     x, y = np.degrees(betas), 100.0 * np.array(torques) / MOTOR_PEAK_TORQUE
-    per_joint = columns * math.ceil(len(mus) / columns)
     for k, panel in enumerate(panels.flat):
-        joint, place = divmod(k, per_joint)
-        if place >= len(mus):
+        if k >= len(mus):
             panel.set_visible(False)
             continue
-        case = joint * len(mus) + place
-        image = panel.pcolormesh(x, y, peaks[case], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
+        image = panel.pcolormesh(x, y, peaks[k], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
+        if several:
+            for (i, j), phase in np.ndenumerate(worst[k]):
+                if np.isfinite(phase):
+                    panel.text(x[j], y[i], f"{math.degrees(phase):.0f}", ha="center", va="center", fontsize=6,
+                               color="white" if peaks[k, i, j] < 0.6 * top else "black")
         panel.set_xlim(x[0], x[-1])  # the grid's range: its outer cells shown to their values, no further
         panel.set_ylim(y[0], y[-1])
-        title = f"mu = {mus[place]:.3g}"
-        panel.set_title(title if len(joints) == 1 else f"{JOINT_NAMES[joints[joint]]}, {title}", fontsize=9)
+        panel.set_title(f"mu = {mus[k]:.3g}", fontsize=9)
     for panel in panels[-1]:
         panel.set_xlabel("bend angle beta [deg]")
     for panel in panels[:, 0]:
         panel.set_ylabel("launch torque [% of peak]")
-    fig.colorbar(image, ax=panels, label="peak 3rd-order pitch acceleration [rad/s2]")
-    fig.suptitle(f"Launch shudder map: {len(rows)} launches of VehicleLaunch, both joints alike", fontsize=10)
-    return fig
+    fig.colorbar(image, ax=panels, label="peak 3rd-order pitch acceleration [rad/s2], worst phase")
+    title = f"Launch shudder map: {len(table)} launches of VehicleLaunch, both joints alike"
+    if several:
+        title += "; worst right-joint phase [deg] in each cell"
+    fig.suptitle(title, fontsize=10)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return figures.save(fig, path)
 
 
 def main(argv: Sequence[str] | None = None) -> None:
     parser = CommandParser(description=summary(__doc__))
     parser.add_argument("--package", type=Path, default=Path("models") / "native" / "VehicleLaunch.ssp",
                         help="the launch's SSP package (default models/native/VehicleLaunch.ssp)")
-    parser.add_argument("--count", type=int, default=8, help="values per axis (default 8: 512 launches)")
-    parser.add_argument("--joints", type=joint_types, default=[PLAIN_TRIPOD],
-                        help="tripod types swept, e.g. 0,1,2 (0 plain, 1 single, 2 double roller; default 0)")
+    parser.add_argument("--count", type=int, default=8, help="values per axis of bend, torque and friction (default 8)")
+    parser.add_argument("--phases", type=int, default=4,
+                        help="phases of the right joint over a third of a turn (default 4: 0, 30, 60, 90 deg; "
+                             "2,048 launches with --count 8)")
     parser.add_argument("--duration", type=float, default=4.0, help="launch length [s] (default 4)")
     parser.add_argument("--step", type=float, default=2e-4, help="communication step [s] (default 2e-4)")
     parser.add_argument("--master", choices=sweep.MASTERS, default=sweep.DEFAULT_MASTER,
@@ -176,6 +224,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786")
     parser.add_argument("--out", type=sweep.table_file, default=Path("results") / "shudder_map.parquet",
                         help=".parquet or .csv")
+    parser.add_argument("--envelope", type=sweep.table_file, default=Path("results") / "shudder_map_envelope.csv",
+                        help="the envelope over the phases, .csv or .parquet")
     parser.add_argument("--figure", type=Path, default=Path("results") / "shudder_map.png", help="PNG file to write")
     parser.add_argument("--figure-only", action="store_true", help="draw the figure from the table at --out")
     args = parser.parse_args(argv)
@@ -186,12 +236,14 @@ def main(argv: Sequence[str] | None = None) -> None:
         return
     if args.count < 2:
         parser.error(f"--count must be at least 2, got {args.count}")
+    if args.phases < 1:
+        parser.error(f"--phases must be at least 1, got {args.phases}")
     too_short = duration_error(args.duration)
     if too_short:
         parser.error(too_short)
     try:
-        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count, args.joints)), args.duration, args.step,
-                                    args.master, (THIRD_ORDER,))
+        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count, args.phases)), args.duration, args.step,
+                                    args.master, THIRD_ORDERS)
         if args.scheduler:
             sweep.check_scheduler(args.scheduler)
     except (ValueError, OSError) as error:
@@ -200,6 +252,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     sweep.write_table(table, args.out)
     failed = sweep.failure_reasons(table)
     if failed.total() < table.num_rows:
+        sweep.write_table(envelope(table), args.envelope)
+        print(args.envelope)
         print(draw(table, args.figure))
     print(f"{table.num_rows} launches, {failed.total()} failed -> {args.out}")
     sweep.print_reasons(failed)

@@ -18,7 +18,7 @@ from .exact_step import Propagator, work_error
 from .implicit_step import implicit_step
 from .layout import MAX_MOUNTS, Layout, load_layout, shipped_layout
 from .rigid_body import COORDINATES
-from .spec import AXES, INPUTS, SHARED_LAYOUT, SIDES, SPEC, VELOCITIES, derivative_name
+from .spec import AXES, INPUTS, RUBBER_LAYOUT, SHARED_LAYOUT, SIDES, SPEC, VELOCITIES, derivative_name
 from .system import MountSystem, Placement
 
 RATES = tuple(derivative_name(name) for name in INPUTS)
@@ -42,7 +42,7 @@ class PowertrainMountsModel(SteppedModel):
                           "T_mean": 150.0},)
     derived_state = ("_system", "_built_for", "_propagator")
     #: the Maxwell branches' forces [N] (:mod:`.rubber`), a tuple of floats: part of the saved state
-    resource_files = (Path(__file__).parent / "data" / f"{SHARED_LAYOUT}.toml",)
+    resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml" for name in (SHARED_LAYOUT, RUBBER_LAYOUT))
 
     def reset_internal_state(self) -> None:
         self._system: MountSystem | None = None

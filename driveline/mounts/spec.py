@@ -14,6 +14,8 @@ LOAD_INPUTS = ("F_x", "F_y", "F_z", "M_x", "M_y", "M_z")
 #: Every load input in the order of the input map: the load at the centre of gravity, the joints', the motor's.
 INPUTS = LOAD_INPUTS + tuple(f"{name}_{side}" for side in SIDES for name in REACTIONS) + ("T_motor",)
 SHARED_LAYOUT = "transverse_fwd_powertrain"
+#: The same powertrain on rubber mounts (progressive characteristics, Maxwell branches), shipped beside it
+RUBBER_LAYOUT = "transverse_fwd_powertrain_rubber"
 COORDINATE_INDEX = ", ".join(f"{i} {name}" for i, name in enumerate(COORDINATES, 1))
 # What the outputs are computed from (``depends_on``): the parameters placing the loads (the
 # joints' frames and centres, the motor axis), the inputs' generalised force, the motion (states)
@@ -130,8 +132,9 @@ def _motion() -> tuple[Variable, ...]:
 
 
 def _states() -> tuple[State, ...]:
-    """Displacements starting in the equilibrium under the start inputs, velocities at rest."""
-    return (*(State(name, LOADS, f"{name}_dot", NOMINALS[name]) for name in COORDINATES),
+    """Displacements starting in the equilibrium under the start inputs, velocities at rest (on progressive
+    mounts that equilibrium's displacement from the weight's depends on the weight: g)."""
+    return (*(State(name, (*LOADS, "g"), f"{name}_dot", NOMINALS[name]) for name in COORDINATES),
             *(State(f"{name}_dot", (), f"{name}_ddot", NOMINALS[name] * NOMINAL_RATE) for name in COORDINATES))
 
 
@@ -144,7 +147,9 @@ def _mounts() -> tuple[Variable, ...]:
 
 
 def _statics_and_modes() -> tuple[Variable, ...]:
-    """Static sag, modes and torque roll axis: functions of the parameters alone."""
+    """Static sag, modes and torque roll axis: functions of the parameters alone (the modes those of the
+    operating point under the weight and T_mean about motor_axis: the tangent rates of progressive mounts
+    and the rubber's branches there)."""
     found = []
     for name in COORDINATES:
         unit, display = _unit(name, 0)
@@ -157,22 +162,22 @@ def _statics_and_modes() -> tuple[Variable, ...]:
                           depends_on=STATICS))
     found += [Variable(f"f_mode_{j}", "output", 0.0,
                        f"Natural frequency of mode {j} (ascending) at the static equilibrium under the weight and "
-                       "T_mean, with the rubber's storage stiffness at that frequency", "Hz", depends_on=("layout",))
+                       "T_mean, with the rubber's storage stiffness at that frequency", "Hz", depends_on=STATICS)
               for j in range(1, 7)]
     found += [Variable(f"zeta_mode_{j}", "output", 0.0,
                        f"Damping ratio of mode {j} (modal strain energy: loss over twice the storage stiffness "
-                       "at its frequency)", "1", depends_on=("layout",))
+                       "at its frequency)", "1", depends_on=STATICS)
               for j in range(1, 7)]
     for j in range(1, 7):
         found.append(Variable(f"mode_{j}_coordinate", "output", 0,
                               f"Coordinate with the largest kinetic-energy share of mode {j}: {COORDINATE_INDEX}",
-                              type="Integer", depends_on=("layout",)))
+                              type="Integer", depends_on=STATICS))
         found.append(Variable(f"mode_{j}_share", "output", 0.0,
                               f"Kinetic-energy share of mode {j} in its dominant coordinate", "1",
-                              depends_on=("layout",)))
+                              depends_on=STATICS))
     found += [Variable(f"share_{j}_{name}", "output", 0.0,
                        f"Kinetic-energy share of coordinate {name} in mode {j} (each mode's shares sum to 1)", "1",
-                       depends_on=("layout",))
+                       depends_on=STATICS)
               for j in range(1, 7) for name in COORDINATES]
     found += [Variable(f"torque_roll_axis_{axis}", "output", 0.0,
                        f"Torque roll axis (unit vector, vehicle {axis} component): the free powertrain's "

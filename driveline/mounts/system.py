@@ -160,8 +160,12 @@ def _torque(placement: Placement, mean_torque: float) -> np.ndarray:
 
 
 def _elastic_magnitude(layout: Layout, q: np.ndarray) -> np.ndarray:
-    """``sum_i |T_i^T A_i^T| |F_i|``: the scale of :func:`.forces.elastic_load`'s rounding."""
-    return sum(np.abs(to_axes.T) @ np.abs(f) for to_axes, f in zip(layout.maps, elastic_forces(layout, q)))
+    """``sum_i |T_i^T A_i^T| |F_i| + |K_t(q)| max|q|``: the scale of :func:`.forces.elastic_load`'s rounding,
+    and of the equilibrium's: Newton's solves leave each coordinate of q within cond(K_t) eps of the largest,
+    so a coordinate of the load (a lateral one, nearly zero under the weight) rounds with its row of K_t
+    times max|q|."""
+    return (sum(np.abs(to_axes.T) @ np.abs(f) for to_axes, f in zip(layout.maps, elastic_forces(layout, q)))
+            + np.abs(tangent_stiffness(layout, q)) @ np.full(6, np.max(np.abs(q))))
 
 
 def _equilibrium(body: RigidBody, load: np.ndarray) -> np.ndarray:

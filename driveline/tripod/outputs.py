@@ -6,6 +6,8 @@ time stepping gives exactly what stepping the FMU would, without a Python loop.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..scalar import Real, arcsin
@@ -39,12 +41,25 @@ def efficiency(output_power: Real, loss: Real) -> Real:
     return np.where(output_power >= 0.0, drive, np.where(coast > 0.0, coast, 0.0))
 
 
+def to_housing(x: Real, y: Real, psi: Real) -> tuple[Real, Real]:
+    """Components ``(x, y)`` in the bend plane's frame turned by ``psi`` about Z' into the housing's X'Y'
+    (M8); where ``psi`` is 0 they are returned as they are, so that even a zero's sign stays."""
+    if type(psi) is float:
+        if psi == 0.0:
+            return x, y
+        c, s = math.cos(psi), math.sin(psi)
+        return c * x - s * y, s * x + c * y
+    c, s = np.cos(psi), np.sin(psi)
+    return np.where(psi == 0.0, x, c * x - s * y), np.where(psi == 0.0, y, s * x + c * y)
+
+
 def coupling_outputs(
     phi_in: Real, beta: Real, omega_in: Real, T_load: Real, r: float, l: float, m: float,
     kinematics: int, solution: plane_solver.Solution | None = None,
     alpha_in: Real = 0.0, seed_reactions: int = 0, mu: float = 0.0, v_slip: float = 1e-3,
     beta_dot: Real = 0.0, beta_ddot: Real = 0.0, tripod_type: int = PLAIN_TRIPOD, mu_roll: float = 0.0,
-    roller_radius: float = 0.0, roller_bore_radius: float = 0.0,
+    roller_radius: float = 0.0, psi: Real = 0.0, psi_dot: Real = 0.0, psi_ddot: Real = 0.0, plunge_dot: Real = 0.0,
+    roller_bore_radius: float = 0.0,
 ) -> tuple[dict[str, Real], plane_solver.Solution | None]:
     """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's solution.
 
@@ -58,33 +73,41 @@ def coupling_outputs(
     tripods' contacts (:mod:`.rollers`), with rolling resistance ``mu_roll`` and the rollers' outer
     and bore radii ``roller_radius``, ``roller_bore_radius`` [m]; without friction, and in the closed
     form, every type is the plain one.
+    The moving housing (docs/tripod_coupling.md, eqs M1-M8): the bend plane at ``psi`` about Z' with its
+    rates ``psi_dot``, ``psi_ddot``, and the spider's axial speed ``plunge_dot`` relative to the housing;
+    all 0 is the fixed housing, bit for bit.
     """
     rho = orbit_radius(beta, r)
     pin = dynamics.pin_force(T_load, rho, r)
+    phi = phi_in - psi  # the input angle from the bend plane (M1)
+    spin, spin_dot = omega_in - psi_dot, alpha_in - psi_ddot  # the input speed relative to it (M3)
     if kinematics == EXACT:
-        phi_out, ratio, solution = plane_solver.solve(phi_in, beta, r, l, solution)
+        phi_out, ratio, solution = plane_solver.solve(phi, beta, r, l, solution)
         theta = solution.cone_angle
         if tripod_type == PLAIN_TRIPOD:
-            forces = exact_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, mu,
-                                     v_slip, beta_dot, beta_ddot)
+            forces = exact_reactions(phi, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, mu,
+                                     v_slip, beta_dot, beta_ddot, psi_dot, psi_ddot, plunge_dot)
         else:
-            state = mechanism(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, beta_dot,
-                              beta_ddot)
+            state = mechanism(phi, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, beta_dot,
+                              beta_ddot, psi_dot, psi_ddot, plunge_dot)
             forces = roller_reactions(state, omega_in, T_load, m, tripod_type, mu, mu_roll, v_slip, roller_radius,
                                       roller_bore_radius)[0]
         omega_spin, axial_in, loss = forces.omega_spin, forces.Rz_in, forces.P_friction
     else:
-        deviation, ratio = closed_form.kinematics(phi_in, beta, r, l)
-        phi_out = phi_in + deviation
+        deviation, ratio = closed_form.kinematics(phi, beta, r, l)
+        phi_out = phi + deviation
         theta = arcsin(rho / l)
-        forces = leading_order_reactions(phi_in, beta, omega_in, alpha_in, T_load, r, l, m, ratio, pin,
+        forces = leading_order_reactions(phi, beta, spin, spin_dot, T_load, r, l, m, ratio, pin,
                                          beta_dot, beta_ddot)
-        omega_spin, axial_in, loss = omega_in * ratio, 0.0 * ratio, 0.0 * ratio
+        omega_spin, axial_in, loss = spin * ratio + psi_dot, 0.0 * ratio, 0.0 * ratio
+    phi_out = phi_out + psi  # (M2)
     output_power = T_load * omega_spin
+    Rx_in, Ry_in = to_housing(forces.Rx_in, forces.Ry_in, psi)
+    Mx_in, My_in = to_housing(forces.Mx_in, forces.My_in, psi)
     values = {
         "phi_out": phi_out,
         "delta_phi": phi_out - phi_in,
-        "omega_out": omega_in * ratio,
+        "omega_out": spin * ratio + psi_dot,  # (M7)
         "omega_spin": omega_spin,
         "T_in": forces.T_in,
         "F_pin": pin,
@@ -94,10 +117,10 @@ def coupling_outputs(
         "Rz_out": forces.Rz_out,
         "Rx_out": forces.Rx_out,
         "Ry_out": forces.Ry_out,
-        "Rx_in": forces.Rx_in,
-        "Ry_in": forces.Ry_in,
-        "Mx_in": forces.Mx_in,
-        "My_in": forces.My_in,
+        "Rx_in": Rx_in,
+        "Ry_in": Ry_in,
+        "Mx_in": Mx_in,
+        "My_in": My_in,
         "Rz_in": axial_in,
         "P_friction": loss,
         "efficiency": efficiency(output_power, loss),
@@ -106,6 +129,7 @@ def coupling_outputs(
         values["F_arm" + arm] = f_arm
         values["F_plunger" + arm] = f_plunger
     if seed_reactions:
-        seed = dynamics.reactions(phi_in, beta, omega_in, rho, l, m)
-        values.update(a_plunger_sum=seed.a_plunger_sum, Rz_out=seed.Rz_out, Rx_in=seed.Rx_in, Ry_in=seed.Ry_in)
+        seed = dynamics.reactions(phi, beta, spin, rho, l, m)
+        Rx_in, Ry_in = to_housing(seed.Rx_in, seed.Ry_in, psi)
+        values.update(a_plunger_sum=seed.a_plunger_sum, Rz_out=seed.Rz_out, Rx_in=Rx_in, Ry_in=Ry_in)
     return values, solution

@@ -36,6 +36,17 @@ output bearing along ``S = l e_out(beta)``: ``Sdot = l betadot de_out/dbeta`` jo
 velocities in step 2 (``Sdot + Omega x d_j - omega e_z x g_j = zdot_j e_z - sigma_j e_j``) and
 ``Sddot = l (betaddot de_out/dbeta - betadot^2 e_out)`` its accelerations in step 3; the force
 balance keeps its form (massless tripod, bearing force through S).
+
+The moving housing (docs/tripod_coupling.md, "The moving housing", eqs M1-M8): everything above is in
+the bend-plane frame, X'Y'Z' turned by psi about Z', where ``phi_in`` is the input angle from the bend
+plane. That frame turns at psi_dot: the mechanism moves in it as the fixed-plane one with the input speed
+``omega - psi_dot`` and its rate ``omega_dot - psi_ddot`` (steps 2-3), the output shaft's angular velocity
+is that one's plus ``psi_dot e_z``, the groove points' accelerations (what the plungers' inertia and the
+groove forces take) are the circular motion at ``omega``, ``omega_dot`` themselves, and the axial
+accelerations ``zddot_j`` are the same in both frames (a turn about Z' has no axial part). The spider
+plunging along Z' at ``plunge_dot`` relative to the housing adds it to every plunger's axial speed
+``zdot_j`` (the sliding speed in its groove, relative to the housing), nothing else (the grooves are
+parallel to Z').
 """
 
 from __future__ import annotations
@@ -66,7 +77,7 @@ class ExactReactions(NamedTuple):
     F_arm: tuple[Real, Real, Real]  # ball on arm j, in the tripod plane (along U x arm)
     F_plunger: tuple[Real, Real, Real]  # ball joint on plunger j along Z' = m zddot_j
     a_plunger_sum: Real  # zddot_0 + zddot_1 + zddot_2 [m/s^2]
-    omega_spin: Real  # Omega . U, the output shaft's angular velocity about its own axis [rad/s]
+    omega_spin: Real  # Omega . U, the output shaft's angular velocity about its own axis, in the housing [rad/s]
     Rz_in: Real = 0.0  # input bearing force on the input shaft along Z' (friction only)
     P_friction: Real = 0.0  # power dissipated by friction [W]
 
@@ -79,23 +90,24 @@ class Mechanism(NamedTuple):
     arms: list  # (gx, gy, bz, ex, ey, ez, dx, dy, dz, |e_xy|^2, k_jx, k_jy, k_jz): pose, arm e_j, d_j, row k_j
     adj: tuple  # adjugate rows of K (Cramer's rule)
     inv_det: Real  # 1 / det K
-    known: list  # (ax, ay, hx, hy, hz): the groove point's acceleration and the tripod's known terms
+    known: list  # (ax, ay, hx, hy, hz): the groove point's acceleration (housing) and the tripod's known terms
     zddot: list  # plunger (roller) accelerations along Z'
-    slides: list  # (zdot_j, sigma_j): axial speed on the groove, sliding rate along the arm (sdot_j / |e_j|)
+    slides: list  # (zdot_j, sigma_j): axial speed in the groove (relative to the housing), sliding rate along the arm (sdot_j / |e_j|)
     lams: list  # lambda_j of the frictionless balance
     mus: list  # mu_j of the frictionless balance
     U: tuple  # the output shaft's axis (Ux, Uy, Uz)
     E1: tuple  # its twist-free frame, E1 (bend-plane side)
     E2: tuple  # ... and E2
-    Omega: tuple  # the output shaft's angular velocity (Wx, Wy, Wz)
+    Omega: tuple  # the output shaft's angular velocity relative to the housing (Wx, Wy, Wz)
 
 
 def mechanism(
     phi_in: Real, beta: Real, omega: Real, omega_dot: Real, T_load: Real,
     r: float, l: float, m: float, x: Real, y: Real, beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
+    psi_dot: Real = 0.0, psi_ddot: Real = 0.0, plunge_dot: Real = 0.0,
 ) -> Mechanism:
     """The module's steps 1-4 without friction: pose, velocities, accelerations and the arm forces,
-    for the arguments of :func:`exact_reactions`."""
+    for the arguments of :func:`exact_reactions`, in the bend-plane frame (M1-M5)."""
     xp = lib(phi_in, beta, x, y)
     cb, sb = xp.cos(beta), xp.sin(beta)
     zn = xp.sqrt(1.0 - x * x - y * y)
@@ -108,11 +120,13 @@ def mechanism(
     Ux, Uy, Uz = cb * x - sb * zn, y, sb * x + cb * zn
     Sx, Sz = -l * sb, l * cb
     # the moving bearing: Sdot = l betadot (-cos, 0, -sin), Sddot = l betaddot (-cos, 0, -sin) - l betadot^2 e_out
-    Svx, Svz = -l * cb * beta_dot, -l * sb * beta_dot
+    Svx, Svz = -l * cb * beta_dot, -l * sb * beta_dot + plunge_dot  # the spider's plunge joins zdot_j (M5)
     Sax, Saz = l * (sb * beta_dot * beta_dot - cb * beta_ddot), -l * (cb * beta_dot * beta_dot + sb * beta_ddot)
     Px, Py, Pz = Sx - l * Ux, -l * Uy, Sz - l * Uz
     p_dot_u = Px * Ux + Py * Uy + Pz * Uz
-    omega2 = omega * omega
+    # the mechanism in the bend plane's frame, turning at psi_dot: the input speed relative to it (M3)
+    spin, spin_dot = omega - psi_dot, omega_dot - psi_ddot
+    omega2, spin2 = omega * omega, spin * spin
     c0, s0 = xp.cos(phi_in), xp.sin(phi_in)
     c1, s1 = -0.5 * c0 - HALF_ROOT_3 * s0, -0.5 * s0 + HALF_ROOT_3 * c0
     c2, s2 = -0.5 * c0 + HALF_ROOT_3 * s0, -0.5 * s0 - HALF_ROOT_3 * c0
@@ -135,36 +149,36 @@ def mechanism(
     inv_det = 1.0 / (k0x * adj[0][0] + k0y * adj[0][1] + k0z * adj[0][2])
 
     # 2. angular velocity of the output shaft: (e_z x g_j) . n_j = -(g_x e_x + g_y e_y), Sdot . n_j = Sdot_x e_y
-    rhs = [(-omega * (a[0] * a[3] + a[1] * a[4]) - Svx * a[4]) * inv_det for a in arms]
+    rhs = [(-spin * (a[0] * a[3] + a[1] * a[4]) - Svx * a[4]) * inv_det for a in arms]
     Wx = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
     Wy = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]
     Wz = rhs[0] * adj[0][2] + rhs[1] * adj[1][2] + rhs[2] * adj[2][2]
     W2 = Wx * Wx + Wy * Wy + Wz * Wz
 
     # 3. accelerations: known terms per arm, then K Omegadot = (known . n_j)
-    known, slides = [], []
+    known, relative, slides = [], [], []
     for gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_ in arms:
         # sliding rate along the arm (sigma e_j = sdot a_j) from the velocity closure
-        vx = Wy * dz - Wz * dy + omega * gy + Svx
-        vy = Wz * dx - Wx * dz - omega * gx
+        vx = Wy * dz - Wz * dy + spin * gy + Svx
+        vy = Wz * dx - Wx * dz - spin * gx
         sigma = -(vx * ex + vy * ey) / exy2
         wd = Wx * dx + Wy * dy + Wz * dz  # Omega x (Omega x d) = Omega (Omega . d) - d |Omega|^2
         # whirl + 2 sigma Omega x e + the bearing's acceleration
         hx = Wx * wd - dx * W2 + 2.0 * sigma * (Wy * ez - Wz * ey) + Sax
         hy = Wy * wd - dy * W2 + 2.0 * sigma * (Wz * ex - Wx * ez)
         hz = Wz * wd - dz * W2 + 2.0 * sigma * (Wx * ey - Wy * ex) + Saz
-        ax = -omega_dot * gy - omega2 * gx  # groove point's acceleration, radial and tangential
-        ay = omega_dot * gx - omega2 * gy
-        known.append((ax, ay, hx, hy, hz))
+        # groove point's acceleration, radial and tangential: in the bend plane's frame, and in the housing (M4)
+        relative.append((-spin_dot * gy - spin2 * gx, spin_dot * gx - spin2 * gy))
+        known.append((-omega_dot * gy - omega2 * gx, omega_dot * gx - omega2 * gy, hx, hy, hz))
         slides.append((Wx * dy - Wy * dx + sigma * ez + Svz, sigma))  # (zdot_j, sdot_j / |e_j|)
-    rhs = [((kn[0] - kn[2]) * a[4] - (kn[1] - kn[3]) * a[3]) * inv_det for kn, a in zip(known, arms)]
+    rhs = [((ar[0] - kn[2]) * a[4] - (ar[1] - kn[3]) * a[3]) * inv_det for ar, kn, a in zip(relative, known, arms)]
     Ax = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0]
     Ay = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1]
     Az = rhs[0] * adj[0][2] + rhs[1] * adj[1][2] + rhs[2] * adj[2][2]
     # plunger accelerations and 4. the Z' parts of the arm forces, F_j = lambda_j n_j + mu_j (e_j x n_j)
     zddot, mus = [], []
     Mx, My, Mz = T_load * Ux, T_load * Uy, T_load * Uz  # moment balance about S, right-hand side
-    for (ax, ay, hx, hy, hz), (gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_) in zip(known, arms):
+    for (ax, ay), (_, _, hx, hy, hz), (gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, *_) in zip(relative, known, arms):
         wx = Ay * dz - Az * dy + hx - ax  # Omegadot x d + known = zddot e_z - tau e_j
         wy = Az * dx - Ax * dz + hy - ay
         wz = Ax * dy - Ay * dx + hz
@@ -178,13 +192,13 @@ def mechanism(
         mus.append(mu)
     lams = [(Mx * a0 + My * a1 + Mz * a2) * inv_det for a0, a1, a2 in adj]
     return Mechanism(xp, arms, adj, inv_det, known, zddot, slides, lams, mus, (Ux, Uy, Uz),
-                     (E1x, E1y, E1z), (E2x, E2y, E2z), (Wx, Wy, Wz))
+                     (E1x, E1y, E1z), (E2x, E2y, E2z), (Wx, Wy, Wz + psi_dot))  # (M6)
 
 
 def exact_reactions(
     phi_in: Real, beta: Real, omega: Real, omega_dot: Real, T_load: Real,
     r: float, l: float, m: float, x: Real, y: Real, friction: float = 0.0, slip_speed: float = 1e-3,
-    beta_dot: Real = 0.0, beta_ddot: Real = 0.0,
+    beta_dot: Real = 0.0, beta_ddot: Real = 0.0, psi_dot: Real = 0.0, psi_ddot: Real = 0.0, plunge_dot: Real = 0.0,
 ) -> ExactReactions:
     """Reactions at input angle ``phi_in``, bend ``beta``, input speed ``omega`` and its rate
     ``omega_dot``, for the output-shaft axis ``(x, y, sqrt(1 - x^2 - y^2))`` in the nominal
@@ -193,8 +207,11 @@ def exact_reactions(
     horizontal, ``k_j = (d_z e_x, d_z e_y, -(d_x e_x + d_y e_y))`` and
     ``e_j x n_j = (e_z e_x, e_z e_y, -(e_x^2 + e_y^2))``). ``friction`` > 0 adds Coulomb
     friction in both sliding pairs (:func:`_frictional_balance`); 0 is the frictionless balance.
-    ``beta_dot``, ``beta_ddot``: the bend angle's rates, which move the output bearing S."""
-    state = mechanism(phi_in, beta, omega, omega_dot, T_load, r, l, m, x, y, beta_dot, beta_ddot)
+    ``beta_dot``, ``beta_ddot``: the bend angle's rates, which move the output bearing S; ``psi_dot``,
+    ``psi_ddot``: the bend plane's (``phi_in`` is then measured from it and the forces are in its frame);
+    ``plunge_dot``: the spider's axial speed relative to the housing (M1-M6)."""
+    state = mechanism(phi_in, beta, omega, omega_dot, T_load, r, l, m, x, y, beta_dot, beta_ddot, psi_dot, psi_ddot,
+                      plunge_dot)
     xp, arms, adj, inv_det, known, zddot, slides, lams, mus = state[:9]
     (Ux, Uy, Uz), (E1x, E1y, E1z), (E2x, E2y, E2z), (Wx, Wy, Wz) = state.U, state.E1, state.E2, state.Omega
     slips = grooves = (0.0, 0.0, 0.0)

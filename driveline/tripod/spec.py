@@ -19,9 +19,12 @@ RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 # the rates of speed and bend, the plungers' forces and the forces with friction. An output's list is
 # the union over the modes: the seed's eqs 20, 30, 33, 34 and the leading order need fewer, the exact
 # reactions (a_plunger_sum, Rz_out, Rx_in, Ry_in with the bend's rates, the load and friction) more.
-POSITION = ("phi_in", "beta", "r", "l", "kinematics")
-PLUNGERS = (*POSITION, "omega_in", "m_plunger", "alpha_in", "beta_dot", "beta_ddot", "beta_rate")
-FORCES = (*PLUNGERS, "T_load", "mu", "v_slip", "tripod_type", "mu_roll", "roller_radius",
+# The moving housing: psi turns the bend plane (the position), its rates the speeds and accelerations
+# relative to that plane, plunge_dot the plungers' sliding speed in the grooves (the friction alone).
+POSITION = ("phi_in", "beta", "psi", "r", "l", "kinematics")
+PLUNGERS = (*POSITION, "omega_in", "m_plunger", "alpha_in", "beta_dot", "beta_ddot", "psi_dot", "psi_ddot",
+            "beta_rate")
+FORCES = (*PLUNGERS, "T_load", "mu", "v_slip", "tripod_type", "mu_roll", "roller_radius", "plunge_dot",
           "roller_bore_radius")
 FRICTION = tuple(name for name in FORCES if name != "kinematics")  # zero without friction, which needs the exact
 ARM_OUTPUTS = tuple(
@@ -39,7 +42,8 @@ SPEC = ModelSpec(
     description=(
         "Tripod sliding universal coupling with a self-aligning output bearing (Xiu, Chang, Ju, "
         "Zheng 2024): output angle, speed and torque, pin force and bearing reactions. Angles: "
-        "phi_in = 0 with plunger groove 1 in the bend plane on the outer side of the bend."
+        "phi_in = 0 with plunger groove 1 in the bend plane on the outer side of the bend when psi = 0; the "
+        "housing's motion enters as the bend plane's angle psi about Z' with its rates and the plunge rate."
     ),
     variables=(
         Variable("r", "parameter", 0.026, "Groove radius r: plunger-groove axis to input axis (seed sec. 2)",
@@ -83,13 +87,15 @@ SPEC = ModelSpec(
         Variable("delta_phi", "output", 0.0, "Angular deviation phi_out - phi_in (eq 18)", "rad", "deg",
                  depends_on=POSITION),
         Variable("omega_out", "output", 0.0,
-                 "Output shaft speed at the current bend, omega_in d(phi_out)/d(phi_in) (derivative of eq 18 or "
-                 "of the exact kinematics); d(phi_out)/dt only while beta is constant: a moving bend adds "
-                 "d(phi_out)/d(beta) beta_dot", "rad/s", "rpm", depends_on=(*POSITION, "omega_in")),
+                 "Output shaft speed at the current bend, psi_dot + (omega_in - psi_dot) d(phi_out)/d(phi_in) "
+                 "(derivative of eq 18 or of the exact kinematics); d(phi_out)/dt only while beta is constant: a "
+                 "moving bend adds d(phi_out)/d(beta) beta_dot", "rad/s", "rpm",
+                 depends_on=(*POSITION, "omega_in", "psi_dot")),
         Variable("omega_spin", "output", 0.0,
-                 "Angular velocity of the output shaft about its own axis (T_in omega_in = T0 omega_spin "
-                 "+ dKE/dt); differs from omega_out by the cone's geometric phase", "rad/s", "rpm",
-                 depends_on=(*POSITION, "omega_in", "beta_dot", "beta_rate")),
+                 "Angular velocity of the output shaft about its own axis, relative to the housing (T_in omega_in "
+                 "= T0 omega_spin + dKE/dt with the housing at rest); differs from omega_out by the cone's "
+                 "geometric phase", "rad/s", "rpm",
+                 depends_on=(*POSITION, "omega_in", "beta_dot", "psi_dot", "beta_rate")),
         Variable("T_in", "output", 0.0, "Driving torque on the input shaft about Z', plunger inertia included",
                  "N.m", depends_on=FORCES),
         Variable("F_pin", "output", 0.0, "Force F on each tripod arm, eq 24 with corrected eq 21: T0/(3r + 3rho)", "N",
@@ -99,28 +105,30 @@ SPEC = ModelSpec(
         Variable("theta", "output", 0.0, "Cone angle theta of the output shaft about the bearing centre", "rad", "deg",
                  depends_on=POSITION),
         Variable("a_plunger_sum", "output", 0.0, "Sum a1 + a2 + a3 of the plungers' axial accelerations (eq 20)",
-                 "m/s2", depends_on=(*POSITION, "omega_in", "alpha_in", "beta_dot", "beta_ddot", "beta_rate",
-                                     "seed_reactions")),
+                 "m/s2", depends_on=(*POSITION, "omega_in", "alpha_in", "beta_dot", "beta_ddot", "psi_dot",
+                                     "psi_ddot", "beta_rate", "seed_reactions")),
         Variable("Rz_out", "output", 0.0,
                  "Output self-aligning bearing on the output shaft: axial force R_z'' along the shaft (eq 30)", "N",
                  depends_on=(*FORCES, "seed_reactions")),
         Variable("Rx_out", "output", 0.0,
-                 "Output bearing on the output shaft: radial force along E1 (bend-plane side, normal to the shaft)",
+                 "Output bearing on the output shaft: radial force along E1 (in the bend plane, normal to the shaft)",
                  "N", depends_on=FORCES),
-        Variable("Ry_out", "output", 0.0, "Output bearing on the output shaft: radial force along E2 = Y' swung", "N",
+        Variable("Ry_out", "output", 0.0, "Output bearing on the output shaft: radial force along E2, the bend plane's normal swung with the shaft", "N",
                  depends_on=FORCES),
-        Variable("Rx_in", "output", 0.0, "Input bearing on the input shaft: force R_x' along X' (eq 33)", "N",
+        Variable("Rx_in", "output", 0.0,
+                 "Input bearing on the input shaft: force R_x' along the housing's X' (eq 33 at psi = 0)", "N",
                  depends_on=(*FORCES, "seed_reactions")),
-        Variable("Ry_in", "output", 0.0, "Input bearing on the input shaft: force R_y' along Y' (eq 34)", "N",
+        Variable("Ry_in", "output", 0.0,
+                 "Input bearing on the input shaft: force R_y' along the housing's Y' (eq 34 at psi = 0)", "N",
                  depends_on=(*FORCES, "seed_reactions")),
-        Variable("Mx_in", "output", 0.0, "Input bearing on the input shaft: moment about X' through the joint centre O",
+        Variable("Mx_in", "output", 0.0, "Input bearing on the input shaft: moment about the housing's X' through the joint centre O",
                  "N.m", depends_on=FORCES),
-        Variable("My_in", "output", 0.0, "Input bearing on the input shaft: moment about Y' through the joint centre O",
+        Variable("My_in", "output", 0.0, "Input bearing on the input shaft: moment about the housing's Y' through the joint centre O",
                  "N.m", depends_on=FORCES),
         Variable("Rz_in", "output", 0.0,
                  "Input bearing on the input shaft: axial force along Z'; the joint's generated axial force "
                  "on its housing is -Rz_in (friction only)", "N", depends_on=FRICTION),
-        Variable("P_friction", "output", 0.0, "Power dissipated by friction in the six sliding pairs", "W",
+        Variable("P_friction", "output", 0.0, "Power dissipated by friction in the six sliding pairs (sliding speeds relative to the housing)", "W",
                  depends_on=FRICTION),
         Variable("efficiency", "output", 1.0,
                  "Instantaneous efficiency, delivered over supplied power, with P_load = T_load omega_spin: drive "
@@ -141,7 +149,8 @@ SPEC = ModelSpec(
                  "Source of the bend angle's rates: 0 = the inputs beta_dot and beta_ddot, 1 = estimated "
                  "from the last three beta samples (quadratic through them; beta_dot, beta_ddot ignored), "
                  "2 = automatic: the samples until the host sets beta_dot or beta_ddot non-zero (or their input "
-                 "derivatives), the inputs from then on; an information line at the start while both are 0",
+                 "derivatives), the inputs from then on; an information line at the start while both are 0 "
+                 "(the bend plane's rates psi_dot, psi_ddot are always the inputs)",
                  type="Integer", min=RATES_FROM_INPUTS, max=RATES_AUTOMATIC),
         Variable("tripod_type", "parameter", PLAIN_TRIPOD,
                  "Joint: 0 = plain tripod (plungers sliding in the grooves, the seed's), 1 = single roller (a roller "
@@ -164,6 +173,19 @@ SPEC = ModelSpec(
         Variable("track_width", "parameter", 0.0331,
                  "Width of each roller track, flank to flank (assembly check)", "m", "mm", min=0.0,
                  min_exclusive=True),
+        Variable("psi", "input", 0.0,
+                 "Bend-plane angle psi: the bend plane's turn about the housing axis Z' from X'Z' (psi = 0: the "
+                 "output shaft leans towards -X', 90 deg towards -Y'); the arms' phase from the bend plane is "
+                 "phi_in - psi; psi at the step's end is psi + psi_dot h + psi_ddot h^2/2", "rad", "deg"),
+        Variable("psi_dot", "input", 0.0,
+                 "Bend-plane angle rate d(psi)/dt over the step: the input shaft turns at omega_in - psi_dot "
+                 "relative to the bend plane", "rad/s", derivative="psi"),
+        Variable("psi_ddot", "input", 0.0, "Bend-plane angle acceleration d(psi_dot)/dt over the step", "rad/s2",
+                 derivative="psi_dot"),
+        Variable("plunge_dot", "input", 0.0,
+                 "Plunge rate: axial speed of the spider (tripod centre) relative to the housing along Z', positive "
+                 "towards the output shaft; adds to every plunger's (roller's) sliding speed in its groove, which "
+                 "the groove friction and the rollers' rolling take", "m/s"),
     ),
     default_experiment=DefaultExperiment(0.0, 0.1, 1e-4),
     relations=(

@@ -22,8 +22,11 @@ SHARED = {
                                   "DIRECTION_POINTS", "LEAD_RATIO"),
     "driveline.layout_files": ("MAX_FILE_BYTES", "MAX_NESTING"),
     "driveline.rotor.loader": ("MAX_SEGMENTS", "MAX_POINT_ELEMENTS", "NODE_SNAP"),
-    "driveline.mounts.layout": ("MAX_MOUNTS", "ROTATION_TOLERANCE"),
-    "driveline.mounts.rigid_body": ("MIN_FREQUENCY_RATIO",),
+    "driveline.mounts.layout": ("MAX_MOUNTS", "ROTATION_TOLERANCE", "STOP_BLEND"),
+    "driveline.mounts.rigid_body": ("MIN_FREQUENCY_RATIO", "FREQUENCY_TOLERANCE", "MAX_FREQUENCY_ITERATIONS"),
+    "driveline.mounts.rubber": ("BAND", "RELAXATION_FREQUENCIES", "BRANCHES", "FIT_POINTS", "RATIO_WEIGHT",
+                                "MAX_LOSS_ERROR", "MAX_RATIO_ERROR"),
+    "driveline.mounts.forces": ("MAX_NEWTON", "NEWTON_STEP"),
     "driveline.mounts.joints": ("MIN_DIRECTION",),
     "driveline.mounts.exact_step": ("THETA_13", "MAX_SQUARINGS"),
     "driveline.rotor.elements": ("_SERIES_LIMIT",),
@@ -64,20 +67,31 @@ def c_name(module: str, name: str) -> str:
     return f"{package}_{leaf}_{name.lstrip('_')}".upper()
 
 
-def shared_constants() -> dict[str, tuple[str, int | float]]:
-    """Every shared constant: C name -> (its Python name, its value)."""
+Constant = int | float | tuple[float, ...]
+
+
+def _finite_number(value: object) -> bool:
+    return not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+
+
+def shared_constants() -> dict[str, tuple[str, Constant]]:
+    """Every shared constant: C name -> (its Python name, its value: a finite int or float, or a tuple of
+    them, which C reads as an array's initialiser ``{a, b}``)."""
     found = {}
     for module, names in SHARED.items():
         loaded = importlib.import_module(module)
         for name in names:
             value = getattr(loaded, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise TypeError(f"{module}.{name} = {value!r}: a shared constant is a finite int or float")
+            if not (_finite_number(value) or (isinstance(value, tuple) and value and all(map(_finite_number, value)))):
+                raise TypeError(f"{module}.{name} = {value!r}: a shared constant is a finite int or float, or a "
+                                "tuple of them")
             found[c_name(module, name)] = (f"{module}.{name}", value)
     return found
 
 
-def _literal(value: int | float) -> str:
+def _literal(value: Constant) -> str:
+    if isinstance(value, tuple):
+        return "{" + ", ".join(_literal(item) for item in value) + "}"
     text = str(value) if isinstance(value, int) else repr(float(value))  # repr: the same double in C
     return f"({text})" if value < 0 else text
 

@@ -121,36 +121,67 @@ def test_the_libcosim_master_gives_the_jacobi_masters_metrics(launch_ssp, schedu
 
 
 def test_a_tiny_shudder_map_on_a_local_cluster(launch_ssp, tmp_path, capsys):
-    """The map's command with 2 values per axis (8 launches of 2 s) on a local cluster of one worker: a
-    row per launch; at 20 % torque the joint turns less than the order tracking's window, which the
-    row's reason says; at full torque the peak grows with the friction coefficient at either bend angle;
-    a figure with a panel per friction coefficient, drawn the same again from the table alone."""
-    out, figure = tmp_path / "map.csv", tmp_path / "map.png"
-    shudder_map.main(["--package", str(launch_ssp), "--count", "2", "--duration", str(STOP), "--step", str(STEP),
-                      "--workers", "1", "--out", str(out), "--figure", str(figure)])
+    """The map's command with 2 values per axis and 2 phases of the right joint, 0 and 60 deg (16 launches of
+    2 s) on a local cluster of one worker: a row per launch; at 20 % torque the joint turns less than the
+    order tracking's window, which the row's reason says; at full torque, at either bend angle, the pitch
+    peak grows with the friction coefficient in phase and the lateral one 60 deg apart, where it is well
+    above the in-phase one (the two joints' axial forces nearly cancel in phase). The envelope over the phases:
+    a row per bend, torque and friction that ran, with each peak's largest and smallest value and the phase
+    of the largest, the launches' own. A figure with a panel per friction coefficient, drawn the same again
+    from the table alone."""
+    out, envelope, figure = tmp_path / "map.csv", tmp_path / "envelope.csv", tmp_path / "map.png"
+    shudder_map.main(["--package", str(launch_ssp), "--count", "2", "--phases", "2", "--duration", str(STOP),
+                      "--step", str(STEP), "--workers", "1", "--out", str(out), "--envelope", str(envelope),
+                      "--figure", str(figure)])
     table = read_table(out)
     rows = table.to_pylist()
-    assert len(rows) == 8 and figure.stat().st_size > 10_000
+    assert len(rows) == 16 and figure.stat().st_size > 10_000
     units = {column: unit_of_metric(column) for column in table.column_names
              if column not in ("status", "reason")}
     assert units_of(table) == units and units[shudder_map.PEAK] == "rad/s2" and units[shudder_map.TORQUE] == "N.m"
+    assert units[shudder_map.PHASE] == "rad" and units["mounts.y_ddot_order3_peak"] == "m/s2"
     assert pyarrow.csv.read_csv(out).column_names == [
         f"{name} [{units[name]}]" if name in units else name for name in table.column_names]
     low = [row for row in rows if row[shudder_map.TORQUE] < 100.0]
-    full = {(row[shudder_map.BETA], row[shudder_map.MU]): row[shudder_map.PEAK] for row in rows if row not in low}
+    full = {(row[shudder_map.BETA], row[shudder_map.MU], row[shudder_map.PHASE]): row for row in rows if row not in low}
     assert {row["reason"] for row in low} == {
         "ValueError: the shaft turns less than the 2 revolutions of the order tracking window"}
+    in_phase, apart = shudder_map.phases(2)
+    assert apart == pytest.approx(math.radians(60.0))
+    lateral = "mounts.y_ddot_order3_peak"
     for beta in shudder_map.axes(2)[shudder_map.BETA]:
-        assert full[beta, 0.1] > full[beta, 0.02] > 0.0
+        assert full[beta, 0.1, in_phase][shudder_map.PEAK] > full[beta, 0.02, in_phase][shudder_map.PEAK] > 0.0
+        assert full[beta, 0.1, apart][lateral] > full[beta, 0.02, apart][lateral] > 0.0
+        for mu in (0.02, 0.1):
+            assert full[beta, mu, apart][lateral] > LATERAL_GAIN * full[beta, mu, in_phase][lateral]
+    found = read_table(envelope)
+    assert units_of(found)["phases"] == "1" and units_of(found)[f"{lateral}_worst_phase"] == "rad"
+    assert units_of(found)[f"{lateral}_max"] == units_of(found)[f"{lateral}_min"] == "m/s2"
+    assert len(found) == 4 and all(row["phases"] == 2 for row in found.to_pylist())
+    for row in found.to_pylist():
+        for peak in shudder_map.PEAKS:
+            key = row[shudder_map.BETA], row[shudder_map.MU]
+            values = {phase: full[(*key, phase)][peak] for phase in (in_phase, apart)}
+            assert row[f"{peak}_max"] == max(values.values()) and row[f"{peak}_min"] == min(values.values())
+            assert values[row[f"{peak}_worst_phase"]] == row[f"{peak}_max"]
+        assert row[f"{lateral}_worst_phase"] == apart
     captured = capsys.readouterr()
-    assert "8 launches, 4 failed" in captured.out and "sweep [8/8]" in captured.err
+    assert "16 launches, 8 failed" in captured.out and "sweep [16/16]" in captured.err
     shudder_map.main(["--figure-only", "--out", str(out), "--figure", str(tmp_path / "again.png")])
     assert (tmp_path / "again.png").read_bytes() == figure.read_bytes()
 
 
+LATERAL_GAIN = 1.5
+"""The lateral third order 60 deg apart against in phase in the tiny map's launches, at least: measured 1.9
+to 4.0 (2026-12-07). In the package's 4 s launch at 140 N.m it is 15 times (docs/vehicle_launch.md); these 2 s
+launches at full torque pass the lateral mode's crossing (10 rad/s) within a fraction of a second, so its
+peak stays low, and the largest lateral third order of the short record is in part what lies off its
+crossing, which the phase changes less."""
+
+
 def unit_of_metric(column: str) -> str:
     """The unit of a launch map's numeric column from the components' specs (not the FMUs' model descriptions
-    the sweep reads): a point's name its first target's, a statistic its output's, the third-order peak its
+    the sweep reads): a point's name its first target's, a statistic its output's, a third-order peak its
     signal's and the speed there the shaft angle's per second."""
     models = {component.name: component.model for component in system.vehicle_launch().components}
 
@@ -158,10 +189,12 @@ def unit_of_metric(column: str) -> str:
         component, variable = name.split(".")
         return MODELS[models[component]].spec[variable].unit or "1"
 
-    if column == shudder_map.PEAK:
-        return unit(shudder_map.SIGNAL)
-    if column == f"{shudder_map.SIGNAL}_order3_speed":
-        return f"{unit(shudder_map.SHAFT)}/s"
+    for metric in shudder_map.THIRD_ORDERS:
+        peak, speed = metric.columns
+        if column == peak:
+            return unit(metric.outputs[1])
+        if column == speed:
+            return f"{unit(shudder_map.SHAFT)}/s"
     for output, statistic in SYSTEM_METRICS["VehicleLaunch"]:
         if column == f"{output}_{statistic}":
             return unit(output)

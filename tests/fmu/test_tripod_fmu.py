@@ -40,18 +40,21 @@ def test_model_description_carries_units_ranges_and_structure(tripod_fmu):
 
 
 def test_rates_are_declared_as_input_derivatives(fmu_path, fmi):
-    """alpha_in, beta_dot and beta_ddot are the derivatives of omega_in, beta and beta_dot (FMI 3.0's
-    derivative attribute; FMI 2.0 has it for states only). They come after every variable of before them,
-    the roller tripods' parameters after them, so the earlier value references (positions) stay."""
+    """alpha_in, beta_dot, beta_ddot, psi_dot and psi_ddot are the derivatives of omega_in, beta, beta_dot, psi
+    and psi_dot (FMI 3.0's derivative attribute; FMI 2.0 has it for states only). They come after every
+    variable of before them, the roller tripods' parameters after them and the moving housing's inputs after
+    those, so the earlier value references (positions) stay."""
     md = read_model_description(str(fmu_path("TripodCoupling", fmi)))
     variables = {v.name: v for v in md.modelVariables}
-    pairs = {"alpha_in": "omega_in", "beta_dot": "beta", "beta_ddot": "beta_dot"}
+    pairs = {"alpha_in": "omega_in", "beta_dot": "beta", "beta_ddot": "beta_dot", "psi_dot": "psi",
+             "psi_ddot": "psi_dot"}
     if fmi == "3":
         assert {name: variables[name].derivative.name for name in pairs} == pairs
     names = [v.name for v in md.modelVariables if v.causality != "independent"]
     last = names.index("F_plunger3")
     assert names[last + 1:] == ["beta_dot", "beta_ddot", "beta_rate", "tripod_type", "mu_roll", "roller_radius",
-                                "roller_bore_radius", "trunnion_radius", "track_width"]
+                                "roller_bore_radius", "trunnion_radius", "track_width", "psi", "psi_dot", "psi_ddot",
+                                "plunge_dot"]
     assert [variables[n].valueReference for n in names] == sorted(variables[n].valueReference for n in names)
 
 

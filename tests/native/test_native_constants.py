@@ -19,8 +19,12 @@ C_NAMES = {"FMU_PI": math.pi, "DBL_EPSILON": sys.float_info.epsilon, "DBL_MIN": 
            "DBL_MAX": sys.float_info.max}
 
 
-def _value(expression: str) -> float | None:
-    """The number a C constant expression stands for (literals, the names above, + - * /), else None."""
+def _value(expression: str) -> float | tuple | None:
+    """The number a C constant expression stands for (literals, the names above, + - * /), the tuple of an
+    array's initialiser ``{a, b}``, else None."""
+    if expression.strip().startswith("{") and expression.strip().endswith("}"):
+        items = [_value(item) for item in expression.strip()[1:-1].split(",")]
+        return None if None in items else tuple(items)
     text = re.sub(r"(?<=\d)[uUlLfF]+\b", "", expression.strip())
     for name, value in C_NAMES.items():
         text = re.sub(rf"\b{name}\b", repr(value), text)

@@ -55,10 +55,15 @@ STATES = {"VehicleDriveline": ({"v_x": -2.0, "slip_left": 0.02, "slip_right": -0
 
 #: Points of a model's derivatives beyond its dependency points (which the dependency tests pay for at every
 #: parameter): CriticalSpeeds below zero with heavy damping, the unbalance and the response off the middle, and
-#: on anisotropic damped bearings with two unbalances (the doubled response system, the sorted Campbell table)
+#: on anisotropic damped bearings with two unbalances (the doubled response system, the sorted Campbell table);
+#: PowertrainMounts on snubbers (tests/support/snubbed_mounts.toml), its states moved by SHIFT far onto the stops:
+#: the tangent rates k + k_s of the progressive characteristics (inside a stop's 2 mm blend the rate's third
+#: derivative, k_s 6 / w^2, makes the differences' truncation error h^2 F''' / 6 exceed their bounds)
 DERIVATIVE_POINTS = {"CriticalSpeeds": (
     {"omega_in": -500.0, "c_bearing": 5000.0, "unbalance_position": 0.3, "response_position": 0.8},
-    {"layout": str(Path(__file__).parents[1] / "support" / "anisotropic_tube.toml"), "omega_in": -700.0})}
+    {"layout": str(Path(__file__).parents[1] / "support" / "anisotropic_tube.toml"), "omega_in": -700.0}),
+    "PowertrainMounts": ({"layout": str(Path(__file__).parents[1] / "support" / "snubbed_mounts.toml"),
+                          "F_x": 300.0, "T_in_right": 400.0},)}
 
 
 #: Rows whose values round above eps, with their relative rounding: CriticalSpeeds' unbalance response and

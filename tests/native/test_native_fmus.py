@@ -47,7 +47,8 @@ def test_every_model_has_its_c_port_built(native_dir):
     CriticalSpeeds' rotor library, PowertrainMounts'; today every catalog model is."""
     for name, modules in (("CriticalSpeeds", {"layout.c", "transfer.c", "roots.c", "spline.c", "campbell.c", "fem.c",
                                               "damped.c"}),
-                          ("PowertrainMounts", {"layout.c", "dense.c"})):
+                          ("PowertrainMounts", {"layout.c", "characteristic.c", "rubber.c", "forces.c", "exact_step.c",
+                                               "implicit_step.c", "dense.c"})):
         folder = native.model_folder(name)
         assert native.library_modules(name) == sorted(path.name for path in folder.glob("*.c")
                                                       if path != native.model_source(name))
@@ -151,6 +152,11 @@ MODES = {  # parameters of the modes the standard scenario (spec start values) l
         {"kinematics": 1, "beta_dot": 2.0, "beta_ddot": -40.0},
         {"beta_dot": 2.0, "beta_ddot": -40.0},
         {"kinematics": 1, "beta_rate": 1},  # rates from the scenario's beta samples
+        # the moving housing: the bend plane turned and turning, the spider plunging, every tripod type
+        {"psi": 0.7, "psi_dot": 4.0, "psi_ddot": -30.0, "seed_reactions": 1},
+        {"kinematics": 1, "mu": 0.05, "psi": 0.7, "psi_dot": 4.0, "psi_ddot": -30.0, "plunge_dot": 0.02},
+        {"kinematics": 1, "mu": 0.05, "tripod_type": 1, "psi": -2.0, "psi_dot": -3.0, "plunge_dot": -0.01},
+        {"kinematics": 1, "mu": 0.05, "tripod_type": 2, "psi": 0.7, "psi_ddot": 30.0, "plunge_dot": 0.02},
     ],
 }
 
@@ -308,6 +314,9 @@ ARITHMETIC_FAILURES = [  # where the Python core fails arithmetically, the C por
     ("TripodCoupling", {"T_load": 1e307}),
     ("TripodCoupling", {"T_load": 1e307, "kinematics": 1}),
     ("TripodCoupling", {"T_load": 1e306}),
+    ("TripodCoupling", {"psi": 1e308}),  # the bend plane's angle: the pose at phi_in - psi
+    ("TripodCoupling", {"psi": -1e308, "kinematics": 1}),
+    ("TripodCoupling", {"psi_dot": 1e200, "kinematics": 1, "mu": 0.05}),  # the speed relative to the plane
 ]
 
 

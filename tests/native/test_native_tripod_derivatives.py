@@ -4,15 +4,16 @@ The generic checks (``tests/native/test_native_derivatives.py``) run at the star
 leading-order reactions) and the model's dependency points (exact with friction and the seed's eqs; rates
 from the samples). Here each mode on its own: closed form with the rates from the inputs and the seed's
 eqs, exact without friction, exact with friction (drive and coast: the efficiency's two branches), the
-automatic rates while both are 0, against central differences of the same FMU and the Python core's
+automatic rates while both are 0, each again in a moving housing (psi, psi_dot, psi_ddot, plunge_dot; the
+roller tripods there), against central differences of the same FMU and the Python core's
 extrapolated differences, with the tolerances of the generic test (``support.derivatives``) but for two
 rows where large terms cancel (``a_plunger_sum`` and ``Rz_out`` of the exact reactions, held to the
 differences' own rounding: ``support.derivatives.ROUNDING_ROWS``); their exact values are checked to 1e-10
 in the columns where the outputs are polynomials (below).
 
-Without friction every output is a polynomial of degree at most 2 in omega_in, alpha_in, T_load, beta_dot
-and beta_ddot (velocities linear in omega_in and beta_dot, accelerations and forces quadratic in them,
-linear in alpha_in, beta_ddot and T_load): one central difference of the core with a step of half the
+Without friction every output is a polynomial of degree at most 2 in omega_in, alpha_in, T_load, beta_dot,
+beta_ddot, psi_dot and psi_ddot (velocities linear in omega_in, beta_dot and psi_dot, accelerations and forces
+quadratic in them, linear in alpha_in, beta_ddot, psi_ddot and T_load; plunge_dot acts through friction alone): one central difference of the core with a step of half the
 column's scale is then exact up to rounding (measured 2.5e-11), every row included.
 """
 
@@ -25,7 +26,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 
 from driveline.catalog import MODELS
-from driveline.tripod.spec import EXACT, RATES_FROM_INPUTS
+from driveline.tripod.spec import DOUBLE_ROLLER, EXACT, RATES_FROM_INPUTS, SINGLE_ROLLER
 from fmu_harness.packaging import native
 from support import derivatives
 from support.model_exchange import ModelExchange
@@ -34,14 +35,26 @@ NAME = "TripodCoupling"
 SPEC = MODELS[NAME].spec
 TIME, SHIFT = 0.05, 0.4  # s, rad: as the generic test
 RATES = {"alpha_in": 30.0, "beta_dot": 0.5, "beta_ddot": 3.0}
+HOUSING = {"psi": 0.7, "psi_dot": 4.0, "psi_ddot": 25.0, "plunge_dot": 0.02}
 POINTS = {
     "closed form, rates from the inputs, seed eqs": {"beta_rate": RATES_FROM_INPUTS, "seed_reactions": 1, **RATES},
     "exact, no friction, rates from the inputs": {"kinematics": EXACT, "beta_rate": RATES_FROM_INPUTS, **RATES},
     "exact, friction, drive": {"kinematics": EXACT, "mu": 0.05, **RATES},
     "exact, friction, coast, automatic rates at 0": {"kinematics": EXACT, "mu": 0.05, "T_load": -100.0,
                                                      "alpha_in": -20.0},
+    # the moving housing: the bend plane turned by psi and turning, the spider plunging
+    "closed form, moving housing, seed eqs": {"beta_rate": RATES_FROM_INPUTS, "seed_reactions": 1, **RATES, **HOUSING},
+    "exact, no friction, moving housing": {"kinematics": EXACT, "beta_rate": RATES_FROM_INPUTS, **RATES, **HOUSING},
+    "exact, friction, moving housing": {"kinematics": EXACT, "mu": 0.05, **RATES, **HOUSING},
+    "single roller, friction, moving housing": {"kinematics": EXACT, "mu": 0.05, "tripod_type": SINGLE_ROLLER,
+                                                **RATES, **HOUSING},
+    "double roller, friction, moving housing": {"kinematics": EXACT, "mu": 0.05, "tripod_type": DOUBLE_ROLLER,
+                                                "T_load": -300.0, **RATES, **HOUSING},
 }
-POLYNOMIAL = ("omega_in", "alpha_in", "T_load", "beta_dot", "beta_ddot")
+#: Without friction the outputs are polynomials of degree 2 in these too: psi_dot enters as omega_in does
+#: (omega_in - psi_dot, plus psi_dot e_z in the output's angular velocity), psi_ddot as alpha_in, plunge_dot
+#: not at all
+POLYNOMIAL = ("omega_in", "alpha_in", "T_load", "beta_dot", "beta_ddot", "psi_dot", "psi_ddot", "plunge_dot")
 FMU_TOLERANCE, CORE_TOLERANCE = 1e-7, 1e-10
 
 

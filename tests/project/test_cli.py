@@ -46,6 +46,8 @@ def assert_one_line_mistake(run: subprocess.CompletedProcess, *words: str) -> No
     (["sweep", "--grid", "beta=0.1", "--out", "x.xlsx"], ["--out", "x.xlsx: write a .parquet or a .csv file"]),
     (["map", "--out", "map.xlsx"], ["--out", "map.xlsx: write a .parquet or a .csv file"]),
     (["map", "--duration", "1"], ["--duration 1 s", "less than the 2 revolutions", "at least 1.4 s"]),
+    (["map", "--phases", "0"], ["--phases must be at least 1, got 0"]),
+    (["map", "--envelope", "envelope.xlsx"], ["--envelope", "envelope.xlsx: write a .parquet or a .csv file"]),
 ])
 def test_a_mistake_is_one_line_and_a_non_zero_exit(arguments, words, tmp_path):
     assert_one_line_mistake(driveline_fmus(*arguments, cwd=tmp_path), *words)

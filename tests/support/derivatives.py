@@ -33,8 +33,12 @@ CORE_STEP = 2e-3
 #: accelerations built from terms of |Omega|^2 l, about 3e4 m/s^2, to about 0.04 m/s^2: the differences'
 #: rounding, eps 3e4 / h over the row's scale of 0.5, is 1e-5 with the FMU's step 1e-6 (measured 1.9e-5) and
 #: 3e-8 with the core's 5e-4 (measured 7.0e-8); ``Rz_out``, the axial part of three arm forces of some 1e3 N:
-#: the core's rounding measured 2.6e-10.
-ROUNDING_ROWS = {"TripodCoupling": {"a_plunger_sum": (1e-4, 5e-7), "Rz_out": (1e-7, 1e-9)}}
+#: the core's rounding measured 2.6e-10; ``Rx_in``, ``Ry_in``, the input bearing's radial force, sum the three
+#: groove forces that carry the plungers' inertia, m |Omega|^2 l of some 6e3 N each, to tens of N: the core's
+#: extrapolated rounding, 6.6 eps 6e3 / 2e-3 over the row's scale of about 40, is 1e-10 (measured 1.1e-10 in the
+#: column psi_dot, whose scale is 1 rad/s against omega_in's 209).
+ROUNDING_ROWS = {"TripodCoupling": {"a_plunger_sum": (1e-4, 5e-7), "Rz_out": (1e-7, 1e-9), "Rx_in": (1e-7, 5e-10),
+                                   "Ry_in": (1e-7, 5e-10)}}
 
 
 def row_bounds(name: str, fmu_tolerance: float, core_tolerance: float) -> tuple[np.ndarray, np.ndarray]:

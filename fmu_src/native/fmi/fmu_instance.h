@@ -23,10 +23,10 @@
 #define UNUSED
 #endif
 
-/* Internal state slots: the most any model needs (TripodCoupling: a flag and the exact solver's
- * five-number warm start, the bend samples, the rates' choice); a new count needs a new
- * STATE_FORMAT (fmu_state.c). */
-#define FMU_INTERNAL_SLOTS 12
+/* Internal state slots: the most any model needs (PowertrainMounts: the Maxwell branches' forces, one per
+ * mount, axis and branch; TripodCoupling needs 12: a flag and the exact solver's five-number warm start, the
+ * bend samples, the rates' choice); a new count needs a new STATE_FORMAT (fmu_state.c). */
+#define FMU_INTERNAL_SLOTS (MOUNTS_LAYOUT_MAX_MOUNTS * 3 * MOUNTS_RUBBER_BRANCHES)
 /* Longest String value accepted, in characters (code points; model_adapter.MAX_STRING), and so
  * in bytes of UTF-8 at most four times that. */
 #define FMU_MAX_STRING 4096

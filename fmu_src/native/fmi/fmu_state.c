@@ -11,7 +11,7 @@
 /* ---- FMU state ---------------------------------------------------------------------------- */
 
 #define STATE_TAG 0x4452564C53544154ull /* marks a live StoredState */
-#define STATE_FORMAT 5u /* 5: twelve internal slots (4: eleven; 3: String values; 2: six internal slots; 1 had four) */
+#define STATE_FORMAT 6u /* 6: 96 internal slots (5: twelve; 4: eleven; 3: String values; 2: six internal slots; 1 had four) */
 static const char STATE_MAGIC[8] = {'D', 'R', 'V', 'L', 'S', 'T', 'A', 'T'};
 
 /* A stored state owns the copies of its strings; its ``data.cache`` is NULL. */

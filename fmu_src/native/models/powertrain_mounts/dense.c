@@ -22,6 +22,17 @@ void dense_multiply(const double *a, const double *b, double *c, int n, int m, i
     }
 }
 
+/* max |v_i| of the ``n`` numbers of ``v`` */
+double dense_largest(const double *v, int n)
+{
+    double found = 0.0;
+    int i;
+    for (i = 0; i < n; i++) {
+        found = fmax(found, fabs(v[i]));
+    }
+    return found;
+}
+
 /* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) by Gaussian
  * elimination with partial pivoting (a overwritten); 0 if a is singular. */
 int dense_solve(double *a, double *b, int n, int columns)
@@ -122,14 +133,14 @@ void dense_symmetric_eigen(double *a, double *vectors, int n)
 }
 
 /* exp(z) by the degree-13 Pade approximant with ``count`` squarings (Higham 2005); 0 without memory */
-int dense_exponential(double *z, int count, double *out)
+int dense_exponential(double *z, int n, int count, double *out)
 {
     static const double b[14] = {64764752532480000.0, 32382376266240000.0, 7771770303897600.0,
                                  1187353796428800.0,  129060195264000.0,   10559470521600.0,
                                  670442572800.0,      33522128640.0,       1323241920.0,
                                  40840800.0,          960960.0,            16380.0,
                                  182.0,               1.0};
-    const int n = MOUNTS_AUGMENTED, nn = MOUNTS_AUGMENTED * MOUNTS_AUGMENTED;
+    const int nn = n * n;
     double *w = malloc(6 * nn * sizeof *w), *a2, *a4, *a6, *u, *v, scale = ldexp(1.0, -count);
     int i;
     if (w == NULL) {

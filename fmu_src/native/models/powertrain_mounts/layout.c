@@ -10,8 +10,6 @@ static const char *const TOP_KEYS[] = {"centre_of_gravity", "inertia", "loss_fac
                                        "name", NULL};
 static const char *const MOUNT_KEYS[] = {"damping",  "dynamic_ratio", "gap",       "label",      "loss_factor",
                                          "orientation", "position",  "stiffness", "stop_blend", "stop_rate", NULL};
-/* The keys of progressive and rubber mounts (layout._stop, layout._branches), not ported yet: refused by name */
-static const char *const RUBBER_KEYS[] = {"dynamic_ratio", "gap", "stop_blend", "stop_rate", NULL};
 
 /* layout._vector */
 static ErrorKind vector3(const Loader *loader, const char *where, const char *key, const Value *value, int signed_,
@@ -79,6 +77,82 @@ static ErrorKind orientation(const Loader *loader, const char *where, const Valu
     return ERROR_NONE;
 }
 
+/* layout._branches: the Maxwell weights of a mount's loss_factor in (0, 1) and dynamic_ratio >= 1 */
+static ErrorKind branches(const Loader *loader, const char *where, const Value *t, Mount *m)
+{
+    const Value *loss = layout_get(t, "loss_factor"), *ratio_value = layout_get(t, "dynamic_ratio");
+    double eta, ratio;
+    RubberFit fit;
+    int j;
+    ErrorKind failed;
+    if (loss == NULL) {
+        return layout_error(loader->error, loader->size,
+                            "%s.dynamic_ratio needs the key 'loss_factor' (the loss factor its branches fit)", where);
+    }
+    if ((failed = layout_number(loader, where, "loss_factor", loss, 0, 0, &eta)) != ERROR_NONE) {
+        return failed;
+    }
+    if (!(0.0 < eta && eta < 1.0)) {
+        return layout_error(loader->error, loader->size, "%s.loss_factor must lie in (0, 1) for rubber damping, got %v",
+                            where, loss);
+    }
+    if ((failed = layout_number(loader, where, "dynamic_ratio", ratio_value, 0, 0, &ratio)) != ERROR_NONE) {
+        return failed;
+    }
+    if (!(ratio >= 1.0)) {
+        return layout_error(loader->error, loader->size,
+                            "%s.dynamic_ratio must be >= 1 (dynamic over static rate), got %v", where, ratio_value);
+    }
+    rubber_fit(eta, ratio, &fit);
+    if (rubber_fit_error(where, &fit, eta, ratio, loader->error, loader->size)) {
+        return ERROR_VALUE;
+    }
+    m->branch_count = MOUNTS_RUBBER_BRANCHES;
+    for (j = 0; j < MOUNTS_RUBBER_BRANCHES; j++) {
+        m->branches[j] = fit.weights[j];
+    }
+    return ERROR_NONE;
+}
+
+/* layout._stop: a mount's snubber, gap >= 0 and stop_rate given together, the characteristic monotonic */
+static ErrorKind stop(const Loader *loader, const char *where, const Value *t, Mount *m)
+{
+    const Value *gap = layout_get(t, "gap"), *rate = layout_get(t, "stop_rate"), *blend = layout_get(t, "stop_blend");
+    char rate_text[40], sum_text[40];
+    int k;
+    ErrorKind failed;
+    if ((gap == NULL) != (rate == NULL)) {
+        return layout_error(loader->error, loader->size, "%s.%s needs the key %r (a snubber has both)", where,
+                            gap != NULL ? "gap" : "stop_rate", gap != NULL ? "stop_rate" : "gap");
+    }
+    m->stop_blend = MOUNTS_LAYOUT_STOP_BLEND;
+    if (blend != NULL && (failed = layout_number(loader, where, "stop_blend", blend, 1, 0, &m->stop_blend))) {
+        return failed;
+    }
+    if (gap == NULL) {
+        return ERROR_NONE;
+    }
+    if ((failed = vector3(loader, where, "gap", gap, 0, m->gap)) != ERROR_NONE ||
+        (failed = vector3(loader, where, "stop_rate", rate, 1, m->stop_rate)) != ERROR_NONE) {
+        return failed;
+    }
+    for (k = 0; k < 3; k++) {
+        if (m->stiffness[k] + m->stop_rate[k] < 0.0) {
+            python_float_repr(m->stop_rate[k], rate_text, sizeof rate_text);
+            python_float_repr(m->stiffness[k] + m->stop_rate[k], sum_text, sizeof sum_text);
+            return layout_error(loader->error, loader->size,
+                                "%s.stop_rate[%d] %s makes the characteristic not monotonic: stiffness[%d] + "
+                                "stop_rate[%d] = %s < 0 beyond the gap", where, k, rate_text, k, k, sum_text);
+        }
+    }
+    return ERROR_NONE;
+}
+
+int mount_progressive(const Mount *m)
+{
+    return m->stop_rate[0] != 0.0 || m->stop_rate[1] != 0.0 || m->stop_rate[2] != 0.0;
+}
+
 /* layout._mount; ``loss_frequency`` < 0: the layout gives none */
 static ErrorKind mount(const Loader *loader, int i, const Value *t, double loss_frequency, Mount *m)
 {
@@ -93,13 +167,6 @@ static ErrorKind mount(const Loader *loader, int i, const Value *t, double loss_
     if ((failed = layout_unknown(loader, where, t, MOUNT_KEYS)) != ERROR_NONE) {
         return failed;
     }
-    for (k = 0; RUBBER_KEYS[k] != NULL; k++) {
-        if (layout_get(t, RUBBER_KEYS[k]) != NULL) {
-            return layout_error(loader->error, loader->size,
-                                "%s.%s: progressive and rubber mounts are taken by the Python FMUs only so far (the "
-                                "native FMU reads linear mounts)", where, RUBBER_KEYS[k]);
-        }
-    }
     for (k = 0; k < 2; k++) {
         if (layout_get(t, required[k]) == NULL) {
             return layout_error(loader->error, loader->size, "%s: missing key %r", where, required[k]);
@@ -111,7 +178,11 @@ static ErrorKind mount(const Loader *loader, int i, const Value *t, double loss_
     if (damping != NULL && loss != NULL) {
         return layout_error(loader->error, loader->size, "%s: give either 'damping' or 'loss_factor', not both", where);
     }
-    if (loss != NULL) {
+    if (layout_get(t, "dynamic_ratio") != NULL) {
+        if ((failed = branches(loader, where, t, m)) != ERROR_NONE) {
+            return failed;
+        }
+    } else if (loss != NULL) {
         if (loss_frequency < 0.0) {
             return layout_error(loader->error, loader->size,
                                 "%s.loss_factor needs the top-level key 'loss_factor_frequency'", where);
@@ -136,6 +207,9 @@ static ErrorKind mount(const Loader *loader, int i, const Value *t, double loss_
         m->axes[k][2] = k == 2;
     }
     if (axes != NULL && (failed = orientation(loader, where, axes, m->axes)) != ERROR_NONE) {
+        return failed;
+    }
+    if ((failed = stop(loader, where, t, m)) != ERROR_NONE) {
         return failed;
     }
     return vector3(loader, where, "position", layout_get(t, "position"), 1, m->position);

@@ -1,12 +1,13 @@
-/* PowertrainMounts: a rigid powertrain on linear rubber mounts, small motion about its static equilibrium
- * (port of driveline/mounts/: layout.py, rigid_body.py, joints.py, exact_step.py, system.py, model.py).
+/* PowertrainMounts: a rigid powertrain on rubber mounts, small motion about its static equilibrium
+ * (port of driveline/mounts/: rigid_body.py, joints.py, system.py, model.py; the library of mounts.h the rest).
  *
  * The layout is read with the shared layout reader (lib/toml.h: the file rules of
  * driveline/layout_files.py). The system (matrices, modes, input map, the weight's sag) is the model's
  * derived data, built when the parameters change; the propagator of a step size (Phi, Gamma0, Gamma1, one
  * exponential of the augmented matrix: Pade 13 with scaling and squaring, exact_step.squarings' count) is
- * built again only when the step size changes. The state (q, q') is the outputs x ... yaw_dot, Model Exchange's
- * continuous states (spec._states).
+ * built again only when the step size changes; progressive mounts step by the implicit scheme
+ * (implicit_step.c). The state (q, q', z): q and q' the outputs x ... yaw_dot, Model Exchange's continuous states
+ * (spec._states), z the Maxwell branches' forces, the internal state (data->internal, one slot a branch).
  */
 #include <math.h>
 #include <stdio.h>
@@ -17,7 +18,8 @@
 #include "mounts.h"
 
 #define ERROR_SIZE FMU_MESSAGE_SIZE
-#define AUGMENTED MOUNTS_AUGMENTED
+#define MAX_STATE MOUNTS_MAX_STATE
+#define MAPS(s) ((const double(*)[3][6])(s)->maps)
 
 /* ---- the system (rigid_body.py, joints.py, system.py) --------------------------------------------- */
 
@@ -32,19 +34,19 @@ static const int STATIC_VARIABLES[6] = {V_x_static,    V_y_static,     V_z_stati
 static const char *const COORDINATES[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
 
 typedef struct {
-    double h, phi[12][12], gamma0[12][6], gamma1[12][6];
-} Propagator;
-
-typedef struct {
     int held;
     int parameter_count, parameter[MODEL_VARIABLE_COUNT]; /* the Real parameters it was built for */
     double parameters[MODEL_VARIABLE_COUNT];               /* and their values */
     char *layout_name;                      /* owned */
     Layout layout;
-    double mass[6][6], stiffness[6][6], damping[6][6], a[12][12], b[12][6], inputs[6][N_INPUTS];
+    double mass[6][6], stiffness[6][6], damping[6][6], a[MAX_STATE][MAX_STATE], b[MAX_STATE][6];
+    double inputs[6][N_INPUTS];
     double maps[MOUNTS_LAYOUT_MAX_MOUNTS][3][6]; /* each mount's A T(p) */
     double frequencies[6], shares[6][6], damping_ratios[6], roll_axis[3], motor_axis[3], weight_sag[6];
+    double weight[6], operating[6]; /* the weight's generalised force; Q under it and -T_mean (the static sag) */
     int dominant[6];
+    int progressive, size; /* a mount's characteristic is nonlinear; the state's length, 12 and the branches */
+    Branches branches;
     int has_propagator;
     Propagator propagator;
     char failure[ERROR_SIZE];
@@ -148,15 +150,15 @@ static void matrices(System *s)
     }
 }
 
-/* rigid_body.modes: K phi = w^2 M phi through M = L L^T (Cholesky) and Jacobi on L^-1 K L^-T; the damping
- * ratios of the modal strain energy, phi^T (2 pi f C) phi / (2 phi^T K phi) */
-static void modes(System *s)
+/* K phi = w^2 M phi through M = L L^T (Cholesky) and Jacobi on L^-1 K L^-T (scipy.linalg.eigh's part): the
+ * eigenvalues ascending, the mass-normalised shapes in the columns */
+static void eigen(double mass[6][6], double stiffness[6][6], double values[6], double shapes[6][6])
 {
-    double l[6][6] = {{0}}, c[36], vectors[36], shapes[6][6], momenta[6], w2[6];
+    double l[6][6] = {{0}}, c[36], vectors[36], w2[6];
     int order[6], i, j, k;
     for (j = 0; j < 6; j++) {
         for (i = j; i < 6; i++) {
-            double sum = s->mass[i][j];
+            double sum = mass[i][j];
             for (k = 0; k < j; k++) {
                 sum -= l[i][k] * l[j][k];
             }
@@ -166,7 +168,7 @@ static void modes(System *s)
     for (j = 0; j < 6; j++) { /* c = L^-1 K L^-T, column by column of L^-1 K, then rows */
         double column[6];
         for (i = 0; i < 6; i++) {
-            double sum = s->stiffness[i][j];
+            double sum = stiffness[i][j];
             for (k = 0; k < i; k++) {
                 sum -= l[i][k] * column[k];
             }
@@ -205,6 +207,7 @@ static void modes(System *s)
         }
     }
     for (j = 0; j < 6; j++) { /* shape j = L^-T v */
+        values[j] = w2[order[j]];
         for (i = 5; i >= 0; i--) {
             double sum = vectors[i * 6 + order[j]];
             for (k = i + 1; k < 6; k++) {
@@ -213,19 +216,83 @@ static void modes(System *s)
             shapes[i][j] = sum / l[i][i];
         }
     }
-    for (j = 0; j < 6; j++) {
-        double total = 0.0, storage = 0.0, loss = 0.0;
-        s->frequencies[j] = sqrt(fmax(w2[order[j]], 0.0)) / (2.0 * FMU_PI);
-        for (i = 0; i < 6; i++) {
-            double stiff = 0.0, damp = 0.0;
-            for (k = 0; k < 6; k++) {
-                stiff += s->stiffness[i][k] * shapes[k][j];
-                damp += 2.0 * FMU_PI * s->frequencies[j] * s->damping[i][k] * shapes[k][j];
-            }
-            storage += shapes[i][j] * stiff;
-            loss += shapes[i][j] * damp;
+}
+
+/* phi_j^T a phi_j */
+static double modal(double a[6][6], double shapes[6][6], int j)
+{
+    double total = 0.0;
+    int i, k;
+    for (i = 0; i < 6; i++) {
+        double row = 0.0;
+        for (k = 0; k < 6; k++) {
+            row += a[i][k] * shapes[k][j];
         }
-        s->damping_ratios[j] = storage > 0.0 ? loss / (2.0 * storage) : 0.0;
+        total += shapes[i][j] * row;
+    }
+    return total;
+}
+
+/* Mode j's fixed point (K + K_s(f_j)) phi_j = (2 pi f_j)^2 M phi_j, the branches' storage at its own frequency
+ * (rigid_body.modes), from ``frequency``: the frequency, its shape into column j of ``shapes``, the branches'
+ * stiffness there into ``storage`` (K + K_s), ``loss``, ``slope`` */
+static double fixed_point(System *s, double stiffness[6][6], int j, double frequency,
+                          double shapes[6][6], double storage[6][6], double loss[6][6], double slope[6][6])
+{
+    double values[6], vectors[6][6] = {{0}};
+    int iteration, i, k;
+    for (iteration = 0; iteration < MOUNTS_RIGID_BODY_MAX_FREQUENCY_ITERATIONS; iteration++) {
+        double previous = frequency;
+        forces_branch_stiffness(&s->branches, frequency, storage, loss, slope);
+        for (i = 0; i < 6; i++) {
+            for (k = 0; k < 6; k++) {
+                storage[i][k] = stiffness[i][k] + storage[i][k];
+            }
+        }
+        eigen(s->mass, storage, values, vectors);
+        frequency = sqrt(fmax(values[j], 0.0)) / (2.0 * FMU_PI);
+        if (fabs(frequency - previous) <= MOUNTS_RIGID_BODY_FREQUENCY_TOLERANCE * frequency) {
+            break;
+        }
+    }
+    for (i = 0; i < 6; i++) {
+        shapes[i][j] = vectors[i][j];
+    }
+    forces_branch_stiffness(&s->branches, frequency, storage, loss, slope);
+    for (i = 0; i < 6; i++) {
+        for (k = 0; k < 6; k++) {
+            storage[i][k] = stiffness[i][k] + storage[i][k];
+        }
+    }
+    return frequency;
+}
+
+/* rigid_body.modes about an operating point of tangent stiffness ``stiffness``, with the Maxwell branches
+ * (``with_branches``): the damping ratios of the modal strain energy, phi^T K_l phi / (2 phi^T K_s phi -
+ * phi^T w dK_s/dw phi), K_l = 2 pi f C + the branches' loss stiffness */
+static void modes(System *s, double stiffness[6][6], int with_branches)
+{
+    double shapes[6][6], momenta[6], w2[6], storage[6][6], loss[6][6], slope[6][6];
+    int i, j, k;
+    eigen(s->mass, stiffness, w2, shapes);
+    for (j = 0; j < 6; j++) {
+        s->frequencies[j] = sqrt(fmax(w2[j], 0.0)) / (2.0 * FMU_PI);
+    }
+    for (j = 0; j < 6; j++) {
+        double total = 0.0, energy;
+        memcpy(storage, stiffness, sizeof storage);
+        memset(loss, 0, sizeof loss);
+        memset(slope, 0, sizeof slope);
+        if (with_branches) {
+            s->frequencies[j] = fixed_point(s, stiffness, j, s->frequencies[j], shapes, storage, loss, slope);
+        }
+        for (i = 0; i < 6; i++) {
+            for (k = 0; k < 6; k++) {
+                loss[i][k] = loss[i][k] + 2.0 * FMU_PI * s->frequencies[j] * s->damping[i][k];
+            }
+        }
+        energy = 2.0 * modal(storage, shapes, j) - modal(slope, shapes, j);
+        s->damping_ratios[j] = energy > 0.0 ? modal(loss, shapes, j) / energy : 0.0;
         for (i = 0; i < 6; i++) {
             momenta[i] = 0.0;
             for (k = 0; k < 6; k++) {
@@ -243,36 +310,12 @@ static void modes(System *s)
     }
 }
 
-/* exact_step.state_matrices and system.input_map */
+/* exact_step.state_matrices (with the branches) and system.input_map */
 static int state_and_inputs(System *s, double centres[2][3], double frames[2][3][3])
 {
-    double inverse[6][6], identity[6][6] = {{0}}, product[6][6], mass[6][6];
-    int i, j, side, k;
-    memcpy(mass, s->mass, sizeof mass);
-    for (i = 0; i < 6; i++) {
-        identity[i][i] = 1.0;
-    }
-    memcpy(inverse, identity, sizeof inverse);
-    if (!dense_solve(&mass[0][0], &inverse[0][0], 6, 6)) {
+    int i, side, k;
+    if (!exact_state_matrices(s->mass, s->stiffness, s->damping, &s->branches, s->a, s->b)) {
         return 0;
-    }
-    memset(s->a, 0, sizeof s->a);
-    memset(s->b, 0, sizeof s->b);
-    for (i = 0; i < 6; i++) {
-        s->a[i][6 + i] = 1.0;
-    }
-    dense_multiply(&inverse[0][0], &s->stiffness[0][0], &product[0][0], 6, 6, 6);
-    for (i = 0; i < 6; i++) {
-        for (j = 0; j < 6; j++) {
-            s->a[6 + i][j] = -product[i][j];
-            s->b[6 + i][j] = inverse[i][j];
-        }
-    }
-    dense_multiply(&inverse[0][0], &s->damping[0][0], &product[0][0], 6, 6, 6);
-    for (i = 0; i < 6; i++) {
-        for (j = 0; j < 6; j++) {
-            s->a[6 + i][6 + j] = -product[i][j];
-        }
     }
     memset(s->inputs, 0, sizeof s->inputs);
     for (i = 0; i < 6; i++) {
@@ -311,6 +354,17 @@ static int static_displacement(const System *s, const double load[6], double out
     return dense_solve(&k[0][0], out, 6, 1);
 }
 
+/* system._equilibrium: Q under the generalised ``load`` (the weight's included), K^-1 load for linear mounts
+ * (as ever), else Newton's root of the characteristics; ERROR_NONE or the failure with its message */
+static ErrorKind equilibrium(const System *s, const double load[6], double out[6], const char **message)
+{
+    if (!s->progressive) {
+        *message = "Singular matrix";
+        return static_displacement(s, load, out) ? ERROR_NONE : ERROR_VALUE;
+    }
+    return forces_equilibrium(&s->layout, (const double(*)[3][6])s->maps, load, s->stiffness, out, message);
+}
+
 /* rigid_body.torque_roll_axis */
 static void torque_roll_axis(System *s)
 {
@@ -347,6 +401,44 @@ static int restrained(const System *s, char *error)
 
 /* ---- building the system (MountSystem.build, model.extra_parameter_errors) -------------------------- */
 
+/* MountSystem.build past the unrestrained check: the weight's equilibrium, the operating point under the
+ * weight and -T_mean about the motor axis (the static sag), the branches' rates there, the state matrices and
+ * input map, the modes about the operating point; 0 with the message */
+static int operating_point(System *s, const ModelData *data, double centres[2][3], double frames[2][3][3], char *error)
+{
+    double load[6] = {0}, tangent[6][6];
+    const char *message = NULL;
+    ErrorKind failed;
+    int i, n;
+    s->progressive = 0;
+    for (n = 0; n < s->layout.count; n++) {
+        s->progressive |= mount_progressive(&s->layout.mounts[n]);
+    }
+    memset(s->weight, 0, sizeof s->weight);
+    s->weight[2] = -s->layout.mass * VALUE(g);
+    for (i = 0; i < 6; i++) {
+        load[i] = s->weight[i] + (i < 3 ? 0.0 : -VALUE(T_mean) * s->motor_axis[i - 3]);
+    }
+    if ((failed = equilibrium(s, load, s->operating, &message)) != ERROR_NONE ||
+        (failed = equilibrium(s, s->weight, s->weight_sag, &message)) != ERROR_NONE) {
+        snprintf(error, ERROR_SIZE, "%s", message);
+        return 0;
+    }
+    s->size = 12 + forces_branch_map(&s->layout, (const double(*)[3][6])s->maps, s->operating, &s->branches);
+    if (!state_and_inputs(s, centres, frames)) {
+        snprintf(error, ERROR_SIZE, "Singular matrix");
+        return 0;
+    }
+    if (s->progressive) {
+        forces_tangent_stiffness(&s->layout, (const double(*)[3][6])s->maps, s->operating, tangent);
+    } else {
+        memcpy(tangent, s->stiffness, sizeof tangent);
+    }
+    modes(s, tangent, s->branches.count > 0);
+    torque_roll_axis(s);
+    return 1;
+}
+
 static void vector_of(const ModelData *data, const int variables[3], double out[3])
 {
     int k;
@@ -368,7 +460,7 @@ static int build(System *s, const ModelData *data, char *error)
                                     {V_bend_x_right, V_bend_y_right, V_bend_z_right}};
     static const int motor[3] = {V_motor_axis_x, V_motor_axis_y, V_motor_axis_z};
     static const char *const sides[2] = {"left", "right"};
-    double centre[2][3], shaft[3], bend[3], frames[2][3][3], axis[3], length, gravity[6] = {0};
+    double centre[2][3], shaft[3], bend[3], frames[2][3][3], axis[3], length;
     int side, k;
     for (side = 0; side < 2; side++) {
         vector_of(data, centres[side], centre[side]);
@@ -397,17 +489,11 @@ static int build(System *s, const ModelData *data, char *error)
         return 0;
     }
     matrices(s);
-    modes(s);
+    modes(s, s->stiffness, 0);
     if (!restrained(s, error)) {
         return 0;
     }
-    gravity[2] = -s->layout.mass * VALUE(g);
-    if (!state_and_inputs(s, centre, frames) || !static_displacement(s, gravity, s->weight_sag)) {
-        snprintf(error, ERROR_SIZE, "Singular matrix");
-        return 0;
-    }
-    torque_roll_axis(s);
-    return 1;
+    return operating_point(s, data, centre, frames, error);
 }
 
 static int built_for(const System *s, const ModelData *data)
@@ -465,91 +551,6 @@ static void extra_parameter_errors(const ModelData *data, Messages *out)
     cache->derived = built;
 }
 
-/* ---- the exact step (exact_step.py) ----------------------------------------------------------------- */
-
-/* exact_step.augmented: Z h (24 x 24) */
-static void augmented(const System *s, double h, double *z)
-{
-    int i, j;
-    memset(z, 0, AUGMENTED * AUGMENTED * sizeof *z);
-    for (i = 0; i < 12; i++) {
-        for (j = 0; j < 12; j++) {
-            z[i * AUGMENTED + j] = s->a[i][j] * h;
-        }
-        for (j = 0; j < 6; j++) {
-            z[i * AUGMENTED + 12 + j] = s->b[i][j] * h;
-        }
-    }
-    for (i = 0; i < 6; i++) {
-        z[(12 + i) * AUGMENTED + 18 + i] = h;
-    }
-}
-
-/* exact_step.squarings: -1 where the norm is not finite (no count of squarings scales it) */
-static int squarings(const double *z)
-{
-    double norm = 0.0;
-    int i, j;
-    for (j = 0; j < AUGMENTED; j++) {
-        double sum = 0.0;
-        for (i = 0; i < AUGMENTED; i++) {
-            sum += fabs(z[i * AUGMENTED + j]);
-        }
-        norm = fmax(norm, sum);
-    }
-    if (!isfinite(norm)) {
-        return -1;
-    }
-    /* a finite norm needs at most log2(DBL_MAX / THETA_13) + 1 = 1022 squarings: an int holds the count */
-    return norm > MOUNTS_EXACT_STEP_THETA_13 ? (int)fmax(0.0, ceil(log2(norm / MOUNTS_EXACT_STEP_THETA_13))) : 0;
-}
-
-/* exact_step.work_error and Propagator.build; 0 with the message in s->failure */
-static int propagator(System *s, double h)
-{
-    double *z = malloc(2 * AUGMENTED * AUGMENTED * sizeof *z), *e;
-    char step[40];
-    int count, i, j;
-    if (z == NULL) {
-        snprintf(s->failure, ERROR_SIZE, "out of memory");
-        return 0;
-    }
-    e = z + AUGMENTED * AUGMENTED;
-    augmented(s, h, z);
-    count = squarings(z);
-    python_float_repr(h, step, sizeof step);
-    if (count < 0) {
-        snprintf(s->failure, ERROR_SIZE, "a step of %s s overflows the matrix exponential's norm: take shorter steps",
-                 step);
-        free(z);
-        return 0;
-    }
-    if (count > MOUNTS_EXACT_STEP_MAX_SQUARINGS) {
-        snprintf(s->failure, ERROR_SIZE, "a step of %s s would take %d squarings of the matrix exponential, more than "
-                 "the %d accepted: take shorter steps", step, count, MOUNTS_EXACT_STEP_MAX_SQUARINGS);
-        free(z);
-        return 0;
-    }
-    if (!dense_exponential(z, count, e)) {
-        snprintf(s->failure, ERROR_SIZE, "out of memory");
-        free(z);
-        return 0;
-    }
-    for (i = 0; i < 12; i++) {
-        for (j = 0; j < 12; j++) {
-            s->propagator.phi[i][j] = e[i * AUGMENTED + j];
-        }
-        for (j = 0; j < 6; j++) {
-            s->propagator.gamma0[i][j] = e[i * AUGMENTED + 12 + j];
-            s->propagator.gamma1[i][j] = e[i * AUGMENTED + 18 + j];
-        }
-    }
-    s->propagator.h = h;
-    s->has_propagator = 1;
-    free(z);
-    return 1;
-}
-
 /* ---- per step (model.py) ---------------------------------------------------------------------------- */
 
 /* G u of the loads (``rates`` 0) or of their rates (1) */
@@ -569,39 +570,85 @@ static void generalised(const System *s, const ModelData *data, int rates, doubl
     }
 }
 
-/* PowertrainMountsModel._show: motion and mount forces of ``state`` under ``force`` */
-static void show(const System *s, ModelData *data, const double state[12], const double force[6])
+/* MountSystem.accelerations: q'' at ``state`` under the generalised ``force`` */
+static void accelerations(const System *s, const double *state, const double force[6], double out[6])
 {
-    double q[6];
-    int i, k, n;
+    int i, k;
+    if (!s->progressive) {
+        for (i = 0; i < 6; i++) { /* (A s + B f)[6:12] */
+            double sum = 0.0;
+            for (k = 0; k < s->size; k++) {
+                sum += s->a[6 + i][k] * state[k];
+            }
+            for (k = 0; k < 6; k++) {
+                sum += s->b[6 + i][k] * force[k];
+            }
+            out[i] = sum;
+        }
+        return;
+    }
+    {
+        double q[6], elastic[6], total[6];
+        for (i = 0; i < 6; i++) {
+            q[i] = s->weight_sag[i] + state[i];
+        }
+        forces_elastic_load(&s->layout, MAPS(s), q, elastic);
+        for (i = 0; i < 6; i++) {
+            double viscous = 0.0, branches = 0.0;
+            for (k = 0; k < 6; k++) {
+                viscous += s->damping[i][k] * state[6 + k];
+            }
+            for (k = 0; k < s->branches.count; k++) {
+                branches += s->branches.rows[k][i] * state[12 + k];
+            }
+            total[i] = force[i] + s->weight[i] - elastic[i] - viscous - branches;
+        }
+        for (i = 0; i < 6; i++) { /* M^-1 total: B's rows are M^-1 */
+            out[i] = 0.0;
+            for (k = 0; k < 6; k++) {
+                out[i] += s->b[6 + i][k] * total[k];
+            }
+        }
+    }
+}
+
+/* PowertrainMountsModel._show: motion and mount forces of ``state`` (q, q', z) under ``force``; the branch
+ * forces into the internal state */
+static void show(const System *s, ModelData *data, const double *state, const double force[6])
+{
+    double q[6], acceleration[6];
+    int i, k, n, first_branch = 0;
+    accelerations(s, state, force, acceleration);
     for (i = 0; i < 12; i++) {
         data->real_value[STATE_VARIABLES[i]] = state[i];
     }
-    for (i = 0; i < 6; i++) { /* (A s + B f)[6:] */
-        double sum = 0.0;
-        for (k = 0; k < 12; k++) {
-            sum += s->a[6 + i][k] * state[k];
-        }
-        for (k = 0; k < 6; k++) {
-            sum += s->b[6 + i][k] * force[k];
-        }
-        data->real_value[ACCELERATION_VARIABLES[i]] = sum;
+    for (i = 0; i < 6; i++) {
+        data->real_value[ACCELERATION_VARIABLES[i]] = acceleration[i];
         q[i] = s->weight_sag[i] + state[i];
     }
-    for (n = 0; n < MOUNTS_LAYOUT_MAX_MOUNTS; n++) { /* RigidBody.mount_forces */
+    for (k = 0; k < FMU_INTERNAL_SLOTS; k++) {
+        data->internal[k] = k < s->branches.count ? state[12 + k] : 0.0;
+    }
+    for (n = 0; n < MOUNTS_LAYOUT_MAX_MOUNTS; n++) { /* MountSystem.mount_forces */
         double local[3] = {0, 0, 0};
         int first = V_F_x_mount1 + 3 * n;
         if (n < s->layout.count) {
             const Mount *m = &s->layout.mounts[n];
             const double(*map)[6] = s->maps[n];
+            double spring[3];
+            forces_elastic(&s->layout, MAPS(s), n, q, spring);
             for (k = 0; k < 3; k++) {
-                double moved = 0.0, speed = 0.0;
+                double speed = 0.0, branches = 0.0;
+                int j;
                 for (i = 0; i < 6; i++) {
-                    moved += map[k][i] * q[i];
                     speed += map[k][i] * state[6 + i];
                 }
-                local[k] = m->stiffness[k] * moved + m->damping[k] * speed;
+                for (j = 0; j < m->branch_count; j++) {
+                    branches += state[12 + first_branch + k * m->branch_count + j];
+                }
+                local[k] = spring[k] + m->damping[k] * speed + branches;
             }
+            first_branch += 3 * m->branch_count;
             for (i = 0; i < 3; i++) {
                 data->real_value[first + i] = -(m->axes[0][i] * local[0] + m->axes[1][i] * local[1] +
                                                  m->axes[2][i] * local[2]);
@@ -617,21 +664,13 @@ static void show(const System *s, ModelData *data, const double state[12], const
 /* PowertrainMountsModel._show_analysis */
 static Failure show_analysis(System *s, ModelData *data)
 {
-    double load[6] = {0}, sag[6];
     int i, j;
-    load[2] = -s->layout.mass * VALUE(g);
-    for (i = 0; i < 3; i++) {
-        load[3 + i] = -VALUE(T_mean) * s->motor_axis[i];
-    }
-    if (!static_displacement(s, load, sag)) {
-        return FAILURE(ERROR_VALUE, "Singular matrix");
-    }
     data->real_value[V_wind_up] = 0.0;
     for (i = 0; i < 6; i++) {
-        data->real_value[STATIC_VARIABLES[i]] = sag[i];
+        data->real_value[STATIC_VARIABLES[i]] = s->operating[i];
     }
     for (i = 0; i < 3; i++) { /* MountSystem.wind_up */
-        data->real_value[V_wind_up] -= (sag[3 + i] - s->weight_sag[3 + i]) * s->motor_axis[i];
+        data->real_value[V_wind_up] -= (s->operating[3 + i] - s->weight_sag[3 + i]) * s->motor_axis[i];
     }
     for (j = 0; j < 6; j++) {
         data->real_value[V_f_mode_1 + j] = s->frequencies[j];
@@ -652,43 +691,70 @@ static Failure show_analysis(System *s, ModelData *data)
 static Failure start(ModelData *data, double start_time UNUSED)
 {
     System *s = data->cache->derived;
-    double force[6], state[12] = {0};
+    double force[6], load[6], state[MAX_STATE] = {0};
+    const char *message = NULL;
+    ErrorKind failed;
+    int i;
     if (s == NULL) { /* the parameter check builds it before every initialisation */
         return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
     }
     generalised(s, data, 0, force);
-    if (!static_displacement(s, force, state)) {
+    if (s->progressive) { /* the equilibrium under the weight and the start inputs, from the weight's */
+        for (i = 0; i < 6; i++) {
+            load[i] = s->weight[i] + force[i];
+        }
+        if ((failed = equilibrium(s, load, state, &message)) != ERROR_NONE) {
+            return FAILURE(failed, message);
+        }
+        for (i = 0; i < 6; i++) {
+            state[i] -= s->weight_sag[i];
+        }
+    } else if (!static_displacement(s, force, state)) {
         return FAILURE(ERROR_VALUE, "Singular matrix");
     }
     show(s, data, state, force);
     return show_analysis(s, data);
 }
 
-static Failure advance(ModelData *data, double current_time UNUSED, double step_size)
+/* The state (q, q', z) of the outputs and the internal state */
+static void current_state(const System *s, const ModelData *data, double *state)
 {
-    System *s = data->cache->derived;
-    double held[6], rates[6], state[12], next[12], force[6];
-    int i, k;
-    if (s == NULL) {
-        return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
-    }
-    if ((!s->has_propagator || s->propagator.h != step_size) && !propagator(s, step_size)) {
-        return FAILURE(ERROR_VALUE, s->failure);
-    }
-    generalised(s, data, 0, held);
-    generalised(s, data, 1, rates);
+    int i;
     for (i = 0; i < 12; i++) {
         state[i] = data->real_value[STATE_VARIABLES[i]];
     }
-    for (i = 0; i < 12; i++) { /* Propagator.step */
-        double sum = 0.0, loads = 0.0;
-        for (k = 0; k < 12; k++) {
-            sum += s->propagator.phi[i][k] * state[k];
+    for (i = 0; i < s->branches.count; i++) {
+        state[12 + i] = data->internal[i];
+    }
+}
+
+static Failure advance(ModelData *data, double current_time UNUSED, double step_size)
+{
+    System *s = data->cache->derived;
+    double held[6], rates[6], state[MAX_STATE], next[MAX_STATE], force[6];
+    int i;
+    if (s == NULL) {
+        return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
+    }
+    generalised(s, data, 0, held);
+    generalised(s, data, 1, rates);
+    current_state(s, data, state);
+    if (s->progressive) {
+        const char *message = NULL;
+        StepSystem step = {&s->layout, MAPS(s), (const double(*)[6])s->mass, (const double(*)[6])s->damping,
+                           &s->branches, s->weight, s->weight_sag};
+        ErrorKind failed = implicit_step(&step, state, held, rates, step_size, next, &message);
+        if (failed != ERROR_NONE) {
+            return FAILURE(failed, message);
         }
-        for (k = 0; k < 6; k++) {
-            loads += s->propagator.gamma0[i][k] * held[k] + s->propagator.gamma1[i][k] * rates[k];
+    } else {
+        if ((!s->has_propagator || s->propagator.h != step_size) &&
+            !exact_propagator((const double(*)[MAX_STATE])s->a, (const double(*)[6])s->b, s->size, step_size,
+                              &s->propagator, s->failure, ERROR_SIZE)) {
+            return FAILURE(ERROR_VALUE, s->failure);
         }
-        next[i] = sum + loads;
+        s->has_propagator = 1;
+        exact_step(&s->propagator, state, held, rates, next);
     }
     for (i = 0; i < 6; i++) {
         force[i] = held[i] + rates[i] * step_size;
@@ -698,15 +764,20 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
 }
 
 /* Model Exchange: the accelerations (the velocities' derivatives) and mount forces at the solver's state
- * (q, q') under the inputs now, M q'' + C q' + K q = G u; the static sag and modal table stay as the
- * initialisation left them (functions of the parameters alone). */
+ * (q, q') under the inputs now, M q'' + C q' + K q = G u (the characteristics' forces for progressive mounts);
+ * the static sag and modal table stay as the initialisation left them (functions of the parameters alone).
+ * Model Exchange declares no states for the Maxwell branches: a layout with them is refused. */
 static Failure evaluate(ModelData *data, double time UNUSED)
 {
     System *s = data->cache->derived;
-    double force[6], state[12];
+    double force[6], state[MAX_STATE] = {0};
     int i;
     if (s == NULL) {
         return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
+    }
+    if (s->branches.count > 0) {
+        return FAILURE(ERROR_VALUE, "Model Exchange does not take rubber damping yet (the layout's dynamic_ratio: "
+                                    "its Maxwell branches' forces are no declared states): use Co-Simulation");
     }
     generalised(s, data, 0, force);
     for (i = 0; i < 12; i++) {
@@ -716,20 +787,45 @@ static Failure evaluate(ModelData *data, double time UNUSED)
     return NO_FAILURE;
 }
 
-/* Directional derivatives: the model is linear, its partials constant. The accelerations (A s + B G u)[6:]
- * by the states and the loads (their rates: none, as in evaluate), each mount's force by the states
- * (show's mount forces); the states' own rows and der(<state>)'s are the layer's. */
+/* Directional derivatives: linear mounts' partials are constant, progressive ones' take the tangent rates
+ * F'(d) at the state's deflections. The accelerations (A s + B G u)[6:] (-M^-1 K_t(Q) for the displacements)
+ * by the states and the loads (their rates: none, as in evaluate), each mount's force by the states (show's
+ * mount forces); the states' own rows and der(<state>)'s are the layer's. */
 static Failure jacobian(const ModelData *data, double partial[])
 {
     const System *s = data->cache->derived;
+    double tangent[6][6], rates[MOUNTS_LAYOUT_MAX_MOUNTS][3], q[6];
     int i, j, k, n;
     if (s == NULL) {
         return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
     }
     for (i = 0; i < 6; i++) {
+        q[i] = s->weight_sag[i] + data->real_value[STATE_VARIABLES[i]];
+    }
+    if (s->progressive) {
+        forces_tangent_stiffness(&s->layout, MAPS(s), q, tangent);
+    }
+    for (n = 0; n < s->layout.count; n++) {
+        for (k = 0; k < 3; k++) {
+            double d = 0.0;
+            for (j = 0; j < 6; j++) {
+                d += s->maps[n][k][j] * q[j];
+            }
+            rates[n][k] = s->progressive ? characteristic_tangent(&s->layout.mounts[n], k, d)
+                                         : s->layout.mounts[n].stiffness[k];
+        }
+    }
+    for (i = 0; i < 6; i++) {
         double *row = partial + model_jacobian_rows[ACCELERATION_VARIABLES[i]] * MODEL_COLUMN_COUNT;
         for (k = 0; k < 12; k++) {
-            row[model_jacobian_columns[STATE_VARIABLES[k]]] = s->a[6 + i][k];
+            double value = s->a[6 + i][k];
+            if (s->progressive && k < 6) {
+                value = 0.0;
+                for (j = 0; j < 6; j++) {
+                    value -= s->b[6 + i][j] * tangent[j][k];
+                }
+            }
+            row[model_jacobian_columns[STATE_VARIABLES[k]]] = value;
         }
         for (k = 0; k < N_INPUTS; k++) {
             double sum = 0.0;
@@ -746,7 +842,7 @@ static Failure jacobian(const ModelData *data, double partial[])
             for (j = 0; j < 6; j++) {
                 double moved = 0.0, speed = 0.0;
                 for (k = 0; k < 3; k++) {
-                    moved -= m->axes[k][i] * m->stiffness[k] * s->maps[n][k][j];
+                    moved -= m->axes[k][i] * rates[n][k] * s->maps[n][k][j];
                     speed -= m->axes[k][i] * m->damping[k] * s->maps[n][k][j];
                 }
                 row[model_jacobian_columns[STATE_VARIABLES[j]]] = moved;

@@ -23,9 +23,9 @@ DualClosure closure_derivatives(double x, double y, Dual phi_in, Dual cb, Dual s
 
 /* ---- reaction_derivatives.c ----------------------------------------------------------------- */
 
-/* The step's Load in dual numbers (cb, sb: cos, sin of beta) */
+/* The step's Load in dual numbers (cb, sb: cos, sin of beta; phi_in from the bend plane, as step.h's Load) */
 typedef struct {
-    Dual phi_in, cb, sb, omega, omega_dot, T_load, beta_dot, beta_ddot;
+    Dual phi_in, cb, sb, omega, omega_dot, T_load, beta_dot, beta_ddot, psi_dot, psi_ddot, plunge_dot;
     double r, l, m, friction, slip_speed;
     int tripod_type;               /* 0 plain, 1 single roller, 2 double roller */
     double mu_roll, roller_radius; /* the roller tripods' rolling resistance and rollers' outer radius */

@@ -148,7 +148,8 @@ static void pose(DualArm *a, Dual c, Dual s, double r, double l, Dual P[3], Dual
     a->k[2] = dual_neg(dual_mul2(a->dx, a->ex, a->dy, a->ey));
 }
 
-/* Steps 2 and 3's known terms of arm j: velocities, sliding rates, whirl and Coriolis terms */
+/* Steps 2 and 3's known terms of arm j: velocities, sliding rates, whirl and Coriolis terms, at the input speed
+ * ``omega`` and its rate relative to the bend plane */
 static void known_terms(DualArm *a, const Dual W[3], Dual W2, Dual omega, Dual omega_dot, const Dual Sv[2],
                         const Dual Sa[2])
 {
@@ -513,6 +514,9 @@ Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions
     Dual zn = dual_sqrt(dual_sub(one, dual_mul2(x, x, y, y))), k = dual_div(one, dual_shift(zn, 1.0));
     Dual xyk = dual_mul(dual_mul(x, y), k), e1x = dual_sub(one, dual_mul(dual_mul(x, x), k));
     Dual e2y = dual_sub(one, dual_mul(dual_mul(y, y), k)), bd2 = dual_mul(bd, bd);
+    /* the mechanism in the bend plane's frame, turning at psi_dot: the input speed relative to it (M3) */
+    Dual spin = dual_sub(load->omega, load->psi_dot), spin_dot = dual_sub(load->omega_dot, load->psi_ddot);
+    Dual omega2 = dual_mul(load->omega, load->omega);
     Dual E1[3], E2[3], U[3], P[3], Sv[2], Sa[2], c[3], s[3], adj[3][3], inv_det, rhs[3], W[3], W2, A[3];
     Dual moment[3], Mx, My, Mz, p_dot_u, lams[3], mus[3], slips[3], grooves[3], power = dual_constant(0.0);
     DualArm arm[3];
@@ -532,7 +536,7 @@ Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions
     P[2] = dual_scale(dual_sub(cb, U[2]), l);
     /* the moving bearing: Sdot = l betadot (-cos, 0, -sin), Sddot = l betaddot (-cos, 0, -sin) - l betadot^2 e_out */
     Sv[0] = dual_scale(dual_mul(cb, bd), -l);
-    Sv[1] = dual_scale(dual_mul(sb, bd), -l);
+    Sv[1] = dual_add(dual_scale(dual_mul(sb, bd), -l), load->plunge_dot); /* the spider's plunge joins zdot_j (M5) */
     Sa[0] = dual_scale(dual_cross(sb, bd2, cb, bdd), l);
     Sa[1] = dual_scale(dual_mul2(cb, bd2, sb, bdd), -l);
     p_dot_u = dot(P[0], P[1], P[2], U[0], U[1], U[2]);
@@ -556,7 +560,7 @@ Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions
     /* 2. angular velocity of the output shaft */
     for (j = 0; j < 3; j++) {
         Dual g_dot_e = dual_mul2(arm[j].gx, arm[j].ex, arm[j].gy, arm[j].ey);
-        rhs[j] = dual_mul(dual_neg(dual_mul2(load->omega, g_dot_e, Sv[0], arm[j].ey)), inv_det);
+        rhs[j] = dual_mul(dual_neg(dual_mul2(spin, g_dot_e, Sv[0], arm[j].ey)), inv_det);
     }
     for (j = 0; j < 3; j++) {
         W[j] = cramer(rhs, adj, j);
@@ -564,7 +568,7 @@ Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions
     W2 = dot(W[0], W[1], W[2], W[0], W[1], W[2]);
     /* 3. accelerations: known terms per arm, then K Omegadot = (known . n_j) */
     for (j = 0; j < 3; j++) {
-        known_terms(&arm[j], W, W2, load->omega, load->omega_dot, Sv, Sa);
+        known_terms(&arm[j], W, W2, spin, spin_dot, Sv, Sa);
     }
     for (j = 0; j < 3; j++) {
         const DualArm *a = &arm[j];
@@ -592,8 +596,12 @@ Failure reaction_derivatives(const DualLoad *load, Dual x, Dual y, DualReactions
         My = dual_sub(My, dual_mul(mus[j], dual_cross(a->dz, qx, a->dx, qz)));
         Mz = dual_sub(Mz, dual_mul(mus[j], dual_cross(a->dx, qy, a->dy, qx)));
         slips[j] = grooves[j] = dual_constant(0.0);
+        /* the groove point's acceleration in the housing, what the forces take (M4) */
+        a->ax = dual_neg(dual_mul2(load->omega_dot, a->gy, omega2, a->gx));
+        a->ay = dual_cross(load->omega_dot, a->gx, omega2, a->gy);
     }
     transposed_solve(Mx, My, Mz, adj, inv_det, lams);
+    W[2] = dual_add(W[2], load->psi_dot); /* the output shaft's angular velocity in the housing (M6) */
     if (load->tripod_type != TRIPOD_SPEC_PLAIN_TRIPOD) { /* outputs.coupling_outputs: the rollers' balance */
         if (!roller_reactions(arm, adj, inv_det, load, E1, E2, U, W, lams, mus, out)) {
             return FAILURE(ERROR_ARITHMETIC, "roller tripod friction balance: its partial derivatives did not converge");

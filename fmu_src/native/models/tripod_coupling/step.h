@@ -48,9 +48,11 @@ typedef struct {
     double F_arm[3], F_plunger[3], a_plunger_sum, omega_spin, Rz_in, P_friction;
 } Reactions;
 
+/* phi_in: the input angle from the bend plane; omega, omega_dot: the input shaft's speed and its rate in the
+ * housing; psi_dot, psi_ddot: the bend plane's rates; plunge_dot: the spider's axial speed in the housing */
 typedef struct {
     double phi_in, cb, sb, omega, omega_dot, T_load, r, l, m, friction, slip_speed; /* cb, sb: cos, sin of beta */
-    double beta_dot, beta_ddot;
+    double beta_dot, beta_ddot, psi_dot, psi_ddot, plunge_dot;
     int tripod_type;                /* 0 plain, 1 single roller, 2 double roller (spec.tripod_type) */
     double mu_roll, roller_radius;  /* the roller tripods' rolling resistance and rollers' outer radius */
     double roller_bore_radius;      /* the rollers' bore radius: the double roller's needles run on it */
@@ -60,8 +62,8 @@ typedef struct {
  * d = b - S, |n|^2 = ex^2 + ey^2 and k = d x n (a row of K). */
 typedef struct {
     double gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2, k[3];
-    double ax, ay, hx, hy, hz; /* groove point's acceleration; whirl and Coriolis terms */
-    double zdot, sigma, zddot;  /* plunger speed, sliding rate along the arm per |e|, plunger acceleration */
+    double ax, ay, hx, hy, hz; /* groove point's acceleration (in the housing); whirl and Coriolis terms */
+    double zdot, sigma, zddot;  /* plunger speed in the housing, sliding rate along the arm per |e|, acceleration */
 } Arm;
 
 /* Regularised sign u / sqrt(1 + u^2), u = speed / slip_speed (reactions.slip_sign). */
@@ -71,7 +73,8 @@ static inline double slip_sign(Guard *guard, double speed, double slip_speed)
     return divide(guard, u, pow(1.0 + u * u, 0.5));
 }
 
-/* The frame and motion of the output shaft that the rollers' reactions need (exact_reactions' steps 1-3). */
+/* The frame and motion of the output shaft that the rollers' reactions need (exact_reactions' steps 1-3): the
+ * angular velocity W relative to the housing. */
 typedef struct {
     double U[3], E1[3], E2[3], W[3];
 } Shaft;

@@ -266,6 +266,8 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
 {
     const double half_root_3 = 0.5 * sqrt(3.0), r = load->r, l = load->l, m = load->m;
     const double omega = load->omega, omega_dot = load->omega_dot;
+    /* the mechanism in the bend plane's frame, turning at psi_dot: the input speed relative to it (M3) */
+    const double spin = omega - load->psi_dot, spin_dot = omega_dot - load->psi_ddot;
     double cb = load->cb, sb = load->sb, zn = root(guard, 1.0 - x * x - y * y);
     double k = divide(guard, 1.0, 1.0 + zn);
     /* twist-free frame (E1, E2, U) of the output shaft, nominal output frame -> input frame (eq 2) */
@@ -276,9 +278,9 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     double Sx = -l * sb, Sz = l * cb, Px = Sx - l * Ux, Py = -l * Uy, Pz = Sz - l * Uz;
     /* the moving bearing: Sdot = l betadot (-cos, 0, -sin), Sddot = l betaddot (-cos, 0, -sin) - l betadot^2 e_out */
     double bd = load->beta_dot, bdd = load->beta_ddot;
-    double Svx = -l * cb * bd, Svz = -l * sb * bd;
+    double Svx = -l * cb * bd, Svz = -l * sb * bd + load->plunge_dot; /* the spider's plunge joins zdot_j (M5) */
     double Sax = l * (sb * bd * bd - cb * bdd), Saz = -l * (cb * bd * bd + sb * bdd);
-    double p_dot_u = Px * Ux + Py * Uy + Pz * Uz, omega2 = omega * omega;
+    double p_dot_u = Px * Ux + Py * Uy + Pz * Uz, omega2 = omega * omega, spin2 = spin * spin;
     double c[3], s[3], adj[3][3], inv_det, rhs[3], Wx, Wy, Wz, W2, Ax, Ay, Az, Mx, My, Mz;
     double lams[3], mus[3], slips[3] = {0.0, 0.0, 0.0}, grooves[3] = {0.0, 0.0, 0.0}, moment[3];
     double Rx_out = 0.0, Ry_out = 0.0, Rz_out = 0.0, Rx_in = 0.0, Ry_in = 0.0, Lx = 0.0, Ly = 0.0, Lz = 0.0;
@@ -318,7 +320,7 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     inv_det = divide(guard, 1.0, arm[0].k[0] * adj[0][0] + arm[0].k[1] * adj[0][1] + arm[0].k[2] * adj[0][2]);
     /* 2. angular velocity of the output shaft: (e_z x g_j) . n_j = -(g_x e_x + g_y e_y), Sdot . n_j = Sdot_x e_y */
     for (j = 0; j < 3; j++) {
-        rhs[j] = (-omega * (arm[j].gx * arm[j].ex + arm[j].gy * arm[j].ey) - Svx * arm[j].ey) * inv_det;
+        rhs[j] = (-spin * (arm[j].gx * arm[j].ex + arm[j].gy * arm[j].ey) - Svx * arm[j].ey) * inv_det;
     }
     Wx = rhs[0] * adj[0][0] + rhs[1] * adj[1][0] + rhs[2] * adj[2][0];
     Wy = rhs[0] * adj[0][1] + rhs[1] * adj[1][1] + rhs[2] * adj[2][1];
@@ -327,14 +329,14 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
     /* 3. accelerations: known terms per arm, then K Omegadot = (known . n_j) */
     for (j = 0; j < 3; j++) {
         Arm *a = &arm[j];
-        double vx = Wy * a->dz - Wz * a->dy + omega * a->gy + Svx, vy = Wz * a->dx - Wx * a->dz - omega * a->gx;
+        double vx = Wy * a->dz - Wz * a->dy + spin * a->gy + Svx, vy = Wz * a->dx - Wx * a->dz - spin * a->gx;
         double wd = Wx * a->dx + Wy * a->dy + Wz * a->dz; /* Omega x (Omega x d) = Omega (Omega . d) - d |Omega|^2 */
         a->sigma = divide(guard, -(vx * a->ex + vy * a->ey), a->exy2);
         a->hx = Wx * wd - a->dx * W2 + 2.0 * a->sigma * (Wy * a->ez - Wz * a->ey) + Sax;
         a->hy = Wy * wd - a->dy * W2 + 2.0 * a->sigma * (Wz * a->ex - Wx * a->ez);
         a->hz = Wz * wd - a->dz * W2 + 2.0 * a->sigma * (Wx * a->ey - Wy * a->ex) + Saz;
-        a->ax = -omega_dot * a->gy - omega2 * a->gx; /* groove point's acceleration */
-        a->ay = omega_dot * a->gx - omega2 * a->gy;
+        a->ax = -spin_dot * a->gy - spin2 * a->gx; /* groove point's acceleration in the bend plane's frame */
+        a->ay = spin_dot * a->gx - spin2 * a->gy;
         a->zdot = Wx * a->dy - Wy * a->dx + a->sigma * a->ez + Svz;
     }
     for (j = 0; j < 3; j++) {
@@ -359,10 +361,13 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
         Mx -= mus[j] * (a->dy * qz - a->dz * qy);
         My -= mus[j] * (a->dz * qx - a->dx * qz);
         Mz -= mus[j] * (a->dx * qy - a->dy * qx);
+        a->ax = -omega_dot * a->gy - omega2 * a->gx; /* ... and in the housing, what the forces take (M4) */
+        a->ay = omega_dot * a->gx - omega2 * a->gy;
     }
     for (j = 0; j < 3; j++) {
         lams[j] = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det;
     }
+    Wz = Wz + load->psi_dot; /* the output shaft's angular velocity in the housing (M6) */
     if (load->tripod_type != TRIPOD_SPEC_PLAIN_TRIPOD) { /* outputs.coupling_outputs: the rollers' balance */
         Shaft shaft = {{Ux, Uy, Uz}, {E1x, E1y, E1z}, {E2x, E2y, E2z}, {Wx, Wy, Wz}};
         if (guard->failure.kind == ERROR_NONE) {
@@ -411,12 +416,14 @@ static void exact_reactions(Guard *guard, const Load *load, double x, double y, 
 }
 
 /* Leading order in r/l (reactions_closed_form.py) with A = 3/2 m r^2 tan(beta) / cos^2(beta) and
- * t = tan(beta / 2); ``ratio`` from eq 18's derivative, ``pin`` from eq 24 (corrected eq 21). */
+ * t = tan(beta / 2); ``ratio`` from eq 18's derivative, ``pin`` from eq 24 (corrected eq 21); in the bend
+ * plane's frame, at the input speed relative to it (outputs.coupling_outputs). */
 static void leading_order_reactions(Guard *guard, const Load *load, double ratio, double pin, Reactions *out)
 {
-    double m = load->m, r = load->r, l = load->l, omega_dot = load->omega_dot, T = load->T_load;
+    double m = load->m, r = load->r, l = load->l, omega_dot = load->omega_dot - load->psi_ddot, T = load->T_load;
+    double omega = load->omega - load->psi_dot;
     double cb = load->cb, tb = divide(guard, load->sb, cb), half = divide(guard, load->sb, 1.0 + cb);
-    double A = divide(guard, 1.5 * m * r * r * tb, cb * cb), omega2 = load->omega * load->omega;
+    double A = divide(guard, 1.5 * m * r * r * tb, cb * cb), omega2 = omega * omega;
     double ry_in = divide(guard, -(T * half + A * omega_dot * cb), l);
     double bend = divide(guard, m * r, cb * cb);
     double bend_rates = load->beta_ddot + 2.0 * tb * load->beta_dot * load->beta_dot;
@@ -424,7 +431,7 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
     for (j = 0; j < 3; j++) {
         double angle = load->phi_in + TRIPOD_GEOMETRY_THIRD_TURN * j, c = cosine(guard, angle), s = sine(guard, angle);
         out->F_plunger[j] = -m * r * tb * (omega2 * c + omega_dot * s) +
-                            bend * (c * bend_rates - 2.0 * load->omega * load->beta_dot * s);
+                            bend * (c * bend_rates - 2.0 * omega * load->beta_dot * s);
         out->F_arm[j] = pin;
     }
     out->Rx_in = divide(guard, -A * omega2, l * cb);
@@ -439,6 +446,17 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
 }
 
 /* ---- outputs (outputs.coupling_outputs) ------------------------------------------------------ */
+
+/* Components (x, y) in the bend plane's frame turned by psi about Z' into the housing's X'Y' (M8,
+ * outputs.to_housing); at psi = 0 they stay as they are, a zero's sign included. */
+static void to_housing(Guard *guard, double *x, double *y, double psi)
+{
+    if (psi != 0.0) {
+        double c = cosine(guard, psi), s = sine(guard, psi), turned_x = c * *x - s * *y;
+        *y = s * *x + c * *y;
+        *x = turned_x;
+    }
+}
 
 /* Rate and acceleration of beta at the newest of ``count`` (time, beta) samples, newest first
  * (tripod.model.sampled_rates: the derivatives of the polynomial through them). */
@@ -470,7 +488,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     double beta_dot = VALUE(beta_dot), beta_ddot = VALUE(beta_ddot), beta, omega;
     double phi_in = VALUE(phi_in), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
     double cos_beta, sin_beta, rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin;
-    double output_power, total;
+    double output_power, total, psi, psi_dot, phi, spin;
     if (INTEGER(beta_rate) != RATES_FROM_INPUTS) { /* the samples are kept for the automatic choice too */
         double samples[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         int count = 1, k;
@@ -498,14 +516,21 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     if (!(0.0 <= beta && beta <= VALUE(beta_max))) {
         return FAILURE(ERROR_VALUE, BETA_LEAVES_RANGE);
     }
+    psi = VALUE(psi) + (VALUE(psi_dot) + 0.5 * VALUE(psi_ddot) * elapsed) * elapsed;
+    psi_dot = VALUE(psi_dot) + VALUE(psi_ddot) * elapsed;
     omega = VALUE(omega_in) + VALUE(alpha_in) * elapsed;
+    phi = phi_in - psi;    /* the input angle from the bend plane (M1) */
+    spin = omega - psi_dot; /* the input speed relative to it (M3) */
     cos_beta = cos(beta);
     sin_beta = sin(beta);
-    load.phi_in = phi_in;
+    load.phi_in = phi;
     load.cb = cos_beta;
     load.sb = sin_beta;
     load.beta_dot = beta_dot + beta_ddot * elapsed;
     load.beta_ddot = beta_ddot;
+    load.psi_dot = psi_dot;
+    load.psi_ddot = VALUE(psi_ddot);
+    load.plunge_dot = VALUE(plunge_dot);
     load.omega = omega;
     load.omega_dot = VALUE(alpha_in);
     load.T_load = T_load;
@@ -521,7 +546,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     rho = divide(&guard, r * (1.0 - cos_beta), 2.0 * cos_beta); /* orbit radius of the tripod centre */
     pin = divide(&guard, T_load, 3.0 * (r + rho));              /* eq 24 with the corrected eq 21 */
     if (INTEGER(kinematics) == TRIPOD_SPEC_EXACT) {
-        plane_solve(&guard, phi_in, cos_beta, sin_beta, r, l, HAS_SOLUTION != 0.0, SOLUTION, &phi_out, &ratio);
+        plane_solve(&guard, phi, cos_beta, sin_beta, r, l, HAS_SOLUTION != 0.0, SOLUTION, &phi_out, &ratio);
         if (guard.failure.kind != ERROR_NONE) {
             return guard.failure;
         }
@@ -532,21 +557,24 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     } else {
         /* eq 18 with the seed's phi, A cos 3 phi = A sin 3 phi_in, and its derivative (not eq 19) */
         double amplitude = divide(&guard, r * (1.0 - cos_beta), 2.0 * l * (1.0 + cos_beta)) * tan(beta);
-        double phase = 3.0 * (phi_in + TRIPOD_CLOSED_FORM_PAPER_PHASE);
+        double phase = 3.0 * (phi + TRIPOD_CLOSED_FORM_PAPER_PHASE);
         double deviation = amplitude * cosine(&guard, phase);
         ratio = 1.0 - 3.0 * amplitude * sine(&guard, phase);
-        phi_out = phi_in + deviation;
+        phi_out = phi + deviation;
         theta = arcsine(&guard, divide(&guard, rho, l));
         leading_order_reactions(&guard, &load, ratio, pin, &forces);
-        omega_spin = omega * ratio;
+        omega_spin = spin * ratio + psi_dot;
         forces.Rz_in = 0.0 * ratio;
         forces.P_friction = 0.0 * ratio;
     }
+    phi_out = phi_out + psi; /* (M2) */
     output_power = T_load * omega_spin;
     total = output_power + forces.P_friction;
+    to_housing(&guard, &forces.Rx_in, &forces.Ry_in, psi);
+    to_housing(&guard, &forces.Mx_in, &forces.My_in, psi);
     VALUE(phi_out) = phi_out;
     VALUE(delta_phi) = phi_out - phi_in;
-    VALUE(omega_out) = omega * ratio;
+    VALUE(omega_out) = spin * ratio + psi_dot; /* (M7) */
     VALUE(omega_spin) = omega_spin;
     VALUE(T_in) = forces.T_in;
     VALUE(F_pin) = pin;
@@ -577,14 +605,17 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     VALUE(F_plunger3) = forces.F_plunger[2];
     if (INTEGER(seed_reactions)) {
         /* eqs 20, 30, 33, 34 as printed, with the seed's phi */
-        double omega_squared = omega * omega, tan_beta = tan(beta);
-        double phi = phi_in + TRIPOD_CLOSED_FORM_PAPER_PHASE, cos_3phi = cosine(&guard, 3.0 * phi);
+        double omega_squared = spin * spin, tan_beta = tan(beta), seed_x, seed_y;
+        double seed_phi = phi + TRIPOD_CLOSED_FORM_PAPER_PHASE, cos_3phi = cosine(&guard, 3.0 * seed_phi);
         double a_sum = -6.0 * omega_squared * rho * sin_beta * cos_3phi, m = VALUE(m_plunger);
         VALUE(a_plunger_sum) = a_sum;                                                        /* eq 20 */
         VALUE(Rz_out) = -6.0 * m * rho * omega_squared * tan_beta * cos_3phi;               /* eq 30 */
-        VALUE(Rx_in) = tan_beta * m * a_sum;                                                 /* eq 33 */
-        VALUE(Ry_in) = divide(&guard, -3.0 * m * rho * rho * omega_squared * tan_beta * sine(&guard, 6.0 * phi),
-                              l);                                                            /* eq 34 */
+        seed_x = tan_beta * m * a_sum;                                                       /* eq 33 */
+        seed_y = divide(&guard, -3.0 * m * rho * rho * omega_squared * tan_beta * sine(&guard, 6.0 * seed_phi),
+                        l);                                                                  /* eq 34 */
+        to_housing(&guard, &seed_x, &seed_y, psi);
+        VALUE(Rx_in) = seed_x;
+        VALUE(Ry_in) = seed_y;
     }
     return guard.failure;
 }
