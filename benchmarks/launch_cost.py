@@ -5,8 +5,11 @@ Usage: ``python -m benchmarks.launch_cost [--package models/native/VehicleLaunch
 [--repeat 3] [--update-docs]`` after ``python build_fmu.py``. Not part of the test suite. Each engine runs
 the launch in this process as a sweep runs it (:func:`fmu_harness.runs.system_sweep.run_system`: the
 outputs of the sweep's metrics recorded at every step, instantiation included; the container built once
-beforehand, as the sweep's client does, and extracted once, as each worker does); the Model Exchange engine
-(DOP853 at rtol 1e-8, rows every 0.2 ms) records the same outputs. CPU by ``time.process_time`` (every
+beforehand, as the sweep's client does, and extracted once, as each worker does); the container FMU as built
+(Jacobi at 1e-4 s) also through ``fmpy.simulate_fmu`` recording vehicle speed, halfshaft torques and pitch
+acceleration, at every step and at fmpy's own output interval; the Model Exchange engine (DOP853 at rtol
+1e-8, rows every 1 ms as ``driveline-fmus system`` writes them) records the sweep's outputs, its integrator
+steps and right-hand sides counted. CPU by ``time.process_time`` (every
 thread of the process: libcosim's workers count), the least of ``--repeat`` alternating measurements (other
 load only adds), Model Exchange measured once. The last column divides by the container's cost at the same
 step and order.
@@ -20,6 +23,8 @@ from pathlib import Path
 
 from benchmarks import report
 from benchmarks.launch_throughput import launch_arguments
+from fmpy import simulate_fmu
+
 from fmu_harness.runs.model_exchange_system import run_model_exchange
 from fmu_harness.runs.system_sweep import SystemInterface, UnpackedSystem, container_of, run_system
 
@@ -28,7 +33,12 @@ GOAL = 0.3
 ENGINES = (("container", "jacobi", 1e-4), ("master", "jacobi", 1e-4), ("libcosim", "libcosim", 1e-4),
            ("container", "gauss-seidel", 2e-4), ("master", "gauss-seidel", 2e-4))
 """(engine, scheme, step): the package's step by Jacobi (the FMU as built), the map's Gauss-Seidel at 2e-4 s."""
-MODEL_EXCHANGE_INTERVAL = 2e-4
+MODEL_EXCHANGE_INTERVAL = 1e-3
+"""The Model Exchange engine's rows: ``driveline-fmus system``'s default output interval."""
+FMPY_OUTPUTS = ("drive.v_x", "drive.T_load_left", "drive.T_load_right", "mounts.pitch_ddot")
+FMPY_INTERVALS = (1e-4, None)
+"""fmpy's output interval, its communication step: every container step, and fmpy's own choice (None: the
+FMU's step doubled until at most 1000 rows)."""
 
 
 def main() -> None:
@@ -50,13 +60,25 @@ def main() -> None:
                        step, scheme, scratch)
             return time.process_time() - start
 
-        measured = [[cpu(*engine) for engine in ENGINES] for _ in range(args.repeat)]
-        best = dict(zip(ENGINES, map(min, zip(*measured))))
+        _, unzipdir, description = unpacked["container", "jacobi"].container
+
+        def fmpy_cpu(interval: float | None) -> float:
+            start = time.process_time()
+            simulate_fmu(unzipdir, model_description=description, stop_time=args.stop_time, output_interval=interval,
+                         output=list(FMPY_OUTPUTS))
+            return time.process_time() - start
+
+        measured = [[cpu(*engine) for engine in ENGINES] + [fmpy_cpu(i) for i in FMPY_INTERVALS]
+                    for _ in range(args.repeat)]
+        least = list(map(min, zip(*measured)))
+        best = dict(zip(ENGINES, least))
+        through_fmpy = dict(zip(FMPY_INTERVALS, least[len(ENGINES):]))
+        counts: dict[str, int] = {}
         package = unpacked["master", None]
         start = time.process_time()
         run_model_exchange(package.fmus, {c.name: c.parameters for c in interface.package.components},
                            interface.package.connections, args.stop_time, MODEL_EXCHANGE_INTERVAL,
-                           interface.recorded(), scratch / "model_exchange")
+                           interface.recorded(), scratch / "model_exchange", counts=counts)
         model_exchange = time.process_time() - start
     lines = ["| engine | scheme | step [s] | CPU per launch [s] | CPU per step [us] | of the map's goal | "
              "against the container |", "|---|---|---|---|---|---|---|"]
@@ -65,8 +87,16 @@ def main() -> None:
         container = best["container", scheme if scheme != "libcosim" else "jacobi", step]
         lines.append(f"| {engine} | {scheme} | {step:g} | {seconds:.2f} | {1e6 * seconds / steps:.1f} | "
                      f"{seconds / (GOAL * args.stop_time / 4.0):.2f} | {seconds / container:.1f} |")
-    lines.append(f"| Model Exchange | DOP853, rtol 1e-08 | rows every {MODEL_EXCHANGE_INTERVAL:g} | "
-                 f"{model_exchange:.1f} | | {model_exchange / (GOAL * args.stop_time / 4.0):.0f} | "
+    steps = round(args.stop_time / 1e-4)
+    for interval, seconds in through_fmpy.items():
+        rows = f"rows every {interval:g} s" if interval else "fmpy's output interval"
+        lines.append(f"| container in fmpy.simulate_fmu, {rows} | jacobi | 0.0001 | {seconds:.2f} | "
+                     f"{1e6 * seconds / steps:.1f} | {seconds / (GOAL * args.stop_time / 4.0):.2f} | "
+                     f"{seconds / best['container', 'jacobi', 1e-4]:.1f} |")
+    lines.append(f"| Model Exchange: {counts['steps']} steps, {counts['right-hand sides']} right-hand sides | "
+                 f"DOP853, rtol 1e-08 | rows every {MODEL_EXCHANGE_INTERVAL:g} | {model_exchange:.1f} | "
+                 f"{1e6 * model_exchange / counts['right-hand sides']:.0f} per right-hand side | "
+                 f"{model_exchange / (GOAL * args.stop_time / 4.0):.0f} | "
                  f"{model_exchange / best['container', 'jacobi', 1e-4]:.0f} |")
     report.publish("benchmark-launch-cost", measurement.stamp(
         f"{args.stop_time:g} s launches of {args.package.stem} (native FMUs), one process, CPU by "

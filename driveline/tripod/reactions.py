@@ -261,6 +261,16 @@ def slip_sign(speed: Real, slip_speed: float) -> Real:
     return u / (1.0 + u * u) ** 0.5
 
 
+def _friction_arm(arm, xp):
+    """What the friction balance's iterations do not change on one arm: |e|^2, |e|, |n| |e|, |n|, and the
+    moment arms of mu_j and of phi_j (the moments' coefficients in :func:`_frictional_balance`)."""
+    ex, ey, ez, dx, dy, dz, exy2 = arm[3:10]
+    e2 = exy2 + ez * ez
+    mu_arm = (dy * -exy2 - dz * ez * ey, dz * ez * ex + dx * exy2, dx * ez * ey - dy * ez * ex)
+    slip_arm = (dy * ez - dz * ey, dz * ex - dx * ez, dx * ey - dy * ex)
+    return e2, xp.sqrt(e2), xp.sqrt(exy2 * e2), xp.sqrt(exy2), mu_arm, slip_arm
+
+
 def _frictional_balance(arms, adj, inv_det, known, zddot, slides, load_moment, m, friction, slip_speed,
                         lams, mus, xp):
     """Arm forces with Coulomb friction ``friction`` in both sliding pairs of each arm.
@@ -276,29 +286,31 @@ def _frictional_balance(arms, adj, inv_det, known, zddot, slides, load_moment, m
     Tx, Ty, Tz = load_moment
     signs = [(slip_sign(zdot, slip_speed), slip_sign(sigma * xp.sqrt(a[9] + a[5] * a[5]), slip_speed))
              for (zdot, sigma), a in zip(slides, arms)]
+    fixed = [_friction_arm(a, xp) for a in arms]  # what the iterations do not change
     for _ in range(MAX_FRICTION_ITERATIONS):
         Mx, My, Mz = Tx, Ty, Tz
         new_mus, slips, grooves = [], [], []
         change = scale = 0.0
-        for a, lam, mu, (ax, ay, *_), acc, (groove_sign, arm_sign) in zip(arms, lams, mus, known, zddot, signs):
+        for a, lam, mu, (ax, ay, *_), acc, (groove_sign, arm_sign), arm in zip(arms, lams, mus, known, zddot, signs,
+                                                                               fixed):
             gx, gy, bz, ex, ey, ez, dx, dy, dz, exy2 = a[:10]
-            e2 = exy2 + ez * ez
+            e2, e_norm, ne_norm, _, mu_arm, slip_arm = arm
             normal = xp.sqrt(exy2 * (lam * lam + mu * mu * e2))  # |lambda n + mu e x n|
-            slip = friction * normal * arm_sign / xp.sqrt(e2)  # phi_j, per unit of |e_j|
+            slip = friction * normal * arm_sign / e_norm  # phi_j, per unit of |e_j|
             Nx = m * ax + lam * ey + mu * ez * ex + slip * ex
             Ny = m * ay - lam * ex + mu * ez * ey + slip * ey
             groove = -friction * xp.sqrt(Nx * Nx + Ny * Ny) * groove_sign
             # plunger along Z': groove - F_z = m zddot with F_z = -mu |n|^2 + phi e_z
             new_mu = (m * acc - groove + slip * ez) / exy2
-            Mx = Mx - new_mu * (dy * -exy2 - dz * ez * ey) - slip * (dy * ez - dz * ey)
-            My = My - new_mu * (dz * ez * ex + dx * exy2) - slip * (dz * ex - dx * ez)
-            Mz = Mz - new_mu * (dx * ez * ey - dy * ez * ex) - slip * (dx * ey - dy * ex)
-            change = change + abs(new_mu - mu) * xp.sqrt(exy2 * e2)
+            Mx = Mx - new_mu * mu_arm[0] - slip * slip_arm[0]
+            My = My - new_mu * mu_arm[1] - slip * slip_arm[1]
+            Mz = Mz - new_mu * mu_arm[2] - slip * slip_arm[2]
+            change = change + abs(new_mu - mu) * ne_norm
             scale = scale + normal
             new_mus.append(new_mu), slips.append(slip), grooves.append(groove)
         new_lams = [(Mx * a0 + My * a1 + Mz * a2) * inv_det for a0, a1, a2 in adj]
-        for a, lam, new_lam in zip(arms, lams, new_lams):
-            change = change + abs(new_lam - lam) * xp.sqrt(a[9])
+        for arm, lam, new_lam in zip(fixed, lams, new_lams):
+            change = change + abs(new_lam - lam) * arm[3]
         lams, mus = new_lams, new_mus
         if converged(change <= FRICTION_TOLERANCE * scale):
             break

@@ -5,6 +5,10 @@ after ``python build_fmu.py``. Prints the matrix as markdown; with ``--update`` 
 that page's ``interop`` section (:mod:`fmu_harness.doc_pages.sections`). The native FMUs are those
 under ``models/native/`` (:mod:`fmu_harness.packaging.native`).
 
+The packages built as one FMU (``native/VehicleLaunch.fmu``, ``native/Driveline.fmu``: FMU Manipulation Toolbox's
+container, :mod:`fmu_harness.runs.container`) are rows too, family ``container``: an engine runs
+:data:`CONTAINER_RUN` of the package as bound, compared with fmpy's run of the same container.
+
 Importers: ``fmpy validate``, ``fmutool -input X.fmu -check`` (FMU Manipulation Toolbox),
 fmpy's Model Exchange (:func:`_fmpy_model_exchange`), and two co-simulation engines, libcosimpy
 and ecospy, that run the model's standard scenario
@@ -28,6 +32,7 @@ from typing import Literal
 
 import numpy as np
 from fmpy import read_model_description, simulate_fmu
+from fmpy.model_description import ModelDescription
 from fmpy.validation import validate_fmu
 
 from driveline.catalog import MODELS
@@ -35,6 +40,7 @@ from driveline.catalog import MODELS
 from ..console import Progress, summary
 from ..doc_pages.sections import replace_section, section
 from ..packaging import fmu_path, native
+from ..runs import container
 from ..runs.runner import FmuInstance
 from ..runs.scenario import scenario, standard_run
 from ..runs.start_values import StartValuesRefused
@@ -49,7 +55,12 @@ PYTHON_CO_SIMULATION_ONLY = ("co-simulation only: pythonfmu 0.7 (FMI 2.0) has no
                              "adapter does not use pythonfmu3's")
 RESULT = "interop result: "
 Status = Literal["pass", "fail", "unsupported", "unavailable"]
-Family = Literal["Python", "native"]
+Family = Literal["Python", "native", "container"]
+CONTAINERS = ("Driveline", "VehicleLaunch")
+"""The packages the build also writes as one FMU (:func:`fmu_harness.runs.system.write_container`)."""
+CONTAINER_RUN = 200
+"""Steps of a container's engine run at its own step (20 ms of the launch, 0.2 s of the driveline)."""
+CONTAINER_CO_SIMULATION_ONLY = "co-simulation only: the container steps its components' co-simulation"
 
 
 @dataclass(frozen=True)
@@ -148,7 +159,10 @@ SESSIONS = {"libcosimpy": importers.cosim_session, "ecospy": importers.ecos_sess
 def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcome:
     """The model's standard scenario in ``engine`` against fmpy's run of ``reference`` (default:
     ``fmu`` itself; runs inside the worker)."""
-    name = read_model_description(str(fmu)).modelName
+    description = read_model_description(str(fmu))
+    if description.modelName not in MODELS:
+        return _container_in(engine, fmu, description)
+    name = description.modelName
     case = scenario(MODELS[name].spec)
     with FmuInstance(reference or fmu) as instance:
         expected = standard_run(instance, case.outputs)
@@ -173,11 +187,31 @@ def simulate_in(engine: str, fmu: Path, reference: Path | None = None) -> Outcom
     return Outcome("fail", f"largest relative deviation from the fmpy run {deviation:.3g} > {TOLERANCE:g}", deviation)
 
 
+def _container_in(engine: str, fmu: Path, description: ModelDescription) -> Outcome:
+    """:data:`CONTAINER_RUN` steps of the container ``fmu`` as bound in ``engine`` against fmpy's run of it, every
+    Real output compared (runs inside the worker)."""
+    step = float(description.defaultExperiment.stepSize)
+    outputs = [v.name for v in description.modelVariables if v.causality == "output" and v.type in ("Real", "Float64")]
+    expected = container.run(fmu, {}, CONTAINER_RUN * step, step, outputs)[:, 1:]
+    session = SESSIONS[engine](step, fmus={"m": fmu})
+    try:
+        found = importers.record(session, CONTAINER_RUN, step, [f"m.{n}" for n in outputs])[:, 1:]
+    finally:
+        session.close()
+    scale = np.abs(expected).max(axis=0)
+    deviation = float((np.abs(found - expected).max(axis=0) / np.where(scale > 0.0, scale, 1.0)).max())
+    if deviation <= TOLERANCE:
+        return Outcome("pass", deviation=deviation)
+    return Outcome("fail", f"largest relative deviation from the fmpy run {deviation:.3g} > {TOLERANCE:g}", deviation)
+
+
 def outcome(importer: Importer, fmu: Path, reference: Path | None = None) -> Outcome:
     """``fmu`` in ``importer``, engine runs compared with fmpy's run of ``reference`` (default: ``fmu``)."""
     description = read_model_description(str(fmu))
     if description.fmiVersion not in importer.versions:
         return Outcome("unsupported", importer.unsupported)
+    if importer.model_exchange_only and description.modelExchange is None and description.modelName not in MODELS:
+        return Outcome("unsupported", CONTAINER_CO_SIMULATION_ONLY)
     if importer.model_exchange_only and description.modelExchange is None:
         return Outcome("unsupported", MODELS[description.modelName].co_simulation_only
                        if description.generationTool == native.GENERATION_TOOL else importer.model_exchange_only)
@@ -192,12 +226,16 @@ def outcome(importer: Importer, fmu: Path, reference: Path | None = None) -> Out
 def fmus(models: Path, natives: Path | None = None) -> list[Fmu]:
     """The catalog's built FMUs, per model the Python ones in ``models`` (FMI 2.0) and
     ``models/fmi3`` (FMI 3.0), then the native ones in ``native/`` and ``native/fmi3/`` below
-    ``natives`` (default: ``models``); a native FMU counts when its Python reference is built."""
+    ``natives`` (default: ``models``); a native FMU counts when its Python reference is built; then the
+    :data:`CONTAINERS` built there, each its own reference."""
     found = []
     for name in MODELS:
         references = {fmi: fmu_path(models, name, fmi) for fmi in ("2", "3")}
         found += [Fmu("Python", path, path) for path in references.values()]
         found += [Fmu("native", native.fmu_path(natives or models, name, fmi), path) for fmi, path in references.items()]
+    for name in CONTAINERS:
+        found += [Fmu("container", path, path) for path in (native.fmu_path(natives or models, name, fmi)
+                                                            for fmi in ("2", "3"))]
     return [fmu for fmu in found if fmu.path.exists() and fmu.reference.exists()]
 
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import zipfile
 from collections.abc import Callable, Collection, Mapping, Sequence
-from ctypes import POINTER, c_double
+from ctypes import POINTER, Array, c_double, c_uint32
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -51,6 +51,7 @@ ATOL = 1e-12
 #: scipy's integrators by name: DOP853 (explicit, the default), Radau and BDF (implicit, given the
 #: system's exact Jacobian from the FMUs' directional derivatives).
 METHODS = {"DOP853": DOP853, "Radau": Radau, "BDF": BDF}
+WARNING = 1  # FMI's status Warning: the call done
 
 
 class ModelExchangeInstance:
@@ -77,6 +78,11 @@ class ModelExchangeInstance:
             interface = ET.fromstring(archive.read("modelDescription.xml")).find("ModelExchange")
         flag = "providesDirectionalDerivatives" if self.fmi3 else "providesDirectionalDerivative"
         self.gives_derivatives = interface is not None and interface.get(flag) in ("true", "1")
+        self._get, self._set = ("getFloat64", "setFloat64") if self.fmi3 else ("getReal", "setReal")
+        self._rates_function = "getContinuousStateDerivatives" if self.fmi3 else "getDerivatives"
+        self._functions: dict[str, Callable] = {}
+        self._buffers: dict[tuple[str, ...], tuple[Array, Array]] = {}
+        self._states, self._rates = (c_double * self.size)(), (c_double * self.size)()
 
     def call(self, function: str, *arguments):
         """fmpy's ``function`` of this instance; a non-OK status raises :class:`StepRefused` naming it."""
@@ -87,13 +93,38 @@ class ModelExchangeInstance:
             raise StepRefused(f"{self.name}: {function}", status_name(error.status), self.time,
                               self.log[first:]) from None
 
+    def _direct(self, function: str, *arguments) -> None:
+        """fmpy's low-level ``function`` (``getReal`` for ``fmi2GetReal``) called on ctypes buffers as fmpy declared
+        it, without fmpy's wrapper: the engine makes some 80 such calls per right-hand side, and the wrapper was
+        most of their cost. A status above Warning raises :class:`StepRefused` naming it, as :meth:`call` does."""
+        declared = self._functions.get(function)
+        if declared is None:
+            declared = self._functions[function] = getattr(self.fmu.dll, f"fmi{3 if self.fmi3 else 2}"
+                                                                          f"{function[0].upper()}{function[1:]}")
+        first = len(self.log)
+        status = declared(self.fmu.component, *arguments)
+        if status > WARNING:
+            raise StepRefused(f"{self.name}: {function}", status_name(status), self.time, self.log[first:])
+
+    def _buffer(self, names: Sequence[str]) -> tuple[Array, Array]:
+        """The value references of ``names`` and a value array of their length, made once per list of names."""
+        key = tuple(names)
+        found = self._buffers.get(key)
+        if found is None:
+            found = self._buffers[key] = ((c_uint32 * len(key))(*(self.references[n] for n in key)),
+                                          (c_double * len(key))())
+        return found
+
     def get(self, names: Sequence[str]) -> list[float]:
-        return self.call("getFloat64" if self.fmi3 else "getReal", [self.references[n] for n in names])
+        references, values = self._buffer(names)
+        self._direct(self._get, references, len(references), values, *((len(references),) if self.fmi3 else ()))
+        return values[:]
 
     def set(self, names: Sequence[str], values: Sequence[float]) -> None:
         if names:
-            self.call("setFloat64" if self.fmi3 else "setReal", [self.references[n] for n in names],
-                      [float(v) for v in values])
+            references, buffer = self._buffer(names)
+            buffer[:] = [float(v) for v in values]
+            self._direct(self._set, references, len(references), buffer, *((len(references),) if self.fmi3 else ()))
 
     def set_start_values(self, values: Mapping[str, object]) -> None:
         for name, value in values.items():
@@ -107,12 +138,14 @@ class ModelExchangeInstance:
 
     def partials(self, unknowns: Sequence[str], knowns: Sequence[str]) -> np.ndarray:
         """The block d unknowns / d knowns at the instance's present point, a directional derivative per known."""
-        rows, columns = [self.references[n] for n in unknowns], [self.references[n] for n in knowns]
+        (rows, sensitivity), (columns, seed) = self._buffer(unknowns), self._buffer(knowns)
+        counts = ((len(columns),), (len(rows),)) if self.fmi3 else ((), ())
         block = np.zeros((len(rows), len(columns)))
         for j in range(len(columns)):
-            seed = [0.0] * len(columns)
-            seed[j] = 1.0
-            block[:, j] = self.call("getDirectionalDerivative", rows, columns, seed)
+            seed[:] = [1.0 if i == j else 0.0 for i in range(len(columns))]
+            self._direct("getDirectionalDerivative", rows, len(rows), columns, len(columns), seed, *counts[0],
+                         sensitivity, *counts[1])
+            block[:, j] = sensitivity
         return block
 
     def enter_initialization(self, start_values: Mapping[str, object]) -> None:
@@ -142,10 +175,10 @@ class ModelExchangeInstance:
 
     def set_point(self, time: float, states: np.ndarray) -> None:
         self.time = time
-        self.call("setTime", time)
+        self._direct("setTime", time)
         if self.size:
-            buffer = np.ascontiguousarray(states, dtype=float)
-            self.call("setContinuousStates", buffer.ctypes.data_as(POINTER(c_double)), self.size)
+            self._states[:] = states.tolist()
+            self._direct("setContinuousStates", self._states, self.size)
 
     def states(self) -> np.ndarray:
         values = np.zeros(self.size)
@@ -154,11 +187,10 @@ class ModelExchangeInstance:
         return values
 
     def derivatives(self) -> np.ndarray:
-        values = np.zeros(self.size)
-        if self.size:
-            self.call("getContinuousStateDerivatives" if self.fmi3 else "getDerivatives",
-                      values.ctypes.data_as(POINTER(c_double)), self.size)
-        return values
+        if not self.size:
+            return np.zeros(0)
+        self._direct(self._rates_function, self._rates, self.size)
+        return np.frombuffer(self._rates).copy()
 
     def completed_step(self) -> None:
         """Tell the FMU a step is complete; an event or a termination it asks for is refused."""
@@ -244,9 +276,13 @@ class ModelExchangeSystem:
                     self.close()
                     raise NotRunnable(f"{target}: the algebraic loop of {self.loop_name(block)} goes through it, and "
                                       "it gives no directional derivatives to solve it with")
-        self._reads = {id(block): self._grouped(block, 0) for block in self.blocks}
-        self._writes = {id(block): self._grouped(block, 1) for block in self.blocks}
+        self.stages = self._stages(after)
+        carried = self.blocks + [stage for stage in self.stages if stage is not None]
+        self._loop_columns = {id(block): self._columns(block) for block, loop in zip(self.blocks, self.loops) if loop}
+        self._reads = {id(block): self._grouped(block, 0) for block in carried}
+        self._writes = {id(block): self._grouped(block, 1) for block in carried}
         sizes = [instance.size for instance in self.instances.values()]
+        self.evaluations = 0  # of :meth:`rates`, the integrator's right-hand sides
         self.slices = dict(zip(self.instances, (slice(a, b) for a, b in zip(np.cumsum([0, *sizes]), np.cumsum(sizes)))))
 
     def _order(self) -> dict[int, list[int]]:
@@ -256,6 +292,30 @@ class ModelExchangeSystem:
             after[k] = [j for j, ((source, output), _) in enumerate(self.connections)
                         if source == target and input_ in self.instances[source].dependencies.get(output, set())]
         return after
+
+    def _stages(self, after: Mapping[int, Collection[int]]) -> list[list[int] | None]:
+        """The blocks that are no loop, in order, joined while none needs another's input: each such stage is
+        carried with one get per source instance and one set per target, the same values as block by block;
+        each loop is a stage of its own, ``None`` in its place (:meth:`settle` solves it)."""
+        stages: list[list[int] | None] = []
+        for block, loop in zip(self.blocks, self.loops):
+            if loop:
+                stages.append(None)
+            elif stages and stages[-1] is not None and not any(j in block for k in stages[-1] for j in after[k]):
+                stages[-1] = stages[-1] + block
+            else:
+                stages.append(list(block))
+        return stages
+
+    def _columns(self, block: list[int]) -> list[tuple[ModelExchangeInstance, list[str], list[int], str]]:
+        """Per connection of the loop ``block``: the instance it feeds, that instance's outputs in the loop, their
+        rows in the block, and the input it feeds."""
+        found = []
+        for k in block:
+            _, (target, input_) = self.connections[k]
+            rows = [row for row, j in enumerate(block) if self.connections[j][0][0] == target]
+            found.append((self.instances[target], [self.connections[block[row]][0][1] for row in rows], rows, input_))
+        return found
 
     def loop_name(self, block: list[int]) -> str:
         return ", ".join(f"{s}.{o}" for (s, o), _ in (self.connections[k] for k in block))
@@ -284,19 +344,26 @@ class ModelExchangeSystem:
             values[positions] = instance.get(outputs)
         return values
 
+    def _loop_jacobian(self, block: list[int]) -> np.ndarray:
+        """I - dy/dv of the loop ``block`` at the present point: a directional derivative of the outputs of the
+        loop that each input feeds, per input."""
+        jacobian = np.eye(len(block))
+        for column, (instance, outputs, rows, input_) in enumerate(self._loop_columns[id(block)]):
+            jacobian[rows, column] -= instance.directional(outputs, input_)
+        return jacobian
+
     def _solve_loop(self, block: list[int]) -> None:
         """The loop's values v = y(v) by Newton's method, (I - dy/dv) dv = y(v) - v, the Jacobian from the
-        directional derivatives of each output with respect to the inputs of the loop it depends on."""
+        directional derivatives of each output with respect to the inputs of the loop it depends on, taken at
+        the first iteration and kept (the loop is nearly linear: the second update is 1e-12 of the first, and
+        ends it)."""
         values = self._outputs(block)
+        jacobian = None
         for _ in range(MAX_LOOP_ITERATIONS):
             self._carry(block, values)
             residual = self._outputs(block) - values
-            jacobian = np.eye(len(block))
-            for column, k in enumerate(block):
-                _, (target, input_) = self.connections[k]
-                rows = [row for row, j in enumerate(block) if self.connections[j][0][0] == target]
-                outputs = [self.connections[block[row]][0][1] for row in rows]
-                jacobian[rows, column] -= self.instances[target].directional(outputs, input_)
+            if jacobian is None:
+                jacobian = self._loop_jacobian(block)
             update = np.linalg.solve(jacobian, residual)
             values = values + update
             if np.all(np.abs(update) <= LOOP_TOLERANCE * np.maximum(1.0, np.abs(values))):
@@ -309,11 +376,12 @@ class ModelExchangeSystem:
         """Every instance at ``time`` and its share of ``states``, every connection's input set."""
         for name, instance in self.instances.items():
             instance.set_point(time, states[self.slices[name]])
-        for block, loop in zip(self.blocks, self.loops):
-            if loop:
-                self._solve_loop(block)
+        loops = iter(block for block, loop in zip(self.blocks, self.loops) if loop)
+        for stage in self.stages:
+            if stage is None:
+                self._solve_loop(next(loops))
             else:
-                self._carry(block, self._outputs(block))
+                self._carry(stage, self._outputs(stage))
 
     def completed_step(self, time: float, states: np.ndarray) -> None:
         """An integrator step ends at ``(time, states)``: every instance there, then told."""
@@ -322,6 +390,7 @@ class ModelExchangeSystem:
             instance.completed_step()
 
     def rates(self, time: float, states: np.ndarray) -> np.ndarray:
+        self.evaluations += 1
         self.settle(time, states)
         return np.concatenate([instance.derivatives() for instance in self.instances.values()])
 
@@ -349,7 +418,14 @@ class ModelExchangeSystem:
 
     def outputs(self, time: float, states: np.ndarray, ports: Sequence[Port]) -> list[float]:
         self.settle(time, states)
-        return [self.instances[name].get([variable])[0] for name, variable in ports]
+        by_instance: dict[str, list[int]] = {}
+        for position, (name, _) in enumerate(ports):
+            by_instance.setdefault(name, []).append(position)
+        values = [0.0] * len(ports)
+        for name, positions in by_instance.items():
+            for position, value in zip(positions, self.instances[name].get([ports[p][1] for p in positions])):
+                values[position] = value
+        return values
 
     def close(self) -> None:
         for instance in self.instances.values():
@@ -360,11 +436,12 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
                        connections: Sequence[tuple[Port, Port]], stop_time: float, interval: float,
                        outputs: list[str], scratch: Path, rtol: float = 1e-8,
                        on_step: Callable[[int, int], None] | None = None, method: str = "DOP853",
-                       initial: bool = False) -> np.ndarray:
+                       initial: bool = False, counts: dict[str, int] | None = None) -> np.ndarray:
     """Rows of t_k = k ``interval`` (k = 1 ... N, from k = 0 with ``initial``) and ``outputs`` (``"instance.variable"``) of the system
     integrated by ``method`` (:data:`METHODS`; the implicit ones with :meth:`ModelExchangeSystem.jacobian`)
     at relative tolerance ``rtol``, step by step (``completedIntegratorStep`` after each), the rows from
-    its dense output; ``on_step(k, N)`` after each integrator step with the rows done."""
+    its dense output; ``on_step(k, N)`` after each integrator step with the rows done. ``counts``, when given, gets
+    the run's integrator steps, right-hand sides and Jacobians (what its cost is made of)."""
     system = ModelExchangeSystem(fmus, parameters, connections, scratch)
     try:
         count = int(round(stop_time / interval))
@@ -379,8 +456,10 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
         solver = METHODS[method](system.rates, 0.0, start, times[-1], rtol=rtol, atol=ATOL, **exact)
         rows: list[list[float]] = []
         first = [[0.0, *system.outputs(0.0, start, ports)]] if initial else []
+        steps = 0
         while len(rows) < count:
             message = solver.step()
+            steps += 1
             if solver.status == "failed":
                 raise StepRefused(method, "Discard", solver.t, [message])
             end, interpolant = solver.t, solver.dense_output()
@@ -389,6 +468,8 @@ def run_model_exchange(fmus: Mapping[str, Path], parameters: Mapping[str, Mappin
             system.completed_step(end, solver.y)
             if on_step is not None:
                 on_step(len(rows), count)
+        if counts is not None:
+            counts.update({"steps": steps, "right-hand sides": system.evaluations, "Jacobians": solver.njev})
         return np.array(first + rows)
     finally:
         system.close()

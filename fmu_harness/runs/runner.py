@@ -184,7 +184,9 @@ class FmuInstance(ABC):
     state_functions: tuple[str, str, str, str, str]
     """fmpy's names of get, set, free, serialize and deserialize FMU state."""
 
-    def __new__(cls, path: str | Path, *args: Any, description: ModelDescription | None = None, **kwargs: Any) -> FmuInstance:
+    def __new__(cls, path: str | Path, instance_name: str = "instance", unzipdir: str | None = None,
+                description: ModelDescription | None = None) -> FmuInstance:
+        # the arguments of __init__, positional too: a description passed so was read again (0.015 s a launch)
         if cls is not FmuInstance:
             return super().__new__(cls)
         description = description or read_model_description(str(path))

@@ -14,6 +14,7 @@ from fmu_harness import packaging
 from fmu_harness.checks import interop
 from fmu_harness.packaging import native
 from fmu_harness.doc_pages.sections import section
+from fmu_harness.runs import system
 
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "interoperability.md"
 
@@ -25,6 +26,10 @@ def matrix(fmu_dir: Path, native_dir: Path, fmi_versions: list[str]) -> interop.
     missing = [i.package for i in interop.IMPORTERS if importlib.util.find_spec(i.package) is None]
     if missing:
         pytest.skip(f"importers not installed on this platform: {', '.join(missing)} (pip install '.[interop]')")
+    for made in system.systems():  # the packages as one FMU, as the build writes them
+        system.write_ssp(made, native_dir, native_dir)
+        for version in packaging.FMI_VERSIONS:
+            system.write_container(made, native_dir, version)
     return interop.matrix(fmu_dir, native_dir)
 
 
@@ -32,8 +37,10 @@ def test_every_fmu_passes_every_importer_that_supports_its_fmi_version(matrix):
     """Engines run the standard scenario; a pass means every output within
     interop.TOLERANCE (1e-9) of its largest magnitude in fmpy's run of the Python FMU (measured:
     at most 1.4e-13, from the hosts' different time grids; a native FMU's deviations are its
-    Python FMU's). Model Exchange: the native FMUs only."""
-    families = [(name, "Python") for name in MODELS] + [(name, "native") for name in native.native_models()]
+    Python FMU's; a container's are from fmpy's run of it). Model Exchange: the native FMUs only, not the
+    packages as one FMU (the container steps its components' co-simulation)."""
+    families = ([(name, "Python") for name in MODELS] + [(name, "native") for name in native.native_models()]
+                + [(name, "container") for name in interop.CONTAINERS])
     assert set(matrix) == {(name, family, version) for name, family in families for version in ("2.0", "3.0")}
     for (name, family, version), row in matrix.items():
         for importer in interop.IMPORTERS:

@@ -208,30 +208,42 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
                                const double load_moment[3], const Load *load, double lams[3], double mus[3],
                                double slips[3], double grooves[3], double *power)
 {
-    double signs[3][2], new_mus[3], new_lams[3], m = load->m, friction = load->friction;
+    /* per arm, what the iterations do not change: |e|^2, |e|, |n||e|, |n| and the moment arms of mu_j and phi_j */
+    double signs[3][2], e2s[3], e_norms[3], ne_norms[3], n_norms[3], mu_arms[3][3], slip_arms[3][3];
+    double new_mus[3], new_lams[3], m = load->m, friction = load->friction;
     int iteration, j;
     for (j = 0; j < 3; j++) {
         const Arm *a = &arm[j];
         signs[j][0] = slip_sign(guard, a->zdot, load->slip_speed);
         signs[j][1] = slip_sign(guard, a->sigma * root(guard, a->exy2 + a->ez * a->ez), load->slip_speed);
+        e2s[j] = a->exy2 + a->ez * a->ez;
+        e_norms[j] = root(guard, e2s[j]);
+        ne_norms[j] = root(guard, a->exy2 * e2s[j]);
+        n_norms[j] = root(guard, a->exy2);
+        mu_arms[j][0] = a->dy * -a->exy2 - a->dz * a->ez * a->ey;
+        mu_arms[j][1] = a->dz * a->ez * a->ex + a->dx * a->exy2;
+        mu_arms[j][2] = a->dx * a->ez * a->ey - a->dy * a->ez * a->ex;
+        slip_arms[j][0] = a->dy * a->ez - a->dz * a->ey;
+        slip_arms[j][1] = a->dz * a->ex - a->dx * a->ez;
+        slip_arms[j][2] = a->dx * a->ey - a->dy * a->ex;
     }
     for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE;
          iteration++) {
         double Mx = load_moment[0], My = load_moment[1], Mz = load_moment[2], change = 0.0, scale = 0.0;
         for (j = 0; j < 3; j++) {
             const Arm *a = &arm[j];
-            double lam = lams[j], mu = mus[j], e2 = a->exy2 + a->ez * a->ez;
+            double lam = lams[j], mu = mus[j], e2 = e2s[j];
             double normal = root(guard, a->exy2 * (lam * lam + mu * mu * e2));
-            double slip = divide(guard, friction * normal * signs[j][1], root(guard, e2));
+            double slip = divide(guard, friction * normal * signs[j][1], e_norms[j]);
             double Nx = m * a->ax + lam * a->ey + mu * a->ez * a->ex + slip * a->ex;
             double Ny = m * a->ay - lam * a->ex + mu * a->ez * a->ey + slip * a->ey;
             double groove = -friction * root(guard, Nx * Nx + Ny * Ny) * signs[j][0];
             /* plunger along Z': groove - F_z = m zddot with F_z = -mu |n|^2 + phi e_z */
             double new_mu = divide(guard, m * a->zddot - groove + slip * a->ez, a->exy2);
-            Mx = Mx - new_mu * (a->dy * -a->exy2 - a->dz * a->ez * a->ey) - slip * (a->dy * a->ez - a->dz * a->ey);
-            My = My - new_mu * (a->dz * a->ez * a->ex + a->dx * a->exy2) - slip * (a->dz * a->ex - a->dx * a->ez);
-            Mz = Mz - new_mu * (a->dx * a->ez * a->ey - a->dy * a->ez * a->ex) - slip * (a->dx * a->ey - a->dy * a->ex);
-            change = change + fabs(new_mu - mu) * root(guard, a->exy2 * e2);
+            Mx = Mx - new_mu * mu_arms[j][0] - slip * slip_arms[j][0];
+            My = My - new_mu * mu_arms[j][1] - slip * slip_arms[j][1];
+            Mz = Mz - new_mu * mu_arms[j][2] - slip * slip_arms[j][2];
+            change = change + fabs(new_mu - mu) * ne_norms[j];
             scale = scale + normal;
             new_mus[j] = new_mu;
             slips[j] = slip;
@@ -241,7 +253,7 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
             new_lams[j] = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det;
         }
         for (j = 0; j < 3; j++) {
-            change = change + fabs(new_lams[j] - lams[j]) * root(guard, arm[j].exy2);
+            change = change + fabs(new_lams[j] - lams[j]) * n_norms[j];
         }
         for (j = 0; j < 3; j++) {
             lams[j] = new_lams[j];
