@@ -59,6 +59,7 @@ def coupling_outputs(
     alpha_in: Real = 0.0, seed_reactions: int = 0, mu: float = 0.0, v_slip: float = 1e-3,
     beta_dot: Real = 0.0, beta_ddot: Real = 0.0, tripod_type: int = PLAIN_TRIPOD, mu_roll: float = 0.0,
     roller_radius: float = 0.0, psi: Real = 0.0, psi_dot: Real = 0.0, psi_ddot: Real = 0.0, plunge_dot: Real = 0.0,
+    roller_bore_radius: float = 0.0,
 ) -> tuple[dict[str, Real], plane_solver.Solution | None]:
     """The ``TripodCoupling`` outputs (names as in the spec) and the exact solver's solution.
 
@@ -70,7 +71,8 @@ def coupling_outputs(
     ``beta_dot``, ``beta_ddot``: rates of the bend angle (the output bearing moves with beta).
     ``tripod_type`` 1 (single roller) or 2 (double roller) with the exact kinematics: the roller
     tripods' contacts (:mod:`.rollers`), with rolling resistance ``mu_roll`` and the rollers' outer
-    radius ``roller_radius`` [m]; without friction, and in the closed form, every type is the plain one.
+    and bore radii ``roller_radius``, ``roller_bore_radius`` [m]; without friction, and in the closed
+    form, every type is the plain one.
     The moving housing (docs/tripod_coupling.md, eqs M1-M8): the bend plane at ``psi`` about Z' with its
     rates ``psi_dot``, ``psi_ddot``, and the spider's axial speed ``plunge_dot`` relative to the housing;
     all 0 is the fixed housing, bit for bit.
@@ -88,7 +90,8 @@ def coupling_outputs(
         else:
             state = mechanism(phi, beta, omega_in, alpha_in, T_load, r, l, m, solution.x, solution.y, beta_dot,
                               beta_ddot, psi_dot, psi_ddot, plunge_dot)
-            forces = roller_reactions(state, omega_in, T_load, m, tripod_type, mu, mu_roll, v_slip, roller_radius)[0]
+            forces = roller_reactions(state, omega_in, T_load, m, tripod_type, mu, mu_roll, v_slip, roller_radius,
+                                      roller_bore_radius)[0]
         omega_spin, axial_in, loss = forces.omega_spin, forces.Rz_in, forces.P_friction
     else:
         deviation, ratio = closed_form.kinematics(phi, beta, r, l)

@@ -3,7 +3,7 @@
 The pose, velocities and accelerations are the plain tripod's (:func:`.reactions.mechanism`): the
 roller's centre ``b_j`` is where the arm meets the track's axis, the ball centre of the plain
 tripod, and carries the roller's mass m (``m_plunger``). What changes is each arm's contacts
-(docs/tripod_coupling.md, "Roller tripods", eqs R1-R14):
+(docs/tripod_coupling.md, "Roller tripods", eqs R1-R18):
 
 * trunnion: the roller (single roller) or the inner ring (double roller) slides along the arm at
   ``v_t = sigma_j |e_j|^2 / |e_j|`` with Coulomb friction ``mu`` on the normal force ``|F_perp|``
@@ -14,7 +14,11 @@ tripod, and carries the roller's mass m (``m_plunger``). What changes is each ar
   ``v_r`` and Coulomb friction ``mu N`` opposing the skew slip ``v_s`` (eqs R6-R9), both at the
   contact point ``b_j - R k``; what they turn about b_j goes to the trunnion (eq R10);
 * track, double roller (type 2): the outer roller stays parallel to its track and rolls along it
-  at the axial speed ``zdot_j``: rolling resistance ``mu_roll N`` along the track alone (eq R11).
+  at the axial speed ``zdot_j``: rolling resistance ``mu_roll N`` along the track (eq R11); the needles,
+  moving with the inner ring, which turns with the trunnion, slip along its axis ``a_j`` over the outer
+  roller's bore (radius ``r_b``) at ``v_n = r_b (zdot_j a_j . e_z / R - w . (k x a_j))`` (R16); the outer
+  roller's spin balance passes ``r_b / R`` of their friction's component along the track to the track
+  (R17), and the inner ring passes their moment ``-r_b F_n k x a_j`` about b_j to the trunnion (R18).
 
 Every friction force's sign is regularised as the plain tripod's (:func:`.reactions.slip_sign`).
 The normal forces depend on the friction forces: the balance is solved by successive substitution
@@ -45,10 +49,10 @@ class RollerContacts(NamedTuple):
     N_trunnion: Array  # normal force between roller (inner ring) and trunnion, |F_perp| [N]
     v_trunnion: Array  # sliding speed of the roller (inner ring) outwards along the trunnion [m/s]
     v_roll: Array  # rolling speed of the roller on the track [m/s]
-    v_skew: Array  # skew slip speed of the roller over the track along s_j [m/s] (0 for the double roller)
+    v_skew: Array  # skew slip speed of the roller over the track along s_j (double roller: the needles' slip v_n) [m/s]
     F_trunnion: Array  # friction force of the roller on the arm, along the arm [N]
     F_roll: Array  # rolling resistance of the track on the roller, along u_j [N]
-    F_skew: Array  # sliding friction of the track on the roller, along s_j [N]
+    F_skew: Array  # sliding friction of the track on the roller, along s_j (double roller: the needles', along a_j) [N]
     couple: Array  # moment of the roller on the trunnion about b_j [N.m] (vectors)
     P_trunnion: Array  # power dissipated at the trunnion [W]
     P_roll: Array  # ... by rolling resistance [W]
@@ -76,10 +80,11 @@ def _unit(a: Array) -> tuple[Array, Array]:
 
 def roller_reactions(
     state: Mechanism, omega: Real, T_load: Real, m: float, tripod_type: int, mu: float, mu_roll: float,
-    slip_speed: float, roller_radius: float,
+    slip_speed: float, roller_radius: float, roller_bore_radius: float,
 ) -> tuple[ExactReactions, RollerContacts]:
     """Reactions and contacts of the single (``tripod_type`` 1) or double (2) roller tripod at the
-    instant ``state`` describes, at input speed ``omega`` [rad/s] and load ``T_load`` [N.m]."""
+    instant ``state`` describes, at input speed ``omega`` [rad/s] and load ``T_load`` [N.m], with the
+    rollers' outer radius ``roller_radius`` and bore radius ``roller_bore_radius`` [m]."""
     arms = [np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in a)) for a in state.arms]
     shape = arms[0][0].shape
 
@@ -114,6 +119,9 @@ def roller_reactions(
     zero = np.zeros_like(exy2)
     friction_h = np.zeros_like(arm)  # horizontal part of the track's friction on the roller
     R = roller_radius
+    needle_share = roller_bore_radius / R  # r_b / R
+    relax, last_lam, last_mu = np.ones(shape), np.zeros_like(lam), np.zeros_like(mu_q)  # the double roller's damping
+    length2 = arm_length * arm_length
     for _ in range(MAX_FRICTION_ITERATIONS):
         N_trunnion = np.sqrt(exy2 * (lam * lam + mu_q * mu_q * arm_length * arm_length))
         phi = mu * N_trunnion * trunnion_sign / arm_length  # F = lam n + mu q + phi e (R5)
@@ -126,11 +134,12 @@ def roller_reactions(
             couple = _cross(-R * k, friction) + (R * F_roll * across)[..., None] * axis  # R10
         else:
             k, N_track = _unit(horizontal)  # N k = H (R11)
-            v_roll, v_skew = zdot, zero
+            ring = _cross(k, axis)  # k x a
+            v_roll, v_skew = zdot, roller_bore_radius * (zdot * axis[..., 2] / R - _dot(spin, ring))  # v_n (R16)
             F_roll = -mu_roll * N_track * slip_sign(v_roll, slip_speed)
-            F_skew = zero
-            friction = F_roll[..., None] * E_Z
-            couple = np.zeros_like(arm)
+            F_skew = -mu * N_track * slip_sign(v_skew, slip_speed)
+            friction = (F_roll + needle_share * axis[..., 2] * F_skew)[..., None] * E_Z  # R17
+            couple = (-roller_bore_radius * F_skew)[..., None] * ring  # R18
         new_friction_h = friction * np.array([1.0, 1.0, 0.0])
         # the roller along Z': friction_z - F_z = m zddot with F_z = -mu |e_xy|^2 + phi e_z (R12)
         new_mu_q = (m * zddot - friction[..., 2] + phi * arm[..., 2]) / exy2
@@ -140,6 +149,19 @@ def roller_reactions(
         change = np.sum(np.abs(new_lam - lam) * np.sqrt(exy2) + np.abs(new_mu_q - mu_q) * np.sqrt(exy2) * arm_length
                         + np.sqrt(_dot(new_friction_h - friction_h, new_friction_h - friction_h)), -1)
         scale = np.sum(N_trunnion + N_track, -1)
+        if tripod_type != SINGLE_ROLLER:
+            # the needles' steep regularised sign can make the substitution swing between two states: the
+            # steps' ratio rho to the last ones (projected, in forces) estimates the map's gain g = 1 + (rho - 1)
+            # / relax, and the steps take the share relax = 1 / (1 - g) that cancels it, at most 1 (Irons-Tuck)
+            step_lam, step_mu = new_lam - lam, new_mu_q - mu_q
+            last = np.sum(exy2 * (last_lam * last_lam + length2 * last_mu * last_mu), -1)
+            ratio = (np.sum(exy2 * (step_lam * last_lam + length2 * step_mu * last_mu), -1)
+                     / np.where(last > 0.0, last, 1.0))
+            shared = relax / np.where(ratio < 1.0, 1.0 - ratio, 1.0)
+            shared = np.where(ratio < 1.0, np.minimum(1.0, shared), 0.5 * relax)
+            relax = np.where(last > 0.0, shared, relax)
+            last_lam, last_mu = step_lam, step_mu
+            new_lam, new_mu_q = lam + relax[..., None] * step_lam, mu_q + relax[..., None] * step_mu
         lam, mu_q, friction_h = new_lam, new_mu_q, new_friction_h
         if np.all(change <= FRICTION_TOLERANCE * scale):
             break

@@ -24,7 +24,8 @@ RATES_FROM_INPUTS, RATES_FROM_SAMPLES, RATES_AUTOMATIC = 0, 1, 2
 POSITION = ("phi_in", "beta", "psi", "r", "l", "kinematics")
 PLUNGERS = (*POSITION, "omega_in", "m_plunger", "alpha_in", "beta_dot", "beta_ddot", "psi_dot", "psi_ddot",
             "beta_rate")
-FORCES = (*PLUNGERS, "T_load", "mu", "v_slip", "tripod_type", "mu_roll", "roller_radius", "plunge_dot")
+FORCES = (*PLUNGERS, "T_load", "mu", "v_slip", "tripod_type", "mu_roll", "roller_radius", "plunge_dot",
+          "roller_bore_radius")
 FRICTION = tuple(name for name in FORCES if name != "kinematics")  # zero without friction, which needs the exact
 ARM_OUTPUTS = tuple(
     Variable(f"{name}{j}", "output", 0.0, f"{text} (arm {j}: groove at phi_in + {120 * (j - 1)} deg)", "N",
@@ -154,8 +155,8 @@ SPEC = ModelSpec(
         Variable("tripod_type", "parameter", PLAIN_TRIPOD,
                  "Joint: 0 = plain tripod (plungers sliding in the grooves, the seed's), 1 = single roller (a roller "
                  "turning and sliding on each trunnion, rolling and skewing on its track), 2 = double roller (outer "
-                 "roller kept parallel to its track, inner ring sliding on the trunnion); the rollers' friction needs "
-                 "the exact kinematics", type="Integer", min=PLAIN_TRIPOD, max=DOUBLE_ROLLER),
+                 "roller kept parallel to its track on needles, inner ring sliding on the trunnion); the rollers' "
+                 "friction needs the exact kinematics", type="Integer", min=PLAIN_TRIPOD, max=DOUBLE_ROLLER),
         Variable("mu_roll", "parameter", ROLLING_RESISTANCE,
                  "Rolling resistance of each roller on its track, tangential over normal force (roller tripods; "
                  "their sliding contacts take mu)", "1", min=0.0),
@@ -163,8 +164,9 @@ SPEC = ModelSpec(
                  "Outer radius R of the rollers: the track contact lies R from the roller's centre (roller tripods)",
                  "m", "mm", min=0.0, min_exclusive=True),
         Variable("roller_bore_radius", "parameter", 0.0115,
-                 "Bore radius of the roller (single) or inner ring (double) on the trunnion, needles included "
-                 "(assembly check)", "m", "mm", min=0.0, min_exclusive=True),
+                 "Bore radius of the roller: the single roller's on the trunnion, needles included; the double "
+                 "roller's outer roller's, on which the needles of its inner ring run (assembly check)", "m", "mm",
+                 min=0.0, min_exclusive=True),
         Variable("trunnion_radius", "parameter", 0.009,
                  "Radius of the trunnions (tripod arms) that carry the rollers (assembly check)", "m", "mm",
                  min=0.0, min_exclusive=True),

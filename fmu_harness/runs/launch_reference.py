@@ -98,7 +98,8 @@ class LaunchEquations:
         p = self.joints[side]
         values, self._warm[side] = coupling_outputs(
             phi_in, p["beta"], omega_in, T_load, p["r"], p["l"], p["m_plunger"], p["kinematics"], self._warm[side],
-            alpha_in, p["seed_reactions"], p["mu"], p["v_slip"])
+            alpha_in, p["seed_reactions"], p["mu"], p["v_slip"], tripod_type=p["tripod_type"], mu_roll=p["mu_roll"],
+            roller_radius=p["roller_radius"], roller_bore_radius=p["roller_bore_radius"])
         return values
 
     def _kinematics(self, side: str, phi_in: float) -> tuple[float, float]:

@@ -1,7 +1,7 @@
 """Side-by-side comparison of the coupling FMUs, and the two-joint Cardan shaft.
 
-* :func:`speed_fluctuation_table` runs TripodCoupling, CardanJoint and UniversalReducer at the
-  same input speed over a sweep of bend angles and measures the output-speed fluctuation
+* :func:`speed_fluctuation_table` runs TripodCoupling (plain, single and double roller), CardanJoint
+  and UniversalReducer at the same input speed over a sweep of bend angles and measures the output-speed fluctuation
   (peak-to-peak / mean over one input turn) and its dominant order.
 * :func:`cardan_shaft` co-simulates two CardanJoint instances in one process, the first one's
   output speed feeding the second one's input, to show phasing cancel or double the fluctuation.
@@ -34,10 +34,17 @@ class Coupling:
     to_input: float  # offset: input = offset + sign * beta
     sign: float
     parameters: dict[str, float]
+    fmu: str = ""  # the FMU's model name, when not the name
 
 
+TRIPOD = {"kinematics": 1, "beta_max": math.radians(60.0)}
 COUPLINGS = (
-    Coupling("TripodCoupling", "beta", 0.0, 1.0, {"kinematics": 1, "beta_max": math.radians(60.0)}),
+    Coupling("TripodCoupling", "beta", 0.0, 1.0, TRIPOD),
+    # The roller tripods (tripod_type 1, 2) with friction: the plain tripod's closure, so its output speed
+    Coupling("TripodCoupling single roller", "beta", 0.0, 1.0, {**TRIPOD, "tripod_type": 1, "mu": 0.05},
+             "TripodCoupling"),
+    Coupling("TripodCoupling double roller", "beta", 0.0, 1.0, {**TRIPOD, "tripod_type": 2, "mu": 0.05},
+             "TripodCoupling"),
     Coupling("CardanJoint", "beta", 0.0, 1.0, {"beta_max": math.radians(80.0)}),
     # The reducer's intersection angle is 180 deg for in-line shafts.
     Coupling("UniversalReducer", "intersection_angle", math.pi, -1.0,
@@ -59,7 +66,7 @@ def fluctuation_and_order(omega_out: np.ndarray) -> tuple[float, int | None]:
 def one_turn(models: Path, coupling: Coupling, beta: float) -> np.ndarray:
     period = 2 * math.pi / SPEED
     result = simulate(
-        models / f"{coupling.name}.fmu", period, period / SAMPLES_PER_TURN,
+        models / f"{coupling.fmu or coupling.name}.fmu", period, period / SAMPLES_PER_TURN,
         inputs={"omega_in": SPEED, coupling.angle_input: coupling.to_input + coupling.sign * beta},
         start_values=coupling.parameters, outputs=["omega_out"],
     )
@@ -97,12 +104,17 @@ def write(models: Path, out: Path, betas_deg: list[float] | None = None) -> list
 def comparison_figure(rows: list[dict[str, object]], betas_deg: list[float]) -> Figure:
     """The fluctuation against beta on a log scale; a coupling whose fluctuation stays under
     NO_ORDER_BELOW (the reducer's constant ratio gives 0) is named in the axes instead, at its
-    largest value: a log scale has no 0."""
+    largest value: a log scale has no 0; one with another's values (the roller tripods, on the
+    plain tripod's closure) is named in that one's label, ``TripodCoupling = ...``, not drawn over it."""
     fig, ax = figure(figsize=(7, 4))
+    drawn = []
     for k, coupling in enumerate(COUPLINGS):
         values = [row["fluctuation"] for row in rows if row["coupling"] == coupling.name]
-        if max(values) >= NO_ORDER_BELOW:
-            ax.semilogy(betas_deg, values, "o-", color=f"C{k}", label=coupling.name)
+        twin = next((line for line, seen in drawn if seen == values), None)
+        if twin is not None:
+            twin.set_label(f"{twin.get_label()} = {coupling.name}")
+        elif max(values) >= NO_ORDER_BELOW:
+            drawn.append((ax.semilogy(betas_deg, values, "o-", color=f"C{k}", label=coupling.name)[0], values))
         else:
             ax.text(0.98, 0.04 + 0.07 * len(ax.texts), f"{coupling.name}: {max(values):.2g} at every bend angle (constant speed "
                     "ratio), no point on a log scale", transform=ax.transAxes, ha="right", va="bottom", fontsize=8)

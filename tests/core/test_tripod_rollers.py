@@ -17,7 +17,7 @@ from driveline.tripod.spec import DOUBLE_ROLLER, ROLLING_RESISTANCE, SINGLE_ROLL
 from support.roller_tripod_reference import random_case, solve
 from support.tripod_mechanism import OMEGA, PHI, Mechanism, R, L, M
 
-ROLLER = 0.0165
+ROLLER, BORE = 0.0165, 0.0115
 # Both computations solve to the last digits of float64: the reference's root to a residual of
 # 1e-12 of the forces (measured 5e-13 N for loads of 1e4 N), this model's balance to 1e-13 of the
 # forces; their difference, measured up to 5e-10 N (forces) and 2e-12 m/s (slips), is rounding
@@ -31,7 +31,7 @@ def roller_forces(case):
     state = mechanism(case.phi_in, case.beta, case.omega, case.omega_dot, case.T_load, case.r, case.l, case.m,
                       solution.x, solution.y, case.beta_dot, case.beta_ddot)
     return roller_reactions(state, case.omega, case.T_load, case.m, case.tripod_type, case.mu, case.mu_roll,
-                            case.slip_speed, case.roller_radius)
+                            case.slip_speed, case.roller_radius, case.roller_bore_radius)
 
 
 @pytest.mark.parametrize("tripod_type", [SINGLE_ROLLER, DOUBLE_ROLLER])
@@ -65,7 +65,7 @@ def over_a_turn(tripod_type, beta, T_load, omega=OMEGA, mu=0.05, mu_roll=ROLLING
     if tripod_type == 0:
         return exact_reactions(PHI, betas, omega, 0.0, T_load, R, L, m, solution.x, solution.y, mu, 1e-3)
     state = mechanism(PHI, betas, omega, 0.0, T_load, R, L, m, solution.x, solution.y)
-    return roller_reactions(state, omega, T_load, m, tripod_type, mu, mu_roll, 1e-3, ROLLER)[0]
+    return roller_reactions(state, omega, T_load, m, tripod_type, mu, mu_roll, 1e-3, ROLLER, BORE)[0]
 
 
 @pytest.mark.parametrize("tripod_type", [SINGLE_ROLLER, DOUBLE_ROLLER])
@@ -90,21 +90,23 @@ def third_order(force):
 
 def test_generated_axial_force_against_the_plain_tripod():
     """At 300 N.m, mu = 0.05 and the default rolling resistance: both roller tripods' third-order
-    generated axial force lies below the plain tripod's at 4, 8 and 12 deg; the single roller's grows
-    with the angle (its skew); the double roller's is its rolling resistance alone, Rz_in = sum F_roll."""
+    generated axial force lies below the plain tripod's at 4, 8 and 12 deg and grows with the angle (the
+    single roller's skew, the double roller's needles); the double roller's is its rolling resistance and
+    the share r_b / R of its needles' friction along the track, Rz_in = sum (F_roll + r_b / R sin(gamma) F_n)."""
     amplitudes = {}
     for tripod_type in (0, SINGLE_ROLLER, DOUBLE_ROLLER):
         amplitudes[tripod_type] = [third_order(over_a_turn(tripod_type, math.radians(deg), 300.0).Rz_in)
                                    for deg in (4.0, 8.0, 12.0)]
     for roller in (SINGLE_ROLLER, DOUBLE_ROLLER):
         assert all(a < p for a, p in zip(amplitudes[roller], amplitudes[0]))
-    single = amplitudes[SINGLE_ROLLER]
-    assert single[0] < single[1] < single[2]
+        assert amplitudes[roller][0] < amplitudes[roller][1] < amplitudes[roller][2]
     betas = np.full_like(PHI, math.radians(8.0))
     _, _, solution = plane_solver.solve(PHI, betas, R, L)
     state = mechanism(PHI, betas, OMEGA, 0.0, 300.0, R, L, M, solution.x, solution.y)
-    forces, contacts = roller_reactions(state, OMEGA, 300.0, M, DOUBLE_ROLLER, 0.05, ROLLING_RESISTANCE, 1e-3, ROLLER)
-    np.testing.assert_allclose(forces.Rz_in, contacts.F_roll.sum(axis=-1), rtol=0, atol=1e-9)
+    forces, contacts = roller_reactions(state, OMEGA, 300.0, M, DOUBLE_ROLLER, 0.05, ROLLING_RESISTANCE, 1e-3, ROLLER,
+                                        BORE)
+    along = contacts.F_roll + BORE / ROLLER * np.sin(contacts.gamma) * contacts.F_skew
+    np.testing.assert_allclose(forces.Rz_in, along.sum(axis=-1), rtol=0, atol=1e-9)
 
 
 @pytest.mark.parametrize("tripod_type", [SINGLE_ROLLER, DOUBLE_ROLLER])

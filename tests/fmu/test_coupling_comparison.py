@@ -1,4 +1,5 @@
-"""The three couplings side by side, and the two-joint Cardan shaft co-simulation."""
+"""The couplings side by side (the tripod as plain, single and double roller joint), and the two-joint
+Cardan shaft co-simulation."""
 
 from __future__ import annotations
 
@@ -21,6 +22,9 @@ def test_fluctuation_and_dominant_order_of_each_coupling(fmi2_dir):
         assert rows[("TripodCoupling", beta)]["order"] == 3
         assert rows[("TripodCoupling", beta)]["fluctuation"] < 0.02 * cardan["fluctuation"]
         assert rows[("UniversalReducer", beta)]["order"] is None
+        # the roller tripods turn on the plain tripod's closure: its output speed, bit for bit
+        for roller in ("TripodCoupling single roller", "TripodCoupling double roller"):
+            assert rows[(roller, beta)] | {"coupling": "TripodCoupling"} == rows[("TripodCoupling", beta)]
 
 
 def fluctuation(speed: np.ndarray) -> float:

@@ -37,7 +37,8 @@ def test_outputs_match_the_core(fmu_path, fmi, tripod_type):
     result = one_turn(fmu_path("TripodCoupling", fmi), tripod_type, 8.0)
     phi = result["phi_in"]
     core, _ = coupling_outputs(phi, np.full_like(phi, math.radians(8.0)), OMEGA, 300.0, R, L, M, EXACT, mu=0.05,
-                               tripod_type=tripod_type, mu_roll=ROLLING_RESISTANCE, roller_radius=0.0165)
+                               tripod_type=tripod_type, mu_roll=ROLLING_RESISTANCE, roller_radius=0.0165,
+                               roller_bore_radius=0.0115)
     for name, values in core.items():
         scale = np.abs(core["F_plunger1"]).max() / M if name == "a_plunger_sum" else np.abs(values).max()
         np.testing.assert_allclose(result[name], values, rtol=0, atol=1e-7 * scale + 1e-12, err_msg=name)
@@ -45,16 +46,15 @@ def test_outputs_match_the_core(fmu_path, fmi, tripod_type):
 
 def test_generated_axial_force_below_the_plain_tripods(fmu_path):
     """At 300 N.m, mu = 0.05 and the default mu_roll, read through the FMU: both roller tripods' third-order
-    generated axial force lies below the plain tripod's at 4, 8 and 12 deg, the single roller's grows with the
-    angle; the double roller's stays within 3 % of 10.8 N (its rolling resistance, docs/tripod_coupling.md)."""
+    generated axial force lies below the plain tripod's at 4, 8 and 12 deg and grows from 4 to 12 deg (the
+    single roller's skew, the double roller's needles, docs/tripod_coupling.md)."""
     path = fmu_path("TripodCoupling", "2")
     amplitude = {(t, deg): third_order(one_turn(path, t, deg)["Rz_in"])
                  for t in (0, SINGLE_ROLLER, DOUBLE_ROLLER) for deg in (4.0, 8.0, 12.0)}
-    for deg in (4.0, 8.0, 12.0):
-        assert amplitude[SINGLE_ROLLER, deg] < amplitude[0, deg]
-        assert amplitude[DOUBLE_ROLLER, deg] < amplitude[0, deg]
-        assert amplitude[DOUBLE_ROLLER, deg] == pytest.approx(10.8, rel=0.03)
-    assert amplitude[SINGLE_ROLLER, 4.0] < amplitude[SINGLE_ROLLER, 8.0] < amplitude[SINGLE_ROLLER, 12.0]
+    for roller in (SINGLE_ROLLER, DOUBLE_ROLLER):
+        for deg in (4.0, 8.0, 12.0):
+            assert amplitude[roller, deg] < amplitude[0, deg]
+        assert amplitude[roller, 4.0] < amplitude[roller, 8.0] < amplitude[roller, 12.0]
 
 
 def test_the_rollers_parameters_leave_the_plain_tripod_bit_for_bit(fmu_path, fmi):

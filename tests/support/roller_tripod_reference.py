@@ -8,6 +8,9 @@ tripods"), written from the docs' equations, not from driveline.tripod.rollers:
 * the single roller's slips from absolute velocities: the roller turns at ``Omega + omega_r a_j``,
   ``omega_r`` such that its contact point does not slip along the rolling direction, and the slip is
   its velocity less the track's at the contact point;
+* the double roller's needles from absolute angular velocities: the outer roller's, such that its
+  contact point rests on the track along it, against the inner ring's, the tripod's; their friction's
+  moment about the outer roller's axis balanced by the track's tangential force (its spin balance);
 * the forces as 15 unknowns per configuration (the three force vectors on the arms, the three
   horizontal normal forces of the tracks) and 15 equations (the tripod's moments about S, the friction
   law along each trunnion, each roller's force balance), solved by scipy's ``root``.
@@ -46,11 +49,12 @@ class Case:
     roller_radius: float
     beta_dot: float = 0.0
     beta_ddot: float = 0.0
+    roller_bore_radius: float = 0.0
 
 
 def random_case(rng: np.random.Generator, tripod_type: int) -> Case:
     """A configuration drawn over the ranges a driveline meets, either sense of speed and torque."""
-    return Case(
+    case = Case(
         tripod_type=tripod_type, phi_in=rng.uniform(0.0, 2.0 * np.pi), beta=np.radians(rng.uniform(1.0, 40.0)),
         omega=rng.choice((-1.0, 1.0)) * rng.uniform(20.0, 600.0), omega_dot=rng.uniform(-500.0, 500.0),
         T_load=rng.uniform(-600.0, 600.0), r=rng.uniform(0.018, 0.04), l=rng.uniform(0.3, 1.0),
@@ -58,6 +62,9 @@ def random_case(rng: np.random.Generator, tripod_type: int) -> Case:
         slip_speed=10.0 ** rng.uniform(-4.0, -2.0), roller_radius=rng.uniform(0.01, 0.02),
         beta_dot=rng.uniform(-2.0, 2.0), beta_ddot=rng.uniform(-20.0, 20.0),
     )
+    if tripod_type == 2:  # the needles' bore, below the smallest outer radius drawn
+        case.roller_bore_radius = rng.uniform(0.004, 0.009)
+    return case
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -115,17 +122,32 @@ def track_contact(case: Case, mo: dict, j: int, normal: np.ndarray) -> dict[str,
     N = np.linalg.norm(normal)
     k = _unit(normal)
     b, a, zdot = mo["b"][j], mo["a"][j], mo["zdot"][j]
-    if case.tripod_type == 2:  # outer roller parallel to the track: rolls along it at zdot
-        F_roll = -case.mu_roll * N * slip_sign(zdot, case.slip_speed)
-        return dict(N=N, k=k, friction=F_roll * EZ, moment=np.zeros(3), v_roll=zdot, v_skew=0.0, F_roll=F_roll,
-                    F_skew=0.0)
     R = case.roller_radius
     contact = b - R * k
+    centre_velocity = case.omega * np.cross(EZ, mo["g"][j]) + zdot * EZ  # the roller's centre on its groove
+    track_velocity = case.omega * np.cross(EZ, contact)
+    if case.tripod_type == 2:  # outer roller parallel to the track: rolls along it at zdot
+        F_roll = -case.mu_roll * N * slip_sign(zdot, case.slip_speed)
+        # it turns about its horizontal axis normal to k, so fast that its contact point rests on the track
+        axis_o = np.cross(k, EZ)
+
+        def rest(spin: float) -> float:
+            return (centre_velocity + np.cross(case.omega * EZ + spin * axis_o, contact - b) - track_velocity) @ EZ
+
+        outer = case.omega * EZ - rest(0.0) / (rest(1.0) - rest(0.0)) * axis_o  # its angular velocity
+        # the needles move with the inner ring, which turns with the tripod (Omega): their slip along the
+        # ring's axis a over the outer roller's bore, under the loaded needle at b - r_b k
+        needle = -case.roller_bore_radius * k
+        v_needle = np.cross(mo["Omega"] - outer, needle) @ a
+        F_needle = case.mu * N * slip_sign(v_needle, case.slip_speed) * a  # their friction on the outer roller
+        # the outer roller's spin balance about axis_o: the needles' friction at the bore, the track's
+        # tangential force along e_z at the contact; the inner ring passes the needles' moment to the trunnion
+        tangential = -(np.cross(needle, F_needle) @ axis_o) / (np.cross(contact - b, EZ) @ axis_o)
+        return dict(N=N, k=k, friction=(F_roll + tangential) * EZ, moment=np.cross(needle, -F_needle), v_roll=zdot,
+                    v_skew=v_needle, F_roll=F_roll, F_skew=-(F_needle @ a))
     along = np.cross(a, k)
     u = _unit(along)
     s = np.cross(k, u)
-    centre_velocity = case.omega * np.cross(EZ, mo["g"][j]) + zdot * EZ  # the roller's centre on its groove
-    track_velocity = case.omega * np.cross(EZ, contact)
 
     def slip(omega_r: float) -> np.ndarray:
         return centre_velocity + np.cross(mo["Omega"] + omega_r * a, contact - b) - track_velocity

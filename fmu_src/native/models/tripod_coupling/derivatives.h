@@ -29,6 +29,7 @@ typedef struct {
     double r, l, m, friction, slip_speed;
     int tripod_type;               /* 0 plain, 1 single roller, 2 double roller */
     double mu_roll, roller_radius; /* the roller tripods' rolling resistance and rollers' outer radius */
+    double roller_bore_radius;     /* the rollers' bore radius: the double roller's needles run on it */
 } DualLoad;
 
 /* The step's Reactions in dual numbers */

@@ -96,6 +96,7 @@ Failure tripod_jacobian(const ModelData *data, const double *axis, double partia
     load.tripod_type = INTEGER(tripod_type);
     load.mu_roll = VALUE(mu_roll);
     load.roller_radius = VALUE(roller_radius);
+    load.roller_bore_radius = VALUE(roller_bore_radius);
     rho = dual_div(dual_scale(dual_sub(dual_constant(1.0), cb), r), dual_scale(cb, 2.0));
     pin = dual_div(T_load, dual_scale(dual_shift(rho, r), 3.0));
     if (axis != NULL) {

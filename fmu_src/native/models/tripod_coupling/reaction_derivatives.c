@@ -14,6 +14,7 @@
 #include "derivatives.h"
 
 #include "driveline_constants.h"
+#include "illinois.h"
 
 static const double PI = 3.141592653589793; /* math.pi */
 
@@ -298,9 +299,19 @@ static DualContact skewed_contact_at(const DualLoad *load, Dual angle, Dual targ
     return c;
 }
 
-static double sign_of(double a)
+/* What the miss of the contacts' values needs (illinois.h) */
+typedef struct {
+    const DualLoad *load;
+    const Vec *axis;
+    const double *zdot, *target;
+    Vec spin;
+} MissContext;
+
+static double miss_at(void *context, int arm, double angle)
 {
-    return a > 0.0 ? 1.0 : (a < 0.0 ? -1.0 : 0.0);
+    MissContext *at = (MissContext *)context;
+    return skewed_contact_at(at->load, dual_constant(angle), dual_constant(at->target[arm]), at->axis[arm],
+                             dual_constant(at->zdot[arm]), at->spin).miss.v;
 }
 
 /* rollers._skewed_contact for the three arms together: the angle's value by the Illinois method, then its
@@ -308,62 +319,25 @@ static double sign_of(double a)
 static void skewed_contacts(const DualLoad *load, const Vec H[3], const Vec axis[3], const Dual zdot[3], Vec spin,
                             DualContact c[3], Dual N[3], Dual F_roll[3], Dual F_skew[3])
 {
-    double low[3], high[3], f_low[3], f_high[3], angle;
-    double share = load->friction + load->mu_roll;
-    double spread = asin(share < TRIPOD_ROLLERS_FRICTION_SHARE_CAP ? share : TRIPOD_ROLLERS_FRICTION_SHARE_CAP)
-                    + TRIPOD_ROLLERS_BRACKET_MARGIN;
+    double target_v[3], zdot_v[3], angles[3], angle;
     Dual target[3], size[3];
     Vec axis_v[3], spin_v = vvalue(spin);
-    int side[3] = {0, 0, 0}, iteration, j;
+    MissContext context;
+    int j;
     for (j = 0; j < 3; j++) {
         target[j] = dual_atan2(H[j].v[1], H[j].v[0]);
         size[j] = dual_sqrt(vdot(H[j], H[j]));
         axis_v[j] = vvalue(axis[j]);
-        low[j] = target[j].v - spread;
-        high[j] = target[j].v + spread;
-        f_low[j] = skewed_contact_at(load, dual_constant(low[j]), dual_constant(target[j].v), axis_v[j],
-                                     dual_constant(zdot[j].v), spin_v).miss.v;
-        f_high[j] = skewed_contact_at(load, dual_constant(high[j]), dual_constant(target[j].v), axis_v[j],
-                                      dual_constant(zdot[j].v), spin_v).miss.v;
+        target_v[j] = target[j].v;
+        zdot_v[j] = zdot[j].v;
     }
-    for (iteration = 0; iteration < TRIPOD_ROLLERS_CONTACT_ITERATIONS; iteration++) {
-        int done = 1;
-        for (j = 0; j < 3; j++) {
-            double least = fabs(f_low[j]) < fabs(f_high[j]) ? fabs(f_low[j]) : fabs(f_high[j]);
-            done = done && (fabs(high[j] - low[j]) <= TRIPOD_ROLLERS_CONTACT_TOLERANCE
-                            || least <= TRIPOD_ROLLERS_CONTACT_TOLERANCE);
-        }
-        if (done) {
-            break;
-        }
-        for (j = 0; j < 3; j++) {
-            double a = f_high[j] != f_low[j] ? (low[j] * f_high[j] - high[j] * f_low[j]) / (f_high[j] - f_low[j])
-                                             : 0.5 * (low[j] + high[j]);
-            double f_mid = skewed_contact_at(load, dual_constant(a), dual_constant(target[j].v), axis_v[j],
-                                             dual_constant(zdot[j].v), spin_v).miss.v;
-            int lower = sign_of(f_mid) == sign_of(f_low[j]);
-            double new_low = lower ? f_mid : f_low[j], new_high = lower ? f_high[j] : f_mid;
-            if (lower) {
-                low[j] = a;
-            } else {
-                high[j] = a;
-            }
-            if (lower && side[j] == 1) {
-                new_high = 0.5 * new_high;
-            }
-            if (!lower && side[j] == -1) {
-                new_low = 0.5 * new_low;
-            }
-            side[j] = lower ? 1 : -1;
-            f_low[j] = new_low;
-            f_high[j] = new_high;
-        }
-    }
+    context = (MissContext){load, axis_v, zdot_v, target_v, spin_v};
+    illinois_angles(miss_at, &context, target_v, load->friction, load->mu_roll, angles);
     for (j = 0; j < 3; j++) {
         Dual theta, slope;
         DualContact knowns, own;
         int col;
-        angle = fabs(f_low[j]) <= fabs(f_high[j]) ? low[j] : high[j];
+        angle = angles[j];
         knowns = skewed_contact_at(load, dual_constant(angle), target[j], axis[j], zdot[j], spin);
         own = skewed_contact_at(load, dual_known(angle, 0), dual_constant(target[j].v), axis_v[j],
                                 dual_constant(zdot[j].v), spin_v);
@@ -386,13 +360,16 @@ static int roller_reactions(const DualArm arm[3], Dual adj[3][3], Dual inv_det, 
                             Dual mu_q[3], DualReactions *out)
 {
     const double m = load->m, R = load->roller_radius, mu = load->friction;
+    const double needle_share = load->roller_bore_radius / R; /* r_b / R */
     Vec centre[3], e[3], d[3], n[3], q[3], axis[3], groove_acc[3], force[3], friction[3], couple[3], H[3];
     Vec friction_h[3], spin, load_moment, Uv = vec(U[0], U[1], U[2]), Wv = vec(W[0], W[1], W[2]);
     Dual length[3], zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], N_trunnion[3], phi[3], N[3], F_roll[3];
     Dual F_skew[3], v_roll[3], v_skew[3], zero = dual_constant(0.0), power = zero;
     Vec R_out = vec(zero, zero, zero), R_in = R_out, L = R_out;
     DualContact c[3];
+    Dual step_lam[3], step_mu[3], next_lam[3], next_mu[3];
     double change[DUAL_SIZE + 1], scale[DUAL_SIZE + 1];
+    double relax = 1.0, last_lam[3] = {0.0, 0.0, 0.0}, last_mu[3] = {0.0, 0.0, 0.0};
     int iteration, i, j, col, settled = 0;
     for (j = 0; j < 3; j++) {
         const DualArm *a = &arm[j];
@@ -435,13 +412,15 @@ static int roller_reactions(const DualArm arm[3], Dual adj[3][3], Dual inv_det, 
             }
         } else {
             for (j = 0; j < 3; j++) {
-                vunit(H[j], &N[j]);
+                Vec lever = vcross(vunit(H[j], &N[j]), axis[j]); /* k x a */
                 v_roll[j] = zdot[j];
-                v_skew[j] = zero;
+                v_skew[j] = dual_scale(dual_sub(dual_scale(dual_mul(zdot[j], axis[j].v[2]), 1.0 / R),
+                                                vdot(spin, lever)), load->roller_bore_radius); /* R16 */
                 F_roll[j] = dual_mul(dual_scale(N[j], -load->mu_roll), slip_sign(v_roll[j], load->slip_speed));
-                F_skew[j] = zero;
-                friction[j] = vec(zero, zero, F_roll[j]);
-                couple[j] = vec(zero, zero, zero);
+                F_skew[j] = dual_mul(dual_scale(N[j], -mu), slip_sign(v_skew[j], load->slip_speed));
+                friction[j] = vec(zero, zero, dual_add(F_roll[j], dual_mul(dual_scale(axis[j].v[2], needle_share),
+                                                                           F_skew[j]))); /* R17 */
+                couple[j] = vscale(lever, dual_scale(F_skew[j], -load->roller_bore_radius)); /* R18 */
             }
         }
         for (j = 0; j < 3; j++) {
@@ -459,13 +438,37 @@ static int roller_reactions(const DualArm arm[3], Dual adj[3][3], Dual inv_det, 
                 tally(h.v[i], 1.0, scale);
             }
             friction_h[j] = h;
-            mu_q[j] = new_mu;
+            step_mu[j] = dual_sub(new_mu, mu_q[j]);
+            next_mu[j] = new_mu;
         }
         for (j = 0; j < 3; j++) {
             Dual new_lam = dual_mul(vdot(moment, vec(adj[j][0], adj[j][1], adj[j][2])), inv_det);
             tally(dual_sub(new_lam, lam[j]), sqrt(arm[j].exy2.v), change);
             tally(new_lam, sqrt(arm[j].exy2.v), scale);
-            lam[j] = new_lam;
+            step_lam[j] = dual_sub(new_lam, lam[j]);
+            next_lam[j] = new_lam;
+        }
+        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's relaxation, on the values */
+            double last = 0.0, along = 0.0, ratio, shared;
+            for (j = 0; j < 3; j++) {
+                double length2 = length[j].v * length[j].v;
+                last = last + arm[j].exy2.v * (last_lam[j] * last_lam[j] + length2 * last_mu[j] * last_mu[j]);
+                along = along + arm[j].exy2.v * (step_lam[j].v * last_lam[j] + length2 * step_mu[j].v * last_mu[j]);
+                last_lam[j] = step_lam[j].v;
+                last_mu[j] = step_mu[j].v;
+            }
+            ratio = along / (last > 0.0 ? last : 1.0);
+            shared = relax / (ratio < 1.0 ? 1.0 - ratio : 1.0);
+            shared = ratio < 1.0 ? (1.0 < shared ? 1.0 : shared) : 0.5 * relax;
+            relax = last > 0.0 ? shared : relax;
+            for (j = 0; j < 3; j++) {
+                next_lam[j] = dual_add(lam[j], dual_scale(step_lam[j], relax));
+                next_mu[j] = dual_add(mu_q[j], dual_scale(step_mu[j], relax));
+            }
+        }
+        for (j = 0; j < 3; j++) {
+            lam[j] = next_lam[j];
+            mu_q[j] = next_mu[j];
         }
         settled = iteration > 0;
         for (col = 0; col <= DUAL_SIZE; col++) {

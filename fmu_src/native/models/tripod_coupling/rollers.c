@@ -1,10 +1,11 @@
-/* The roller tripods' balance (driveline/tripod/rollers.py; eqs R1-R15 of docs/tripod_coupling.md): each
+/* The roller tripods' balance (driveline/tripod/rollers.py; eqs R1-R18 of docs/tripod_coupling.md): each
  * roller's contacts with its trunnion and its track, the single roller's contact normal by the Illinois method
  * on its bracket, the balance by successive substitution from the plain tripod's frictionless forces. Every
  * expression keeps the Python core's order of operations. */
 #include "step.h"
 
 #include "driveline_constants.h"
+#include "illinois.h"
 
 static const double PI = 3.141592653589793; /* math.pi */
 
@@ -77,9 +78,20 @@ static void skewed_slips(Guard *guard, const Load *load, const double axis[3], d
     c->miss = remainder_of(atan2(c->pushed[1], c->pushed[0]) - target + PI, 2.0 * PI) - PI;
 }
 
-static double sign_of(double a)
+/* What the miss of the step's contacts needs (illinois.h) */
+typedef struct {
+    Guard *guard;
+    const Load *load;
+    const double (*axis)[3];
+    const double *zdot, *spin, *target;
+} MissContext;
+
+static double miss_at(void *context, int arm, double angle)
 {
-    return a > 0.0 ? 1.0 : (a < 0.0 ? -1.0 : 0.0);
+    MissContext *at = (MissContext *)context;
+    Contact probe;
+    skewed_slips(at->guard, at->load, at->axis[arm], at->zdot[arm], at->spin, angle, at->target[arm], &probe);
+    return probe.miss;
 }
 
 /* The three single rollers' track contacts under the horizontal forces H (rollers._skewed_contact): the
@@ -87,61 +99,16 @@ static double sign_of(double a)
 static void skewed_contacts(Guard *guard, const Load *load, const double H[3][3], const double axis[3][3],
                             const double zdot[3], const double spin[3], Contact c[3])
 {
-    double target[3], size[3], low[3], high[3], f_low[3], f_high[3], angle[3];
-    double share = load->friction + load->mu_roll;
-    double spread = asin(share < TRIPOD_ROLLERS_FRICTION_SHARE_CAP ? share : TRIPOD_ROLLERS_FRICTION_SHARE_CAP)
-                    + TRIPOD_ROLLERS_BRACKET_MARGIN;
-    int side[3] = {0, 0, 0}, iteration, j;
-    Contact probe;
+    double target[3], size[3], angle[3];
+    MissContext context;
+    int j;
     for (j = 0; j < 3; j++) {
         target[j] = atan2(H[j][1], H[j][0]);
         size[j] = root(guard, dot3(H[j], H[j]));
-        low[j] = target[j] - spread;
-        high[j] = target[j] + spread;
-        skewed_slips(guard, load, axis[j], zdot[j], spin, low[j], target[j], &probe);
-        f_low[j] = probe.miss;
-        skewed_slips(guard, load, axis[j], zdot[j], spin, high[j], target[j], &probe);
-        f_high[j] = probe.miss;
     }
-    for (iteration = 0; iteration < TRIPOD_ROLLERS_CONTACT_ITERATIONS; iteration++) {
-        int done = 1;
-        for (j = 0; j < 3; j++) {
-            double least = fabs(f_low[j]) < fabs(f_high[j]) ? fabs(f_low[j]) : fabs(f_high[j]);
-            done = done && (fabs(high[j] - low[j]) <= TRIPOD_ROLLERS_CONTACT_TOLERANCE
-                            || least <= TRIPOD_ROLLERS_CONTACT_TOLERANCE);
-        }
-        if (done) {
-            break;
-        }
-        for (j = 0; j < 3; j++) {
-            double a = f_high[j] != f_low[j] ? (low[j] * f_high[j] - high[j] * f_low[j]) / (f_high[j] - f_low[j])
-                                             : 0.5 * (low[j] + high[j]);
-            double f_mid, new_low, new_high;
-            int lower;
-            skewed_slips(guard, load, axis[j], zdot[j], spin, a, target[j], &probe);
-            f_mid = probe.miss;
-            lower = sign_of(f_mid) == sign_of(f_low[j]);
-            new_low = lower ? f_mid : f_low[j];
-            new_high = lower ? f_high[j] : f_mid;
-            if (lower) {
-                low[j] = a;
-            } else {
-                high[j] = a;
-            }
-            /* Illinois: halve the value at the end that stays twice in a row */
-            if (lower && side[j] == 1) {
-                new_high = 0.5 * new_high;
-            }
-            if (!lower && side[j] == -1) {
-                new_low = 0.5 * new_low;
-            }
-            side[j] = lower ? 1 : -1;
-            f_low[j] = new_low;
-            f_high[j] = new_high;
-        }
-    }
+    context = (MissContext){guard, load, axis, zdot, spin, target};
+    illinois_angles(miss_at, &context, target, load->friction, load->mu_roll, angle);
     for (j = 0; j < 3; j++) {
-        angle[j] = fabs(f_low[j]) <= fabs(f_high[j]) ? low[j] : high[j];
         skewed_slips(guard, load, axis[j], zdot[j], spin, angle[j], target[j], &c[j]);
         c[j].N = size[j] / root(guard, dot3(c[j].pushed, c[j].pushed));
         c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
@@ -156,10 +123,12 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                              const Load *load, const Shaft *shaft, double lam[3], double mu_q[3], Reactions *out)
 {
     const double m = load->m, R = load->roller_radius, mu = load->friction;
+    const double needle_share = load->roller_bore_radius / R; /* r_b / R */
     double centre[3][3], e[3][3], d[3][3], n[3][3], q[3][3], axis[3][3], length[3], groove_acc[3][3];
     double zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], spin[3], load_moment[3], friction_h[3][3];
     double N_trunnion[3], phi[3], force[3][3], friction[3][3], couple[3][3], H[3][3];
     double R_out[3] = {0.0, 0.0, 0.0}, R_in[3] = {0.0, 0.0, 0.0}, L[3] = {0.0, 0.0, 0.0}, power = 0.0;
+    double relax = 1.0, last_lam[3] = {0.0, 0.0, 0.0}, last_mu[3] = {0.0, 0.0, 0.0};
     Contact c[3];
     int iteration, i, j;
     for (j = 0; j < 3; j++) {
@@ -217,14 +186,16 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
             }
         } else {
             for (j = 0; j < 3; j++) {
+                double lever[3]; /* k x a */
                 c[j].N = unit3(guard, H[j], c[j].k);
+                cross3(c[j].k, axis[j], lever);
                 c[j].v_roll = zdot[j];
-                c[j].v_skew = 0.0;
+                c[j].v_skew = load->roller_bore_radius * (zdot[j] * axis[j][2] / R - dot3(spin, lever)); /* R16 */
                 c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
-                c[j].F_skew = 0.0;
-                for (i = 0; i < 3; i++) {
-                    friction[j][i] = c[j].F_roll * (i == 2 ? 1.0 : 0.0);
-                    couple[j][i] = 0.0;
+                c[j].F_skew = -mu * c[j].N * slip_sign(guard, c[j].v_skew, load->slip_speed);
+                for (i = 0; i < 3; i++) { /* R17, R18 */
+                    friction[j][i] = (c[j].F_roll + needle_share * axis[j][2] * c[j].F_skew) * (i == 2 ? 1.0 : 0.0);
+                    couple[j][i] = -load->roller_bore_radius * c[j].F_skew * lever[i];
                 }
             }
         }
@@ -254,6 +225,25 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                                + fabs(new_mu[j] - mu_q[j]) * root(guard, arm[j].exy2) * length[j]
                                + root(guard, dot3(change_h, change_h)));
             scale = scale + (N_trunnion[j] + c[j].N);
+        }
+        if (load->tripod_type != TRIPOD_SPEC_SINGLE_ROLLER) { /* the double roller's relaxation (rollers.py) */
+            double last = 0.0, along = 0.0, ratio, shared;
+            for (j = 0; j < 3; j++) {
+                double step_lam = new_lam[j] - lam[j], step_mu = new_mu[j] - mu_q[j];
+                double length2 = length[j] * length[j];
+                last = last + arm[j].exy2 * (last_lam[j] * last_lam[j] + length2 * last_mu[j] * last_mu[j]);
+                along = along + arm[j].exy2 * (step_lam * last_lam[j] + length2 * step_mu * last_mu[j]);
+                last_lam[j] = step_lam;
+                last_mu[j] = step_mu;
+            }
+            ratio = along / (last > 0.0 ? last : 1.0);
+            shared = relax / (ratio < 1.0 ? 1.0 - ratio : 1.0);
+            shared = ratio < 1.0 ? (1.0 < shared ? 1.0 : shared) : 0.5 * relax;
+            relax = last > 0.0 ? shared : relax;
+            for (j = 0; j < 3; j++) {
+                new_lam[j] = lam[j] + relax * last_lam[j];
+                new_mu[j] = mu_q[j] + relax * last_mu[j];
+            }
         }
         for (j = 0; j < 3; j++) {
             lam[j] = new_lam[j];

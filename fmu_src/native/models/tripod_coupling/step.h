@@ -55,6 +55,7 @@ typedef struct {
     double beta_dot, beta_ddot, psi_dot, psi_ddot, plunge_dot;
     int tripod_type;                /* 0 plain, 1 single roller, 2 double roller (spec.tripod_type) */
     double mu_roll, roller_radius;  /* the roller tripods' rolling resistance and rollers' outer radius */
+    double roller_bore_radius;      /* the rollers' bore radius: the double roller's needles run on it */
 } Load;
 
 /* One arm of the exact balance: groove point g, ball height bz, arm vector e = b - P,

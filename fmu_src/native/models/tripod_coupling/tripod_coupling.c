@@ -554,6 +554,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     load.tripod_type = INTEGER(tripod_type);
     load.mu_roll = VALUE(mu_roll);
     load.roller_radius = VALUE(roller_radius);
+    load.roller_bore_radius = VALUE(roller_bore_radius);
     rho = divide(&guard, r * (1.0 - cos_beta), 2.0 * cos_beta); /* orbit radius of the tripod centre */
     pin = divide(&guard, T_load, 3.0 * (r + rho));              /* eq 24 with the corrected eq 21 */
     if (INTEGER(kinematics) == TRIPOD_SPEC_EXACT) {
