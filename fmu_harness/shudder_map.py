@@ -43,7 +43,7 @@ import math
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -135,9 +135,9 @@ def joint_types(names: str) -> list[int]:
     return [JOINT_TYPES[name] for name in found]
 
 
-def joint_of(row: Mapping[str, object]) -> int:
+def joint_of(row: Mapping[str, Any]) -> int:
     """The joints' ``tripod_type`` of a map's ``row``; a table written before the type axis is the plain tripod's."""
-    return int(row.get(JOINT, PLAIN_TRIPOD))  # type: ignore[call-overload]
+    return int(row.get(JOINT, PLAIN_TRIPOD))
 
 
 def joint_name(tripod_type: int) -> str:
