@@ -1,34 +1,38 @@
-"""The launch shudder map: peak third-order powertrain acceleration over bend angle, torque, friction and phase.
+"""The launch shudder map: peak third-order powertrain acceleration over joint, bend, torque, friction and phase.
 
-The peak third-order powertrain acceleration of the vehicle launch over the joints' bend angle, the
-launch torque, the joints' friction coefficient and the right joint's phase against the left's, each
-launch a run of the sweep layer; for each bend, torque and friction the worst phase and the envelope
-over the phases.
+The peak third-order powertrain acceleration of the vehicle launch over the joints' type, their bend
+angle, the launch torque, the joints' friction coefficient and the right joint's phase against the
+left's, each launch a run of the sweep layer; for each type, bend, torque and friction the worst phase
+and the envelope over the phases.
 
 Usage (``driveline-fmus map`` is ``python -m fmu_harness.shudder_map``)::
 
     driveline-fmus map [--package models/native/VehicleLaunch.ssp] [--count 8]
-        [--phases 4] [--duration 4] [--step 2e-4] [--master gauss-seidel] [--workers N | --scheduler tcp://host:8786]
+        [--phases 4] [--joints plain] [--duration 4] [--step 2e-4] [--master gauss-seidel]
+        [--workers N | --scheduler tcp://host:8786]
         [--out results/shudder_map.parquet] [--envelope results/shudder_map_envelope.csv]
         [--figure results/shudder_map.png]
     driveline-fmus map --figure-only [--out ...] [--envelope ...] [--figure ...]
 
-The grid: ``--count`` values each of both halfshafts' design bend (``mounts.beta_design_*``, the joints'
+The grid: the ``--joints`` types of :data:`JOINT_TYPES` (both joints' ``tripod_type`` alike; the plain
+tripod alone by default), ``--count`` values each of both halfshafts' design bend (``mounts.beta_design_*``, the joints'
 bends following the powertrain from there; 5 to 20 deg), ``motor.T_level`` (20 to
 100 % of the default car's motor peak, :data:`driveline.vehicle.compact_car.MOTOR_PEAK_TORQUE`) and
 both joints' ``mu`` (0.02 to 0.1), and ``--phases`` values of the right joint's ``phi_in_start`` (the left
 joint's stays 0) spread over the third of a turn after which a tripod joint repeats itself
 (:data:`PHASE_PERIOD`; 0, 30, 60, 90 deg at the default 4), the cartesian product (2,048 launches at the
-defaults), each one launch of :mod:`fmu_harness.runs.system_sweep` with the launch's metrics and
+defaults, as many again for each further type), each one launch of :mod:`fmu_harness.runs.system_sweep`
+with the launch's metrics and
 :data:`THIRD_ORDERS`: for the powertrain's pitch, lateral and yaw accelerations at its centre of gravity
 (``mounts.pitch_ddot``, ``mounts.y_ddot``, ``mounts.yaw_ddot``) the peak third-order amplitude over the
 left joint's turns (``..._order3_peak``, :func:`fmu_harness.studies.order_tracking.third_order_peak`; the
 right joint turns negatively in its own frame) and the joint's speed there (``..._order3_speed``). A
 launch whose joint turns less than the order tracking's window fails with that reason. The table goes
-to ``--out``; the envelope over the phases (:func:`envelope`: for each bend, torque and friction each
+to ``--out``; the envelope over the phases (:func:`envelope`: for each type, bend, torque and friction each
 peak's largest and smallest value over the phases and the phase of the largest, the worst) to
-``--envelope``; the figure (a panel per friction coefficient: the worst phase's pitch peak over bend
-angle and torque, each cell labelled with its worst phase) to ``--figure``; ``--figure-only`` draws the
+``--envelope``; the figure (a panel per friction coefficient, a row of them per joint type with its own
+colour scale: the worst phase's pitch peak over bend angle and torque, each cell labelled with its worst
+phase) to ``--figure``; ``--figure-only`` draws the
 figure from a table written before.
 """
 
@@ -39,10 +43,11 @@ import math
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from driveline.tripod.spec import DOUBLE_ROLLER, PLAIN_TRIPOD, SINGLE_ROLLER
 from driveline.vehicle.compact_car import MASS, MOTOR_PEAK_TORQUE, RATIO, WHEEL_RADIUS
 
 from .console import CommandParser, summary
@@ -60,6 +65,9 @@ BETA = "mounts.beta_design_left+mounts.beta_design_right"
 TORQUE = "motor.T_level"
 MU = "joint_left.mu+joint_right.mu"
 PHASE = "joint_right.phi_in_start"
+JOINT = "joint_left.tripod_type+joint_right.tripod_type"
+JOINT_TYPES = {"plain": PLAIN_TRIPOD, "single": SINGLE_ROLLER, "double": DOUBLE_ROLLER}
+"""The ``--joints`` names of TripodCoupling's ``tripod_type`` (docs/tripod_coupling.md, "Roller tripods")."""
 PEAK = f"{SIGNAL}_order3_peak"
 BETA_RANGE = (math.radians(5.0), math.radians(20.0))
 TORQUE_RANGE = (0.2 * MOTOR_PEAK_TORQUE, MOTOR_PEAK_TORQUE)
@@ -115,38 +123,62 @@ def duration_error(duration: float) -> str | None:
             f"{math.ceil(shortest * 10.0) / 10.0:g} s (default 4)")
 
 
+def joint_types(names: str) -> list[int]:
+    """The ``tripod_type`` of each comma-separated name of :data:`JOINT_TYPES` in ``names``, in their order.
+    Raises ValueError naming an unknown or repeated type."""
+    found = [name.strip() for name in names.split(",")]
+    for name in found:
+        if name not in JOINT_TYPES:
+            raise ValueError(f"--joints: no joint type {name!r} (choose from {', '.join(JOINT_TYPES)})")
+    if len(set(found)) < len(found):
+        raise ValueError(f"--joints {names}: a type named twice")
+    return [JOINT_TYPES[name] for name in found]
+
+
+def joint_of(row: Mapping[str, Any]) -> int:
+    """The joints' ``tripod_type`` of a map's ``row``; a table written before the type axis is the plain tripod's."""
+    return int(row.get(JOINT, PLAIN_TRIPOD))
+
+
+def joint_name(tripod_type: int) -> str:
+    """The :data:`JOINT_TYPES` name of ``tripod_type``."""
+    return next(name for name, value in JOINT_TYPES.items() if value == tripod_type)
+
+
 def phases(count: int) -> list[float]:
     """``count`` phases [rad] of the right joint against the left, evenly over :data:`PHASE_PERIOD` from 0."""
     return (np.arange(count) * (PHASE_PERIOD / count)).tolist()
 
 
-def axes(count: int, phase_count: int = 1) -> dict[str, list[float]]:
-    """The map's grid axes, ``count`` values each (both ends included) of bend, torque and friction and
-    ``phase_count`` phases (:func:`phases`)."""
+def axes(count: int, phase_count: int = 1, types: Sequence[int] = (PLAIN_TRIPOD,)) -> dict[str, list[float]]:
+    """The map's grid axes: the joints' ``types`` (slowest), ``count`` values each (both ends included) of
+    bend, torque and friction and ``phase_count`` phases (:func:`phases`)."""
     found = {name: np.linspace(*bounds, count).tolist()
              for name, bounds in ((BETA, BETA_RANGE), (TORQUE, TORQUE_RANGE), (MU, MU_RANGE))}
-    return found | {PHASE: phases(phase_count)}
+    return {JOINT: list(types)} | found | {PHASE: phases(phase_count)}
 
 
 def envelope(table: pa.Table) -> pa.Table:
-    """For each bend, torque and friction of a map's ``table``: how many phases ran (``phases``), and for
+    """For each joint type, bend, torque and friction of a map's ``table`` (:func:`joint_of`): how many
+    phases ran (``phases``), and for
     each peak of :data:`PEAKS` its largest value over them (``..._max``), the phase there
     (``..._worst_phase`` [rad]) and its smallest value (``..._min``); a combination whose every launch
     failed has no row. The units those of the map's columns."""
     import pyarrow as pa  # the sweep extra, as the map's own table
 
     units = sweep.units_of(table)
-    groups: dict[tuple[float, float, float], list[dict]] = {}
+    groups: dict[tuple[int, float, float, float], list[dict]] = {}
     for row in table.to_pylist():
         if row["status"] == "ok":
-            groups.setdefault((row[BETA], row[TORQUE], row[MU]), []).append(row)
-    columns: dict[str, list[float]] = {BETA: [], TORQUE: [], MU: [], "phases": []}
-    found_units = {BETA: units[BETA], TORQUE: units[TORQUE], MU: units[MU], "phases": "1"}
+            groups.setdefault((joint_of(row), row[BETA], row[TORQUE], row[MU]), []).append(row)
+    columns: dict[str, list[float]] = {JOINT: [], BETA: [], TORQUE: [], MU: [], "phases": []}
+    found_units = {JOINT: "1", BETA: units[BETA], TORQUE: units[TORQUE], MU: units[MU], "phases": "1"}
     for peak in PEAKS:
         for suffix, unit in (("max", units[peak]), ("worst_phase", units[PHASE]), ("min", units[peak])):
             columns[f"{peak}_{suffix}"] = []
             found_units[f"{peak}_{suffix}"] = unit
-    for (beta, torque, mu), rows in sorted(groups.items()):
+    for (joint, beta, torque, mu), rows in sorted(groups.items()):
+        columns[JOINT].append(joint)
         columns[BETA].append(beta)
         columns[TORQUE].append(torque)
         columns[MU].append(mu)
@@ -156,51 +188,60 @@ def envelope(table: pa.Table) -> pa.Table:
             columns[f"{peak}_max"].append(worst[peak])
             columns[f"{peak}_worst_phase"].append(worst[PHASE])
             columns[f"{peak}_min"].append(min(row[peak] for row in rows))
-    found = pa.table({name: pa.array(values, type=pa.int64() if name == "phases" else pa.float64())
+    found = pa.table({name: pa.array(values, type=pa.int64() if name in (JOINT, "phases") else pa.float64())
                       for name, values in columns.items()})
     return sweep.with_units(found, found_units)
 
 
 def draw(table: pa.Table, path: Path) -> Path:
-    """A panel per friction coefficient: the peak third-order pitch acceleration [rad/s2] of the worst
-    phase (:func:`envelope`) over the bend angle [deg] and the launch torque [% of the motor's peak], one
-    colour scale for all panels, each cell labelled with its worst phase [deg] when the map has several;
-    a combination whose every launch failed is left blank."""
+    """A panel per friction coefficient, a row of them per joint type (:func:`joint_of`): the peak
+    third-order pitch acceleration [rad/s2] of the worst phase (:func:`envelope`) over the bend angle [deg]
+    and the launch torque [% of the motor's peak], one colour scale per type (the roller tripods' peaks are
+    several times below the plain tripod's), each cell labelled with its worst phase [deg] when the map has
+    several; a combination whose every launch failed is left blank. One type's panels wrap at four a row."""
     from .studies import figures  # matplotlib, when a figure is drawn: a mistake is refused before it loads
 
     rows = envelope(table).to_pylist()
-    betas, torques, mus = (sorted({row[name] for row in table.to_pylist()}) for name in (BETA, TORQUE, MU))
-    several = len({row[PHASE] for row in table.to_pylist()}) > 1
-    peaks = np.full((len(mus), len(torques), len(betas)), np.nan)
+    launches = table.to_pylist()
+    betas, torques, mus = (sorted({row[name] for row in launches}) for name in (BETA, TORQUE, MU))
+    joints = sorted({joint_of(row) for row in launches})
+    several = len({row[PHASE] for row in launches}) > 1
+    peaks = np.full((len(joints), len(mus), len(torques), len(betas)), np.nan)
     worst = np.full_like(peaks, np.nan)
     for row in rows:
-        cell = mus.index(row[MU]), torques.index(row[TORQUE]), betas.index(row[BETA])
+        cell = joints.index(row[JOINT]), mus.index(row[MU]), torques.index(row[TORQUE]), betas.index(row[BETA])
         peaks[cell], worst[cell] = row[f"{PEAK}_max"], row[f"{PEAK}_worst_phase"]
-    columns = min(4, len(mus))
-    fig, panels = figures.figure(math.ceil(len(mus) / columns), columns, squeeze=False, sharex=True, sharey=True,
-                                 figsize=(3.2 * columns + 1.2, 2.9 * math.ceil(len(mus) / columns) + 0.6),
-                                 layout="constrained")
-    top = np.nanmax(peaks) if np.any(np.isfinite(peaks)) else 1.0
+    columns = min(4, len(mus)) if len(joints) == 1 else len(mus)
+    lines = math.ceil(len(mus) / columns) * len(joints)
+    fig, panels = figures.figure(lines, columns, squeeze=False, sharex=True, sharey=True,
+                                 figsize=(3.2 * columns + 1.2, 2.9 * lines + 0.6), layout="constrained")
     x, y = np.degrees(betas), 100.0 * np.array(torques) / MOTOR_PEAK_TORQUE
-    for k, panel in enumerate(panels.flat):
-        if k >= len(mus):
-            panel.set_visible(False)
-            continue
-        image = panel.pcolormesh(x, y, peaks[k], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
-        if several:
-            for (i, j), phase in np.ndenumerate(worst[k]):
-                if np.isfinite(phase):
-                    panel.text(x[j], y[i], f"{math.degrees(phase):.0f}", ha="center", va="center", fontsize=6,
-                               color="white" if peaks[k, i, j] < 0.6 * top else "black")
-        panel.set_xlim(x[0], x[-1])  # the grid's range: its outer cells shown to their values, no further
-        panel.set_ylim(y[0], y[-1])
-        panel.set_title(f"mu = {mus[k]:.3g}", fontsize=9)
+    for t, joint in enumerate(joints):
+        own = panels.flat[t * columns: t * columns + len(mus)] if len(joints) > 1 else panels
+        top = np.nanmax(peaks[t]) if np.any(np.isfinite(peaks[t])) else 1.0
+        for k, panel in enumerate(np.ravel(own)):
+            if k >= len(mus):
+                panel.set_visible(False)
+                continue
+            image = panel.pcolormesh(x, y, peaks[t, k], shading="nearest", vmin=0.0, vmax=top, cmap="viridis")
+            if several:
+                for (i, j), phase in np.ndenumerate(worst[t, k]):
+                    if np.isfinite(phase):
+                        panel.text(x[j], y[i], f"{math.degrees(phase):.0f}", ha="center", va="center", fontsize=6,
+                                   color="white" if peaks[t, k, i, j] < 0.6 * top else "black")
+            panel.set_xlim(x[0], x[-1])  # the grid's range: its outer cells shown to their values, no further
+            panel.set_ylim(y[0], y[-1])
+            panel.set_title(f"{joint_name(joint)}, mu = {mus[k]:.3g}" if len(joints) > 1 else f"mu = {mus[k]:.3g}",
+                            fontsize=9)
+        label = "peak 3rd-order pitch acceleration\n[rad/s2], worst phase"
+        fig.colorbar(image, ax=own, label=f"{label}, {joint_name(joint)}" if len(joints) > 1 else label)
     for panel in panels[-1]:
         panel.set_xlabel("bend angle beta [deg]")
     for panel in panels[:, 0]:
         panel.set_ylabel("launch torque [% of peak]")
-    fig.colorbar(image, ax=panels, label="peak 3rd-order pitch acceleration [rad/s2], worst phase")
     title = f"Launch shudder map: {len(table)} launches of VehicleLaunch, both joints alike"
+    if joints != [PLAIN_TRIPOD]:
+        title += f" ({', '.join(joint_name(joint) for joint in joints)})"
     if several:
         title += "; worst right-joint phase [deg] in each cell"
     fig.suptitle(title, fontsize=10)
@@ -216,6 +257,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--phases", type=int, default=4,
                         help="phases of the right joint over a third of a turn (default 4: 0, 30, 60, 90 deg; "
                              "2,048 launches with --count 8)")
+    parser.add_argument("--joints", default="plain",
+                        help=f"joint types of both joints, comma-separated, of {', '.join(JOINT_TYPES)} "
+                             "(default plain; each further type as many launches again)")
     parser.add_argument("--duration", type=float, default=4.0, help="launch length [s] (default 4)")
     parser.add_argument("--step", type=float, default=2e-4, help="communication step [s] (default 2e-4)")
     parser.add_argument("--master", choices=sweep.MASTERS, default=sweep.DEFAULT_MASTER,
@@ -243,8 +287,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     if too_short:
         parser.error(too_short)
     try:
-        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count, args.phases)), args.duration, args.step,
-                                    args.master, THIRD_ORDERS)
+        types = joint_types(args.joints)
+        plan = sweep.Plan.of_system(args.package, sweep.grid(axes(args.count, args.phases, types)), args.duration,
+                                    args.step, args.master, THIRD_ORDERS)
         if args.scheduler:
             sweep.check_scheduler(args.scheduler)
     except (ValueError, OSError) as error:

@@ -225,19 +225,39 @@ def test_the_checks_catch_what_a_report_cannot_show():
     plt.close(fig)
 
 
-def test_the_shudder_map_of_two_values_per_axis_stays_within_its_grid(tmp_path):
-    """``map --count 2``: two bend angles, two torques, two friction coefficients; each panel's axes span
-    the grid (5 to 20 deg, 20 to 100 % of the motor's peak), every label on the canvas."""
+def drawn_map(tmp_path, joints: tuple[int, ...]):
+    """The shudder map's figure, kept open, of a table of ``map --count 2`` (two bend angles, two torques, two
+    friction coefficients, the joints in phase) for each of the ``joints`` types."""
     pa = pytest.importorskip("pyarrow")
-    rows = [{shudder_map.BETA: beta, shudder_map.TORQUE: torque, shudder_map.MU: mu, "status": "ok",
-             shudder_map.PEAK: 1.0 + beta + torque / 100.0 + mu}
-            for beta in shudder_map.BETA_RANGE for torque in shudder_map.TORQUE_RANGE for mu in shudder_map.MU_RANGE]
+    from fmu_harness.runs.sweep import with_units
+
+    rows = [{shudder_map.JOINT: joint, shudder_map.BETA: beta, shudder_map.TORQUE: torque, shudder_map.MU: mu,
+             shudder_map.PHASE: 0.0, "status": "ok", **{peak: (1.0 + beta + torque / 100.0 + mu) / (1 + joint)
+                                                         for peak in shudder_map.PEAKS}}
+            for joint in joints for beta in shudder_map.BETA_RANGE for torque in shudder_map.TORQUE_RANGE
+            for mu in shudder_map.MU_RANGE]
+    units = {shudder_map.JOINT: "1", shudder_map.BETA: "rad", shudder_map.TORQUE: "N.m", shudder_map.MU: "1",
+             shudder_map.PHASE: "rad", **dict.fromkeys(shudder_map.PEAKS, "rad/s2")}
     with pytest.MonkeyPatch.context() as patch:  # the figure kept open instead of saved and closed
         kept = []
         patch.setattr("fmu_harness.studies.figures.save", lambda fig, path: kept.append(fig) or path)
-        shudder_map.draw(pa.Table.from_pylist(rows), tmp_path / "map.png")
+        shudder_map.draw(with_units(pa.Table.from_pylist(rows), units), tmp_path / "map.png")
     (fig,) = kept
+    return fig
+
+
+@pytest.mark.parametrize("joints", [(0,), (0, 1, 2)], ids=["plain", "three types"])
+def test_the_shudder_map_of_two_values_per_axis_stays_within_its_grid(joints, tmp_path):
+    """``map --count 2``: each panel's axes span the grid (5 to 20 deg, 20 to 100 % of the motor's peak), every
+    label on the canvas, no panel empty; with several joint types a row of two panels per type, each titled
+    with its type, a colour bar per type."""
+    fig = drawn_map(tmp_path, joints)
     assert figure_checks.texts_outside_canvas(fig) == [] and figure_checks.empty_axes(fig) == []
-    for panel in fig.axes[:2]:
+    panels = [axes for axes in fig.axes if axes.get_label() != "<colorbar>"]
+    assert len(panels) == 2 * len(joints) and len(fig.axes) - len(panels) == len(joints)
+    for panel in panels:
         assert panel.get_xlim() == pytest.approx((5.0, 20.0)) and panel.get_ylim() == pytest.approx((20.0, 100.0))
+    if len(joints) > 1:
+        assert [panel.get_title().split(",")[0] for panel in panels] == [
+            "plain", "plain", "single", "single", "double", "double"]
     plt.close(fig)

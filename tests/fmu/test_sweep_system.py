@@ -176,6 +176,38 @@ def test_a_tiny_shudder_map_on_a_local_cluster(launch_ssp, tmp_path, capsys):
     assert (tmp_path / "again.png").read_bytes() == figure.read_bytes()
 
 
+def test_a_tiny_shudder_map_of_the_three_joint_types(launch_ssp, tmp_path, capsys):
+    """``--joints plain,single,double`` with 2 values per axis, the joints in phase (24 launches of 2 s): a
+    row per launch with both joints' type, headed with its unit [1]; at full torque, at either bend angle and
+    friction, both roller tripods' pitch peak below the plain tripod's (their generated axial force is
+    several times smaller, docs/tripod_coupling.md; the pitch peak of these short launches, measured
+    2026-12-07, 0.26 to 0.99 of the plain tripod's, the single roller's at 20 deg and mu 0.1 closest). The
+    envelope keyed by the type too, its peaks the launches' own; a figure with a row of
+    panels per type, drawn the same again from the table alone."""
+    out, envelope, figure = tmp_path / "map.csv", tmp_path / "envelope.csv", tmp_path / "map.png"
+    shudder_map.main(["--package", str(launch_ssp), "--count", "2", "--phases", "1", "--joints", "plain,single,double",
+                      "--duration", str(STOP), "--step", str(STEP), "--workers", "1", "--out", str(out),
+                      "--envelope", str(envelope), "--figure", str(figure)])
+    table = read_table(out)
+    rows = table.to_pylist()
+    assert len(rows) == 24 and figure.stat().st_size > 10_000
+    assert units_of(table)[shudder_map.JOINT] == "1" and shudder_map.JOINT == table.column_names[0]
+    assert f"{shudder_map.JOINT} [1]" in pyarrow.csv.read_csv(out).column_names
+    assert "24 launches, 12 failed" in capsys.readouterr().out
+    full = {(row[shudder_map.JOINT], row[shudder_map.BETA], row[shudder_map.MU]): row[shudder_map.PEAK]
+            for row in rows if row[shudder_map.TORQUE] > 100.0}
+    for beta, mu in {key[1:] for key in full}:
+        plain = full[shudder_map.JOINT_TYPES["plain"], beta, mu]
+        for roller in ("single", "double"):
+            assert 0.0 < full[shudder_map.JOINT_TYPES[roller], beta, mu] < plain, (roller, beta, mu)
+    found = read_table(envelope).to_pylist()
+    assert len(found) == 12 and units_of(read_table(envelope))[shudder_map.JOINT] == "1"
+    assert all(row[f"{shudder_map.PEAK}_max"] == full[row[shudder_map.JOINT], row[shudder_map.BETA],
+                                                       row[shudder_map.MU]] for row in found)
+    shudder_map.main(["--figure-only", "--out", str(out), "--figure", str(tmp_path / "again.png")])
+    assert (tmp_path / "again.png").read_bytes() == figure.read_bytes()
+
+
 LATERAL_GAIN = 1.5
 """The lateral third order 60 deg apart against in phase in the tiny map's launches, at least: measured 1.9
 to 4.0 (2026-12-07). In the package's 4 s launch at 140 N.m it is 15 times (docs/vehicle_launch.md); these 2 s

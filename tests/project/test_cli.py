@@ -47,6 +47,8 @@ def assert_one_line_mistake(run: subprocess.CompletedProcess, *words: str) -> No
     (["map", "--out", "map.xlsx"], ["--out", "map.xlsx: write a .parquet or a .csv file"]),
     (["map", "--duration", "1"], ["--duration 1 s", "less than the 2 revolutions", "at least 1.4 s"]),
     (["map", "--phases", "0"], ["--phases must be at least 1, got 0"]),
+    (["map", "--joints", "plain,triple"], ["--joints: no joint type 'triple' (choose from plain, single, double)"]),
+    (["map", "--joints", "double,double"], ["--joints double,double: a type named twice"]),
     (["map", "--envelope", "envelope.xlsx"], ["--envelope", "envelope.xlsx: write a .parquet or a .csv file"]),
 ])
 def test_a_mistake_is_one_line_and_a_non_zero_exit(arguments, words, tmp_path):
