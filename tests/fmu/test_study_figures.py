@@ -174,8 +174,8 @@ def test_the_launch_figures_show_each_curve_and_what_their_titles_name(launch_fi
 
 @pytest.fixture(scope="module")
 def housing_figure(fmi2_dir, native_dir):
-    """The housing-motion figure of quick launches (140 N.m for 4 s at the study's step, about 0.3 s of CPU
-    each): the right joint in phase and 60 deg ahead, the housings held and moving."""
+    """The housing-motion figure of four quick launches (140 N.m for 4 s at the study's step, 7.7 s of CPU in
+    all): the right joint in phase and 60 deg ahead, the housings held and moving."""
     package = system.write_ssp(system.vehicle_launch(), fmi2_dir, native_dir)
     tracks = {}
     for phase in (0.0, 60.0):
