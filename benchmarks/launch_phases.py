@@ -6,7 +6,10 @@ package's launch (140 N.m, 4 s, the project's master in Gauss-Seidel order at 2e
 started 0, 30, 60 and 90 deg ahead, once with ``mounts.housing_motion`` 1 (the package's) and once 0 (the
 housings held): the peak third-order amplitude (the left halfshaft's angle, Hann window of two revolutions)
 of the powertrain's lateral, yaw and pitch accelerations and of mode 1's share, the halfshafts' excursions
-(bend, bend-plane angle, plunge) and the CPU per launch, as a Markdown table under its stamp.
+(bend, bend-plane angle, plunge) and the CPU per launch, as a Markdown table under its stamp. With ``--figure PATH``
+(``--update-docs``: docs/launch_housing_orders.png) also the order tracks of those accelerations over the left
+halfshaft's speed, in phase and at 60 deg, with the housings held and moving
+(:func:`fmu_harness.studies.launch_study.housing_motion_figure`).
 """
 
 from __future__ import annotations
@@ -19,9 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
+from fmu_harness.doc_pages.sections import DOCS
 from fmu_harness.runs import ssp_package
 from fmu_harness.runs.system import LAUNCH_ORDER, run_jacobi
 from fmu_harness.studies import launch_study, order_tracking
+from fmu_harness.studies.figures import save
 
 from benchmarks import report
 
@@ -29,6 +34,8 @@ PHASES = (0.0, 30.0, 60.0, 90.0)  # the right joint's phi_in_start [deg]
 TORQUE, STOP, STEP = 140.0, 4.0, 2e-4
 RESPONSES = ("mounts.y_ddot", "mounts.yaw_ddot", "mounts.pitch_ddot")
 EXCURSIONS = tuple(f"mounts.{name}_{side}" for side in ("left", "right") for name in ("beta", "psi", "plunge"))
+FIGURE_PHASES = (0.0, 60.0)  # the figure's launches: in phase and the worst phase
+FIGURE = DOCS / "launch_housing_orders.png"  # where --update-docs writes the figure
 
 
 def launch(package: Path, phase: float, moving: int) -> tuple[dict[str, np.ndarray], float]:
@@ -58,8 +65,10 @@ def peaks(found: dict[str, np.ndarray]) -> list[float]:
             for signal in (*(found[name] for name in RESPONSES), mode_1)]
 
 
-def table(models: Path) -> str:
+def table(models: Path) -> tuple[str, dict[tuple[float, bool], dict[str, tuple[np.ndarray, np.ndarray]]]]:
+    """The Markdown table, and the order tracks of the figure's launches by (phase [deg], housings moving)."""
     package = models / "native" / "VehicleLaunch.ssp"
+    drawn = {}
     lines = ["| right joint's phase | housings | lateral `y_ddot` [m/s2] | yaw `yaw_ddot` [rad/s2] | pitch `pitch_ddot` "
              "[rad/s2] | mode 1 [m/s2] | bend left, right [deg] | plane angle left, right [deg] | plunge left, "
              "right [mm] | CPU per launch [s] |", "|---" * 10 + "|"]
@@ -74,18 +83,29 @@ def table(models: Path) -> str:
                          + " | ".join(f"{value:.3g}" for value in peaks(found)) + " | " + " | ".join(shown)
                          + f" | {cpu:.2f} |")
             print(lines[-1], flush=True)
-    return "\n".join(lines)
+            if phase in FIGURE_PHASES:
+                drawn[phase, bool(moving)] = launch_study.housing_tracks(found["t"], found[launch_study.SHAFT],
+                                                                         found)
+    return "\n".join(lines), drawn
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = report.parser(__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=Path("models"), help="folder of built FMUs")
+    parser.add_argument("--figure", type=Path,
+                        help=f"also draw the order tracks into this PNG file (--update-docs: {FIGURE})")
     args = parser.parse_args(argv)
+    if not (args.models / "native" / "VehicleLaunch.ssp").is_file():
+        parser.error(f"no {args.models / 'native' / 'VehicleLaunch.ssp'}: run python build_fmu.py first")
     measurement = report.Measurement()
-    found = table(args.models)
+    found, drawn = table(args.models)
     report.publish("benchmark-launch-phases", measurement.stamp(
         "the native VehicleLaunch.ssp, 140 N.m for 4 s, the project's master in Gauss-Seidel order at 2e-4 s; "
         "CPU by time.process_time"), found, args.update_docs)
+    for path in {args.figure, FIGURE if args.update_docs else None} - {None}:
+        subtitle = (f"The native VehicleLaunch.ssp's launch, 140 N.m for 4 s (measured {measurement.date:%Y-%m-%d}):\n"
+                    "the right joint in phase (dashed) or 60 deg ahead (solid), the housings held or moving")
+        print(f"figure: {save(launch_study.housing_motion_figure(drawn, subtitle), path)}")
 
 
 if __name__ == "__main__":

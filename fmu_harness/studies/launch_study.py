@@ -37,7 +37,7 @@ from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody, modes
 from ..runs import ssp_package
 from ..runs.system import LAUNCH_ORDER, run_jacobi
 from . import order_tracking
-from .figures import BLUE, ORANGE, PALETTE, SKY, YELLOW, clear_of_lines, figure, save
+from .figures import BLUE, ORANGE, PALETTE, SKY, VERMILLION, YELLOW, clear_of_lines, figure, save
 from ..runs.result_table import write_csv
 
 TORQUE = 20.0  # motor torque after the ramp [N.m]
@@ -308,6 +308,54 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
                      "peak (dot),\nthe peak's speed against the crossing's", fontsize=10)
     bottom.legend(loc="upper left", fontsize=8)
     bottom.grid(alpha=0.3)
+    return fig
+
+
+#: The housing-motion figure's panels: (output, what it is, unit), the powertrain's accelerations at its centre
+#: of gravity that the shudder shows in
+HOUSING_PANELS = (("mounts.y_ddot", "lateral acceleration y_ddot", "m/s2"),
+                  ("mounts.yaw_ddot", "yaw acceleration yaw_ddot", "rad/s2"),
+                  ("mounts.pitch_ddot", "pitch acceleration pitch_ddot", "rad/s2"))
+#: How each launch is drawn: the housings' motion by colour, the right joint's phase by line style
+HOUSING_STYLE = {False: (VERMILLION, "housings held"), True: (BLUE, "housings moving")}
+PHASE_STYLE = {0.0: "--", 60.0: "-"}
+
+
+def housing_tracks(time: np.ndarray, shaft_angle: np.ndarray,
+                   values: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The third-order tracks (speeds [rad/s], amplitudes) of the housing-motion figure's accelerations
+    (``values`` by output name) over the shaft's speed."""
+    return {name: order_tracking.order_track(time, shaft_angle, values[name], order_tracking.SHUDDER_ORDER)
+            for name, _, _ in HOUSING_PANELS}
+
+
+def housing_motion_figure(tracks: dict[tuple[float, bool], dict[str, tuple[np.ndarray, np.ndarray]]],
+                          subtitle: str = "") -> Figure:
+    """The third-order amplitude of the powertrain's lateral, yaw and pitch accelerations over the left
+    halfshaft's speed, a panel each, for the launches ``tracks`` holds: by (the right joint's phase [deg], the
+    housings moving), each output's order track (speeds [rad/s], amplitudes). A log scale, so that the launches
+    whose peaks lie 70 times apart show side by side."""
+    fig, axes = figure(len(HOUSING_PANELS), 1, figsize=(8, 9.6), sharex=True, layout="constrained")
+    for ax, (name, what, unit) in zip(axes, HOUSING_PANELS):
+        low, high = np.inf, 0.0
+        for (phase, moving), found in sorted(tracks.items(), key=lambda item: (item[0][1], -item[0][0])):
+            speeds, amplitude = found[name]
+            color, housings = HOUSING_STYLE[moving]
+            shown = amplitude > 0.0
+            ax.plot(speeds[shown], amplitude[shown], PHASE_STYLE.get(phase, ":"), color=color, lw=1.3,
+                    label=f"right joint {phase:g} deg ahead, {housings}")
+            low, high = min(low, amplitude[shown].min()), max(high, amplitude[shown].max())
+        ax.set_yscale("log")
+        ax.set_ylim(0.7 * low, 2.0 * high)
+        ax.set_ylabel(f"third order [{unit}]")
+        ax.set_title(f"Powertrain {what} at its centre of gravity, third order", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+    speeds = np.concatenate([found[HOUSING_PANELS[0][0]][0] for found in tracks.values()])
+    axes[-1].set_xlim(speeds.min(), speeds.max())
+    axes[-1].set_xlabel("left halfshaft speed [rad/s]")
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=8)
+    if subtitle:
+        fig.suptitle(subtitle, fontsize=9)
     return fig
 
 

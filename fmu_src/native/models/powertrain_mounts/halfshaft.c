@@ -2,112 +2,29 @@
  * design_wheel, and driveline/mounts/halfshafts.py): each inboard joint's bend angle, bend-plane angle and
  * plunge with their rates from the powertrain's motion, with their exact partial derivatives.
  *
- * The geometry is evaluated once on jets: each quantity carries its partial derivatives by the wheel centre
- * in the housing frame and its rates, (a, a', a''), nine numbers; a = F^T (W - O - T(W) q), a' = -F^T T(W) q',
- * a'' = -F^T T(W) q'' turn them into derivatives by (q, q', q''). The values are those of the Python core's
- * operations, in its order.
+ * The geometry is evaluated once in dual numbers (lib/dual.h): each quantity carries its partial derivatives
+ * by the wheel centre in the housing frame and its rates, (a, a', a''), nine numbers; a = F^T (W - O - T(W) q),
+ * a' = -F^T T(W) q', a'' = -F^T T(W) q'' turn them into derivatives by (q, q', q''). The values are those of
+ * the Python core's operations, in its order.
  */
 #include <math.h>
-#include <string.h>
 
 #include "mounts.h"
 
-#define N HALFSHAFT_JET
+#define DUAL_SIZE HALFSHAFT_JET
+#include "lib/dual.h"
 
-typedef struct {
-    double v, d[N];
-} Jet;
-
-static Jet constant(double v)
+/* sqrt, its derivative a' / (2 sqrt a) taken 0 at 0 (a straight shaft: rho's one-sided slope, no bend plane) */
+static Dual root(Dual a)
 {
-    Jet out;
-    memset(&out, 0, sizeof out);
-    out.v = v;
-    return out;
-}
-
-static Jet variable(double v, int k)
-{
-    Jet out = constant(v);
-    out.d[k] = 1.0;
-    return out;
-}
-
-static Jet add(Jet a, Jet b)
-{
-    int k;
-    a.v += b.v;
-    for (k = 0; k < N; k++) {
-        a.d[k] += b.d[k];
-    }
-    return a;
-}
-
-static Jet sub(Jet a, Jet b)
-{
-    int k;
-    a.v -= b.v;
-    for (k = 0; k < N; k++) {
-        a.d[k] -= b.d[k];
-    }
-    return a;
-}
-
-static Jet neg(Jet a)
-{
-    int k;
-    a.v = -a.v;
-    for (k = 0; k < N; k++) {
-        a.d[k] = -a.d[k];
-    }
-    return a;
-}
-
-static Jet mul(Jet a, Jet b)
-{
-    Jet out;
-    int k;
-    out.v = a.v * b.v;
-    for (k = 0; k < N; k++) {
-        out.d[k] = a.d[k] * b.v + a.v * b.d[k];
-    }
-    return out;
-}
-
-static Jet divide(Jet a, Jet b)
-{
-    Jet out;
-    int k;
-    out.v = a.v / b.v;
-    for (k = 0; k < N; k++) {
-        out.d[k] = (a.d[k] - out.v * b.d[k]) / b.v;
-    }
-    return out;
-}
-
-/* sqrt, its derivative taken 0 at 0 (a straight shaft: rho's one-sided slope, no bend plane) */
-static Jet root(Jet a)
-{
-    Jet out;
-    int k;
-    out.v = sqrt(a.v);
-    for (k = 0; k < N; k++) {
-        out.d[k] = out.v > 0.0 ? a.d[k] / (2.0 * out.v) : 0.0;
-    }
-    return out;
+    double v = sqrt(a.v);
+    return v > 0.0 ? dual_chain_over(a, v, 2.0 * v) : dual_constant(v);
 }
 
 /* atan2, its derivative taken 0 at the origin */
-static Jet angle(Jet y, Jet x)
+static Dual angle(Dual y, Dual x)
 {
-    Jet out;
-    double r2 = x.v * x.v + y.v * y.v;
-    int k;
-    out.v = atan2(y.v, x.v);
-    for (k = 0; k < N; k++) {
-        out.d[k] = r2 > 0.0 ? (x.v * y.d[k] - y.v * x.d[k]) / r2 : 0.0;
-    }
-    return out;
+    return x.v * x.v + y.v * y.v > 0.0 ? dual_atan2(y, x) : dual_constant(atan2(y.v, x.v));
 }
 
 /* mounts/halfshafts.Halfshaft.of with geometry.design_wheel: W = O + F (-L sin beta cos psi, -L sin beta sin psi,
@@ -167,52 +84,53 @@ int halfshaft_geometry(const Halfshaft *shaft, const double q[6], const double v
                        double partial[HALFSHAFT_VALUES][HALFSHAFT_MOTION], double *reach)
 {
     double a[3][3], length2 = shaft->length * shaft->length;
-    Jet ax, ay, az, a1[3], a2[3], rho2, rho, h, er[2], radial, tangential, radial_acc, tangential_acc, psi,
+    Dual ax, ay, az, a1[3], a2[3], rho2, rho, h, er[2], radial, tangential, radial_acc, tangential_acc, psi,
         psi_dot, psi_ddot, rho_ddot, beta_ddot, h_dot, h_ddot, found[HALFSHAFT_VALUES];
     int i, j, k;
     in_housing(shaft, q, 0, a[0]);
     in_housing(shaft, velocity, 1, a[1]);
     in_housing(shaft, acceleration, 2, a[2]);
-    ax = variable(a[0][0], 0), ay = variable(a[0][1], 1), az = variable(a[0][2], 2);
+    ax = dual_known(a[0][0], 0), ay = dual_known(a[0][1], 1), az = dual_known(a[0][2], 2);
     for (k = 0; k < 3; k++) {
-        a1[k] = variable(a[1][k], 3 + k);
-        a2[k] = variable(a[2][k], 6 + k);
+        a1[k] = dual_known(a[1][k], 3 + k);
+        a2[k] = dual_known(a[2][k], 6 + k);
     }
-    rho2 = add(mul(ax, ax), mul(ay, ay));
+    rho2 = dual_add(dual_mul(ax, ax), dual_mul(ay, ay));
     if (!(rho2.v < length2)) {
         *reach = sqrt(rho2.v);
         return 0;
     }
     rho = root(rho2);
-    h = root(sub(constant(length2), rho2));
+    h = root(dual_sub(dual_constant(length2), rho2));
     if (rho.v > 0.0) {
-        er[0] = divide(ax, rho), er[1] = divide(ay, rho);
+        er[0] = dual_div(ax, rho), er[1] = dual_div(ay, rho);
     } else {
-        er[0] = constant(-1.0), er[1] = constant(0.0);
+        er[0] = dual_constant(-1.0), er[1] = dual_constant(0.0);
     }
-    radial = add(mul(er[0], a1[0]), mul(er[1], a1[1]));
-    tangential = sub(mul(er[0], a1[1]), mul(er[1], a1[0]));
-    radial_acc = add(mul(er[0], a2[0]), mul(er[1], a2[1]));
-    tangential_acc = sub(mul(er[0], a2[1]), mul(er[1], a2[0]));
-    psi = angle(neg(ay), neg(ax));
+    radial = dual_add(dual_mul(er[0], a1[0]), dual_mul(er[1], a1[1]));
+    tangential = dual_sub(dual_mul(er[0], a1[1]), dual_mul(er[1], a1[0]));
+    radial_acc = dual_add(dual_mul(er[0], a2[0]), dual_mul(er[1], a2[1]));
+    tangential_acc = dual_sub(dual_mul(er[0], a2[1]), dual_mul(er[1], a2[0]));
+    psi = angle(dual_neg(ay), dual_neg(ax));
     if (rho.v > 0.0) {
-        psi_dot = divide(tangential, rho);
-        rho_ddot = add(radial_acc, mul(mul(rho, psi_dot), psi_dot));
-        psi_ddot = divide(sub(tangential_acc, mul(mul(constant(2.0), radial), psi_dot)), rho);
+        psi_dot = dual_div(tangential, rho);
+        rho_ddot = dual_add(radial_acc, dual_mul(dual_mul(rho, psi_dot), psi_dot));
+        psi_ddot = dual_div(dual_sub(tangential_acc, dual_mul(dual_mul(dual_constant(2.0), radial), psi_dot)), rho);
     } else {
-        psi_dot = psi_ddot = constant(0.0);
+        psi_dot = psi_ddot = dual_constant(0.0);
         rho_ddot = radial_acc;
     }
-    h_dot = divide(mul(neg(rho), radial), h);
-    beta_ddot = divide(sub(mul(rho_ddot, h), mul(radial, h_dot)), mul(h, h));
-    h_ddot = neg(divide(add(add(mul(h_dot, h_dot), mul(rho, rho_ddot)), mul(radial, radial)), h));
+    h_dot = dual_div(dual_mul(dual_neg(rho), radial), h);
+    beta_ddot = dual_div(dual_sub(dual_mul(rho_ddot, h), dual_mul(radial, h_dot)), dual_mul(h, h));
+    h_ddot = dual_neg(dual_div(
+        dual_add(dual_add(dual_mul(h_dot, h_dot), dual_mul(rho, rho_ddot)), dual_mul(radial, radial)), h));
     found[0] = angle(rho, h);
-    found[1] = divide(radial, h);
+    found[1] = dual_div(radial, h);
     found[2] = beta_ddot;
     found[3] = psi, found[4] = psi_dot, found[5] = psi_ddot;
-    found[6] = sub(az, h);
-    found[7] = sub(a1[2], h_dot);
-    found[8] = sub(a2[2], h_ddot);
+    found[6] = dual_sub(az, h);
+    found[7] = dual_sub(a1[2], h_dot);
+    found[8] = dual_sub(a2[2], h_ddot);
     for (j = 0; j < HALFSHAFT_VALUES; j++) {
         values[j] = found[j].v;
         if (partial == NULL) {

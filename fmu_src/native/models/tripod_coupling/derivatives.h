@@ -1,5 +1,7 @@
 /* The exact partial derivatives of the native TripodCoupling FMU's outputs (its ``jacobian`` hook; the step
- * is tripod_coupling.c next to this folder), by forward-mode automatic differentiation (dual.h):
+ * is tripod_coupling.c next to this folder), by forward-mode automatic differentiation (lib/dual.h, one
+ * partial derivative per Jacobian column, COLUMN_<name>; the dual values are not the step's bit for bit, the
+ * outputs come from the step, only their derivatives are used):
  *   closure_derivatives.c    the exact kinematics (plane_solver.py) by the implicit function theorem
  *   reaction_derivatives.c   the exact reactions (reactions.py, rollers.py), the friction balances' fixed points
  *   output_derivatives.c     the Jacobian of the outputs (outputs.py): modes, leading order, the seed's eqs
@@ -7,7 +9,10 @@
 #ifndef TRIPOD_DERIVATIVES_H
 #define TRIPOD_DERIVATIVES_H
 
-#include "dual.h"
+#include "fmi/fmu_instance.h"
+
+#define DUAL_SIZE MODEL_COLUMN_COUNT
+#include "lib/dual.h"
 
 /* ---- closure_derivatives.c ------------------------------------------------------------------ */
 

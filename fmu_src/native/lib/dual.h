@@ -1,21 +1,21 @@
 /* Forward-mode automatic differentiation: a dual number holds a value and its partial derivatives with
- * respect to the Jacobian's columns (the Real inputs and the state, COLUMN_<name>), so one evaluation in
- * dual arithmetic gives a whole row of partial derivatives per result. Each operation is the chain rule of
- * the operator or libm function it replaces; the values are not the step's bit for bit (the outputs come
- * from the step), only their derivatives are used. Header only (static inline functions), standard C99
- * that MSVC compiles (no complex arithmetic). */
-#ifndef TRIPOD_DUAL_H
-#define TRIPOD_DUAL_H
+ * respect to DUAL_SIZE knowns (a Jacobian's columns), so one evaluation in dual arithmetic gives a whole
+ * row of partial derivatives per result. Each operation is the chain rule of the operator or libm function
+ * it replaces. The including file defines DUAL_SIZE, its number of knowns, before it includes this header
+ * (one size per C file: TripodCoupling's Jacobian columns, PowertrainMounts' halfshaft jets). Header only
+ * (static inline functions, no state), standard C99 that MSVC compiles (no complex arithmetic). */
+#ifndef LIB_DUAL_H
+#define LIB_DUAL_H
+
+#ifndef DUAL_SIZE
+#error "define DUAL_SIZE, the number of partial derivatives, before including lib/dual.h"
+#endif
 
 #include <math.h>
-
-#include "fmi/fmu_instance.h"
 
 #if defined(_MSC_VER) && !defined(__cplusplus) && !defined(inline)
 #define inline __inline /* MSVC's C before C11 */
 #endif
-
-#define DUAL_SIZE MODEL_COLUMN_COUNT
 
 typedef struct {
     double v, d[DUAL_SIZE];
@@ -33,6 +33,19 @@ static inline Dual dual_chain(Dual a, double v, double slope)
     return r;
 }
 
+/* v with a's partial derivatives over ``denominator``: f(a) with f(a.v) = v, f'(a.v) = 1 / denominator,
+ * rounded as a quotient */
+static inline Dual dual_chain_over(Dual a, double v, double denominator)
+{
+    Dual r;
+    int c;
+    r.v = v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        r.d[c] = a.d[c] / denominator;
+    }
+    return r;
+}
+
 /* a constant: no partial derivatives */
 static inline Dual dual_constant(double v)
 {
@@ -45,7 +58,7 @@ static inline Dual dual_constant(double v)
     return r;
 }
 
-/* the known of column ``column`` (COLUMN_<name>) at value v: its own partial derivative 1 */
+/* the known ``column`` at value v: its own partial derivative 1 */
 static inline Dual dual_known(double v, int column)
 {
     Dual r = dual_constant(v);
@@ -108,9 +121,15 @@ static inline Dual dual_shift(Dual a, double s)
     return a;
 }
 
+/* -a, exactly: every sign flipped */
 static inline Dual dual_neg(Dual a)
 {
-    return dual_scale(a, -1.0);
+    int c;
+    a.v = -a.v;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        a.d[c] = -a.d[c];
+    }
+    return a;
 }
 
 /* a b + c d, the pattern of the cross products */
@@ -167,12 +186,12 @@ static inline Dual dual_atan2(Dual y, Dual x)
     return r;
 }
 
-/* the partial derivatives of ``a`` into row ``row`` of the Jacobian ``partial`` */
+/* the partial derivatives of ``a`` into row ``row`` of the Jacobian ``partial`` (DUAL_SIZE columns) */
 static inline void dual_row(double partial[], int row, Dual a)
 {
     int c;
     for (c = 0; c < DUAL_SIZE; c++) {
-        partial[row * MODEL_COLUMN_COUNT + c] = a.d[c];
+        partial[row * DUAL_SIZE + c] = a.d[c];
     }
 }
 
