@@ -4,11 +4,11 @@ that a host loads as one FMU).
 
 ``build(package, target, step_size)`` embeds each component's FMU, links every connection, and exposes
 each component's parameters and unconnected inputs as the container's parameters and inputs and every
-output as an output, each named ``component.variable`` with its unit, bounds and description (with ``shown``, only those outputs
-are outputs, every other stays readable by name as a local variable: a host such as fmpy records every output
-at every communication point); the
-package's bindings are the container's start values, applied by the container itself, so a host that
-sets nothing runs the package as bound. The container steps its components at ``step_size`` by Jacobi
+output as an output, each named ``component.variable`` with its unit, bounds and description (with
+``shown``, only those are outputs and every other output a local variable, read by name as before: a host
+such as fmpy records every output at every communication point); the package's bindings are the
+container's start values, applied by the container itself, so a host that sets nothing runs the package
+as bound. The container steps its components at ``step_size`` by Jacobi
 (every input one step late, as the project's master and libcosim) or, with ``sequential``, one after the
 other in the package's order (the Gauss-Seidel master). A host's communication step may be any whole
 number of container steps.
@@ -176,11 +176,9 @@ def _describe(built: bytes, system: SspSystem, descriptions: Mapping[str, ET.Ele
     variables = root.find("ModelVariables")
     for variable in [v for v in variables if v.get("causality") == "local"]:
         variables.remove(variable)
-    hidden = {v.get("valueReference") for v in variables if shown and v.get("causality") == "output"
-              and v.get("name") not in shown}
-    for variable in variables:
-        if variable.get("valueReference") in hidden:
-            variable.set("causality", "local")
+    hidden = [v for v in variables if shown and v.get("causality") == "output" and v.get("name") not in shown]
+    for variable in hidden:
+        variable.set("causality", "local")
     units: dict[str, ET.Element] = {}
     for component in system.components:
         definitions = descriptions[component.name].find("UnitDefinitions")
@@ -213,8 +211,8 @@ def _describe(built: bytes, system: SspSystem, descriptions: Mapping[str, ET.Ele
                 ET.SubElement(structure, section).extend(
                     ET.Element("Unknown", index=str(positions[id(v)])) for v in outputs)
     else:
-        structure = root.find("ModelStructure")
-        for unknown in [u for u in structure if u.get("valueReference") in hidden]:
+        structure, references = root.find("ModelStructure"), {v.get("valueReference") for v in hidden}
+        for unknown in [u for u in structure if u.get("valueReference") in references]:
             structure.remove(unknown)
     names = ", ".join(f"{c.name} ({descriptions[c.name].get('modelName')})" for c in system.components)
     root.set("description", f"The SSP system {system.name} as one co-simulation FMU (FMU Manipulation Toolbox's "

@@ -140,7 +140,8 @@ def test_the_launchs_fmu_shows_its_selection_and_keeps_the_rest_readable(package
     assert np.array_equal(container.run(selected, {}, 0.01, 1e-4, names), container.run(every, {}, 0.01, 1e-4, names))
     assert validate_fmu(str(selected)) == []
     fmi3 = {c.name: native.fmu_path(native_dir, c.model, "3") for c in system.vehicle_launch().components}
-    assert validate_fmu(str(container.build(read, fmi3, tmp_path / "three.fmu", 1e-4, fmi_version=3, shown=shown))) == []
+    three = container.build(read, fmi3, tmp_path / "three.fmu", 1e-4, fmi_version=3, shown=shown)
+    assert validate_fmu(str(three)) == []
     with pytest.raises(container.ContainerRefused) as refused:
         container.build(read, fmus, tmp_path / "wrong.fmu", 1e-4, shown=("drive.v_x", "drive.nope"))
     assert str(refused.value) == "VehicleLaunch: no output drive.nope to show"
