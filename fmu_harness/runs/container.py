@@ -4,9 +4,11 @@ that a host loads as one FMU).
 
 ``build(package, target, step_size)`` embeds each component's FMU, links every connection, and exposes
 each component's parameters and unconnected inputs as the container's parameters and inputs and every
-output as an output, each named ``component.variable`` with its unit, bounds and description; the
-package's bindings are the container's start values, applied by the container itself, so a host that
-sets nothing runs the package as bound. The container steps its components at ``step_size`` by Jacobi
+output as an output, each named ``component.variable`` with its unit, bounds and description (with
+``shown``, only those are outputs and every other output a local variable, read by name as before: a host
+such as fmpy records every output at every communication point); the package's bindings are the
+container's start values, applied by the container itself, so a host that sets nothing runs the package
+as bound. The container steps its components at ``step_size`` by Jacobi
 (every input one step late, as the project's master and libcosim) or, with ``sequential``, one after the
 other in the package's order (the Gauss-Seidel master). A host's communication step may be any whole
 number of container steps.
@@ -34,7 +36,7 @@ import ctypes
 import logging
 import tempfile
 import zipfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -164,15 +166,19 @@ def _bindings_once(configuration: bytes) -> bytes:
 
 
 def _describe(built: bytes, system: SspSystem, descriptions: Mapping[str, ET.Element],
-              others: Mapping[str, bytes]) -> bytes:
+              others: Mapping[str, bytes], shown: Collection[str] = ()) -> bytes:
     """The container's model description made a project FMU's: the links' local variables dropped (hosts
-    see the components' outputs under their own names), each exposed variable with the unit, bounds and
+    see the components' outputs under their own names), the outputs not ``shown`` (if any are) made local
+    variables, each exposed variable with the unit, bounds and
     description of its component's, the units defined, the package's name and stop time, no build time or
     user, a token from the contents."""
     root = ET.fromstring(built)
     variables = root.find("ModelVariables")
     for variable in [v for v in variables if v.get("causality") == "local"]:
         variables.remove(variable)
+    hidden = [v for v in variables if shown and v.get("causality") == "output" and v.get("name") not in shown]
+    for variable in hidden:
+        variable.set("causality", "local")
     units: dict[str, ET.Element] = {}
     for component in system.components:
         definitions = descriptions[component.name].find("UnitDefinitions")
@@ -204,6 +210,10 @@ def _describe(built: bytes, system: SspSystem, descriptions: Mapping[str, ET.Ele
             for section in ("Outputs", "InitialUnknowns"):
                 ET.SubElement(structure, section).extend(
                     ET.Element("Unknown", index=str(positions[id(v)])) for v in outputs)
+    else:
+        structure, references = root.find("ModelStructure"), {v.get("valueReference") for v in hidden}
+        for unknown in [u for u in structure if u.get("valueReference") in references]:
+            structure.remove(unknown)
     names = ", ".join(f"{c.name} ({descriptions[c.name].get('modelName')})" for c in system.components)
     root.set("description", f"The SSP system {system.name} as one co-simulation FMU (FMU Manipulation Toolbox's "
                             f"container): {names}")
@@ -219,10 +229,11 @@ def _describe(built: bytes, system: SspSystem, descriptions: Mapping[str, ET.Ele
 
 
 def build(system: SspSystem, fmus: Mapping[str, Path], target: Path, step_size: float, fmi_version: int = 2,
-          sequential: bool = False) -> Path:
+          sequential: bool = False, shown: Collection[str] = ()) -> Path:
     """The container FMU of ``system`` at ``target``, its components' FMUs ``{component: path}``, stepping at
-    ``step_size`` (Jacobi, or ``sequential``: in the package's order); :class:`ContainerRefused` for what it
-    cannot carry."""
+    ``step_size`` (Jacobi, or ``sequential``: in the package's order), its outputs those ``shown``
+    (``component.variable``; empty: every one) and the others local variables; :class:`ContainerRefused` for
+    what it cannot carry."""
     from fmu_manipulation_toolbox.container import FMUContainer, FMUContainerError
 
     descriptions = model_descriptions(system, fmus)
@@ -230,6 +241,9 @@ def build(system: SspSystem, fmus: Mapping[str, Path], target: Path, step_size: 
     if reasons:
         raise ContainerRefused(f"{system.name}: the container cannot carry {'; '.join(reasons)}")
     inputs, outputs = _exposed(system, descriptions)
+    unknown = sorted(set(shown) - {f"{component}.{name}" for component, name in outputs})
+    if unknown:
+        raise ContainerRefused(f"{system.name}: no output {', '.join(unknown)} to show")
     log = logging.getLogger(TOOLBOX)
     handlers, propagate, level = log.handlers[:], log.propagate, log.level
     messages: list[logging.LogRecord] = []
@@ -271,7 +285,7 @@ def build(system: SspSystem, fmus: Mapping[str, Path], target: Path, step_size: 
         raise ContainerRefused(f"{system.name}: the container refused {'; '.join(errors)}")
     members[CONFIGURATION] = _bindings_once(members[CONFIGURATION])
     others = {name: data for name, data in members.items() if name != "modelDescription.xml"}
-    members["modelDescription.xml"] = _describe(members["modelDescription.xml"], system, descriptions, others)
+    members["modelDescription.xml"] = _describe(members["modelDescription.xml"], system, descriptions, others, shown)
     archive.write_zip(target, members)
     return target
 

@@ -118,6 +118,35 @@ def test_the_container_is_a_valid_fmu_and_the_same_bytes_again(packages, tmp_pat
     assert not [v for v in variables.values() if v.causality == "local"]
 
 
+def test_the_launchs_fmu_shows_its_selection_and_keeps_the_rest_readable(packages, native_dir, tmp_path):
+    """The shipped launch FMU's outputs are the launch's selection (everything the shudder map reads among them),
+    what fmpy records by default; every other output is a local variable of the same run bit for bit, FMI 2.0
+    and 3.0 valid; a name that is no output is refused in one line."""
+    from fmpy import read_model_description
+
+    from fmu_harness import shudder_map
+
+    shown = system.vehicle_launch().shown
+    assert {shudder_map.SHAFT, shudder_map.SIGNAL, shudder_map.LATERAL, shudder_map.YAW} <= set(shown)
+    read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
+    every = container.build(read, fmus, tmp_path / "every.fmu", 1e-4)
+    selected = container.build(read, fmus, tmp_path / "selected.fmu", 1e-4, shown=shown)
+    variables = read_model_description(str(selected)).modelVariables
+    assert sorted(v.name for v in variables if v.causality == "output") == sorted(shown)
+    hidden = [v.name for v in read_model_description(str(every)).modelVariables
+              if v.causality == "output" and v.type == "Real" and v.name not in shown]
+    assert len(hidden) > 150 and {v.name for v in variables if v.causality == "local"} >= set(hidden)
+    names = [*shown, *hidden]
+    assert np.array_equal(container.run(selected, {}, 0.01, 1e-4, names), container.run(every, {}, 0.01, 1e-4, names))
+    assert validate_fmu(str(selected)) == []
+    fmi3 = {c.name: native.fmu_path(native_dir, c.model, "3") for c in system.vehicle_launch().components}
+    three = container.build(read, fmi3, tmp_path / "three.fmu", 1e-4, fmi_version=3, shown=shown)
+    assert validate_fmu(str(three)) == []
+    with pytest.raises(container.ContainerRefused) as refused:
+        container.build(read, fmus, tmp_path / "wrong.fmu", 1e-4, shown=("drive.v_x", "drive.nope"))
+    assert str(refused.value) == "VehicleLaunch: no output drive.nope to show"
+
+
 def test_the_fmi3_container_runs_as_the_fmi2_one(packages, native_dir, tmp_path):
     """The FMI 3.0 container of the native FMI 3.0 FMUs gives the FMI 2.0 container's run bit for bit."""
     read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
