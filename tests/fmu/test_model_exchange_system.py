@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import types
 import zipfile
 from pathlib import Path
 
@@ -29,6 +30,7 @@ from fmu_harness import system_command
 from fmu_harness.packaging import native
 from fmu_harness.runs import launch_reference, ssp_package, system
 from fmu_harness.runs.model_exchange_system import ModelExchangeSystem, run_model_exchange, strongly_connected
+from fmu_harness.runs.runner import StepRefused
 from fmu_harness.runs.system import run_jacobi
 
 
@@ -109,6 +111,48 @@ def test_the_moving_housings_close_the_loop_through_the_mounts_and_the_masters_c
                                                                                     int(round(1e-3 / step))]
         errors.append(np.abs(rows[:, 1:] - exact[:, 1:]).max(axis=0) / np.abs(exact[:, 1:]).max(axis=0))
     assert np.all(errors[1] <= 1e-2) and np.all(np.abs(errors[0] / errors[1] - 2.0) <= 0.3), errors
+
+
+def _loop(outputs, jacobian: np.ndarray) -> ModelExchangeSystem:
+    """An engine whose one loop has the outputs ``outputs(v)`` of the values ``v`` carried, and the kept loop
+    Jacobian ``jacobian`` (I - dy/dv): no FMU, :meth:`ModelExchangeSystem._solve_loop` alone."""
+    engine = ModelExchangeSystem.__new__(ModelExchangeSystem)
+    engine.connections = [(("source", f"y{k}"), ("target", f"u{k}")) for k in range(len(jacobian))]
+    engine.instances = {"source": types.SimpleNamespace(time=0.0)}
+    carried = [np.zeros(len(jacobian))]
+    engine._carry = lambda block, values: carried.__setitem__(0, np.array(values))
+    engine._outputs = lambda block: outputs(carried[0])
+    engine._loop_jacobian = lambda block: jacobian
+    return engine
+
+
+def test_newton_at_its_rounding_floor_is_accepted_and_stalled_far_from_a_solution_refused():
+    """A small value fed by a large one (v1 = 0.034 v0 - 33.2 with v0 = 1000, alpha_in from the torques) whose
+    output rounds by +-2e-11 alternately, more than 1e-11 of v1 but within 1e-11 of the 35 that feed it: solved at
+    the floor (the 2-cycle the launch met). A loop with no solution, whose updates stop falling at 1 (a residual of
+    1 whatever v), is refused after 20 iterations."""
+    calls = [0]
+
+    def rounded(values: np.ndarray) -> np.ndarray:
+        calls[0] += 1
+        return np.array([1000.0, 0.034 * values[0] - 33.2 + (-1) ** calls[0] * 2e-11])
+
+    engine = _loop(rounded, np.array([[1.0, 0.0], [-0.034, 1.0]]))
+    engine._solve_loop([0, 1])
+    assert calls[0] <= 4
+    with pytest.raises(StepRefused, match="did not converge in 20 iterations"):
+        _loop(lambda values: values + 1.0, np.eye(1))._solve_loop([0])
+
+
+def test_the_moving_launch_passes_the_loops_rounding_floor(moving, tmp_path):
+    """The package's launch through 0.5 s at the engine's defaults. At t = 0.4345 s Newton's updates on the loop
+    stop falling at a 2-cycle of +-1.07e-11 on alpha_in_left = 0.79 rad/s2 (the rounding of the 1,115 N.m that
+    feed it, carried through a loop Jacobian of condition 4.3e3; the residual 1.1e-12): the engine accepts
+    that floor and goes on, where it refused the step before; the vehicle gains speed at every row."""
+    package, fmus = moving
+    rows = run_model_exchange(fmus, {c.name: c.parameters for c in package.components}, package.connections, 0.5,
+                              0.05, ["drive.v_x"], tmp_path)
+    assert rows[-1, 0] == pytest.approx(0.5) and np.all(np.diff(rows[:, 1]) > 0.0), rows
 
 
 def test_the_launch_has_one_loop_the_joints_torques_and_the_side_gears_accelerations(launch, tmp_path):
