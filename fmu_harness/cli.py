@@ -19,7 +19,7 @@ COMMANDS = {
     "build": ("fmu_harness.build_command", "build the FMUs (FMI 2.0 and 3.0), their reference results and the SSP system"),
     "run": ("fmu_harness.main", "the main job: simulate the FMUs, write CSV files and figures"),
     "sweep": ("fmu_harness.runs.sweep", "a parameter sweep of one FMU or an SSP system on Dask"),
-    "map": ("fmu_harness.shudder_map", "the launch shudder map: 512 vehicle launches on Dask and its figure"),
+    "map": ("fmu_harness.shudder_map", "the launch shudder map: vehicle launches over bend, torque, friction and phase on Dask, and its figure"),
     "interop": ("fmu_harness.checks.interop", "every FMU in every importer: the interoperability matrix"),
     "check": ("fmu_harness.runs.start_values", "the start values of an SSP package or an FMU, as the FMUs check them"),
     "system": ("fmu_harness.system_command", "run an SSP package, every output of every component to CSV"),

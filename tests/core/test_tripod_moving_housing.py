@@ -161,7 +161,7 @@ def test_the_rollers_roll_and_skew_on_the_speed_in_the_housing(tripod_type):
     still, plunging = (mechanism(phi, beta, omega, 15.0, 120.0, R, L, M, solution.x, solution.y, 0.4, 2.0, 5.0,
                                  10.0, rate) for rate in (0.0, plunge_dot))
     speed = np.array([slide[0] for slide in still.slides]) + plunge_dot
-    contacts = roller_reactions(plunging, omega, 120.0, M, tripod_type, 0.05, 0.0025, 1e-3, 0.0165)[1]
+    contacts = roller_reactions(plunging, omega, 120.0, M, tripod_type, 0.05, 0.0025, 1e-3, 0.0165, 0.0115)[1]
     if tripod_type == DOUBLE_ROLLER:
         np.testing.assert_allclose(contacts.v_roll, speed, rtol=0, atol=1e-15)
         return

@@ -16,7 +16,7 @@ from fmu_harness.runs.runner import simulate
 
 R, L, M, OMEGA, ALPHA, BETA = 0.026, 0.7, 0.2, 40.0, 300.0, math.radians(20.0)
 PSI, PSI_DOT, PSI_DDOT, PLUNGE_DOT = 0.5, 6.0, -80.0, -0.015
-ROLLERS = {"mu_roll": 0.0025, "roller_radius": 0.0165}
+ROLLERS = {"mu_roll": 0.0025, "roller_radius": 0.0165, "roller_bore_radius": 0.0115}
 TERMS = {"a_plunger_sum": "F_plunger1", "Rz_out": "F_arm1"}  # sums of large terms that cancel, and one term
 
 
@@ -42,7 +42,7 @@ def test_a_turning_bend_plane_and_a_plunging_spider_are_the_cores(family, fmi, k
     core, _ = coupling_outputs(result["phi_in"], np.full_like(time, BETA), OMEGA + ALPHA * time, 150.0, R, L, M,
                                kinematics, None, ALPHA, 0, mu, 1e-3, 0.0, 0.0, tripod_type, ROLLERS["mu_roll"],
                                ROLLERS["roller_radius"], housing["psi"], housing["psi_dot"], PSI_DDOT,
-                               np.full_like(time, PLUNGE_DOT))
+                               np.full_like(time, PLUNGE_DOT), ROLLERS["roller_bore_radius"])
     for name, values in core.items():
         scale = np.abs(values).max()
         np.testing.assert_allclose(result[name], values, rtol=0, atol=1e-9 * scale + 1e-12, err_msg=name)
