@@ -47,6 +47,9 @@ TORQUE = 20.0  # motor torque after the ramp [N.m]
 PHASE = math.radians(90.0)
 """The right joint's ``phi_in_start`` in the main job's launch [rad], the left's 0: the joints' third orders in
 quadrature, so every mode is forced (docs/vehicle_launch.md, "The main job's launch")."""
+CHANGES = {"joint_right": {"phi_in_start": PHASE}, "mounts": {"housing_motion": 0}}
+"""The study's launch against the package's: the right joint at ``PHASE``, the housings held at their design
+position (moving, the grooves' friction on the housing's speed damps the mount modes' peaks)."""
 STOP_TIME = 40.0  # [s]
 STEP = 8e-4  # Gauss-Seidel's longest stable step (docs/vehicle_launch.md) [s]
 EVERY = 4  # the CSV file holds every 4th communication point (3.2 ms)
@@ -366,7 +369,7 @@ def write(package: Path, out: Path) -> list[Path]:
     """Run the launch, write ``vehicle_launch.csv``, ``launch_shudder_peaks.csv`` and the three
     figures into ``out``; return the files written."""
     out.mkdir(parents=True, exist_ok=True)
-    launch = run(package, changes={"joint_right": {"phi_in_start": PHASE}, "mounts": {"housing_motion": 0}})
+    launch = run(package, changes=CHANGES)
     units = {name: MODELS[model].spec[variable].unit
              for name, model, variable in _column_models(package)}
     header = ["time [s]", *(f"{csv_name} [{units[name]}]" for name, csv_name in COLUMNS)]
