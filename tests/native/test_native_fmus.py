@@ -55,7 +55,9 @@ def test_every_model_has_its_c_port_built(native_dir):
         assert modules <= set(native.library_modules(name))
     assert NATIVE == list(MODELS)
     built = {path.relative_to(native_dir).as_posix() for path in native_dir.rglob("*.fmu")}
-    assert built == {f"{native.SUBDIR[fmi]}/{name}.fmu" for name in NATIVE for fmi in VERSIONS}
+    packages = {f"{native.SUBDIR[fmi]}/{name}.fmu" for name in interop.CONTAINERS for fmi in VERSIONS}
+    # the importer matrix writes the packages as one FMU beside the models when it runs first
+    assert built - packages == {f"{native.SUBDIR[fmi]}/{name}.fmu" for name in NATIVE for fmi in VERSIONS}
 
 
 @pytest.mark.parametrize("name", NATIVE)
