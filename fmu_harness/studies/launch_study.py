@@ -14,7 +14,8 @@ launch is docs/vehicle_launch.md's "The powertrain's motion in the joints"), run
 in Gauss-Seidel order at 0.8 ms, its stable limit, where a 40 s launch costs about 4 s of CPU.
 
 The powertrain's response is split into its modes with the core's mass-normalised mode shapes of the
-default layout (``driveline.mounts``): mode j's share of the accelerations at the centre of gravity,
+package's mounts (``driveline.mounts``: the default layout, on rubber, linearised about the weight's
+equilibrium, its operating point at the package's ``T_mean`` 0): mode j's share of the accelerations at the centre of gravity,
 ``phi_j phi_j^T M q''``, read in its dominant coordinate. Each mode's third order over the halfshaft
 speed (:mod:`.order_tracking`) peaks near its crossing, later by the sweep: the single-mode reference
 (:func:`swept_peak`) gives where a mode of that frequency and damping passed at the launch's own speed
@@ -34,8 +35,10 @@ from matplotlib.figure import Figure
 from scipy.signal import lsim
 
 from driveline.catalog import MODELS
-from driveline.mounts.layout import load_layout, shipped_layout
-from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody, modes
+from driveline.mounts.model import PowertrainMountsModel
+from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody
+from driveline.mounts.spec import DEFAULT_LAYOUT
+from driveline.vehicle.dynamics import GRAVITY
 
 from ..runs import ssp_package
 from ..runs.system import LAUNCH_ORDER, run_jacobi
@@ -53,7 +56,7 @@ position (moving, the grooves' friction on the housing's speed damps the mount m
 STOP_TIME = 40.0  # [s]
 STEP = 8e-4  # Gauss-Seidel's longest stable step (docs/vehicle_launch.md) [s]
 EVERY = 4  # the CSV file holds every 4th communication point (3.2 ms)
-LAYOUT = "transverse_fwd_powertrain"  # PowertrainMounts' default layout
+LAYOUT = DEFAULT_LAYOUT  # the package's mounts' layout: PowertrainMounts' default
 KMH = 3.6
 SHAFT = "joint_left.phi_out"  # the left halfshaft's angle, whose orders the study tracks
 RESPONSE = "mounts.pitch_ddot"  # the spectrogram's signal: the coordinate that responds most
@@ -107,14 +110,18 @@ def run(package: Path, torque: float = TORQUE, stop_time: float = STOP_TIME, ste
     return Launch(rows[:, 0], {name: rows[:, k + 1] for k, name in enumerate(outputs)})
 
 
-def powertrain_modes() -> tuple[RigidBody, Modes]:
-    body = RigidBody.of(load_layout(shipped_layout(LAYOUT)))
-    return body, modes(body)
-
-
-def modal_damping(body: RigidBody, found: Modes) -> np.ndarray:
-    """Each mode's damping ratio, the diagonal of ``Phi^T C Phi`` over ``2 omega_j``."""
-    return np.diag(found.shapes.T @ body.damping @ found.shapes) / (4.0 * np.pi * found.frequencies)
+def powertrain_modes(layout: str = LAYOUT) -> tuple[RigidBody, Modes]:
+    """The package's powertrain and its modes, as its ``PowertrainMounts`` outputs them: ``layout`` at the
+    package's ``g``, linearised about the operating point of ``T_mean`` 0 (the branches' storage stiffness at
+    each mode's frequency, the stops' tangent rates; ``damping_ratios``: equation (4) of
+    docs/powertrain_mounts.md)."""
+    model = PowertrainMountsModel()
+    model.layout, model.g = layout, GRAVITY
+    errors = model.initialize(0.0)
+    if errors:
+        raise ValueError(errors[0])
+    system = model._system
+    return system.body, system.operating_modes(system.static_sag(model.g, model.T_mean))
 
 
 def modal_accelerations(body: RigidBody, found: Modes, accelerations: np.ndarray) -> np.ndarray:
@@ -165,7 +172,7 @@ def third_order_peaks(launch: Launch) -> tuple[list[Peak], np.ndarray, np.ndarra
     """Each mode's peak, the order tracking's speeds [rad/s] and each mode's third-order amplitude
     there (modes x speeds, the unit of its dominant coordinate's acceleration)."""
     body, found = powertrain_modes()
-    damping = modal_damping(body, found)
+    damping = found.damping_ratios
     shares = modal_accelerations(body, found, launch.accelerations())
     tracks = [order_tracking.order_track(launch.time, launch.shaft_angle, shares[:, j], 3) for j in range(6)]
     speeds = tracks[0][0]
