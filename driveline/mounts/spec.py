@@ -180,7 +180,8 @@ def _mounts() -> tuple[Variable, ...]:
     return tuple(
         Variable(f"F_{axis}_mount{i}", "output", 0.0,
                  f"Force of mount {i} on the powertrain along vehicle {axis}, the weight's preload included "
-                 "(0 when the layout has fewer mounts)", "N", depends_on=("layout", "g", *MOTION, *MOUNT_BRANCHES[i - 1]))
+                 "(0 when the layout has fewer mounts)", "N",
+                 depends_on=("layout", "g", *MOTION, *MOUNT_BRANCHES[i - 1]))
         for i in range(1, MAX_MOUNTS + 1) for axis in AXES)
 
 

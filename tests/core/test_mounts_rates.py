@@ -101,7 +101,8 @@ def test_its_jacobian_is_exact(tmp_path, layout, torque):
     differences = np.empty_like(exact)
     for j, size in enumerate(1e-6 * scale):
         step = np.eye(len(state))[j] * size
-        differences[:, j] = (system.derivatives(state + step, LOAD) - system.derivatives(state - step, LOAD)) / (2 * size)
+        differences[:, j] = (system.derivatives(state + step, LOAD)
+                             - system.derivatives(state - step, LOAD)) / (2 * size)
     bound = 1e-7 * np.max(np.abs(exact) * scale, axis=1, keepdims=True) / scale
     assert np.all(np.abs(exact - differences) <= bound)
     assert np.array_equal(exact[:, 6:], system.a[:, 6:])
