@@ -29,10 +29,12 @@ def test_the_default_layout_is_the_rubber_one():
 def test_the_default_winds_up_at_most_2_deg_under_1_1_kNm_and_its_damping_ratios_lie_within_1_5(family, fmi):
     """``T_motor`` ramped from 0 to 1.1 kN.m over 0.5 s (its rate, first-order hold), then held for 1.5 s, at
     5 ms steps: the powertrain's rotation about the motor axis (-pitch, the default axis y), read from the
-    outputs, within 1 % of the ``wind_up`` output of ``T_mean`` 1.1 kN.m (what is left of the transient: the
-    slowest pitch mode at 15.5 Hz decays by exp(-12) over the hold, the branches relax within 0.2 s; measured
-    2e-6) and at most 2 deg (measured 1.46); the six ``zeta_mode_j`` within a ratio of 1.5 at idle and under the
-    drive (measured 1.04 and 1.04)."""
+    outputs, creeps up to the ``wind_up`` output of ``T_mean`` 1.1 kN.m (the static equilibrium, at most 2 deg;
+    measured 1.46): the modes have rung down (the slowest pitch mode, 15.5 Hz, by exp(-12) over the hold) and
+    the branches relaxing at 1.2 Hz and above with them, while the one at 0.02 Hz (8 s; weight 0.030 of the
+    linear rate) still holds part of the deflection, so the rotation lies below the static one by at most that
+    weight's share, wind_up / 1.031 (measured 0.976 of it); the six ``zeta_mode_j`` within a ratio of 1.5 at
+    idle and under the drive (measured 1.04 and 1.04)."""
     h, ramp, hold = 5e-3, 0.5, 1.5
     with family.open(NAME, fmi) as fmu:
         fmu.initialize({"T_mean": DRIVE})
@@ -49,7 +51,7 @@ def test_the_default_winds_up_at_most_2_deg_under_1_1_kNm_and_its_damping_ratios
         fmu.initialize({})
         idle = fmu.get(ZETAS)
     assert 0.0 < math.degrees(wind_up) <= 2.0
-    assert -pitch == pytest.approx(wind_up, rel=1e-2)
+    assert wind_up / 1.031 <= -pitch <= wind_up
     for zetas in (idle, loaded):
         assert max(zetas) <= 1.5 * min(zetas), zetas
 
