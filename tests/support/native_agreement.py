@@ -35,13 +35,32 @@ SIGNAL_TOLERANCE = {"omega_crit_1": 1e-10, "omega_crit_2": 1e-10, "omega_crit_3"
 # the modal table comes from two eigensolvers (LAPACK, Jacobi): its shares within 1.2e-13.
 SIGNAL_TOLERANCE |= {f"{name}{suffix}": 1e-10 for name in COORDINATES for suffix in ("", "_dot", "_ddot")}
 SIGNAL_TOLERANCE |= {f"F_{axis}_mount{i}": 1e-10 for i in range(1, MAX_MOUNTS + 1) for axis in "xyz"}
+# The modes' kinetic-energy shares are fractions of 1 (each mode's sum to one), their scale. About a progressive
+# operating point they take the tangent rates at the two cores' equilibria, equal to Newton's last step (1e-14 of
+# the displacement); an eigenvector moves by that change over the relative gap to the next mode (modes 3 and 4 of
+# the rubber default at idle lie 7 % apart), so shares agree within 1e-11 (measured up to 7.0e-12; 1.2e-13 on
+# linear mounts).
+SHARES = tuple(f"share_{j}_{name}" for j in range(1, 7) for name in COORDINATES) + tuple(
+    f"mode_{j}_share" for j in range(1, 7))
+SIGNAL_TOLERANCE |= dict.fromkeys(SHARES, 1e-11)
 # The halfshafts' geometry is computed from that motion and carries its differences (measured 1.2e-12 of the
 # largest bend-plane rate after 40 steps of 1 ms).
 SIGNAL_TOLERANCE |= {f"{name}_{side}": 1e-10 for name in GEOMETRY for side in ("left", "right")}
 # The resonance margin is omega / omega_res - 1, a quotient near 1 less 1: its rounding is the
 # quotient's, so it is measured against a scale of at least 1 (a drawn margin of 4.5e-4 differed by
 # 1.1e-15 between the cores: 2.5e-12 of its own size, 1.1e-15 of the quotient's).
-SCALE_FLOOR = {"resonance_margin": 1.0}
+SCALE_FLOOR = {"resonance_margin": 1.0} | dict.fromkeys(SHARES, 1.0)
+# On progressive mounts (the rubber default) the motion is measured from the weight's equilibrium, a Newton root:
+# at rest the accelerations are the rounding of elastic forces of the weight's size, a few eps times g (measured
+# up to 1.4e-15 rad/s2, the halfshafts' second rates up to 1.4e-14 rad/s2, differing by up to 7e-17 between the
+# cores), and a motion under loads near zero carries that rounding through the implicit steps (a drawn run whose
+# motion stayed below 1e-21 m differed by 9e-24 m). So the motion is measured against a scale of at least these floors, where the
+# tolerance 1e-10 is 1e-16 m or rad, 1e-15 per s, 1e-14 per s2: some 100 times that rounding, and far below any
+# motion a load gives (a newton moves the powertrain by micrometres).
+SCALE_FLOOR |= {f"{name}{suffix}": floor for name in COORDINATES for suffix, floor in (("", 1e-6), ("_dot", 1e-5),
+                                                                                      ("_ddot", 1e-4))}
+SCALE_FLOOR |= {f"{name}_{side}": {"": 1e-6, "dot": 1e-5, "ddot": 1e-4}[name.split("_", 1)[1] if "_" in name else ""]
+                for name in GEOMETRY for side in ("left", "right")}
 
 
 #: Where the agreement rule ends: a quantity of up to this magnitude can be multiplied by another
