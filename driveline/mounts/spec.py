@@ -59,8 +59,8 @@ TRANSLATION_NOMINAL = 1e-3  # m
 ROTATION_NOMINAL = 1e-3  # rad
 NOMINAL_RATE = 10.0  # 1/s
 NOMINALS = {name: TRANSLATION_NOMINAL if name in AXES else ROTATION_NOMINAL for name in COORDINATES}
-#: A branch force's nominal: the decade of one branch's force at the translations' nominal deflection on the
-#: rubber layout (its storage rate (r - 1) k spread over four branches: 0.4 x 1.1e5 N/m x 1 mm / 4 = 11 N)
+#: A branch force's nominal: the decade of a branch's force at the translations' nominal deflection on the rubber
+#: layout, its rate w_j k times 1 mm (1.8 to 86 N, mean 25 N); tests/core/test_mounts_rates.py derives it
 BRANCH_NOMINAL = 10.0  # N
 
 

@@ -18,6 +18,7 @@ from driveline.mounts.implicit_step import implicit_step
 from driveline.mounts.layout import shipped_layout
 from driveline.mounts.model import PowertrainMountsModel
 from driveline.mounts.rubber import BRANCHES
+from driveline.mounts.spec import BRANCH_NOMINAL, TRANSLATION_NOMINAL
 
 RUBBER = "transverse_fwd_powertrain_rubber"
 #: A generalised load (N, N.m) that moves the body some millimetres, onto the stops of the rubber layout
@@ -117,3 +118,10 @@ def test_the_branch_slots_are_mount_axis_branch():
                 for k in range(3) for j in range(BRANCHES)]
     assert list(system.branches.slots) == expected
     assert len(set(expected)) == len(expected) and max(expected) < BRANCH_SLOTS
+
+
+def test_the_branch_states_nominal_is_a_branch_s_force_at_the_nominal_deflection():
+    """``BRANCH_NOMINAL``: the decade of the rubber layout's mean branch force at the translations' nominal deflection
+    (its rate w_j k times 1 mm), as the motion's nominals are the default layout's sag (State.nominal)."""
+    gains = _system(RUBBER).branches.gains
+    assert BRANCH_NOMINAL == 10.0 ** np.floor(np.log10(np.mean(gains) * TRANSLATION_NOMINAL))
