@@ -63,6 +63,9 @@ SCALE_FLOOR = {"resonance_margin": 1.0} | dict.fromkeys(SHARES, 1.0)
 # motion a load gives (a newton moves the powertrain by micrometres).
 SCALE_FLOOR |= {f"{name}{suffix}": floor for name in COORDINATES for suffix, floor in (("", 1e-6), ("_dot", 1e-5),
                                                                                       ("_ddot", 1e-4))}
+# The branches' forces follow that motion through their rates (1e4 to 1e5 N/m): their floors are the motion's
+# times 1e5 N/m, 0.1 N and 1 N/s.
+SCALE_FLOOR |= dict.fromkeys(BRANCH_FORCES, 0.1) | dict.fromkeys(BRANCH_RATES, 1.0)
 SCALE_FLOOR |= {f"{name}_{side}": {"": 1e-6, "dot": 1e-5, "ddot": 1e-4}[name.split("_", 1)[1] if "_" in name else ""]
                 for name in GEOMETRY for side in ("left", "right")}
 
