@@ -50,7 +50,8 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
     const VariableInfo *v = reference < MODEL_VARIABLE_COUNT ? &model_variables[reference] : NULL;
     const char *problem = NULL;
     char number[24];
-    if (v != NULL && v->type == type && !setting) { /* a variable of the spec to get: the common case */
+    /* the common cases: a variable of the spec to get, an input to set */
+    if (v != NULL && v->type == type && (!setting || v->causality == CAUSALITY_INPUT)) {
         return 1;
     }
     if (is_time(instance, reference)) {
@@ -96,6 +97,11 @@ static int all_accessible(Instance *instance, const char *function, const uint32
     for (i = 0; i < n; i++) {
         if (!accessible(instance, function, vr[i], type, setting)) {
             return 0;
+        }
+    }
+    for (i = 0; setting && i < n; i++) { /* a parameter set: the next step checks the parameters again */
+        if (vr[i] < MODEL_VARIABLE_COUNT && model_variables[vr[i]].causality == CAUSALITY_PARAMETER) {
+            instance->parameters_checked = 0;
         }
     }
     instance->stale = instance->stale || setting; /* Model Exchange: the outputs follow at the next get */
