@@ -15,13 +15,13 @@ number of container steps.
 
 The toolbox's own SSP reader links the connections but drops the parameter set (the launch then ran with
 the components' defaults: a 0.5 s ramp, both joints bent 30 deg with the closed-form kinematics and no
-friction); the bindings go in here. Its
-initialisation visits the components in the order of their links, each leaving initialisation before its
-outputs feed the next, and warns that a loop's first component (``VehicleDriveline`` in the launch) starts
-without the loop's values. The master instead passes the outputs as they are inside initialisation, where
-the project's FMUs have not computed them (0): in the launch every output is 0 at rest either way and the
-runs are equal bit for bit; in the driveline package the watcher starts at the coupling's speed here and at
-rest in the master, which changes its first step's outputs only (docs/vehicle_launch.md).
+friction); the bindings go in here. The container initialises one component after the other, each leaving
+initialisation before its outputs feed the next; the master reads every connection's output inside
+initialisation in the package's order of connections, where each FMU computes it from what has been set so
+far. The container's order is made the order in which the master first reads each component's outputs, so
+every component leaves initialisation with the inputs the master gives it, and the runs are equal bit for
+bit (docs/vehicle_launch.md). The toolbox warns that a loop's first component (``VehicleDriveline`` in the
+launch) starts without the loop's values: at rest they are the start values in both.
 
 What the container cannot carry is refused in one line before any work: a Python FMU (it needs Python in
 the host: take the native package), an FMU without Co-Simulation, a binding of a variable the FMU has not
@@ -165,6 +165,24 @@ def _bindings_once(configuration: bytes) -> bytes:
     return "\n".join(lines).encode()
 
 
+def _master_order(configuration: bytes, system: SspSystem) -> bytes:
+    """The container's ``container.txt`` initialising its components in the order in which the project's master
+    reads their outputs inside initialisation: the order of the package's connections (the first connection
+    leaving each), the components no connection reads last. Each component's inputs then hold, as it leaves
+    initialisation, the values the master gives it (the toolbox's order of links let the launch's joints start
+    from the package's bound bend angle, a few units in the last place from the bend the mounts compute, and the
+    runs parted by 5e-8 relative over 2 s)."""
+    lines = configuration.decode().split("\n")
+    heading = lines.index("# NB of embedded FMU's")
+    count = int(lines[heading + 1].split()[0])
+    names = [lines[heading + 2 + 3 * k].split()[0].removesuffix(".fmu") for k in range(count)]
+    first_read = list(dict.fromkeys(start for (start, _), _ in system.connections))
+    order = first_read + [name for name in names if name not in first_read]
+    at = lines.index("# Initialization order of the embedded FMU's") + 1
+    lines[at] = " ".join(str(names.index(name)) for name in order)
+    return "\n".join(lines).encode()
+
+
 def _describe(built: bytes, system: SspSystem, descriptions: Mapping[str, ET.Element],
               others: Mapping[str, bytes], shown: Collection[str] = ()) -> bytes:
     """The container's model description made a project FMU's: the links' local variables dropped (hosts
@@ -283,7 +301,7 @@ def build(system: SspSystem, fmus: Mapping[str, Path], target: Path, step_size: 
     errors = [record.getMessage() for record in messages if record.levelno >= logging.ERROR]
     if errors:
         raise ContainerRefused(f"{system.name}: the container refused {'; '.join(errors)}")
-    members[CONFIGURATION] = _bindings_once(members[CONFIGURATION])
+    members[CONFIGURATION] = _master_order(_bindings_once(members[CONFIGURATION]), system)
     others = {name: data for name, data in members.items() if name != "modelDescription.xml"}
     members["modelDescription.xml"] = _describe(members["modelDescription.xml"], system, descriptions, others, shown)
     archive.write_zip(target, members)

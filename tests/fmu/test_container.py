@@ -21,12 +21,14 @@ from fmu_harness.runs.runner import StepRefused
 from fmu_harness.runs.ssp_package import SspComponent, SspSystem
 
 STOP = 0.1
-#: Agreement of the container with the master at the same step and order: the container runs the same FMUs
-#: by the same scheme with the same values in the same order, so only the order of floating-point operations
-#: inside the FMUs could differ, and it does not (measured: equal bit for bit over 4 s of launch). 1e-9 of a
-#: column's largest magnitude leaves room for a runtime that sums its time differently (the motor's ramp
-#: would then differ in the last bits of t, 1e-16 relative) and stays far below any modelling difference.
-AGREEMENT = 1e-9
+# Agreement of the container with the master at the same step and order: the container runs the same FMUs by the
+# same scheme with the same values in the same order (its components initialised in the order the master reads
+# their outputs), so every output is equal bit for bit (measured over the whole 4 s launch with the housings
+# moving, Jacobi at 1e-4 s and Gauss-Seidel at 2e-4 s). In the toolbox's own order the launch's joints started
+# from the package's bound bend angle, a few units in the last place from the mounts' (5e-8 relative after 2 s).
+#: Another host's run of the container against fmpy's: 1e-9 of a column's largest magnitude leaves room for a host
+#: that sums its time differently (the motor's ramp would differ in the last bits of t, 1e-16 relative).
+HOST_AGREEMENT = 1e-9
 
 
 @pytest.fixture(scope="module")
@@ -58,9 +60,8 @@ def _compare(package: Path, tmp_path: Path, step: float, sequential: bool,
                                  order=order)
     found = container.run(fmu, {f"{n}.{v}": x for (n, v), x in changes.items()}, STOP, step, outputs)
     assert found.shape == expected.shape
-    scale = np.maximum(np.abs(expected).max(axis=0), 1e-300)
-    worst = np.abs(found - expected).max(axis=0) / scale
-    assert worst.max() <= AGREEMENT, (["time", *outputs][int(np.argmax(worst))], worst.max())
+    differing = [(row, ["time", *outputs][column]) for row, column in zip(*np.nonzero(found != expected))]
+    assert differing == [], differing[:5]
 
 
 @pytest.mark.parametrize("sequential", [False, True], ids=["jacobi", "gauss-seidel"])
@@ -191,7 +192,7 @@ def test_the_command_refuses_a_step_above_the_drives_limit_in_one_line(packages,
 @pytest.mark.parametrize("engine", ["libcosimpy", "ecospy"])
 def test_libcosim_and_ecos_run_the_container_as_fmpy_does(engine, packages, tmp_path):
     """The launch's container as one FMU in libcosim and in Ecos over 20 ms at its step: fmpy's run within
-    AGREEMENT (measured: equal bit for bit; both call the same doStep with the same values)."""
+    HOST_AGREEMENT (measured: equal bit for bit; both call the same doStep with the same values)."""
     if importlib.util.find_spec(engine) is None:  # not imported here: Ecos needs its tbb loaded first
         pytest.skip(f"{engine} is not installed (pip install '.[interop]')")
     from fmu_harness.checks import importers
@@ -207,4 +208,4 @@ def test_libcosim_and_ecos_run_the_container_as_fmpy_does(engine, packages, tmp_
     finally:
         session.close()
     scale = np.abs(expected).max(axis=0)
-    assert (np.abs(found - expected).max(axis=0) <= AGREEMENT * scale).all()
+    assert (np.abs(found - expected).max(axis=0) <= HOST_AGREEMENT * scale).all()

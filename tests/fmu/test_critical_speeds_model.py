@@ -246,3 +246,35 @@ def test_parameter_edges_get_the_cores_answer(family, name, value):
         else:
             fmu.initialize(start)
             family.assert_outputs_agree(outputs, [fmu.get(outputs)], [[getattr(core, o) for o in outputs]])
+
+
+def test_a_tunable_parameter_is_checked_at_the_next_step_and_after_a_restored_state(family):
+    """The parameters' checks follow every change: a tunable parameter set beyond its bound in Step Mode
+    is refused at the next step with its reason, and a restored FMU state that holds the bad value
+    too; set back, or restored to a state of valid parameters, the steps go on with the outputs of
+    an instance never changed (the native layer checks the parameters again only after such a change)."""
+    start = {"omega_in": 100.0}
+    outputs = ["omega_crit_1", "speed_ratio"]
+    with family.open("CriticalSpeeds") as fmu, family.open("CriticalSpeeds", instance_name="untouched") as untouched:
+        for instance in (fmu, untouched):
+            instance.initialize(start)
+            instance.step(1e-2)
+        good = fmu.get_state()
+        fmu.set({"L_shaft": -1.0})
+        with pytest.raises(StepRefused) as refused:
+            fmu.step(1e-2)
+        assert any("L_shaft" in message for message in refused.value.messages)
+        bad = fmu.get_state()
+        fmu.set_state(good)
+        fmu.step(1e-2)
+        untouched.step(1e-2)
+        assert fmu.get(outputs) == untouched.get(outputs)
+        fmu.set_state(bad)
+        with pytest.raises(StepRefused):
+            fmu.step(1e-2)
+        fmu.set({"L_shaft": 1.4})
+        fmu.step(1e-2)
+        untouched.step(1e-2)
+        assert fmu.get(outputs) == untouched.get(outputs)
+        for state in (good, bad):
+            fmu.free_state(state)

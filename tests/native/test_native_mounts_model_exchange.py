@@ -11,8 +11,11 @@ equilibrium, then at LOAD_STEP_TIME a load stepped on (the forces and moments of
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from fmpy import simulate_fmu
+from scipy.integrate import solve_ivp
 
+from driveline.mounts.forces import elastic_energy
 from driveline.mounts.model import PowertrainMountsModel
 from driveline.mounts.rigid_body import COORDINATES
 from driveline.mounts.spec import BRANCH_FORCES, INPUTS, SPEC, VELOCITIES
@@ -122,3 +125,48 @@ def test_the_derivatives_are_the_cores(native_dir, tmp_path, fmi):
     assert len(COORDINATES + VELOCITIES) == 12 and len(slots) == 36
     assert np.all(np.abs(found - expected) <= 1e-13 * scale)
     assert np.all(found[12:][np.setdiff1d(np.arange(len(BRANCH_FORCES)), slots)] == 0.0)
+
+
+def test_a_free_decay_through_model_exchange_matches_zeta_mode_1_and_balances_its_energy(native_dir, tmp_path, fmi):
+    """The rubber layout at rest in its equilibrium, struck along its lowest mode (a velocity of 2 pi f_1 times
+    50 um at the largest coordinate; the stops 2.5 mm away untouched), the FMU's states integrated by DOP853
+    (rtol 1e-8) through its derivatives alone over six periods: the modal coordinate's logarithmic decrement
+    within 10 % of ``zeta_mode_1`` (the issue's bound; measured 0.9 %: the other modes, barely excited), and the
+    energy (kinetic, elastic, gravity's, the branches' ``z^2 / (2 g)``) falls by what the dampers and branches
+    dissipate, ``q'^T C q' + z^2 / (g tau)`` integrated alongside, within 1e-7 of the initial kinetic energy
+    (ten times the integrator's tolerance on states whose energy is quadratic in them; measured 1.8e-10,
+    2026-12-07): the signs of (ME) are those of a passive mount."""
+    model = ModelExchange(native.fmu_path(native_dir, NAME, fmi), fmi, {"layout": RUBBER}, tmp_path)
+    frequency, zeta = model.get(["f_mode_1", "zeta_mode_1"])
+    core = PowertrainMountsModel()
+    core.layout = RUBBER
+    assert core.initialize(0.0) == []
+    system = core._system
+    shape = system.operating_modes(system.static_sag(9.81, 0.0)).shapes[:, 0]
+    start = model.get_states()
+    start[6:12] = 2.0 * np.pi * frequency * 5e-5 * shape / np.max(np.abs(shape))
+    slots, gains, times = system.branches.slots, system.branches.gains, system.branches.times
+
+    def energy(states: np.ndarray) -> float:
+        q, v, z = states[:6], states[6:12], states[12:][slots]
+        return float(0.5 * v @ system.body.mass @ v + elastic_energy(system.body.layout, system.weight_sag + q)
+                     - system.weight @ q + np.sum(z * z / (2.0 * gains)))
+
+    def rates(t: float, y: np.ndarray) -> np.ndarray:
+        model.fmu.setTime(t)
+        model.set_states(y[:-1])
+        z, v = y[:-1][12:][slots], y[6:12]
+        return np.append(model.derivatives(), v @ system.body.damping @ v + np.sum(z * z / (gains * times)))
+
+    period = 1.0 / frequency
+    run = solve_ivp(rates, (0.0, 6.0 * period), np.append(start, 0.0), method="DOP853", rtol=1e-8, atol=1e-14,
+                    t_eval=np.arange(0.0, 6.0 * period, period / 100.0))
+    model.close()
+    modal = shape @ system.body.mass @ (run.y[:6] - start[:6, None])
+    peaks = [b for a, b, c in zip(modal, modal[1:], modal[2:]) if b > a and b >= c and b > 0]
+    delta = np.log(peaks[0] / peaks[-1]) / (len(peaks) - 1)
+    assert delta / np.sqrt(4 * np.pi ** 2 + delta ** 2) == pytest.approx(zeta, rel=0.10)
+    at_rest = start.copy()
+    at_rest[6:] = 0.0
+    initial, final = energy(start), energy(run.y[:-1, -1])
+    assert abs(final + run.y[-1, -1] - initial) < 1e-7 * (initial - energy(at_rest))

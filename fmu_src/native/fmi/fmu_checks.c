@@ -125,6 +125,15 @@ void parameter_errors(const ModelData *data, Messages *out)
     causality_errors(data, CAUSALITY_PARAMETER, 0, model_hooks.extra_parameter_errors, out);
 }
 
+void instance_parameter_errors(Instance *instance, const ModelData *data)
+{
+    int before = instance->messages.count;
+    if (!instance->parameters_checked) {
+        parameter_errors(data, &instance->messages);
+        instance->parameters_checked = instance->messages.count == before;
+    }
+}
+
 void input_errors(const ModelData *data, Messages *out)
 {
     causality_errors(data, CAUSALITY_INPUT, 1, model_hooks.extra_input_errors, out);

@@ -85,7 +85,7 @@ static void step(Instance *instance, double current_time, double step_size)
                      " s ends at a time that is not finite", (const char *)NULL);
         return;
     }
-    parameter_errors(&instance->data, out);
+    instance_parameter_errors(instance, &instance->data);
     input_errors(&instance->data, out);
     if (out->count == 0 && model_hooks.step_size_errors != NULL) {
         model_hooks.step_size_errors(&instance->data, step_size, out);
@@ -251,6 +251,7 @@ Status instance_reset(Instance *instance)
     }
     instance->epoch++;
     instance->stale = 1;
+    instance->parameters_checked = 0;
     instance->start_time = 0.0;
     instance->terminated = 0;
     instance->refusal[0] = '\0';

@@ -161,6 +161,8 @@ struct Instance {
     int event_mode;     /* Model Exchange after initialisation: event mode, else continuous-time mode */
     int stale;          /* a time, state, input or parameter was set since the outputs were evaluated (Model
                          * Exchange) or the values read in Initialization Mode computed (``initial``) */
+    int parameters_checked; /* the parameters passed their checks and none was set, reset or restored since: a
+                             * step or an evaluation does not check them again (the same values, the same answer) */
     /* Initialization Mode: the values a get reads, initialised at the start time from what has been set so
      * far on a copy, as ExitInitializationMode initialises (instance_readable); ``initial_refused``: the
      * copy's initialisation was refused, a get reads the start values with a warning */
@@ -249,6 +251,8 @@ void messages_add_extra(Messages *out, const ModelData *data, int message);
 /* ---- between the layer's modules -------------------------------------------------------- */
 /* fmu_checks.c: SteppedModel.parameter_errors, input_errors, output_errors, the check of state_from_saved */
 void parameter_errors(const ModelData *data, Messages *out);
+/* parameter_errors into the instance's messages unless the instance's parameters passed them and are unchanged */
+void instance_parameter_errors(Instance *instance, const ModelData *data);
 void input_errors(const ModelData *data, Messages *out);
 void output_errors(const ModelData *data, Messages *out, Failure *failure);
 void restored_errors(const ModelData *data, double start_time, Messages *out);

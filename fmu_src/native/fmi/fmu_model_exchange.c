@@ -55,7 +55,7 @@ void model_exchange_evaluate(Instance *instance, ModelData *data)
     Failure failure;
     int i;
     out->count = 0;
-    parameter_errors(data, out);
+    instance_parameter_errors(instance, data);
     input_errors(data, out);
     if (out->count) {
         return;

@@ -109,6 +109,7 @@ Status state_set(Instance *instance, const char *function, const void *state)
     instance->terminated = 0;
     instance->refusal[0] = '\0';
     instance->stale = 1;
+    instance->parameters_checked = 0;
     instance->epoch++;
     return STATUS_OK;
 }

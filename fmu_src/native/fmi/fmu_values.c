@@ -50,9 +50,6 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
     const VariableInfo *v = reference < MODEL_VARIABLE_COUNT ? &model_variables[reference] : NULL;
     const char *problem = NULL;
     char number[24];
-    if (v != NULL && v->type == type && !setting) { /* a variable of the spec to get: the common case */
-        return 1;
-    }
     if (is_time(instance, reference)) {
         problem = type == VAR_REAL && !setting ? NULL : " is the independent variable time, a Real that cannot be set";
     } else if (instance_derivative_of(instance, reference) >= 0) {
@@ -94,8 +91,15 @@ static int all_accessible(Instance *instance, const char *function, const uint32
         return 0;
     }
     for (i = 0; i < n; i++) {
+        const VariableInfo *v = vr[i] < MODEL_VARIABLE_COUNT ? &model_variables[vr[i]] : NULL;
+        if (v != NULL && v->type == type && (!setting || v->causality == CAUSALITY_INPUT)) {
+            continue; /* the common cases: a variable of the spec to get, an input to set */
+        }
         if (!accessible(instance, function, vr[i], type, setting)) {
             return 0;
+        }
+        if (setting && v != NULL && v->causality == CAUSALITY_PARAMETER) {
+            instance->parameters_checked = 0; /* the next step checks the parameters again */
         }
     }
     instance->stale = instance->stale || setting; /* Model Exchange: the outputs follow at the next get */
