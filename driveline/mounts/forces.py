@@ -18,8 +18,12 @@ from __future__ import annotations
 import numpy as np
 
 from . import characteristic
-from .layout import Layout, Mount
-from .rubber import relaxation_times
+from .layout import MAX_MOUNTS, Layout, Mount
+from .rubber import BRANCHES, relaxation_times
+
+#: Model Exchange's branch states: one slot a mount of the most a layout holds, an axis and a branch (mount, then
+#: axis, then branch), those of mounts without rubber (or beyond the layout's) idle at 0
+BRANCH_SLOTS = MAX_MOUNTS * 3 * BRANCHES
 
 #: Newton's iterations at most, and the step (relative to the displacement) it stops at (the static
 #: equilibrium here and the implicit step's, :mod:`.implicit_step`).
@@ -99,12 +103,13 @@ class BranchMap:
     ``rows`` (n x 6) the deflection rate it sees from q', ``gains`` ``w_j F'(d_op)`` [N/m] (the weight
     times the tangent rate at the operating point ``operating``, Q from the unloaded mounts: the
     linear rate k without a stop), ``times`` tau_j [s]. Their forces ``z`` enter as ``-rows^T z``
-    and move by ``z' = gains (rows q') - z / times``."""
+    and move by ``z' = gains (rows q') - z / times``. ``slots``: each branch's place among Model
+    Exchange's :data:`BRANCH_SLOTS` states (``(3 mount + axis) BRANCHES + branch``)."""
 
     def __init__(self, layout: Layout, operating: np.ndarray):
-        rows, gains, times = [], [], []
+        rows, gains, times, slots = [], [], [], []
         tau = relaxation_times()
-        for m, to_axes in zip(layout.mounts, layout.maps):
+        for n, (m, to_axes) in enumerate(zip(layout.mounts, layout.maps)):
             if not len(m.branches):
                 continue
             rates = characteristic.tangent(to_axes @ operating, *_law(m)) if m.progressive else m.stiffness
@@ -113,9 +118,11 @@ class BranchMap:
                     rows.append(to_axes[k])
                     gains.append(weight * rates[k])
                     times.append(tau[j])
+                    slots.append((3 * n + k) * BRANCHES + j)
         self.rows = np.array(rows).reshape(-1, 6)
         self.gains = np.array(gains)
         self.times = np.array(times)
+        self.slots = np.array(slots, dtype=int)
 
     def __len__(self) -> int:
         return len(self.gains)

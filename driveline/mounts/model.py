@@ -21,7 +21,8 @@ from .halfshafts import GEOMETRY, Halfshaft, values
 from .implicit_step import implicit_step
 from .layout import MAX_MOUNTS, Layout, load_layout, shipped_layout
 from .rigid_body import COORDINATES
-from .spec import AXES, INPUTS, RUBBER_LAYOUT, SHARED_LAYOUT, SIDES, SPEC, VELOCITIES, derivative_name
+from .spec import (AXES, BRANCH_FORCES, BRANCH_RATES, INPUTS, RUBBER_LAYOUT, SHARED_LAYOUT, SIDES, SPEC, VELOCITIES,
+                   derivative_name)
 from .system import MountSystem, Placement
 
 RATES = tuple(derivative_name(name) for name in INPUTS)
@@ -160,20 +161,29 @@ class PowertrainMountsModel(SteppedModel):
         self._show(state, held + rates * step_size)
 
     def evaluate(self, time: float) -> None:
-        """Model Exchange (the native FMUs): accelerations and mount forces at the current state
-        under the inputs now (their rates are co-simulation's alone), the system built if needed."""
+        """Model Exchange (the native FMUs): the state's derivatives, accelerations and mount forces at the
+        current states (the branches' forces from their slots) under the inputs now (their rates are
+        co-simulation's alone), the system built if needed."""
         errors = self.extra_parameter_errors()
         if errors:
             raise ValueError(errors[0])
-        self._show(self._state(), self._system.inputs @ self._values(INPUTS))
+        slots = self._values(BRANCH_FORCES)
+        state = np.concatenate([self._values(COORDINATES + VELOCITIES), slots[self._system.branches.slots]])
+        self._show(state, self._system.inputs @ self._values(INPUTS))
 
     def _show(self, state: np.ndarray, force: np.ndarray) -> None:
-        """Motion and mount-force outputs of ``state`` under the generalised ``force``."""
+        """Motion, branch and mount-force outputs of ``state`` under the generalised ``force`` (the branches' forces
+        and rates in their slots, the idle ones 0)."""
         system = self._system
-        for name, value in zip(COORDINATES + VELOCITIES + ACCELERATIONS,
-                               np.concatenate([state[:12], system.accelerations(state, force)])):
+        rates = system.derivatives(state, force)
+        for name, value in zip(COORDINATES + VELOCITIES + ACCELERATIONS, np.concatenate([state[:12], rates[6:12]])):
             setattr(self, name, float(value))
         self._branch_forces = tuple(float(value) for value in state[12:])
+        slots = np.zeros((2, len(BRANCH_FORCES)))
+        slots[:, system.branches.slots] = state[12:], rates[12:]
+        for force_name, rate_name, value, rate in zip(BRANCH_FORCES, BRANCH_RATES, *slots):
+            setattr(self, force_name, float(value))
+            setattr(self, rate_name, float(rate))
         self._show_halfshafts()
         forces = system.mount_forces(state)
         for i in range(MAX_MOUNTS):

@@ -9,6 +9,7 @@ from ..variables import DefaultExperiment, ModelSpec, Relation, State, Variable
 from .halfshafts import GEOMETRY
 from .layout import MAX_MOUNTS
 from .rigid_body import COORDINATES
+from .rubber import BRANCHES
 
 SIDES = ("left", "right")
 AXES = ("x", "y", "z")
@@ -29,6 +30,12 @@ PLACEMENT = (*(f"{axis}_joint_{side}" for side in SIDES for axis in AXES), *FRAM
 STATICS = ("layout", "g", "T_mean", *MOTOR_AXIS)
 LOADS = ("layout", *PLACEMENT, *INPUTS)
 VELOCITIES = tuple(f"{name}_dot" for name in COORDINATES)
+#: The Maxwell branches' forces, Model Exchange's states after the motion's (forces.BRANCH_SLOTS, mount, then
+#: axis, then branch): those of each mount, and all of them
+MOUNT_BRANCHES = tuple(tuple(f"F_axis{k}_mount{i}_branch{j}" for k in range(1, 4) for j in range(1, BRANCHES + 1))
+                       for i in range(1, MAX_MOUNTS + 1))
+BRANCH_FORCES = tuple(name for names in MOUNT_BRANCHES for name in names)
+BRANCH_RATES = tuple(f"{name}_dot" for name in BRANCH_FORCES)
 MOTION = (*COORDINATES, *VELOCITIES)
 #: The loads' direct part in each acceleration (the mass matrix diag(m I, J)): a translation takes
 #: the force along its axis and the joints' forces through their frames; a rotation every moment,
@@ -48,6 +55,9 @@ TRANSLATION_NOMINAL = 1e-3  # m
 ROTATION_NOMINAL = 1e-3  # rad
 NOMINAL_RATE = 10.0  # 1/s
 NOMINALS = {name: TRANSLATION_NOMINAL if name in AXES else ROTATION_NOMINAL for name in COORDINATES}
+#: A branch force's nominal: the decade of a branch's force at the translations' nominal deflection on the rubber
+#: layout, its rate w_j k times 1 mm (1.8 to 86 N, mean 25 N); tests/core/test_mounts_rates.py derives it
+BRANCH_NOMINAL = 10.0  # N
 
 
 def derivative_name(name: str) -> str:
@@ -130,8 +140,27 @@ def _motion() -> tuple[Variable, ...]:
                 f"{name} (small rotation about vehicle {AXES[COORDINATES.index(name) - 3]})"
             found.append(Variable(f"{name}{suffix}", "output", 0.0,
                                   f"{names[order]} {what}, from the static equilibrium under the weight",
-                                  unit, display, **({"depends_on": (*ACCELERATION_LOADS[name], *MOTION),
+                                  unit, display, **({"depends_on": (*ACCELERATION_LOADS[name], *MOTION,
+                                                                    *BRANCH_FORCES),
                                                      "initial_depends_on": ()} if order == 2 else {})))
+    return tuple(found)
+
+
+def _branches() -> tuple[Variable, ...]:
+    """The Maxwell branches' forces (Model Exchange's states) and their rates (R2): a branch's rate depends on its
+    force and the deflection rate along its axis, so on the velocities; both 0 at rest, where the model starts."""
+    found = []
+    for i, names in enumerate(MOUNT_BRANCHES, start=1):
+        for name in names:
+            k, j = name.split("_")[1][-1], name.split("_")[3][-1]
+            text = (f"Force of Maxwell branch {j} of mount {i} along the mount's axis {k} (rubber damping: it adds to "
+                    "the spring's force, which the mount exerts on the powertrain with the opposite sign; 0 for a "
+                    "mount without dynamic_ratio or beyond the layout's)")
+            found.append(Variable(name, "output", 0.0, text, "N"))
+            found.append(Variable(f"{name}_dot", "output", 0.0,
+                                  f"Rate of {name}: its spring's rate times the deflection rate, less the force over "
+                                  "the branch's relaxation time", "N/s",
+                                  depends_on=(name, *VELOCITIES), initial_depends_on=()))
     return tuple(found)
 
 
@@ -139,14 +168,16 @@ def _states() -> tuple[State, ...]:
     """Displacements starting in the equilibrium under the start inputs, velocities at rest (on progressive
     mounts that equilibrium's displacement from the weight's depends on the weight: g)."""
     return (*(State(name, (*LOADS, "g"), f"{name}_dot", NOMINALS[name]) for name in COORDINATES),
-            *(State(f"{name}_dot", (), f"{name}_ddot", NOMINALS[name] * NOMINAL_RATE) for name in COORDINATES))
+            *(State(f"{name}_dot", (), f"{name}_ddot", NOMINALS[name] * NOMINAL_RATE) for name in COORDINATES),
+            *(State(name, (), f"{name}_dot", BRANCH_NOMINAL) for name in BRANCH_FORCES))
 
 
 def _mounts() -> tuple[Variable, ...]:
     return tuple(
         Variable(f"F_{axis}_mount{i}", "output", 0.0,
                  f"Force of mount {i} on the powertrain along vehicle {axis}, the weight's preload included "
-                 "(0 when the layout has fewer mounts)", "N", depends_on=("layout", "g", *MOTION))
+                 "(0 when the layout has fewer mounts)", "N",
+                 depends_on=("layout", "g", *MOTION, *MOUNT_BRANCHES[i - 1]))
         for i in range(1, MAX_MOUNTS + 1) for axis in AXES)
 
 
@@ -256,7 +287,7 @@ def _halfshafts() -> tuple[Variable, ...]:
             if order:
                 text = f"{('First', 'Second')[order - 1]} time derivative of the {text[0].lower()}{text[1:]}"
             depends = (*placed, *COORDINATES) if order == 0 else (*placed, *MOTION) if order == 1 else \
-                (*placed, *PLACEMENT, *INPUTS, *MOTION)
+                (*placed, *PLACEMENT, *INPUTS, *MOTION, *BRANCH_FORCES)
             found.append(Variable(f"{name}_{side}", "output", 0.0, text, unit, display if order == 0 else None,
                                   depends_on=tuple(dict.fromkeys(depends)),
                                   **({"initial_depends_on": ()} if order else {})))
@@ -295,6 +326,7 @@ SPEC = ModelSpec(
         *_statics_and_modes(),
         # appended after every other variable: value references are positions
         *_halfshafts(),
+        *_branches(),
     ),
     default_experiment=DefaultExperiment(0.0, 1.0, 1e-3),
     relations=RELATIONS,

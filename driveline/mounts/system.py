@@ -130,6 +130,24 @@ class MountSystem:
                  - self.body.damping @ velocity - self.branches.rows.T @ z)
         return np.linalg.solve(self.body.mass, total)
 
+    def derivatives(self, state: np.ndarray, force: np.ndarray) -> np.ndarray:
+        """``s' = (q', q'', z')`` at ``state`` ``(q, q', z)`` under the generalised ``force``: equation (1) with
+        the branches' forces, ``q'' = M^-1 (f + W - F(Q) - C q' - R^T z)``, and (R2), ``z' = g (R q') - z / tau``
+        (Model Exchange's right-hand side: the ODE whose solution the exact and the implicit steps take)."""
+        branches = self.branches
+        z_rate = branches.gains * (branches.rows @ state[6:12]) - state[12:] / branches.times
+        return np.concatenate([state[6:12], self.accelerations(state, force), z_rate])
+
+    def derivative_jacobian(self, state: np.ndarray) -> np.ndarray:
+        """``d s' / d s`` (n x n) at ``state``: ``a``, with ``-M^-1 K_t(Q)`` for the displacements where the
+        characteristics are progressive (``d s' / d f`` is ``b`` everywhere)."""
+        if not self.progressive:
+            return self.a
+        found = self.a.copy()
+        found[6:12, :6] = -np.linalg.solve(self.body.mass,
+                                           tangent_stiffness(self.body.layout, self.weight_sag + state[:6]))
+        return found
+
     def acceleration_scales(self, state: np.ndarray, force: np.ndarray) -> np.ndarray:
         """The sum of the magnitudes of the terms of each ``q''`` (:meth:`accelerations`): zero in
         an equilibrium, the computed ``q''`` is its rounding error, a few eps times this."""

@@ -60,23 +60,26 @@ STATES = {"VehicleDriveline": ({"v_x": -2.0, "slip_left": 0.02, "slip_right": -0
                                     for scale in (1.0, -0.7)
                                     for q, v in [((2e-3, -1.5e-3, 3e-3, 4e-3, -3e-3, 5e-3),
                                                   (0.05, -0.04, 0.03, 0.2, -0.3, 0.25))]),
-                               # the snubbed layout's point: every mount 28 mm or more onto its stop, beyond the blend
-                               {"x": 0.03, "y": -0.03, "z": 0.03, "roll": 0.005, "pitch": -0.004, "yaw": 0.003,
-                                "x_dot": 0.1, "y_dot": -0.1, "z_dot": 0.1, "roll_dot": 0.2, "pitch_dot": -0.2,
-                                "yaw_dot": 0.2})}
+                               # the snubbed layout's point: every mount 28 mm or more onto its stop, beyond the blend;
+                               # the rubber layout's the same (its gaps 2 to 10 mm), its branches' forces SHIFT in N
+                               *({"x": 0.03, "y": -0.03, "z": 0.03, "roll": 0.005, "pitch": -0.004, "yaw": 0.003,
+                                  "x_dot": 0.1, "y_dot": -0.1, "z_dot": 0.1, "roll_dot": 0.2, "pitch_dot": -0.2,
+                                  "yaw_dot": 0.2},) * 2)}
 
 
 #: Points of a model's derivatives beyond its dependency points (which the dependency tests pay for at every
 #: parameter): CriticalSpeeds below zero with heavy damping, the unbalance and the response off the middle, and
 #: on anisotropic damped bearings with two unbalances (the doubled response system, the sorted Campbell table);
-#: PowertrainMounts on snubbers (tests/support/snubbed_mounts.toml), its states moved by SHIFT far onto the stops:
+#: PowertrainMounts on snubbers (tests/support/snubbed_mounts.toml) and on rubber (its Maxwell branches' states,
+#: their rates' rows), its states moved by SHIFT far onto the stops:
 #: the tangent rates k + k_s of the progressive characteristics (inside a stop's 2 mm blend the rate's third
 #: derivative, k_s 6 / w^2, makes the differences' truncation error h^2 F''' / 6 exceed their bounds)
 DERIVATIVE_POINTS = {"CriticalSpeeds": (
     {"omega_in": -500.0, "c_bearing": 5000.0, "unbalance_position": 0.3, "response_position": 0.8},
     {"layout": str(Path(__file__).parents[1] / "support" / "anisotropic_tube.toml"), "omega_in": -700.0}),
     "PowertrainMounts": ({"layout": str(Path(__file__).parents[1] / "support" / "snubbed_mounts.toml"),
-                          "F_x": 300.0, "T_in_right": 400.0},)}
+                          "F_x": 300.0, "T_in_right": 400.0},
+                         {"layout": "transverse_fwd_powertrain_rubber", "T_mean": 1100.0, "T_motor": 1100.0})}
 
 
 #: Rows whose values round above eps, with their relative rounding: CriticalSpeeds' unbalance response and

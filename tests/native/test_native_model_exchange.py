@@ -24,6 +24,7 @@ import math
 import subprocess
 import sys
 from ctypes import POINTER, c_double
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,12 +97,14 @@ def _load_steps(name: str) -> np.ndarray | None:
 RUNS = {"VehicleDriveline": ({"v_start": 5.0, "T_motor": 100.0}, 0.5)}
 #: CVODE's global error in units of its relative tolerance, at 1e-5 and 1e-8 (FMPy's CVODE takes its
 #: absolute tolerance as the relative one times each state's nominal, State.nominal): the source's phase
-#: 2 to 6; PowertrainMounts 33 and 118 (measured 2026-11-27; 230 and 800 with the nominal 1 its
-#: millimetres and milliradians had before); VehicleDriveline 80 and 272 (measured 2026-11-27; 140 and 270
+#: 2 to 6; PowertrainMounts 73 and 219 (measured 2026-12-07; 33 and 118 before its 96 Maxwell-branch states,
+#: idle on the default layout: CVODE's root-mean-square error norm averages over 108 states instead of 12, which
+#: loosens its control by sqrt(108 / 12) = 3; 230 and 800 with the nominal 1 its millimetres and milliradians had
+#: before); VehicleDriveline 80 and 272 (measured 2026-11-27; 140 and 270
 #: with nominals 1: the largest in the wheels' accelerations, 20 periods of the 200 rad/s wheel-on-tyre
 #: mode, an error-per-step control's phase error adding up; against CVODE at 1e-12 the same, 80 and 270),
 #: its co-simulation at 1 ms differing from that at 0.1 ms by 1.4e-6 besides.
-GLOBAL_ERROR = {"VehicleDriveline": (120.0, 400.0), "PowertrainMounts": (50.0, 200.0)}
+GLOBAL_ERROR = {"VehicleDriveline": (120.0, 400.0), "PowertrainMounts": (150.0, 600.0)}
 
 
 @pytest.mark.parametrize("name", NATIVE)
@@ -134,11 +137,16 @@ WITH_STATES = [name for name in NATIVE if MODELS[name].spec.states]
 #: halfshaft rates are linear in the velocities, zero at rest whatever the displacements; 0.01 m keeps the wheels
 #: within their shafts' reach)
 IN_MOTION = {"PowertrainMounts": 0.01}
+#: Points beyond the dependency points: PowertrainMounts on eight rubber mounts turned off the axes, where each of its
+#: 96 branch states acts (on the default layout they are idle)
+STATE_POINTS = {"PowertrainMounts": (
+    {"layout": str(Path(__file__).parents[1] / "support" / "eight_rubber_mounts.toml")},)}
 
 
 @pytest.mark.parametrize("name", WITH_STATES)
 def test_a_state_changes_exactly_the_outputs_that_declare_it(native_dir, tmp_path, name, fmi):
-    """Each state moved by 0.1 (at the start values and the dependency points, in motion where IN_MOTION says):
+    """Each state moved by 0.1 (at the start values, the dependency points and STATE_POINTS, in motion where IN_MOTION
+    says):
     the outputs and the derivatives whose ``dependencies`` name it change, no other does."""
     description = read_model_description(str(_path(native_dir, name, fmi)))
     spec = MODELS[name].spec
@@ -147,7 +155,7 @@ def test_a_state_changes_exactly_the_outputs_that_declare_it(native_dir, tmp_pat
     declared = {u.variable.name: {known.name for known in u.dependencies}
                 for u in (*description.outputs, *description.derivatives)}
     observed: dict[str, set[str]] = {unknown: set() for unknown in (*outputs, *derivatives)}
-    for n, point in enumerate(points(name)):
+    for n, point in enumerate((*points(name), *STATE_POINTS.get(name, ()))):
         model = ModelExchange(_path(native_dir, name, fmi), fmi, point, tmp_path / str(n))
         states = model.get_states() + IN_MOTION.get(name, 0.0)
         model.set_states(states)

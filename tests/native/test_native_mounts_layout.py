@@ -9,12 +9,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy.fmi1 import FMICallException
 
 from driveline.mounts.spec import derivative_name
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
-from support.model_exchange import ModelExchange
 from support.native_agreement import beyond_tolerance, refusals, up_to_the_toml_reason
 
 NAME = "PowertrainMounts"
@@ -158,19 +156,3 @@ def test_rubber_and_progressive_mounts_match_the_python_fmu(native_dir, fmu_path
     beyond = beyond_tolerance(reference, found)
     assert {name: value for name, value in beyond.items()
             if not (name.startswith("share_") or name.endswith("_share")) or value > SHARE_TOLERANCE} == {}
-
-
-def test_model_exchange_refuses_rubber_damping_in_one_line(native_dir, tmp_path, fmi):
-    """Model Exchange declares the motion's 12 states, not the branches' forces: on the rubber layout the
-    first evaluation is discarded (the layer's status for outputs it cannot compute at the solver's point) with
-    one line that points to co-simulation (a layout on snubbers alone is taken: the dependency and derivative
-    tests' point on snubbers)."""
-    model = ModelExchange(native.fmu_path(native_dir, NAME, fmi), fmi, {"layout": str(RUBBER)}, tmp_path)
-    model.set_states(model.get_states() + 1e-3)
-    with pytest.raises(FMICallException) as refused:
-        model.derivatives()
-    assert refused.value.status == 2
-    assert [line for line in model.log if "rubber damping" in line] == [
-        "the outputs at t = 0.0 s could not be computed (ValueError: Model Exchange does not take rubber damping yet "
-        "(the layout's dynamic_ratio: its Maxwell branches' forces are no declared states): use Co-Simulation)"]
-    model.free()

@@ -193,6 +193,7 @@ int forces_branch_map(const Layout *layout, const double maps[][3][6], const dou
                 memcpy(out->rows[out->count], maps[n][k], sizeof out->rows[0]);
                 out->gains[out->count] = m->branches[j] * rate;
                 out->times[out->count] = rubber_relaxation_time(j);
+                out->slots[out->count] = (3 * n + k) * MOUNTS_RUBBER_BRANCHES + j;
                 out->count++;
             }
         }

@@ -76,10 +76,12 @@ int rubber_fit_error(const char *where, const RubberFit *fit, double loss_factor
 /* ---- forces.c --------------------------------------------------------------------------------- */
 
 /* forces.BranchMap: a row per branch (mount, then axis, then branch): the deflection rate it sees from q',
- * its gain w_j F'(d_op) [N/m], its relaxation time [s] */
+ * its gain w_j F'(d_op) [N/m], its relaxation time [s], its slot among Model Exchange's branch states
+ * ((3 mount + axis) MOUNTS_RUBBER_BRANCHES + branch) */
 typedef struct {
     int count;
     double rows[MOUNTS_MAX_BRANCHES][6], gains[MOUNTS_MAX_BRANCHES], times[MOUNTS_MAX_BRANCHES];
+    int slots[MOUNTS_MAX_BRANCHES];
 } Branches;
 
 /* MAX_NEWTON as text, for the messages */

@@ -7,7 +7,8 @@
  * exponential of the augmented matrix: Pade 13 with scaling and squaring, exact_step.squarings' count) is
  * built again only when the step size changes; progressive mounts step by the implicit scheme
  * (implicit_step.c). The state (q, q', z): q and q' the outputs x ... yaw_dot, Model Exchange's continuous states
- * (spec._states), z the Maxwell branches' forces, the internal state (data->internal, one slot a branch).
+ * (spec._states), z the Maxwell branches' forces: co-simulation's internal state (data->internal, one slot a
+ * branch), shown in the outputs of their slots (mount, axis, branch), Model Exchange's states after the motion's.
  */
 #include <math.h>
 #include <stdio.h>
@@ -29,6 +30,10 @@
 #define N_INPUTS MODEL_INPUT_DERIVATIVE_COUNT
 #define STATE_VARIABLES model_states
 #define ACCELERATION_VARIABLES (model_state_derivatives + 6)
+/* The Maxwell branches' slots (spec.BRANCH_FORCES) and their rates, the states and derivatives after the motion's */
+#define BRANCH_VARIABLES (model_states + 12)
+#define BRANCH_RATE_VARIABLES (model_state_derivatives + 12)
+#define BRANCH_SLOTS (MODEL_STATE_COUNT - 12)
 static const int STATIC_VARIABLES[6] = {V_x_static,    V_y_static,     V_z_static,
                                         V_roll_static, V_pitch_static, V_yaw_static};
 static const char *const COORDINATES[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
@@ -630,6 +635,18 @@ static void show(const System *s, ModelData *data, const double *state, const do
     for (k = 0; k < FMU_INTERNAL_SLOTS; k++) {
         data->internal[k] = k < s->branches.count ? state[12 + k] : 0.0;
     }
+    for (k = 0; k < BRANCH_SLOTS; k++) {
+        data->real_value[BRANCH_VARIABLES[k]] = data->real_value[BRANCH_RATE_VARIABLES[k]] = 0.0;
+    }
+    for (k = 0; k < s->branches.count; k++) { /* MountSystem.derivatives: z' = g (R q') - z / tau */
+        double speed = 0.0;
+        for (i = 0; i < 6; i++) {
+            speed += s->branches.rows[k][i] * state[6 + i];
+        }
+        data->real_value[BRANCH_VARIABLES[s->branches.slots[k]]] = state[12 + k];
+        data->real_value[BRANCH_RATE_VARIABLES[s->branches.slots[k]]] =
+            s->branches.gains[k] * speed - state[12 + k] / s->branches.times[k];
+    }
     for (n = 0; n < MOUNTS_LAYOUT_MAX_MOUNTS; n++) { /* MountSystem.mount_forces */
         double local[3] = {0, 0, 0};
         int first = V_F_x_mount1 + 3 * n;
@@ -769,10 +786,11 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
     return halfshafts_show(s->shafts, data, s->failure);
 }
 
-/* Model Exchange: the accelerations (the velocities' derivatives) and mount forces at the solver's state
- * (q, q') under the inputs now, M q'' + C q' + K q = G u (the characteristics' forces for progressive mounts);
- * the static sag and modal table stay as the initialisation left them (functions of the parameters alone).
- * Model Exchange declares no states for the Maxwell branches: a layout with them is refused. */
+/* Model Exchange (PowertrainMountsModel.evaluate): the derivatives, accelerations and mount forces at the
+ * solver's state (q, q', z) under the inputs now, M q'' + C q' + K q + R^T z = G u (the characteristics' forces
+ * for progressive mounts), z' = g (R q') - z / tau; the branches' forces are the states of their slots (those of
+ * mounts without rubber idle: shown 0, their rates 0); the static sag and modal table stay as the initialisation
+ * left them (functions of the parameters alone). */
 static Failure evaluate(ModelData *data, double time UNUSED)
 {
     System *s = data->cache->derived;
@@ -781,22 +799,22 @@ static Failure evaluate(ModelData *data, double time UNUSED)
     if (s == NULL) {
         return FAILURE(ERROR_RUNTIME, "the powertrain was not built");
     }
-    if (s->branches.count > 0) {
-        return FAILURE(ERROR_VALUE, "Model Exchange does not take rubber damping yet (the layout's dynamic_ratio: "
-                                    "its Maxwell branches' forces are no declared states): use Co-Simulation");
-    }
     generalised(s, data, 0, force);
     for (i = 0; i < 12; i++) {
         state[i] = data->real_value[STATE_VARIABLES[i]];
+    }
+    for (i = 0; i < s->branches.count; i++) {
+        state[12 + i] = data->real_value[BRANCH_VARIABLES[s->branches.slots[i]]];
     }
     show(s, data, state, force);
     return halfshafts_show(s->shafts, data, s->failure);
 }
 
-/* Directional derivatives: linear mounts' partials are constant, progressive ones' take the tangent rates
- * F'(d) at the state's deflections. The accelerations (A s + B G u)[6:] (-M^-1 K_t(Q) for the displacements)
- * by the states and the loads (their rates: none, as in evaluate), each mount's force by the states (show's
- * mount forces); the states' own rows and der(<state>)'s are the layer's. */
+/* Directional derivatives (MountSystem.derivative_jacobian): linear mounts' partials are constant, progressive
+ * ones' take the tangent rates F'(d) at the state's deflections. The accelerations (A s + B G u)[6:]
+ * (-M^-1 K_t(Q) for the displacements) by the states and the loads (their rates: none, as in evaluate), the
+ * branches' rates A[12:] by the velocities and their own force, each mount's force by the motion and its
+ * branches (show's mount forces); the states' own rows and der(<state>)'s are the layer's. */
 static Failure jacobian(const ModelData *data, double partial[])
 {
     const System *s = data->cache->derived;
@@ -833,6 +851,9 @@ static Failure jacobian(const ModelData *data, double partial[])
             }
             row[model_jacobian_columns[STATE_VARIABLES[k]]] = value;
         }
+        for (k = 0; k < s->branches.count; k++) {
+            row[model_jacobian_columns[BRANCH_VARIABLES[s->branches.slots[k]]]] = s->a[6 + i][12 + k];
+        }
         for (k = 0; k < N_INPUTS; k++) {
             double sum = 0.0;
             for (j = 0; j < 6; j++) {
@@ -840,6 +861,13 @@ static Failure jacobian(const ModelData *data, double partial[])
             }
             row[model_jacobian_columns[model_input_derivatives[k].input]] = sum;
         }
+    }
+    for (k = 0; k < s->branches.count; k++) {
+        double *row = partial + model_jacobian_rows[BRANCH_RATE_VARIABLES[s->branches.slots[k]]] * MODEL_COLUMN_COUNT;
+        for (j = 0; j < 6; j++) {
+            row[model_jacobian_columns[STATE_VARIABLES[6 + j]]] = s->a[12 + k][6 + j];
+        }
+        row[model_jacobian_columns[BRANCH_VARIABLES[s->branches.slots[k]]]] = s->a[12 + k][12 + k];
     }
     for (n = 0; n < s->layout.count; n++) {
         const Mount *m = &s->layout.mounts[n];
@@ -853,6 +881,10 @@ static Failure jacobian(const ModelData *data, double partial[])
                 }
                 row[model_jacobian_columns[STATE_VARIABLES[j]]] = moved;
                 row[model_jacobian_columns[STATE_VARIABLES[6 + j]]] = speed;
+            }
+            for (k = 0; k < 3 * m->branch_count; k++) { /* its branches, along axis k / branch_count */
+                int slot = 3 * n * MOUNTS_RUBBER_BRANCHES + k;
+                row[model_jacobian_columns[BRANCH_VARIABLES[slot]]] = -m->axes[k / m->branch_count][i];
             }
         }
     }
