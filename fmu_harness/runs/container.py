@@ -20,8 +20,9 @@ initialisation before its outputs feed the next; the master reads every connecti
 initialisation in the package's order of connections, where each FMU computes it from what has been set so
 far. The container's order is made the order in which the master first reads each component's outputs, so
 every component leaves initialisation with the inputs the master gives it, and the runs are equal bit for
-bit (docs/vehicle_launch.md). The toolbox warns that a loop's first component (``VehicleDriveline`` in the
-launch) starts without the loop's values: at rest they are the start values in both.
+bit (on the rubber layout but for the first rows, whose rest values are rounding-level: docs/vehicle_launch.md).
+The toolbox warns that a loop's first component (``VehicleDriveline`` in the launch) starts without the loop's
+values: at rest they are the start values, up to that rounding.
 
 What the container cannot carry is refused in one line before any work: a Python FMU (it needs Python in
 the host: take the native package), an FMU without Co-Simulation, a binding of a variable the FMU has not

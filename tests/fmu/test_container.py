@@ -23,9 +23,14 @@ from fmu_harness.runs.ssp_package import SspComponent, SspSystem
 STOP = 0.1
 # Agreement of the container with the master at the same step and order: the container runs the same FMUs by the
 # same scheme with the same values in the same order (its components initialised in the order the master reads
-# their outputs), so every output is equal bit for bit (measured over the whole 4 s launch with the housings
-# moving, Jacobi at 1e-4 s and Gauss-Seidel at 2e-4 s). In the toolbox's own order the launch's joints started
-# from the package's bound bend angle, a few units in the last place from the mounts' (5e-8 relative after 2 s).
+# their outputs). On the rubber layout the powertrain at rest is in equilibrium to rounding only (accelerations
+# of 1e-19 m/s2 and less), and those values go round the loops inside initialisation in the other order: the
+# first rows differ by up to 1.6e-11 of a column's largest magnitude (Jacobi: rows 1-4, Gauss-Seidel: row 1),
+# then the launch's motion rounds them away and every later row is equal bit for bit (measured over the whole
+# 4 s launch with the housings moving). AGREEMENT bounds the first rows; the last row must be equal. In the
+# toolbox's own order the joints started from the package's bound bend angle, a few units in the last place from
+# the mounts' (the runs parted by 5e-8 relative after 2 s, on the linear layout).
+AGREEMENT = 1e-9
 #: Another host's run of the container against fmpy's: 1e-9 of a column's largest magnitude leaves room for a host
 #: that sums its time differently (the motor's ramp would differ in the last bits of t, 1e-16 relative).
 HOST_AGREEMENT = 1e-9
@@ -60,8 +65,11 @@ def _compare(package: Path, tmp_path: Path, step: float, sequential: bool,
                                  order=order)
     found = container.run(fmu, {f"{n}.{v}": x for (n, v), x in changes.items()}, STOP, step, outputs)
     assert found.shape == expected.shape
-    differing = [(row, ["time", *outputs][column]) for row, column in zip(*np.nonzero(found != expected))]
-    assert differing == [], differing[:5]
+    scale = np.maximum(np.abs(expected).max(axis=0), 1e-300)
+    worst = np.abs(found - expected).max(axis=0) / scale
+    assert worst.max() <= AGREEMENT, (["time", *outputs][int(np.argmax(worst))], worst.max())
+    last = [name for name, equal in zip(["time", *outputs], found[-1] == expected[-1]) if not equal]
+    assert last == [], last[:5]
 
 
 @pytest.mark.parametrize("sequential", [False, True], ids=["jacobi", "gauss-seidel"])

@@ -29,7 +29,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 
-#define MAX_SIGNALS 128
+#define MAX_SIGNALS 512 /* PowertrainMounts: 323 Real outputs with the Maxwell branches' states and rates */
 #define MAX_TEXT 4096
 
 typedef struct {
