@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from driveline.mounts.spec import derivative_name
+from driveline.mounts.spec import SHARED_LAYOUT, derivative_name
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
 from support.native_agreement import beyond_tolerance, refusals, up_to_the_toml_reason
@@ -91,16 +91,36 @@ def test_layout_and_placement_refusals_are_the_python_fmus(native_dir, fmu_path,
 
 @pytest.mark.parametrize("step, reason", [(1e12, "squarings"), (1e300, "squarings"), (1e305, "overflows")])
 def test_a_step_beyond_the_work_limit_is_refused_alike(native_dir, fmu_path, fmi, step, reason):
-    """A step whose exponential needs more than MAX_SQUARINGS squarings, or whose matrix overflows (a step of
-    1e305 s: its norm is infinite, no count of squarings): the same refusal, word for word."""
+    """On linear mounts (the exact step), a step whose exponential needs more than MAX_SQUARINGS squarings, or
+    whose matrix overflows (a step of 1e305 s: its norm is infinite, no count of squarings): the same refusal,
+    word for word."""
     found = []
     for path in (fmu_path(NAME, fmi), native.fmu_path(native_dir, NAME, fmi)):
         with FmuInstance(path) as fmu:
-            fmu.initialize({"F_z": 100.0})
+            fmu.initialize({"F_z": 100.0, "layout": SHARED_LAYOUT})
             with pytest.raises(StepRefused) as refused:
                 fmu.step(step)
             found.append(refused.value.messages)
     assert len(found[0]) == 1 and reason in found[0][0] and found[0] == found[1]
+
+
+@pytest.mark.parametrize("step", [1e12, 1e300, 1e305])
+def test_on_the_rubber_default_a_huge_step_lands_at_the_static_equilibrium(native_dir, fmu_path, fmi, step):
+    """The implicit midpoint step is A-stable and needs no exponential: however long the step, its Newton
+    iteration ends at rest in the static equilibrium under the held load (100 N up: the powertrain lifts by
+    0.26 mm), both families alike within the equilibrium's Newton tolerance."""
+    found = []
+    for path in (fmu_path(NAME, fmi), native.fmu_path(native_dir, NAME, fmi)):
+        with FmuInstance(path) as fmu:
+            fmu.initialize({"F_z": 100.0})
+            fmu.step(step)
+            found.append(np.array(fmu.get(["z", "z_dot", "z_ddot", "pitch_ddot"]), dtype=float))
+    python, native_values = found
+    assert 2.5e-4 < python[0] < 2.7e-4 and abs(native_values[0] - python[0]) <= 1e-12 * python[0]
+    # the rate over the step is twice the lift over the step's length; the accelerations, the forces' at rest, are
+    # their rounding (eps m g over the inertia: some 1e-14, the floor of support.native_agreement)
+    assert np.all(np.abs([python[1], native_values[1]]) <= 1e-3 / step)
+    assert np.all(np.abs(np.concatenate([python[2:], native_values[2:]])) <= 1e-12)
 
 
 RUBBER = Path(__file__).parents[2] / "driveline" / "mounts" / "data" / "transverse_fwd_powertrain_rubber.toml"
