@@ -56,7 +56,7 @@ typedef struct {
 static void skewed_slips(Guard *guard, const Load *load, const double axis[3], double zdot, const double spin[3],
                          double angle, double target, Contact *c)
 {
-    double R = load->roller_radius, along[3], turn[3], v0[3], g[3];
+    double R = load->roller_radius, along[3], turn[3], v0[3], g[3], roll, skew;
     int i;
     c->k[0] = cos(angle);
     c->k[1] = sin(angle);
@@ -70,9 +70,10 @@ static void skewed_slips(Guard *guard, const Load *load, const double axis[3], d
     }
     c->v_roll = dot3(v0, c->u) + R * c->across * dot3(spin, axis);
     c->v_skew = dot3(v0, c->s);
+    roll = slip_sign(guard, c->v_roll, load->slip_speed);
+    skew = slip_sign(guard, c->v_skew, load->slip_speed);
     for (i = 0; i < 3; i++) {
-        g[i] = -load->mu_roll * slip_sign(guard, c->v_roll, load->slip_speed) * c->u[i]
-               - load->friction * slip_sign(guard, c->v_skew, load->slip_speed) * c->s[i];
+        g[i] = -load->mu_roll * roll * c->u[i] - load->friction * skew * c->s[i];
         c->pushed[i] = c->k[i] + g[i] * (i == 2 ? 0.0 : 1.0);
     }
     c->miss = remainder_of(atan2(c->pushed[1], c->pushed[0]) - target + PI, 2.0 * PI) - PI;

@@ -201,63 +201,84 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
 
 /* ---- reactions ----------------------------------------------------------------------------- */
 
+/* One arm in the friction balance: what its iterations do not change (reactions._friction_arm) */
+typedef struct {
+    double ex, ey, ez, exy2, e2, e_norm, ne_norm, n_norm; /* e_j, |n|^2, |e|^2, |e|, |n||e|, |n| */
+    double m_ax, m_ay, m_zddot, groove_sign, arm_sign;    /* m a_xy, m zddot, the slips' regularised signs */
+    double mu_arm[3], slip_arm[3];                        /* the moment arms of mu_j and phi_j */
+} FrictionArm;
+
 /* Arm forces with Coulomb friction in both sliding pairs of each arm, by successive substitution
  * from the frictionless forces (reactions._frictional_balance): lambda_j, mu_j, the slip forces
- * phi_j along the arms, the groove forces g_j and the dissipated power. */
+ * phi_j along the arms, the groove forces g_j and the dissipated power. Nothing in the iterations can
+ * fail as Python would: sigma_j's division has refused |n_j|^2 = 0 before, so |e_j| > 0, and every square
+ * root is of a sum of squares; their arithmetic runs unguarded, on copies the compiler may keep at hand. */
 static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[3][3], double inv_det,
                                const double load_moment[3], const Load *load, double lams[3], double mus[3],
                                double slips[3], double grooves[3], double *power)
 {
-    /* per arm, what the iterations do not change: |e|^2, |e|, |n||e|, |n| and the moment arms of mu_j and phi_j */
-    double signs[3][2], e2s[3], e_norms[3], ne_norms[3], n_norms[3], mu_arms[3][3], slip_arms[3][3];
-    double new_mus[3], new_lams[3], m = load->m, friction = load->friction;
-    int iteration, j;
+    FrictionArm fixed[3];
+    double lam_now[3], mu_now[3], new_mus[3], new_lams[3], slip_now[3] = {0.0, 0.0, 0.0};
+    double groove_now[3] = {0.0, 0.0, 0.0}, inverse[3][3], m = load->m, friction = load->friction;
+    int iteration = 0, i, j;
     for (j = 0; j < 3; j++) {
         const Arm *a = &arm[j];
-        signs[j][0] = slip_sign(guard, a->zdot, load->slip_speed);
-        signs[j][1] = slip_sign(guard, a->sigma * root(guard, a->exy2 + a->ez * a->ez), load->slip_speed);
-        e2s[j] = a->exy2 + a->ez * a->ez;
-        e_norms[j] = root(guard, e2s[j]);
-        ne_norms[j] = root(guard, a->exy2 * e2s[j]);
-        n_norms[j] = root(guard, a->exy2);
-        mu_arms[j][0] = a->dy * -a->exy2 - a->dz * a->ez * a->ey;
-        mu_arms[j][1] = a->dz * a->ez * a->ex + a->dx * a->exy2;
-        mu_arms[j][2] = a->dx * a->ez * a->ey - a->dy * a->ez * a->ex;
-        slip_arms[j][0] = a->dy * a->ez - a->dz * a->ey;
-        slip_arms[j][1] = a->dz * a->ex - a->dx * a->ez;
-        slip_arms[j][2] = a->dx * a->ey - a->dy * a->ex;
+        FrictionArm *f = &fixed[j];
+        f->ex = a->ex;
+        f->ey = a->ey;
+        f->ez = a->ez;
+        f->exy2 = a->exy2;
+        f->e2 = a->exy2 + a->ez * a->ez;
+        f->e_norm = root(guard, f->e2);
+        f->ne_norm = root(guard, a->exy2 * f->e2);
+        f->n_norm = root(guard, a->exy2);
+        f->m_ax = m * a->ax;
+        f->m_ay = m * a->ay;
+        f->m_zddot = m * a->zddot;
+        f->groove_sign = slip_sign(guard, a->zdot, load->slip_speed);
+        f->arm_sign = slip_sign(guard, a->sigma * f->e_norm, load->slip_speed);
+        f->mu_arm[0] = a->dy * -a->exy2 - a->dz * a->ez * a->ey;
+        f->mu_arm[1] = a->dz * a->ez * a->ex + a->dx * a->exy2;
+        f->mu_arm[2] = a->dx * a->ez * a->ey - a->dy * a->ez * a->ex;
+        f->slip_arm[0] = a->dy * a->ez - a->dz * a->ey;
+        f->slip_arm[1] = a->dz * a->ex - a->dx * a->ez;
+        f->slip_arm[2] = a->dx * a->ey - a->dy * a->ex;
+        lam_now[j] = lams[j];
+        mu_now[j] = mus[j];
+        for (i = 0; i < 3; i++) {
+            inverse[j][i] = adj[j][i];
+        }
     }
-    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE;
-         iteration++) {
+    for (; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE; iteration++) {
         double Mx = load_moment[0], My = load_moment[1], Mz = load_moment[2], change = 0.0, scale = 0.0;
         for (j = 0; j < 3; j++) {
-            const Arm *a = &arm[j];
-            double lam = lams[j], mu = mus[j], e2 = e2s[j];
-            double normal = root(guard, a->exy2 * (lam * lam + mu * mu * e2));
-            double slip = divide(guard, friction * normal * signs[j][1], e_norms[j]);
-            double Nx = m * a->ax + lam * a->ey + mu * a->ez * a->ex + slip * a->ex;
-            double Ny = m * a->ay - lam * a->ex + mu * a->ez * a->ey + slip * a->ey;
-            double groove = -friction * root(guard, Nx * Nx + Ny * Ny) * signs[j][0];
+            const FrictionArm *a = &fixed[j];
+            double lam = lam_now[j], mu = mu_now[j];
+            double normal = sqrt(a->exy2 * (lam * lam + mu * mu * a->e2));
+            double slip = friction * normal * a->arm_sign / a->e_norm;
+            double Nx = a->m_ax + lam * a->ey + mu * a->ez * a->ex + slip * a->ex;
+            double Ny = a->m_ay - lam * a->ex + mu * a->ez * a->ey + slip * a->ey;
+            double groove = -friction * sqrt(Nx * Nx + Ny * Ny) * a->groove_sign;
             /* plunger along Z': groove - F_z = m zddot with F_z = -mu |n|^2 + phi e_z */
-            double new_mu = divide(guard, m * a->zddot - groove + slip * a->ez, a->exy2);
-            Mx = Mx - new_mu * mu_arms[j][0] - slip * slip_arms[j][0];
-            My = My - new_mu * mu_arms[j][1] - slip * slip_arms[j][1];
-            Mz = Mz - new_mu * mu_arms[j][2] - slip * slip_arms[j][2];
-            change = change + fabs(new_mu - mu) * ne_norms[j];
+            double new_mu = (a->m_zddot - groove + slip * a->ez) / a->exy2;
+            Mx = Mx - new_mu * a->mu_arm[0] - slip * a->slip_arm[0];
+            My = My - new_mu * a->mu_arm[1] - slip * a->slip_arm[1];
+            Mz = Mz - new_mu * a->mu_arm[2] - slip * a->slip_arm[2];
+            change = change + fabs(new_mu - mu) * a->ne_norm;
             scale = scale + normal;
             new_mus[j] = new_mu;
-            slips[j] = slip;
-            grooves[j] = groove;
+            slip_now[j] = slip;
+            groove_now[j] = groove;
         }
         for (j = 0; j < 3; j++) {
-            new_lams[j] = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det;
+            new_lams[j] = (Mx * inverse[j][0] + My * inverse[j][1] + Mz * inverse[j][2]) * inv_det;
         }
         for (j = 0; j < 3; j++) {
-            change = change + fabs(new_lams[j] - lams[j]) * n_norms[j];
+            change = change + fabs(new_lams[j] - lam_now[j]) * fixed[j].n_norm;
         }
         for (j = 0; j < 3; j++) {
-            lams[j] = new_lams[j];
-            mus[j] = new_mus[j];
+            lam_now[j] = new_lams[j];
+            mu_now[j] = new_mus[j];
         }
         if (change <= TRIPOD_REACTIONS_FRICTION_TOLERANCE * scale) {
             break;
@@ -268,6 +289,10 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
     }
     *power = 0.0;
     for (j = 0; j < 3; j++) {
+        lams[j] = lam_now[j];
+        mus[j] = mu_now[j];
+        slips[j] = slip_now[j];
+        grooves[j] = groove_now[j];
         /* dissipation: -g_j zdot_j (groove) + phi_j sdot_j (arm), sdot_j |e_j| = sigma_j |e_j|^2 */
         *power = *power - grooves[j] * arm[j].zdot + slips[j] * arm[j].sigma * (arm[j].exy2 + arm[j].ez * arm[j].ez);
     }
