@@ -45,9 +45,10 @@ static double arcsine(Guard *guard, double a)
 
 /* ---- exact kinematics, tripod-plane formulation (plane_solver.py) ------------------------- */
 
-/* The star centre at one axis (x, y) and the terms its directional derivatives reuse. */
+/* The star centre at one axis (x, y) and the terms its directional derivatives reuse; arg(alpha) =
+ * atan2(ai, ar) is taken by the solver at its last iterate alone. */
 typedef struct {
-    double fx, fy, twist, orbit_r, orbit_i;
+    double fx, fy, orbit_r, orbit_i;
     double x, y, z, k, cb, sb, E1x, E1z, E2x, E2z, Ux, Uz, f1, f2, ar, ai, norm, tr, ti, qr, qi, turn3[2], r, l;
 } StarCentre;
 
@@ -56,8 +57,8 @@ typedef struct {
     double fx, fy, twist;
 } StarTangent;
 
-/* Star centre relative to P in tripod-plane coordinates, arg(alpha) and the centre's term in
- * turn3 = exp(3i chi); frame vectors mapped to the input frame by eq 2. */
+/* Star centre relative to P in tripod-plane coordinates and the centre's term in turn3 = exp(3i chi);
+ * frame vectors mapped to the input frame by eq 2. */
 static StarCentre star_centre(Guard *guard, double x, double y, const double turn3[2], double cb, double sb,
                               double r, double l)
 {
@@ -80,7 +81,6 @@ static StarCentre star_centre(Guard *guard, double x, double y, const double tur
     s.orbit_i = qr * turn3[1] + qi * turn3[0];
     s.fx = c1 - s.orbit_r;
     s.fy = c2 - s.orbit_i;
-    s.twist = atan2(ai, ar);
     s.x = x;
     s.y = y;
     s.z = z;
@@ -150,7 +150,7 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
     StarCentre f;
     StarTangent along_x = {0.0, 0.0, 0.0}, along_y = along_x;
     int i;
-    f.twist = f.orbit_r = f.orbit_i = 0.0;
+    f.orbit_r = f.orbit_i = 0.0;
     if (!warm) {
         double rho_over_l = divide(guard, r * (1.0 - cb), 2.0 * cb * l);
         x = rho_over_l * cosine(guard, 3.0 * phi_in);
@@ -186,7 +186,7 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
         return;
     }
     /* the last update moved (x, y) by (-dx, -dy): carry arg(alpha) along to first order */
-    twist = f.twist - (along_x.twist * dx + along_y.twist * dy);
+    twist = atan2(f.ai, f.ar) - (along_x.twist * dx + along_y.twist * dy);
     /* d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit */
     dx_dphi = -(jyy * (3.0 * f.orbit_i) - jxy * (-3.0 * f.orbit_r)) / det;
     dy_dphi = -(jxx * (-3.0 * f.orbit_r) - jyx * (3.0 * f.orbit_i)) / det;
@@ -484,13 +484,31 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
 
 /* ---- outputs (outputs.coupling_outputs) ------------------------------------------------------ */
 
-/* Components (x, y) in the bend plane's frame turned by psi about Z' into the housing's X'Y' (M8,
- * outputs.to_housing); at psi = 0 they stay as they are, a zero's sign included. */
-static void to_housing(Guard *guard, double *x, double *y, double psi)
+/* The turn by psi about Z' from the bend plane's frame into the housing's X'Y' (M8, outputs.to_housing):
+ * its cosine and sine, taken once for every vector the step turns; none at psi = 0. */
+typedef struct {
+    int turned;
+    double c, s;
+} HousingTurn;
+
+static HousingTurn housing_turn(Guard *guard, double psi)
 {
+    HousingTurn turn = {0, 1.0, 0.0};
     if (psi != 0.0) {
-        double c = cosine(guard, psi), s = sine(guard, psi), turned_x = c * *x - s * *y;
-        *y = s * *x + c * *y;
+        turn.turned = 1;
+        turn.c = cosine(guard, psi);
+        turn.s = sine(guard, psi);
+    }
+    return turn;
+}
+
+/* Components (x, y) in the bend plane's frame turned into the housing's; at psi = 0 they stay as they are, a
+ * zero's sign included. */
+static void to_housing(const HousingTurn *turn, double *x, double *y)
+{
+    if (turn->turned) {
+        double turned_x = turn->c * *x - turn->s * *y;
+        *y = turn->s * *x + turn->c * *y;
         *x = turned_x;
     }
 }
@@ -526,6 +544,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     double phi_in = VALUE(phi_in), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
     double cos_beta, sin_beta, rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin;
     double output_power, total, psi, psi_dot, phi, spin;
+    HousingTurn turn;
     if (INTEGER(beta_rate) != RATES_FROM_INPUTS) { /* the samples are kept for the automatic choice too */
         double samples[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         int count = 1, k;
@@ -607,8 +626,9 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     phi_out = phi_out + psi; /* (M2) */
     output_power = T_load * omega_spin;
     total = output_power + forces.P_friction;
-    to_housing(&guard, &forces.Rx_in, &forces.Ry_in, psi);
-    to_housing(&guard, &forces.Mx_in, &forces.My_in, psi);
+    turn = housing_turn(&guard, psi);
+    to_housing(&turn, &forces.Rx_in, &forces.Ry_in);
+    to_housing(&turn, &forces.Mx_in, &forces.My_in);
     VALUE(phi_out) = phi_out;
     VALUE(delta_phi) = phi_out - phi_in;
     VALUE(omega_out) = spin * ratio + psi_dot; /* (M7) */
@@ -650,7 +670,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
         seed_x = tan_beta * m * a_sum;                                                       /* eq 33 */
         seed_y = divide(&guard, -3.0 * m * rho * rho * omega_squared * tan_beta * sine(&guard, 6.0 * seed_phi),
                         l);                                                                  /* eq 34 */
-        to_housing(&guard, &seed_x, &seed_y, psi);
+        to_housing(&turn, &seed_x, &seed_y);
         VALUE(Rx_in) = seed_x;
         VALUE(Ry_in) = seed_y;
     }
