@@ -46,9 +46,10 @@ static double remainder_of(double a, double b)
     return mod;
 }
 
-/* One arm's track contact (rollers.RollerContacts, the parts the balance needs). */
+/* One arm's track contact (rollers.RollerContacts, the parts the balance needs), with the regularised signs
+ * of its rolling and skew speeds. */
 typedef struct {
-    double k[3], N, u[3], across, s[3], v_roll, v_skew, F_roll, F_skew, miss, pushed[3];
+    double k[3], N, u[3], across, s[3], v_roll, v_skew, roll_sign, skew_sign, F_roll, F_skew, miss, pushed[3];
 } Contact;
 
 /* The single roller on its track with contact normal at ``angle`` (rollers._skewed_slips and the
@@ -56,7 +57,7 @@ typedef struct {
 static void skewed_slips(Guard *guard, const Load *load, const double axis[3], double zdot, const double spin[3],
                          double angle, double target, Contact *c)
 {
-    double R = load->roller_radius, along[3], turn[3], v0[3], g[3], roll, skew;
+    double R = load->roller_radius, along[3], turn[3], v0[3], g[3];
     int i;
     c->k[0] = cos(angle);
     c->k[1] = sin(angle);
@@ -70,10 +71,10 @@ static void skewed_slips(Guard *guard, const Load *load, const double axis[3], d
     }
     c->v_roll = dot3(v0, c->u) + R * c->across * dot3(spin, axis);
     c->v_skew = dot3(v0, c->s);
-    roll = slip_sign(guard, c->v_roll, load->slip_speed);
-    skew = slip_sign(guard, c->v_skew, load->slip_speed);
+    c->roll_sign = slip_sign(guard, c->v_roll, load->slip_speed);
+    c->skew_sign = slip_sign(guard, c->v_skew, load->slip_speed);
     for (i = 0; i < 3; i++) {
-        g[i] = -load->mu_roll * roll * c->u[i] - load->friction * skew * c->s[i];
+        g[i] = -load->mu_roll * c->roll_sign * c->u[i] - load->friction * c->skew_sign * c->s[i];
         c->pushed[i] = c->k[i] + g[i] * (i == 2 ? 0.0 : 1.0);
     }
     c->miss = remainder_of(atan2(c->pushed[1], c->pushed[0]) - target + PI, 2.0 * PI) - PI;
@@ -112,8 +113,8 @@ static void skewed_contacts(Guard *guard, const Load *load, const double H[3][3]
     for (j = 0; j < 3; j++) {
         skewed_slips(guard, load, axis[j], zdot[j], spin, angle[j], target[j], &c[j]);
         c[j].N = size[j] / root(guard, dot3(c[j].pushed, c[j].pushed));
-        c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
-        c[j].F_skew = -load->friction * c[j].N * slip_sign(guard, c[j].v_skew, load->slip_speed);
+        c[j].F_roll = -load->mu_roll * c[j].N * c[j].roll_sign;
+        c[j].F_skew = -load->friction * c[j].N * c[j].skew_sign;
     }
 }
 
@@ -126,7 +127,8 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
     const double m = load->m, R = load->roller_radius, mu = load->friction;
     const double needle_share = load->roller_bore_radius / R; /* r_b / R */
     double centre[3][3], e[3][3], d[3][3], n[3][3], q[3][3], axis[3][3], length[3], groove_acc[3][3];
-    double zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], spin[3], load_moment[3], friction_h[3][3];
+    double zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], roll_sign[3], n_norm[3], spin[3], load_moment[3];
+    double friction_h[3][3];
     double N_trunnion[3], phi[3], force[3][3], friction[3][3], couple[3][3], H[3][3];
     double R_out[3] = {0.0, 0.0, 0.0}, R_in[3] = {0.0, 0.0, 0.0}, L[3] = {0.0, 0.0, 0.0}, power = 0.0;
     double relax = 1.0, last_lam[3] = {0.0, 0.0, 0.0}, last_mu[3] = {0.0, 0.0, 0.0};
@@ -155,6 +157,10 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
         zddot[j] = a->zddot;
         v_trunnion[j] = a->sigma * length[j];
         trunnion_sign[j] = slip_sign(guard, v_trunnion[j], load->slip_speed);
+        /* the double roller rolls at zdot_j whatever the forces: its rolling sign is the iterations' constant */
+        roll_sign[j] = load->tripod_type == TRIPOD_SPEC_SINGLE_ROLLER ? 0.0
+                                                                       : slip_sign(guard, zdot[j], load->slip_speed);
+        n_norm[j] = root(guard, a->exy2);
         friction_h[j][0] = friction_h[j][1] = friction_h[j][2] = 0.0;
     }
     for (i = 0; i < 3; i++) {
@@ -192,7 +198,7 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                 cross3(c[j].k, axis[j], lever);
                 c[j].v_roll = zdot[j];
                 c[j].v_skew = load->roller_bore_radius * (zdot[j] * axis[j][2] / R - dot3(spin, lever)); /* R16 */
-                c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
+                c[j].F_roll = -load->mu_roll * c[j].N * roll_sign[j];
                 c[j].F_skew = -mu * c[j].N * slip_sign(guard, c[j].v_skew, load->slip_speed);
                 for (i = 0; i < 3; i++) { /* R17, R18 */
                     friction[j][i] = (c[j].F_roll + needle_share * axis[j][2] * c[j].F_skew) * (i == 2 ? 1.0 : 0.0);
@@ -222,8 +228,7 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                 change_h[i] = h - friction_h[j][i];
                 friction_h[j][i] = h;
             }
-            change = change + (fabs(new_lam[j] - lam[j]) * root(guard, arm[j].exy2)
-                               + fabs(new_mu[j] - mu_q[j]) * root(guard, arm[j].exy2) * length[j]
+            change = change + (fabs(new_lam[j] - lam[j]) * n_norm[j] + fabs(new_mu[j] - mu_q[j]) * n_norm[j] * length[j]
                                + root(guard, dot3(change_h, change_h)));
             scale = scale + (N_trunnion[j] + c[j].N);
         }
