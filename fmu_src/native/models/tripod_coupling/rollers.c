@@ -80,20 +80,42 @@ static void skewed_slips(Guard *guard, const Load *load, const double axis[3], d
     c->miss = remainder_of(atan2(c->pushed[1], c->pushed[0]) - target + PI, 2.0 * PI) - PI;
 }
 
-/* What the miss of the step's contacts needs (illinois.h) */
+#define PROBES_KEPT 4 /* each arm's latest probes: the method ends on one of its brackets' ends, mostly recent */
+
+/* What the miss of the step's contacts needs (illinois.h), and each arm's latest probes and their angles */
 typedef struct {
     Guard *guard;
     const Load *load;
     const double (*axis)[3];
     const double *zdot, *spin, *target;
+    Contact probe[3][PROBES_KEPT];
+    double probe_angle[3][PROBES_KEPT];
+    int probes[3];
 } MissContext;
 
 static double miss_at(void *context, int arm, double angle)
 {
     MissContext *at = (MissContext *)context;
-    Contact probe;
-    skewed_slips(at->guard, at->load, at->axis[arm], at->zdot[arm], at->spin, angle, at->target[arm], &probe);
-    return probe.miss;
+    int slot = at->probes[arm]++ % PROBES_KEPT;
+    Contact *probe = &at->probe[arm][slot];
+    at->probe_angle[arm][slot] = angle;
+    skewed_slips(at->guard, at->load, at->axis[arm], at->zdot[arm], at->spin, angle, at->target[arm], probe);
+    return probe->miss;
+}
+
+/* Arm ``arm``'s contact at ``angle``: a kept probe at the same angle, bit for bit (a zero's sign included), or
+ * computed afresh. */
+static void contact_at(MissContext *at, int arm, double angle, Contact *c)
+{
+    int k, kept = at->probes[arm] < PROBES_KEPT ? at->probes[arm] : PROBES_KEPT;
+    for (k = 0; k < kept; k++) {
+        double probed = at->probe_angle[arm][k];
+        if (probed == angle && signbit(probed) == signbit(angle)) {
+            *c = at->probe[arm][k];
+            return;
+        }
+    }
+    skewed_slips(at->guard, at->load, at->axis[arm], at->zdot[arm], at->spin, angle, at->target[arm], c);
 }
 
 /* The three single rollers' track contacts under the horizontal forces H (rollers._skewed_contact): the
@@ -108,10 +130,16 @@ static void skewed_contacts(Guard *guard, const Load *load, const double H[3][3]
         target[j] = atan2(H[j][1], H[j][0]);
         size[j] = root(guard, dot3(H[j], H[j]));
     }
-    context = (MissContext){guard, load, axis, zdot, spin, target};
+    context.guard = guard;
+    context.load = load;
+    context.axis = axis;
+    context.zdot = zdot;
+    context.spin = spin;
+    context.target = target;
+    context.probes[0] = context.probes[1] = context.probes[2] = 0;
     illinois_angles(miss_at, &context, target, load->friction, load->mu_roll, angle);
     for (j = 0; j < 3; j++) {
-        skewed_slips(guard, load, axis[j], zdot[j], spin, angle[j], target[j], &c[j]);
+        contact_at(&context, j, angle[j], &c[j]);
         c[j].N = size[j] / root(guard, dot3(c[j].pushed, c[j].pushed));
         c[j].F_roll = -load->mu_roll * c[j].N * c[j].roll_sign;
         c[j].F_skew = -load->friction * c[j].N * c[j].skew_sign;
