@@ -80,7 +80,7 @@ static void skewed_slips(Guard *guard, const Load *load, const double axis[3], d
     c->miss = remainder_of(atan2(c->pushed[1], c->pushed[0]) - target + PI, 2.0 * PI) - PI;
 }
 
-#define PROBES_KEPT 4 /* each arm's latest probes: the method ends on one of its brackets' ends, mostly recent */
+#define PROBES_KEPT 2 /* each arm's latest probes: the method ends on one of its brackets' ends, mostly recent */
 
 /* What the miss of the step's contacts needs (illinois.h), and each arm's latest probes and their angles */
 typedef struct {
