@@ -88,11 +88,13 @@ def _fields(item: object) -> dict:
 
 def _described(path: Path) -> dict:
     """Everything a host reads from a model description, except token, generator and Model Exchange
-    (the native FMUs': the states' derivatives, tests/native/test_native_model_exchange.py)."""
+    (the native FMUs': the states' derivatives, and the states that are locals among the initial unknowns,
+    tests/native/test_native_model_exchange.py)."""
     d = read_model_description(str(path))
     derivatives = {u.variable.name for u in d.derivatives}
+    local_states = {u.variable.derivative.name for u in d.derivatives if u.variable.derivative.causality == "local"}
     d.modelVariables = [v for v in d.modelVariables if v.name not in derivatives]
-    d.initialUnknowns = [u for u in d.initialUnknowns if u.variable.name not in derivatives]
+    d.initialUnknowns = [u for u in d.initialUnknowns if u.variable.name not in derivatives | local_states]
     fields = ("name", "valueReference", "causality", "variability", "description", "type", "unit", "displayUnit",
               "min", "max", "start", "initial")
     return {
@@ -130,7 +132,7 @@ def test_every_start_value_is_the_specs_bit_for_bit_in_both_families(native_dir,
     assert written[0] == written[1]
     for variable in spec.variables:
         text = written[1][variable.name]
-        if variable.causality == "output":
+        if variable.causality in ("output", "local"):
             assert text is None, variable.name
         elif variable.type == "Real":
             assert struct.pack("<d", float(text)) == struct.pack("<d", variable.start), (variable.name, text)

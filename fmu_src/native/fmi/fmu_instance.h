@@ -33,7 +33,9 @@
 #define FMU_MAX_STRING_BYTES (4 * FMU_MAX_STRING)
 
 typedef enum { VAR_REAL, VAR_INTEGER, VAR_BOOLEAN, VAR_STRING } VariableType;
-typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT } Causality;
+/* A local is computed as an output is (checked after each step, read, never set) but is the model's own: an
+ * internal state no host wires, in no list of outputs */
+typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT, CAUSALITY_LOCAL } Causality;
 
 /* A refusal message: text, then the checked value or the bound it broke (as Python's repr(), or
  * in the display unit with format '.6g'), up to two values; generated from the Python checks. */

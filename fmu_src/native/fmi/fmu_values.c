@@ -63,6 +63,8 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
                                         : " is not of type String";
     } else if (setting && v->causality == CAUSALITY_OUTPUT) {
         problem = " is an output and cannot be set";
+    } else if (setting && v->causality == CAUSALITY_LOCAL) {
+        problem = " is a local variable and cannot be set";
     } else if (setting && instance->mode == MODE_STEP && v->causality == CAUSALITY_PARAMETER && !v->tunable) {
         problem = " is a fixed parameter and cannot be changed after initialisation";
     }
