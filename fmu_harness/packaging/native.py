@@ -367,6 +367,7 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
     checked = [v for variables in by_group for v in variables]
     starts = [sum(len(variables) for variables in by_group[:k]) for k in range(len(groups) + 1)]
     real_computed = [v for v in spec.of(*COMPUTED) if v.type == "Real"]
+    int_computed = [v for v in spec.of(*COMPUTED) if v.type in ("Integer", "Boolean")]
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
 #ifndef MODEL_VARIABLES_H
 #define MODEL_VARIABLES_H
@@ -390,6 +391,9 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 extern const int model_checked[MODEL_CHECKED_COUNT + 1];
 extern const int model_checked_from[{len(groups) + 1}];
 extern const int model_real_computed[MODEL_REAL_COMPUTED_COUNT + 1];
+/* the Integer and Boolean outputs and locals: with the Real ones, the values a step may change (StepUndo) */
+#define MODEL_INT_COMPUTED_COUNT {len(int_computed)}
+extern const int model_int_computed[MODEL_INT_COMPUTED_COUNT + 1];
 /* Directional derivatives: the Jacobian's rows are the Real outputs and locals (ROW_<name>), then der(<state>), its
  * columns the Real inputs and the states (COLUMN_<name>) */
 #define MODEL_OUTPUT_ROWS {len(rows)}
@@ -424,6 +428,7 @@ const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 const int model_checked[MODEL_CHECKED_COUNT + 1] = {{{_references(checked)}}};
 const int model_checked_from[{len(groups) + 1}] = {{{", ".join(map(str, starts))}}};
 const int model_real_computed[MODEL_REAL_COMPUTED_COUNT + 1] = {{{_references(real_computed)}}};
+const int model_int_computed[MODEL_INT_COMPUTED_COUNT + 1] = {{{_references(int_computed)}}};
 """
     source += f"""
 /* each variable's row and column of the Jacobian (directional derivatives), -1 for none */

@@ -372,6 +372,20 @@ def test_misuse_returns_error_with_a_reason(native_dir, fmi):
         assert "not finite" in fmu.log[-1].message
 
 
+@pytest.mark.parametrize("name", NATIVE)
+def test_a_step_changes_the_outputs_and_locals_alone(native_dir, name, fmi):
+    """A refused step is undone by restoring the outputs, locals and internal slots alone (StepUndo in
+    fmu_instance.h): every parameter and input, Strings included, reads the same after steps as before."""
+    step = MODELS[name].spec.default_experiment.step_size
+    with FmuInstance(_native(native_dir, name, fmi)) as fmu:
+        fmu.initialize()
+        names = [v.name for v in fmu.description.modelVariables if v.causality in ("parameter", "input")]
+        before = fmu.get(names)
+        for _ in range(3):
+            fmu.step(step)
+        assert dict(zip(names, fmu.get(names))) == dict(zip(names, before))
+
+
 def test_a_wrong_token_is_refused_at_instantiation(native_dir, tmp_path, fmi):
     path = _native(native_dir, "SpeedSource", fmi)
     unzipdir = extract(str(path), unzipdir=str(tmp_path))

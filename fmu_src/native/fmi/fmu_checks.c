@@ -99,11 +99,17 @@ static void relation_errors(const ModelData *data, int inputs, Messages *out)
     int i;
     for (i = 0; i < MODEL_RELATION_COUNT; i++) {
         const RelationInfo *r = &model_relations[i];
-        double left = value_of(data, r->lhs), right = r->rhs >= 0 ? value_of(data, r->rhs) : r->constant;
-        double bound = r->scale == 1.0 && r->offset == 0.0 ? right : r->scale * right + r->offset;
-        int holds = r->op == OP_LT ? left < bound : r->op == OP_LE ? left <= bound : r->op == OP_GT ? left > bound
-                                                                                                     : left >= bound;
-        if (r->involves_input == inputs && !holds) {
+        double left, right, bound;
+        int holds;
+        if (r->involves_input != inputs) { /* the other group's */
+            continue;
+        }
+        left = value_of(data, r->lhs);
+        right = r->rhs >= 0 ? value_of(data, r->rhs) : r->constant;
+        bound = r->scale == 1.0 && r->offset == 0.0 ? right : r->scale * right + r->offset;
+        holds = r->op == OP_LT ? left < bound : r->op == OP_LE ? left <= bound : r->op == OP_GT ? left > bound
+                                                                                   : left >= bound;
+        if (!holds) {
             add_message(out, &r->message, &model_variables[r->lhs], left, bound, r->integer_bound);
         }
     }
@@ -150,21 +156,33 @@ void input_errors(const ModelData *data, Messages *out)
 
 typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_FAILED } SumOutcome;
 
-/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it);
- * exactly only where a partial sum could come near overflow. */
+/* Whether the Real outputs and locals are finite values whose partial sums stay far from overflow, in any
+ * order (their magnitudes' sum, in four running sums, at most DBL_MAX / 4; a value that is not finite makes it
+ * NaN or infinite): then math.fsum of them is finite, whatever fsum_outcome would find. */
+static int far_from_overflow(const ModelData *data)
+{
+    double sums[4] = {0.0, 0.0, 0.0, 0.0};
+    const int *names = model_real_computed;
+    int i;
+    for (i = 0; i + 4 <= MODEL_REAL_COMPUTED_COUNT; i += 4) {
+        sums[0] += fabs(data->real_value[names[i]]);
+        sums[1] += fabs(data->real_value[names[i + 1]]);
+        sums[2] += fabs(data->real_value[names[i + 2]]);
+        sums[3] += fabs(data->real_value[names[i + 3]]);
+    }
+    for (; i < MODEL_REAL_COMPUTED_COUNT; i++) {
+        sums[0] += fabs(data->real_value[names[i]]);
+    }
+    return (sums[0] + sums[1]) + (sums[2] + sums[3]) <= DBL_MAX / 4.0;
+}
+
+/* What Python's math.fsum does with these values (output_errors sums the Real outputs and locals with it), once
+ * far_from_overflow could not tell. */
 static SumOutcome fsum_outcome(const double values[], int count, Failure *failure)
 {
-    double magnitude = 0.0, sum = 0.0;
+    double sum = 0.0;
     const char *message;
-    ErrorKind kind;
-    int i;
-    for (i = 0; i < count; i++) {
-        magnitude += fabs(values[i]);
-    }
-    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
-        return SUM_FINITE;
-    }
-    kind = python_fsum(values, count, &sum, &message);
+    ErrorKind kind = python_fsum(values, count, &sum, &message);
     if (kind != ERROR_NONE) {
         *failure = FAILURE(kind, message);
         return SUM_FAILED;
@@ -181,6 +199,10 @@ void output_errors(const ModelData *data, Messages *out, Failure *failure)
     int count = MODEL_REAL_COMPUTED_COUNT, i;
     char shown[40];
     SumOutcome outcome;
+    if (far_from_overflow(data)) { /* the common case: no copy, no exact sum */
+        range_errors(data, CHECKED_COMPUTED, out);
+        return;
+    }
     for (i = 0; i < count; i++) {
         values[i] = data->real_value[names[i]];
     }
