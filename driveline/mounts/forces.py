@@ -29,6 +29,9 @@ BRANCH_SLOTS = MAX_MOUNTS * 3 * BRANCHES
 #: equilibrium here and the implicit step's, :mod:`.implicit_step`).
 MAX_NEWTON = 60
 NEWTON_STEP = 1e-14
+#: The implicit step keeps its Jacobian's factors for the next iteration when a correction is at most this
+#: fraction of the one before (the simplified Newton method's contraction), else computes it again.
+NEWTON_CONTRACTION = 0.1
 
 
 def _law(mount: Mount) -> tuple[np.ndarray, ...]:
@@ -59,15 +62,18 @@ def elastic_energy(layout: Layout, q: np.ndarray) -> float:
                      for m, to_axes in zip(layout.mounts, layout.maps)))
 
 
-def mean_elastic_load(layout: Layout, q0: np.ndarray, q1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def mean_elastic_load(layout: Layout, q0: np.ndarray, q1: np.ndarray,
+                      with_jacobian: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
     """The discrete gradient of the elastic energy between ``q0`` and ``q1`` (its generalised force,
-    whose product with ``q1 - q0`` is the energy's change) and its Jacobian by ``q1``."""
-    load, jacobian = np.zeros(6), np.zeros((6, 6))
+    whose product with ``q1 - q0`` is the energy's change) and its Jacobian by ``q1`` (None unless
+    ``with_jacobian``)."""
+    load, jacobian = np.zeros(6), np.zeros((6, 6)) if with_jacobian else None
     for m, to_axes in zip(layout.mounts, layout.maps):
         d0, d1 = to_axes @ q0, to_axes @ q1
         mean, slope = characteristic.mean_force(d0, d1, *_law(m))
         load += to_axes.T @ mean
-        jacobian += to_axes.T @ (slope[:, None] * to_axes)
+        if with_jacobian:
+            jacobian += to_axes.T @ (slope[:, None] * to_axes)
     return load, jacobian
 
 

@@ -18,7 +18,7 @@ from ..model import SteppedModel
 from ..halfshaft.geometry import GeometryError
 from .exact_step import Propagator, work_error
 from .halfshafts import GEOMETRY, Halfshaft, values
-from .implicit_step import implicit_step
+from .implicit_step import StepMatrices, implicit_step
 from .layout import MAX_MOUNTS, Layout, load_layout, shipped_layout
 from .rigid_body import COORDINATES
 from .spec import (AXES, BRANCH_FORCES, BRANCH_RATES, INPUTS, RUBBER_LAYOUT, SHARED_LAYOUT, SIDES, SPEC, VELOCITIES,
@@ -44,7 +44,7 @@ class PowertrainMountsModel(SteppedModel):
                           "shaft_x_left": 0.1, "shaft_z_left": -0.05, "bend_x_left": 0.2, "shaft_x_right": -0.08,
                           "shaft_z_right": 0.04, "bend_y_right": 0.15, "motor_axis_x": 0.1, "motor_axis_z": 0.2,
                           "T_mean": 150.0},)
-    derived_state = ("_system", "_built_for", "_propagator", "_shafts")
+    derived_state = ("_system", "_built_for", "_propagator", "_step_matrices", "_shafts")
     #: the Maxwell branches' forces [N] (:mod:`.rubber`), a tuple of floats: part of the saved state
     resource_files = tuple(Path(__file__).parent / "data" / f"{name}.toml" for name in (SHARED_LAYOUT, RUBBER_LAYOUT))
 
@@ -52,6 +52,7 @@ class PowertrainMountsModel(SteppedModel):
         self._system: MountSystem | None = None
         self._built_for: tuple | None = None
         self._propagator: Propagator | None = None
+        self._step_matrices: StepMatrices | None = None
         self._shafts: dict[str, Halfshaft] = {}
         self._branch_forces: tuple[float, ...] = ()
 
@@ -73,7 +74,7 @@ class PowertrainMountsModel(SteppedModel):
             system = MountSystem.build(read_layout(self.layout), placement, self.g, self.T_mean)
         except (ValueError, ArithmeticError) as error:
             return [f"powertrain: {error}"]
-        self._system, self._built_for, self._propagator = system, key, None
+        self._system, self._built_for, self._propagator, self._step_matrices = system, key, None, None
         self._shafts = {side: Halfshaft.of(placement.frames[side], placement.centres[side],
                                            system.body.layout.centre_of_gravity, getattr(self, f"l_{side}"),
                                            getattr(self, f"beta_design_{side}"), getattr(self, f"psi_design_{side}"),
@@ -142,8 +143,12 @@ class PowertrainMountsModel(SteppedModel):
         system = self._system
         held, rates = system.inputs @ self._values(INPUTS), system.inputs @ self._values(RATES)
         if system.progressive:
+            matrices = self._step_matrices
+            if matrices is None or matrices.h != step_size:
+                matrices = StepMatrices.of(system.body.mass, system.body.damping, system.branches, step_size)
             state, _ = implicit_step(system.body.layout, system.body.mass, system.body.damping, system.branches,
-                                     system.weight, system.weight_sag, self._state(), held, rates, step_size)
+                                     system.weight, system.weight_sag, self._state(), held, rates, step_size, matrices)
+            self._step_matrices = matrices
             self._show(state, held + rates * step_size)
             return
         propagator = self._propagator

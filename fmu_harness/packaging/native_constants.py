@@ -26,7 +26,7 @@ SHARED = {
     "driveline.mounts.rigid_body": ("MIN_FREQUENCY_RATIO", "FREQUENCY_TOLERANCE", "MAX_FREQUENCY_ITERATIONS"),
     "driveline.mounts.rubber": ("BAND", "RELAXATION_FREQUENCIES", "BRANCHES", "FIT_POINTS", "RATIO_WEIGHT",
                                 "MAX_LOSS_ERROR", "MAX_RATIO_ERROR"),
-    "driveline.mounts.forces": ("MAX_NEWTON", "NEWTON_STEP"),
+    "driveline.mounts.forces": ("MAX_NEWTON", "NEWTON_STEP", "NEWTON_CONTRACTION"),
     "driveline.mounts.joints": ("MIN_DIRECTION",),
     "driveline.mounts.exact_step": ("THETA_13", "MAX_SQUARINGS"),
     "driveline.rotor.elements": ("_SERIES_LIMIT",),

@@ -169,3 +169,37 @@ def test_rubber_and_progressive_mounts_match_the_python_fmu(native_dir, fmu_path
     reference = _run(fmu_path(NAME, fmi), str(path[layout]), torque)
     found = _run(native.fmu_path(native_dir, NAME, fmi), str(path[layout]), torque)
     assert beyond_tolerance(reference, found) == {}
+
+
+
+def _steps(fmu: FmuInstance, h: float, count: int = 20) -> list[list[float]]:
+    found = []
+    for _ in range(count):
+        fmu.step(h)
+        found.append(fmu.get(["x", "z", "pitch", "roll_dot", "F_z_mount1", "F_x_mount3"]))
+    return found
+
+
+@pytest.mark.parametrize("family", ["python", "native"])
+def test_a_new_step_size_or_a_restored_state_steps_as_a_fresh_instance(request, fmu_path, fmi, family):
+    """The implicit step keeps what depends on the step size alone (implicit_step.StepMatrices) from one step
+    to the next. On the rubber layout under the drive reaction (on its stops): 20 steps of 1 ms, the state
+    saved; 20 of 0.5 ms; the saved state restored and 20 of 1 ms. A fresh instance restored to the saved
+    state repeats either continuation bit for bit: its matrices built for that step size from the start."""
+    path = (fmu_path(NAME, fmi) if family == "python"
+            else native.fmu_path(request.getfixturevalue("native_dir"), NAME, fmi))
+    start = {"layout": str(RUBBER), "T_mean": 1100.0, "T_motor": 1100.0, "F_x": 500.0, "M_y": -200.0}
+    with FmuInstance(path) as fmu:
+        fmu.initialize(start)
+        _steps(fmu, 1e-3)
+        saved, saved_time = fmu.serialize_state(fmu.get_state()), fmu.time
+        halved = _steps(fmu, 5e-4)
+        fmu.set_state(fmu.deserialize_state(saved))
+        fmu.time = saved_time
+        again = _steps(fmu, 1e-3)
+    for h, expected in ((5e-4, halved), (1e-3, again)):
+        with FmuInstance(path) as fresh:
+            fresh.initialize(start)
+            fresh.set_state(fresh.deserialize_state(saved))
+            fresh.time = saved_time
+            assert _steps(fresh, h) == expected

@@ -5,10 +5,14 @@
 
 #include <math.h>
 
-/* rho(x) of equation (C2) (characteristic.ramp: the cubic's piece evaluated within its range only) */
+/* rho(x) of equation (C2) (characteristic.ramp: the cubic's piece evaluated within its range only; at x <= 0
+ * its 0 / w^2 - 0 / (2 w^3) is +0 without the powers, unless w^3 underflows) */
 static double ramp(double x, double w)
 {
     double u = fmin(fmax(x, 0.0), w);
+    if (x <= 0.0 && w * w * w > 0.0) {
+        return 0.0;
+    }
     return x >= w ? x - 0.5 * w : u * u * u / (w * w) - pow(u, 4.0) / (2.0 * pow(w, 3.0));
 }
 

@@ -33,9 +33,9 @@ double dense_largest(const double *v, int n)
     return found;
 }
 
-/* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) by Gaussian
- * elimination with partial pivoting (a overwritten); 0 if a is singular. */
-int dense_solve(double *a, double *b, int n, int columns)
+/* Factors a (n x n) in place as P a = L U by Gaussian elimination with partial pivoting (L's multipliers
+ * below the diagonal, U on and above it, row k swapped with row pivots[k] at step k); 0 if a is singular. */
+int dense_factor(double *a, int *pivots, int n)
 {
     int i, j, k, pivot;
     for (k = 0; k < n; k++) {
@@ -48,35 +48,62 @@ int dense_solve(double *a, double *b, int n, int columns)
         if (a[pivot * n + k] == 0.0) {
             return 0;
         }
+        pivots[k] = pivot;
         if (pivot != k) {
             for (j = 0; j < n; j++) {
                 double t = a[k * n + j];
                 a[k * n + j] = a[pivot * n + j], a[pivot * n + j] = t;
             }
-            for (j = 0; j < columns; j++) {
-                double t = b[k * columns + j];
-                b[k * columns + j] = b[pivot * columns + j], b[pivot * columns + j] = t;
-            }
         }
         for (i = k + 1; i < n; i++) {
             double f = a[i * n + k] / a[k * n + k];
-            for (j = k; j < n; j++) {
+            for (j = k + 1; j < n; j++) {
                 a[i * n + j] -= f * a[k * n + j];
             }
-            for (j = 0; j < columns; j++) {
-                b[i * columns + j] -= f * b[k * columns + j];
-            }
+            a[i * n + k] = f;
         }
     }
-    for (k = n - 1; k >= 0; k--) {
-        for (j = 0; j < columns; j++) {
-            double sum = b[k * columns + j];
+    return 1;
+}
+
+/* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) with the factors of
+ * dense_factor (each row of b takes the eliminations in the order of dense_factor's steps) */
+void dense_substitute(const double *lu, const int *pivots, double *b, int n, int columns)
+{
+    int i, j, k;
+    for (j = 0; j < columns; j++) { /* column by column, x[i] = b[i][j] */
+        double *x = b + j;
+        for (k = 0; k < n; k++) {
+            if (pivots[k] != k) {
+                double t = x[k * columns];
+                x[k * columns] = x[pivots[k] * columns], x[pivots[k] * columns] = t;
+            }
+        }
+        for (k = 0; k < n; k++) {
+            const double xk = x[k * columns];
             for (i = k + 1; i < n; i++) {
-                sum -= a[k * n + i] * b[i * columns + j];
+                x[i * columns] -= lu[i * n + k] * xk;
             }
-            b[k * columns + j] = sum / a[k * n + k];
+        }
+        for (k = n - 1; k >= 0; k--) {
+            double sum = x[k * columns];
+            for (i = k + 1; i < n; i++) {
+                sum -= lu[k * n + i] * x[i * columns];
+            }
+            x[k * columns] = sum / lu[k * n + k];
         }
     }
+}
+
+/* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) by Gaussian
+ * elimination with partial pivoting (a overwritten); 0 if a is singular. */
+int dense_solve(double *a, double *b, int n, int columns)
+{
+    int pivots[MOUNTS_MAX_AUGMENTED];
+    if (!dense_factor(a, pivots, n)) {
+        return 0;
+    }
+    dense_substitute(a, pivots, b, n, columns);
     return 1;
 }
 

@@ -107,7 +107,9 @@ void forces_mean_elastic_load(const Layout *layout, const double maps[][3][6], c
             load[i] += sum;
         }
     }
-    congruence(layout, maps, slopes, jacobian);
+    if (jacobian != NULL) {
+        congruence(layout, maps, slopes, jacobian);
+    }
 }
 
 static double norm6(const double v[6])

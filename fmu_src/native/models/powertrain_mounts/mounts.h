@@ -91,7 +91,8 @@ typedef struct {
 
 /* Mount n's elastic force along its axes at q (from the unloaded mounts) */
 void forces_elastic(const Layout *layout, const double maps[][3][6], int n, const double q[6], double out[3]);
-/* forces.elastic_load, tangent_stiffness, elastic_energy, mean_elastic_load */
+/* forces.elastic_load, tangent_stiffness, elastic_energy, mean_elastic_load (its Jacobian left out when
+ * ``jacobian`` is NULL) */
 void forces_elastic_load(const Layout *layout, const double maps[][3][6], const double q[6], double out[6]);
 void forces_tangent_stiffness(const Layout *layout, const double maps[][3][6], const double q[6], double out[6][6]);
 double forces_elastic_energy(const Layout *layout, const double maps[][3][6], const double q[6]);
@@ -136,10 +137,19 @@ typedef struct {
     const double *weight, *weight_sag;
 } StepSystem;
 
-/* implicit_step.implicit_step: ``next`` (12 + branches) after a step of h from ``state`` under f0 + f1 tau;
+/* implicit_step.StepMatrices: what the steps of one size h take of h and the parameters alone, the branches'
+ * z1 = keep z0 + gain (R dq), ``resistance`` C / h + R^T diag(gain / 2) R and the Jacobian's linear part
+ * ``jacobian`` 2 M / h^2 + resistance */
+typedef struct {
+    double h, keep[MOUNTS_MAX_BRANCHES], gain[MOUNTS_MAX_BRANCHES], resistance[6][6], jacobian[6][6];
+} StepMatrices;
+
+/* StepMatrices.of */
+void implicit_matrices(const StepSystem *s, double h, StepMatrices *out);
+/* implicit_step.implicit_step: ``next`` (12 + branches) after a step of m->h from ``state`` under f0 + f1 tau;
  * ERROR_NONE or ERROR_ARITHMETIC with its message */
-ErrorKind implicit_step(const StepSystem *s, const double *state, const double f0[6], const double f1[6], double h,
-                        double *next, const char **message);
+ErrorKind implicit_step(const StepSystem *s, const StepMatrices *m, const double *state, const double f0[6],
+                        const double f1[6], double *next, const char **message);
 
 /* ---- dense.c ----------------------------------------------------------------------------------- */
 
@@ -150,6 +160,10 @@ void dense_multiply(const double *a, const double *b, double *c, int n, int m, i
 /* Solves a x = b for ``columns`` right-hand sides (b: n x columns, overwritten by x) by Gaussian
  * elimination with partial pivoting (a overwritten); 0 if a is singular. */
 int dense_solve(double *a, double *b, int n, int columns);
+/* dense_solve in two parts: P a = L U in place (``pivots``: n), 0 if a is singular; then x for ``columns``
+ * right-hand sides b (overwritten), as many times as needed (the same numbers as dense_solve) */
+int dense_factor(double *a, int *pivots, int n);
+void dense_substitute(const double *lu, const int *pivots, double *b, int n, int columns);
 /* Cyclic Jacobi rotations of the symmetric ``a`` (n x n): its eigenvalues on the diagonal, the
  * eigenvectors in the columns of ``vectors``. */
 void dense_symmetric_eigen(double *a, double *vectors, int n);

@@ -52,8 +52,9 @@ typedef struct {
     int dominant[6];
     int progressive, size; /* a mount's characteristic is nonlinear; the state's length, 12 and the branches */
     Branches branches;
-    int has_propagator;
+    int has_propagator, has_matrices;
     Propagator propagator;
+    StepMatrices matrices; /* of the last step size, progressive mounts' */
     Halfshaft shafts[2];
     char failure[ERROR_SIZE];
 } System;
@@ -766,7 +767,12 @@ static Failure advance(ModelData *data, double current_time UNUSED, double step_
         const char *message = NULL;
         StepSystem step = {&s->layout, MAPS(s), (const double(*)[6])s->mass, (const double(*)[6])s->damping,
                            &s->branches, s->weight, s->weight_sag};
-        ErrorKind failed = implicit_step(&step, state, held, rates, step_size, next, &message);
+        ErrorKind failed;
+        if (!s->has_matrices || s->matrices.h != step_size) {
+            implicit_matrices(&step, step_size, &s->matrices);
+            s->has_matrices = 1;
+        }
+        failed = implicit_step(&step, &s->matrices, state, held, rates, next, &message);
         if (failed != ERROR_NONE) {
             return FAILURE(failed, message);
         }
