@@ -52,6 +52,7 @@ typedef struct {
     int dominant[6];
     int progressive, size; /* a mount's characteristic is nonlinear; the state's length, 12 and the branches */
     Branches branches;
+    int idle[BRANCH_SLOTS], idle_count; /* the branch slots no branch takes */
     int has_propagator, has_matrices;
     Propagator propagator;
     StepMatrices matrices; /* of the last step size, progressive mounts' */
@@ -318,6 +319,21 @@ static void modes(System *s, double stiffness[6][6], int with_branches)
 }
 
 /* exact_step.state_matrices (with the branches) and system.input_map */
+/* The slots no branch of ``s->branches`` takes, in s->idle */
+static void idle_slots(System *s)
+{
+    int taken[BRANCH_SLOTS] = {0}, k;
+    for (k = 0; k < s->branches.count; k++) {
+        taken[s->branches.slots[k]] = 1;
+    }
+    s->idle_count = 0;
+    for (k = 0; k < BRANCH_SLOTS; k++) {
+        if (!taken[k]) {
+            s->idle[s->idle_count++] = k;
+        }
+    }
+}
+
 static int state_and_inputs(System *s, double centres[2][3], double frames[2][3][3])
 {
     int i, side, k;
@@ -432,6 +448,7 @@ static int operating_point(System *s, const ModelData *data, double centres[2][3
         return 0;
     }
     s->size = 12 + forces_branch_map(&s->layout, (const double(*)[3][6])s->maps, s->operating, &s->branches);
+    idle_slots(s);
     if (!state_and_inputs(s, centres, frames)) {
         snprintf(error, ERROR_SIZE, "Singular matrix");
         return 0;
@@ -645,11 +662,10 @@ static void show(const System *s, ModelData *data, const double *state, const do
     for (i = 0; i < 6; i++) {
         data->real_value[ACCELERATION_VARIABLES[i]] = acceleration[i];
     }
-    for (k = 0; k < FMU_INTERNAL_SLOTS; k++) {
-        data->internal[k] = k < s->branches.count ? state[12 + k] : 0.0;
-    }
-    for (k = 0; k < BRANCH_SLOTS; k++) {
-        data->real_value[BRANCH_VARIABLES[k]] = data->real_value[BRANCH_RATE_VARIABLES[k]] = 0.0;
+    memcpy(data->internal, state + 12, s->branches.count * sizeof *state);
+    memset(data->internal + s->branches.count, 0, (FMU_INTERNAL_SLOTS - s->branches.count) * sizeof *state);
+    for (k = 0; k < s->idle_count; k++) {
+        data->real_value[BRANCH_VARIABLES[s->idle[k]]] = data->real_value[BRANCH_RATE_VARIABLES[s->idle[k]]] = 0.0;
     }
     for (k = 0; k < s->branches.count; k++) { /* MountSystem.derivatives: z' = g (R q') - z / tau, slot (3 n + axis) */
         int slot = s->branches.slots[k];
