@@ -15,7 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
-from .variables import ModelSpec, Relation, Variable
+from .variables import COMPUTED, ModelSpec, Relation, Variable
 
 #: How far, relative to the time reached (at least 1 s), a step may start before that time: a host
 #: that adds step sizes and one that multiplies them differ in the last bits. Earlier is time going
@@ -181,7 +181,8 @@ class SteppedModel(ABC):
         if spec is not None:
             cls._parameter_names = tuple(v.name for v in spec.of("parameter"))
             cls._inputs = spec.of("input")
-            cls._real_outputs = tuple(v.name for v in spec.of("output") if v.type == "Real")
+            cls._computed = spec.of(*COMPUTED)
+            cls._real_computed = tuple(v for v in cls._computed if v.type == "Real")
             cls._input_relations = tuple(r for r in spec.relations if spec.involves_input(r))
             cls._parameter_relations = tuple(r for r in spec.relations if not spec.involves_input(r))
 
@@ -214,14 +215,14 @@ class SteppedModel(ABC):
             return [f"{what} could not be checked ({type(error).__name__}: {error})"]
 
     def output_errors(self) -> list[str]:
-        """Outputs that are not finite, then outputs beyond their declared bounds (a physical bound
+        """Outputs and locals that are not finite, then beyond their declared bounds (a physical bound
         the model's equations no longer describe): the step is not taken."""
-        values = [getattr(self, name) for name in self._real_outputs]
+        values = [getattr(self, v.name) for v in self._real_computed]
         if math.isfinite(math.fsum(values)):
-            return [e for v in self.spec.of("output") if (e := self._range_error(v))]
+            return [e for v in self._computed if (e := self._range_error(v))]
         return [
-            f"output {name} is not finite ({value!r}); the step was not taken"
-            for name, value in zip(self._real_outputs, values)
+            f"{v.causality} {v.name} is not finite ({value!r}); the step was not taken"
+            for v, value in zip(self._real_computed, values)
             if not math.isfinite(value)
         ]
 
@@ -297,14 +298,14 @@ class SteppedModel(ABC):
 
     def _restored_error(self, state: dict[str, Any]) -> str | None:
         """Why the values a saved state restores are none the model could have left: the time not finite,
-        then a Real output not finite, then an output beyond its bounds (as :meth:`_range_error` says it)."""
+        then a Real output or local not finite, then one beyond its bounds (as :meth:`_range_error` says it)."""
         if not math.isfinite(state["time"]):
             return f"time = {state['time']!r} is not finite"
-        not_finite = (f"output {name} = {state[name]!r} is not finite" for name in self._real_outputs
-                      if not math.isfinite(state[name]))
+        not_finite = (f"{v.causality} {v.name} = {state[v.name]!r} is not finite" for v in self._real_computed
+                      if not math.isfinite(state[v.name]))
         probe = type(self).__new__(type(self))
         probe.__dict__.update(state)
-        beyond = (error for v in self.spec.of("output") if (error := probe._range_error(v)) is not None)
+        beyond = (error for v in self._computed if (error := probe._range_error(v)) is not None)
         return next(not_finite, None) or next(beyond, None)
 
     def internal_from_saved(self, state: dict[str, Any]) -> dict[str, Any]:

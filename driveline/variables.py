@@ -18,10 +18,14 @@ import operator
 from dataclasses import dataclass, field
 from typing import Literal
 
-Causality = Literal["parameter", "input", "output"]
+Causality = Literal["parameter", "input", "output", "local"]
 Variability = Literal["constant", "fixed", "tunable", "discrete", "continuous"]
 VarType = Literal["Real", "Integer", "Boolean", "String"]
 Operator = Literal["<", "<=", ">", ">="]
+
+#: The causalities of what a model computes (after each step, checked finite and within bounds; read, never set):
+#: an output, for others to use, and a local, the model's own (an internal state no host wires)
+COMPUTED: tuple[Causality, ...] = ("output", "local")
 
 OPERATORS = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
 
@@ -116,6 +120,11 @@ class Variable:
         if (self.min_exclusive and self.min is None) or (self.max_exclusive and self.max is None):
             raise ValueError(f"{self.name}: an exclusive bound needs its value")
 
+    @property
+    def article(self) -> str:
+        """The causality with its article, as a message names it: ``an output``, ``a local``."""
+        return f"{'an' if self.causality[0] in 'aeiou' else 'a'} {self.causality}"
+
     def shown(self, value: float) -> str:
         """``value`` (SI) as a message shows it: in the display unit if there is one."""
         if self.display_unit is not None:
@@ -182,7 +191,7 @@ SHAFT_ANGLE_NOMINAL = 1.0  # rad
 
 @dataclass(frozen=True)
 class State:
-    """An output the model integrates over time (an input shaft's angle): its value at one instant
+    """An output or local the model integrates over time (an input shaft's angle): its value at one instant
     is its own, ``initial`` names the parameters and inputs its value at initialisation is computed
     from (inputs: a start in the equilibrium under the start inputs) and ``derivative`` the input
     or output that is its time derivative (a Model Exchange FMU's continuous state, whose
@@ -234,34 +243,34 @@ class ModelSpec:
             if any(side not in names for side in sides) or relation.op not in OPERATORS:
                 raise ValueError(f"{self.name}: relation {relation} names no variable of the model or no operator")
             variables = [self[side] for side in sides]
-            if any(v.causality == "output" or v.type not in ("Real", "Integer") for v in variables):
+            if any(v.causality in COMPUTED or v.type not in ("Real", "Integer") for v in variables):
                 raise ValueError(f"{self.name}: relation {relation} must relate numeric parameters or inputs")
             if len({v.unit for v in variables}) > 1:
                 raise ValueError(f"{self.name}: relation {relation} relates different units")
         self._check_dependencies()
 
     def _check_dependencies(self) -> None:
-        """Every output is a state or declares ``depends_on``, naming inputs, parameters and states."""
+        """Every output or local is a state or declares ``depends_on``, naming inputs, parameters and states."""
         states = {state.name for state in self.states}
         knowns = {v.name for v in self.of("input", "parameter")}
-        outputs = {v.name for v in self.of("output")}
+        computed = {v.name for v in self.of(*COMPUTED)}
         for state in self.states:
-            if state.name not in outputs or not set(state.initial) <= knowns:
-                raise ValueError(f"{self.name}: state {state.name} must be an output and its initial values "
-                                 f"must name parameters or inputs, got {state.initial}")
-            if state.derivative not in outputs | {v.name for v in self.of("input")}:
-                raise ValueError(f"{self.name}: the derivative of state {state.name} must be an input or output, "
-                                 f"got {state.derivative!r}")
-        for v in self.of("output"):
+            if state.name not in computed or not set(state.initial) <= knowns:
+                raise ValueError(f"{self.name}: state {state.name} must be an output or local and its initial "
+                                 f"values must name parameters or inputs, got {state.initial}")
+            if state.derivative not in computed | {v.name for v in self.of("input")}:
+                raise ValueError(f"{self.name}: the derivative of state {state.name} must be an input, output or "
+                                 f"local, got {state.derivative!r}")
+        for v in self.of(*COMPUTED):
             if v.depends_on is None and v.name not in states:
                 raise ValueError(
-                    f"{self.name}: output {v.name} declares no dependencies: give its Variable "
+                    f"{self.name}: {v.causality} {v.name} declares no dependencies: give its Variable "
                     f"depends_on=(...), the inputs, parameters and states (ModelSpec.states) it is computed "
                     f"from, or () for none (docs/development.md, Add a model)")
             for names in (v.depends_on or (), v.initial_depends_on or ()):
                 unknown = [name for name in names if name not in knowns | states]
                 if unknown:
-                    raise ValueError(f"{self.name}: output {v.name} depends on {unknown}, which are no "
+                    raise ValueError(f"{self.name}: {v.causality} {v.name} depends on {unknown}, which are no "
                                      f"input, parameter or state of the model")
 
     def output_dependencies(self, name: str, states: bool = False) -> tuple[str, ...]:

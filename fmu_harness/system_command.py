@@ -89,7 +89,8 @@ def parameter_changes(settings: list[str], system: SspSystem, descriptions: dict
         if found.causality not in ("parameter", "input") or (component, variable) in connected:
             raise UsageError(f"--set {setting!r}: {component}.{variable} is no parameter or unconnected input "
                              f"(it is a connected {found.causality})" if (component, variable) in connected else
-                             f"--set {setting!r}: {component}.{variable} is an {found.causality}, not a parameter")
+                             f"--set {setting!r}: {component}.{variable} is "
+                             f"{'a local' if found.causality == 'local' else 'an ' + found.causality}, not a parameter")
         changes[component, variable] = (found.type, _parse_value(found.type, text))
     return changes
 

@@ -27,6 +27,7 @@ from typing import Any, Callable, ClassVar
 
 from driveline import __version__
 from driveline.model import SteppedModel
+from driveline.variables import COMPUTED
 
 from . import saved_state
 
@@ -118,7 +119,7 @@ class ModelAdapter:
                 variability=self.variabilities[variable.effective_variability],
                 description=variable.description,
                 getter=self._getter(variable.name),
-                setter=None if variable.causality == "output" else self._setter(variable.name),
+                setter=None if variable.causality in COMPUTED else self._setter(variable.name),
             )
             self.register_variable(fmi_variable)
             self._spec_of_reference[fmi_variable.value_reference] = variable
@@ -296,8 +297,8 @@ class ModelAdapter:
             variable = self._variable(call, reference, kind)
             if variable is None:
                 continue
-            if variable.causality in ("output", "independent"):
-                self._fail(call, f"{variable.name} is an {variable.causality} variable and cannot be set")
+            if variable.causality in (*COMPUTED, "independent"):
+                self._fail(call, f"{variable.name} is {variable.article} variable and cannot be set")
             elif variable.effective_variability == "fixed" and self.phase is Phase.STEPPING:
                 self._fail(call, f"{variable.name} is a fixed parameter and cannot change after initialisation")
             elif kind == "String" and len(value) > MAX_STRING:

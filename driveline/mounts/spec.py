@@ -148,7 +148,9 @@ def _motion() -> tuple[Variable, ...]:
 
 def _branches() -> tuple[Variable, ...]:
     """The Maxwell branches' forces (Model Exchange's states) and their rates (R2): a branch's rate depends on its
-    force and the deflection rate along its axis, so on the velocities; both 0 at rest, where the model starts."""
+    force and the deflection rate along its axis, so on the velocities; both 0 at rest, where the model starts.
+    Locals: internal states no host wires (the mount forces include them), readable, set only as Model Exchange's
+    continuous states."""
     found = []
     for i, names in enumerate(MOUNT_BRANCHES, start=1):
         for name in names:
@@ -156,8 +158,8 @@ def _branches() -> tuple[Variable, ...]:
             text = (f"Force of Maxwell branch {j} of mount {i} along the mount's axis {k} (rubber damping: it adds to "
                     "the spring's force, which the mount exerts on the powertrain with the opposite sign; 0 for a "
                     "mount without dynamic_ratio or beyond the layout's)")
-            found.append(Variable(name, "output", 0.0, text, "N"))
-            found.append(Variable(f"{name}_dot", "output", 0.0,
+            found.append(Variable(name, "local", 0.0, text, "N"))
+            found.append(Variable(f"{name}_dot", "local", 0.0,
                                   f"Rate of {name}: its spring's rate times the deflection rate, less the force over "
                                   "the branch's relaxation time", "N/s",
                                   depends_on=(name, *VELOCITIES), initial_depends_on=()))

@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from driveline.variables import ModelSpec, Unit, Variable
+from driveline.variables import COMPUTED, ModelSpec, Unit, Variable
 
 
 def number_text(value: float | int | bool) -> str:
@@ -52,19 +52,21 @@ def _complete(
     root: ET.Element,
     spec: ModelSpec,
     variables: list[tuple[ET.Element, ET.Element]],
-    structure: Callable[[ET.Element, list[Unknown], list[Unknown]], None],
+    structure: Callable[[ET.Element, list[Unknown], list[Unknown], list[Unknown]], None],
 ) -> bytes:
     """Add units, descriptions and attributes to ``variables`` (pairs of the variable's element
     and the element that carries unit, min and max, in document order) and rebuild the model
-    structure with ``structure`` from the outputs' and state derivatives' 1-based indices,
-    elements and dependencies. A description with a ``<ModelExchange>`` element has the states'
+    structure with ``structure`` from the 1-based indices, elements and dependencies of the outputs,
+    the state derivatives and the initial unknowns. A description with a ``<ModelExchange>`` element has the states'
     derivatives ``der(<state>)`` among its variables (written complete), its states their
-    ``nominal``, and its outputs depend on the states too."""
+    ``nominal``, and its outputs depend on the states too; a state that is a local is an initial unknown
+    there (FMI 2.0 and 3.0: every continuous state whose initial value is calculated), and a local
+    appears nowhere else in the structure."""
     if spec.units:
         unit_definitions = ET.Element("UnitDefinitions")
         unit_definitions.extend(_unit_element("Unit", unit) for unit in spec.units)
         root.insert(list(root).index(root.find("CoSimulation")) + 1, unit_definitions)
-    outputs = []
+    outputs, local_states = [], []
     references = {element.get("name"): element.get("valueReference") for element, _ in variables}
     indices = {element.get("name"): index for index, (element, _) in enumerate(variables, start=1)}
     fmi3 = root.get("fmiVersion", "").startswith("3")
@@ -86,17 +88,20 @@ def _complete(
         typed.attrib.update(_type_attributes(variable))
         if variable.name in nominals:  # a continuous state: its typical magnitude, the solver's scale
             typed.set("nominal", number_text(nominals[variable.name]))
-        if variable.causality != "output" and variable.type != "String":  # pythonfmu writes 16 digits
+        if variable.causality not in COMPUTED and variable.type != "String":  # pythonfmu writes 16 digits
             typed.set("start", number_text(variable.start))
         if fmi3 and variable.derivative is not None:  # FMI 3.0: an input's derivative is an input too
             element.set("derivative", references[variable.derivative])
         if variable.causality == "output":
             outputs.append(Unknown(index, element, known(spec.output_dependencies(variable.name, states)),
                                    known(spec.initial_dependencies(variable.name))))
+        elif variable.causality == "local" and variable.name in nominals:
+            local_states.append(Unknown(index, element, [], known(spec.initial_dependencies(variable.name))))
     model_structure = root.find("ModelStructure")
     for child in list(model_structure):
         model_structure.remove(child)
-    structure(model_structure, outputs, derivatives)
+    initial_unknowns = sorted(outputs + local_states, key=lambda unknown: unknown.index) + derivatives
+    structure(model_structure, outputs, derivatives, initial_unknowns)
     ET.indent(root)
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
@@ -118,9 +123,10 @@ def _dependencies(known: list[str]) -> dict[str, str]:
     return {"dependencies": " ".join(known), "dependenciesKind": " ".join(["dependent"] * len(known))}
 
 
-def _fmi2_structure(model_structure: ET.Element, outputs: list[Unknown], derivatives: list[Unknown]) -> None:
+def _fmi2_structure(model_structure: ET.Element, outputs: list[Unknown], derivatives: list[Unknown],
+                    initial_unknowns: list[Unknown]) -> None:
     for tag, unknowns, initial in (("Outputs", outputs, False), ("Derivatives", derivatives, False),
-                                   ("InitialUnknowns", outputs + derivatives, True)):
+                                   ("InitialUnknowns", initial_unknowns, True)):
         if unknowns:
             ET.SubElement(model_structure, tag).extend(
                 ET.Element("Unknown", index=str(unknown.index),
@@ -128,9 +134,10 @@ def _fmi2_structure(model_structure: ET.Element, outputs: list[Unknown], derivat
                 for unknown in unknowns)
 
 
-def _fmi3_structure(model_structure: ET.Element, outputs: list[Unknown], derivatives: list[Unknown]) -> None:
+def _fmi3_structure(model_structure: ET.Element, outputs: list[Unknown], derivatives: list[Unknown],
+                    initial_unknowns: list[Unknown]) -> None:
     for tag, unknowns, initial in (("Output", outputs, False), ("ContinuousStateDerivative", derivatives, False),
-                                   ("InitialUnknown", outputs + derivatives, True)):
+                                   ("InitialUnknown", initial_unknowns, True)):
         model_structure.extend(
             ET.Element(tag, valueReference=unknown.element.get("valueReference"),
                        **_dependencies([reference for _, reference in (unknown.initial if initial else unknown.step)]))

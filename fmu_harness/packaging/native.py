@@ -42,7 +42,7 @@ import fmu_src
 from driveline import __version__
 from driveline.catalog import MODELS
 from driveline.model import TIME_TOLERANCE, SteppedModel
-from driveline.variables import UNITS, ModelSpec, Relation, Variable
+from driveline.variables import COMPUTED, UNITS, ModelSpec, Relation, Variable
 
 from ..console import Progress
 from . import documentation, toolchain
@@ -83,10 +83,10 @@ def provides_derivatives(name: str) -> bool:
 
 
 def jacobian_layout(spec: ModelSpec) -> tuple[list[str], list[str]]:
-    """The rows of a model's Jacobian (its Real outputs; the states' derivatives follow them) and its
+    """The rows of a model's Jacobian (its Real outputs and locals; the states' derivatives follow them) and its
     columns (its Real inputs and states), in spec order."""
     states = {state.name for state in spec.states}
-    rows = [v.name for v in spec.of("output") if v.type == "Real"]
+    rows = [v.name for v in spec.of(*COMPUTED) if v.type == "Real"]
     columns = [v.name for v in spec.variables
                if v.type == "Real" and (v.causality == "input" or v.name in states)]
     return rows, columns
@@ -360,12 +360,14 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
         + f"    PARTS\n}};\n#define PART_MOST_VALUES {most}\nextern const int model_part_values[PARTS][PART_MOST_VALUES + 1];\n")
     extra_enum = part_enum + "" if not probes else part_enum + "\n/* messages of the model's own checks */\nenum {\n" + "".join(
         f"    MESSAGE_{name} = {index},\n" for index, name in enumerate(probes)) + "};\n"
-    by_causality = [[v for v in spec.variables if v.causality == causality
-                     and (v.type == "Real" and causality != "output" or v.min is not None or v.max is not None)]
-                    for causality in ("parameter", "input", "output")]
-    checked = [v for variables in by_causality for v in variables]
-    starts = [sum(len(variables) for variables in by_causality[:k]) for k in range(4)]
-    real_outputs = [v for v in spec.of("output") if v.type == "Real"]
+    groups = (("parameter",), ("input",), COMPUTED)
+    by_group = [[v for v in spec.of(*causalities)
+                 if v.type == "Real" and causalities != COMPUTED or v.min is not None or v.max is not None]
+                for causalities in groups]
+    checked = [v for variables in by_group for v in variables]
+    starts = [sum(len(variables) for variables in by_group[:k]) for k in range(len(groups) + 1)]
+    real_computed = [v for v in spec.of(*COMPUTED) if v.type == "Real"]
+    int_computed = [v for v in spec.of(*COMPUTED) if v.type in ("Integer", "Boolean")]
     header = f"""/* Variables of {spec.name}, generated from its spec by the native build: do not edit. */
 #ifndef MODEL_VARIABLES_H
 #define MODEL_VARIABLES_H
@@ -381,15 +383,18 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
 #define MODEL_INPUT_DERIVATIVE_COUNT {len(derivatives)}
 /* Model Exchange: continuous states (ModelSpec.states) */
 #define MODEL_STATE_COUNT {len(spec.states)}
-/* the variables the range checks read, by causality (model_checked_from), in the table's order: the bounded
- * ones and the Real parameters and inputs (finite; the Real outputs' sum shows that they are before their bounds
- * are checked: model_real_outputs) */
+/* the variables the range checks read, by group (model_checked_from: the parameters, the inputs, the outputs and
+ * locals, CheckedGroup), in the table's order: the bounded ones and the Real parameters and inputs (finite; the
+ * sum of the Real outputs and locals shows that they are before their bounds are checked: model_real_computed) */
 #define MODEL_CHECKED_COUNT {len(checked)}
-#define MODEL_REAL_OUTPUT_COUNT {len(real_outputs)}
+#define MODEL_REAL_COMPUTED_COUNT {len(real_computed)}
 extern const int model_checked[MODEL_CHECKED_COUNT + 1];
-extern const int model_checked_from[4];
-extern const int model_real_outputs[MODEL_REAL_OUTPUT_COUNT + 1];
-/* Directional derivatives: the Jacobian's rows are the Real outputs (ROW_<name>), then der(<state>), its
+extern const int model_checked_from[{len(groups) + 1}];
+extern const int model_real_computed[MODEL_REAL_COMPUTED_COUNT + 1];
+/* the Integer and Boolean outputs and locals: with the Real ones, the values a step may change (StepUndo) */
+#define MODEL_INT_COMPUTED_COUNT {len(int_computed)}
+extern const int model_int_computed[MODEL_INT_COMPUTED_COUNT + 1];
+/* Directional derivatives: the Jacobian's rows are the Real outputs and locals (ROW_<name>), then der(<state>), its
  * columns the Real inputs and the states (COLUMN_<name>) */
 #define MODEL_OUTPUT_ROWS {len(rows)}
 #define MODEL_ROW_COUNT {len(rows) + len(spec.states)}
@@ -421,8 +426,9 @@ const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 
 /* -1 ends each list */
 const int model_checked[MODEL_CHECKED_COUNT + 1] = {{{_references(checked)}}};
-const int model_checked_from[4] = {{{", ".join(map(str, starts))}}};
-const int model_real_outputs[MODEL_REAL_OUTPUT_COUNT + 1] = {{{_references(real_outputs)}}};
+const int model_checked_from[{len(groups) + 1}] = {{{", ".join(map(str, starts))}}};
+const int model_real_computed[MODEL_REAL_COMPUTED_COUNT + 1] = {{{_references(real_computed)}}};
+const int model_int_computed[MODEL_INT_COMPUTED_COUNT + 1] = {{{_references(int_computed)}}};
 """
     source += f"""
 /* each variable's row and column of the Jacobian (directional derivatives), -1 for none */
@@ -535,7 +541,7 @@ def _skeleton(spec: ModelSpec, fmi: str, token: str, sources: list[str]) -> ET.E
     for reference, v in enumerate(spec.variables):
         attributes = {"name": v.name, "valueReference": str(reference), "causality": v.causality,
                       "variability": v.effective_variability}
-        start = {} if v.causality == "output" else {"start": number_text(v.start) if v.type != "String" else v.start}
+        start = {} if v.causality in COMPUTED else {"start": number_text(v.start) if v.type != "String" else v.start}
         if fmi3 and v.type == "String":  # FMI 3.0: a String's start is an element
             element = ET.SubElement(variables, "String", attributes)
             if start:

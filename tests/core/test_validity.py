@@ -125,6 +125,46 @@ def test_a_spec_refuses_outputs_without_a_correct_dependency_declaration(output,
                   states=states)
 
 
+def test_a_local_is_computed_as_an_output_is_and_relates_to_nothing():
+    """A local (an internal state) may be a state and a state's derivative, declares its dependencies as an
+    output does, is checked after a step with the outputs, and no relation names it."""
+    variables = (Variable("x", "input", 1.0, "an input"), Variable("s", "local", 0.0, "an internal state"),
+                 Variable("s_dot", "local", 0.0, "its rate", depends_on=("s", "x")))
+    spec = ModelSpec("Probe", "an internal state", variables, DefaultExperiment(0.0, 1.0, 0.1),
+                     states=(State("s", (), "s_dot", 1.0),))
+    assert spec.of("local") == variables[1:] and not spec.of("output")
+    assert spec.derivative_dependencies(spec.states[0]) == ("x", "s")
+    assert [v.article for v in variables] == ["an input", "a local", "a local"]
+    with pytest.raises(ValueError, match="local s_dot declares no dependencies"):
+        ModelSpec("Probe", "undeclared", (*variables[:2], Variable("s_dot", "local", 0.0, "its rate")),
+                  DefaultExperiment(0.0, 1.0, 0.1), states=(State("s", (), "s_dot", 1.0),))
+    with pytest.raises(ValueError, match="numeric parameters or inputs"):
+        ModelSpec("Probe", "a relation on a local", variables, DefaultExperiment(0.0, 1.0, 0.1),
+                  (Relation("x", "<", "s"),), states=(State("s", (), "s_dot", 1.0),))
+
+
+def test_a_step_refuses_a_local_that_is_not_finite_as_an_output():
+    class Internal(SteppedModel):
+        spec = ModelSpec("Internal", "an internal value", (
+            Variable("x", "input", 1.0, "an input"),
+            Variable("y", "output", 0.0, "an output", depends_on=("x",)),
+            Variable("z", "local", 0.0, "an internal value", depends_on=("x",))), DefaultExperiment(0.0, 1.0, 0.1))
+
+        def _evaluate(self) -> None:
+            self.y, self.z = self.x, 1.0 / self.x if self.x else math.nan
+
+        def start(self, start_time: float) -> None:
+            self._evaluate()
+
+        def advance(self, current_time: float, step_size: float) -> None:
+            self._evaluate()
+
+    model = Internal()
+    assert model.initialize(0.0) == []
+    model.x = 0.0
+    assert model.step(0.0, 0.1) == ["local z is not finite (nan); the step was not taken"]
+
+
 def test_the_dependencies_at_initialisation_follow_a_state_to_its_initial_values():
     variables = (Variable("x", "input", 1.0, "an input"), Variable("p", "parameter", 1.0, "a parameter"),
                  Variable("x0", "parameter", 0.0, "the state's initial value"),

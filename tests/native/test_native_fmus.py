@@ -88,11 +88,13 @@ def _fields(item: object) -> dict:
 
 def _described(path: Path) -> dict:
     """Everything a host reads from a model description, except token, generator and Model Exchange
-    (the native FMUs': the states' derivatives, tests/native/test_native_model_exchange.py)."""
+    (the native FMUs': the states' derivatives, and the states that are locals among the initial unknowns,
+    tests/native/test_native_model_exchange.py)."""
     d = read_model_description(str(path))
     derivatives = {u.variable.name for u in d.derivatives}
+    local_states = {u.variable.derivative.name for u in d.derivatives if u.variable.derivative.causality == "local"}
     d.modelVariables = [v for v in d.modelVariables if v.name not in derivatives]
-    d.initialUnknowns = [u for u in d.initialUnknowns if u.variable.name not in derivatives]
+    d.initialUnknowns = [u for u in d.initialUnknowns if u.variable.name not in derivatives | local_states]
     fields = ("name", "valueReference", "causality", "variability", "description", "type", "unit", "displayUnit",
               "min", "max", "start", "initial")
     return {
@@ -130,7 +132,7 @@ def test_every_start_value_is_the_specs_bit_for_bit_in_both_families(native_dir,
     assert written[0] == written[1]
     for variable in spec.variables:
         text = written[1][variable.name]
-        if variable.causality == "output":
+        if variable.causality in ("output", "local"):
             assert text is None, variable.name
         elif variable.type == "Real":
             assert struct.pack("<d", float(text)) == struct.pack("<d", variable.start), (variable.name, text)
@@ -368,6 +370,20 @@ def test_misuse_returns_error_with_a_reason(native_dir, fmi):
         fmu.initialize()
         assert _error(fmu.fmu.doStep, math.nan, 1e-3) == 3
         assert "not finite" in fmu.log[-1].message
+
+
+@pytest.mark.parametrize("name", NATIVE)
+def test_a_step_changes_the_outputs_and_locals_alone(native_dir, name, fmi):
+    """A refused step is undone by restoring the outputs, locals and internal slots alone (StepUndo in
+    fmu_instance.h): every parameter and input, Strings included, reads the same after steps as before."""
+    step = MODELS[name].spec.default_experiment.step_size
+    with FmuInstance(_native(native_dir, name, fmi)) as fmu:
+        fmu.initialize()
+        names = [v.name for v in fmu.description.modelVariables if v.causality in ("parameter", "input")]
+        before = fmu.get(names)
+        for _ in range(3):
+            fmu.step(step)
+        assert dict(zip(names, fmu.get(names))) == dict(zip(names, before))
 
 
 def test_a_wrong_token_is_refused_at_instantiation(native_dir, tmp_path, fmi):

@@ -60,12 +60,21 @@ void messages_add_extra(Messages *out, const ModelData *data, int message)
 
 /* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
 
-/* SteppedModel._range_error for every variable of ``causality``: finite, then the declared bounds (the
+/* The groups of model_checked (model_checked_from): the parameters, the inputs, the outputs and locals. */
+typedef enum { CHECKED_PARAMETERS, CHECKED_INPUTS, CHECKED_COMPUTED } CheckedGroup;
+
+static const char *causality_name(Causality causality)
+{
+    static const char *const names[] = {"parameter", "input", "output", "local"};
+    return names[causality];
+}
+
+/* SteppedModel._range_error for every variable of ``group``: finite, then the declared bounds (the
  * generated list of the variables that have a check of these; the outputs' finiteness: output_errors). */
-static void range_errors(const ModelData *data, Causality causality, Messages *out)
+static void range_errors(const ModelData *data, CheckedGroup group, Messages *out)
 {
     int k;
-    for (k = model_checked_from[causality]; k < model_checked_from[causality + 1]; k++) {
+    for (k = model_checked_from[group]; k < model_checked_from[group + 1]; k++) {
         const VariableInfo *v = &model_variables[model_checked[k]];
         const MessageTemplate *message = NULL;
         double value = value_of(data, model_checked[k]);
@@ -90,11 +99,17 @@ static void relation_errors(const ModelData *data, int inputs, Messages *out)
     int i;
     for (i = 0; i < MODEL_RELATION_COUNT; i++) {
         const RelationInfo *r = &model_relations[i];
-        double left = value_of(data, r->lhs), right = r->rhs >= 0 ? value_of(data, r->rhs) : r->constant;
-        double bound = r->scale == 1.0 && r->offset == 0.0 ? right : r->scale * right + r->offset;
-        int holds = r->op == OP_LT ? left < bound : r->op == OP_LE ? left <= bound : r->op == OP_GT ? left > bound
-                                                                                                     : left >= bound;
-        if (r->involves_input == inputs && !holds) {
+        double left, right, bound;
+        int holds;
+        if (r->involves_input != inputs) { /* the other group's */
+            continue;
+        }
+        left = value_of(data, r->lhs);
+        right = r->rhs >= 0 ? value_of(data, r->rhs) : r->constant;
+        bound = r->scale == 1.0 && r->offset == 0.0 ? right : r->scale * right + r->offset;
+        holds = r->op == OP_LT ? left < bound : r->op == OP_LE ? left <= bound : r->op == OP_GT ? left > bound
+                                                                                   : left >= bound;
+        if (!holds) {
             add_message(out, &r->message, &model_variables[r->lhs], left, bound, r->integer_bound);
         }
     }
@@ -107,11 +122,11 @@ static void relation_errors(const ModelData *data, int inputs, Messages *out)
 
 /* The checks of one causality in the core's order: bounds, then relations, then the model's own
  * (each only if the ones before found nothing). */
-static void causality_errors(const ModelData *data, Causality causality, int inputs,
+static void causality_errors(const ModelData *data, CheckedGroup group, int inputs,
                              void (*extra)(const ModelData *, Messages *), Messages *out)
 {
     int before = out->count;
-    range_errors(data, causality, out);
+    range_errors(data, group, out);
     if (out->count == before) {
         relation_errors(data, inputs, out);
     }
@@ -122,7 +137,7 @@ static void causality_errors(const ModelData *data, Causality causality, int inp
 
 void parameter_errors(const ModelData *data, Messages *out)
 {
-    causality_errors(data, CAUSALITY_PARAMETER, 0, model_hooks.extra_parameter_errors, out);
+    causality_errors(data, CHECKED_PARAMETERS, 0, model_hooks.extra_parameter_errors, out);
 }
 
 void instance_parameter_errors(Instance *instance, const ModelData *data)
@@ -136,26 +151,38 @@ void instance_parameter_errors(Instance *instance, const ModelData *data)
 
 void input_errors(const ModelData *data, Messages *out)
 {
-    causality_errors(data, CAUSALITY_INPUT, 1, model_hooks.extra_input_errors, out);
+    causality_errors(data, CHECKED_INPUTS, 1, model_hooks.extra_input_errors, out);
 }
 
 typedef enum { SUM_FINITE, SUM_NOT_FINITE, SUM_FAILED } SumOutcome;
 
-/* What Python's math.fsum does with these values (output_errors sums the Real outputs with it);
- * exactly only where a partial sum could come near overflow. */
+/* Whether the Real outputs and locals are finite values whose partial sums stay far from overflow, in any
+ * order (their magnitudes' sum, in four running sums, at most DBL_MAX / 4; a value that is not finite makes it
+ * NaN or infinite): then math.fsum of them is finite, whatever fsum_outcome would find. */
+static int far_from_overflow(const ModelData *data)
+{
+    double sums[4] = {0.0, 0.0, 0.0, 0.0};
+    const int *names = model_real_computed;
+    int i;
+    for (i = 0; i + 4 <= MODEL_REAL_COMPUTED_COUNT; i += 4) {
+        sums[0] += fabs(data->real_value[names[i]]);
+        sums[1] += fabs(data->real_value[names[i + 1]]);
+        sums[2] += fabs(data->real_value[names[i + 2]]);
+        sums[3] += fabs(data->real_value[names[i + 3]]);
+    }
+    for (; i < MODEL_REAL_COMPUTED_COUNT; i++) {
+        sums[0] += fabs(data->real_value[names[i]]);
+    }
+    return (sums[0] + sums[1]) + (sums[2] + sums[3]) <= DBL_MAX / 4.0;
+}
+
+/* What Python's math.fsum does with these values (output_errors sums the Real outputs and locals with it), once
+ * far_from_overflow could not tell. */
 static SumOutcome fsum_outcome(const double values[], int count, Failure *failure)
 {
-    double magnitude = 0.0, sum = 0.0;
+    double sum = 0.0;
     const char *message;
-    ErrorKind kind;
-    int i;
-    for (i = 0; i < count; i++) {
-        magnitude += fabs(values[i]);
-    }
-    if (magnitude <= DBL_MAX / 4.0) { /* finite values whose partial sums stay far from overflow */
-        return SUM_FINITE;
-    }
-    kind = python_fsum(values, count, &sum, &message);
+    ErrorKind kind = python_fsum(values, count, &sum, &message);
     if (kind != ERROR_NONE) {
         *failure = FAILURE(kind, message);
         return SUM_FAILED;
@@ -163,26 +190,31 @@ static SumOutcome fsum_outcome(const double values[], int count, Failure *failur
     return isfinite(sum) ? SUM_FINITE : SUM_NOT_FINITE;
 }
 
-/* SteppedModel.output_errors (not finite, then beyond the declared bounds); an arithmetic failure
- * of the sum itself becomes ``failure``. */
+/* SteppedModel.output_errors of the outputs and locals (not finite, then beyond the declared bounds); an
+ * arithmetic failure of the sum itself becomes ``failure``. */
 void output_errors(const ModelData *data, Messages *out, Failure *failure)
 {
-    double values[MODEL_REAL_OUTPUT_COUNT + 1];
-    const int *names = model_real_outputs;
-    int count = MODEL_REAL_OUTPUT_COUNT, i;
+    double values[MODEL_REAL_COMPUTED_COUNT + 1];
+    const int *names = model_real_computed;
+    int count = MODEL_REAL_COMPUTED_COUNT, i;
     char shown[40];
     SumOutcome outcome;
+    if (far_from_overflow(data)) { /* the common case: no copy, no exact sum */
+        range_errors(data, CHECKED_COMPUTED, out);
+        return;
+    }
     for (i = 0; i < count; i++) {
         values[i] = data->real_value[names[i]];
     }
     outcome = fsum_outcome(values, count, failure);
     if (outcome == SUM_FINITE) {
-        range_errors(data, CAUSALITY_OUTPUT, out);
+        range_errors(data, CHECKED_COMPUTED, out);
     } else if (outcome == SUM_NOT_FINITE) {
         for (i = 0; i < count; i++) {
             if (!isfinite(values[i])) {
+                const VariableInfo *v = &model_variables[names[i]];
                 python_float_repr(values[i], shown, sizeof shown);
-                messages_add(out, "output ", model_variables[names[i]].name, " is not finite (", shown,
+                messages_add(out, causality_name(v->causality), " ", v->name, " is not finite (", shown,
                              "); the step was not taken", (const char *)NULL);
             }
         }
@@ -191,7 +223,7 @@ void output_errors(const ModelData *data, Messages *out, Failure *failure)
 
 
 /* SteppedModel.state_from_saved's check of the values a serialized state restores, as the model could have
- * left them: the times finite, then every Real output finite, then every output within its bounds. */
+ * left them: the times finite, then every Real output and local finite, then each within its bounds. */
 void restored_errors(const ModelData *data, double start_time, Messages *out)
 {
     char shown[40];
@@ -202,13 +234,14 @@ void restored_errors(const ModelData *data, double start_time, Messages *out)
                      (const char *)NULL);
         return;
     }
-    for (i = 0; i < MODEL_REAL_OUTPUT_COUNT; i++) {
-        if (!isfinite(data->real_value[model_real_outputs[i]])) {
-            python_float_repr(data->real_value[model_real_outputs[i]], shown, sizeof shown);
-            messages_add(out, "output ", model_variables[model_real_outputs[i]].name, " = ", shown, " is not finite",
+    for (i = 0; i < MODEL_REAL_COMPUTED_COUNT; i++) {
+        const VariableInfo *v = &model_variables[model_real_computed[i]];
+        if (!isfinite(data->real_value[model_real_computed[i]])) {
+            python_float_repr(data->real_value[model_real_computed[i]], shown, sizeof shown);
+            messages_add(out, causality_name(v->causality), " ", v->name, " = ", shown, " is not finite",
                          (const char *)NULL);
             return;
         }
     }
-    range_errors(data, CAUSALITY_OUTPUT, out);
+    range_errors(data, CHECKED_COMPUTED, out);
 }

@@ -18,14 +18,39 @@
 
 typedef enum { ACTION_START, ACTION_ADVANCE } Action;
 
+void step_undo_keep(const ModelData *data, StepUndo *undo)
+{
+    int i;
+    for (i = 0; i < MODEL_REAL_COMPUTED_COUNT; i++) {
+        undo->real[i] = data->real_value[model_real_computed[i]];
+    }
+    for (i = 0; i < MODEL_INT_COMPUTED_COUNT; i++) {
+        undo->integer[i] = data->int_value[model_int_computed[i]];
+    }
+    memcpy(undo->internal, data->internal, sizeof undo->internal);
+}
+
+void step_undo_restore(ModelData *data, const StepUndo *undo)
+{
+    int i;
+    for (i = 0; i < MODEL_REAL_COMPUTED_COUNT; i++) {
+        data->real_value[model_real_computed[i]] = undo->real[i];
+    }
+    for (i = 0; i < MODEL_INT_COMPUTED_COUNT; i++) {
+        data->int_value[model_int_computed[i]] = undo->integer[i];
+    }
+    memcpy(data->internal, undo->internal, sizeof data->internal);
+}
+
 /* Runs the action on ``data``; if it fails arithmetically or leaves a non-finite output, undoes it and
  * says why in ``out`` ("the start values ..." or "the step from t = ... s ...", formatted only then). */
 static void undoable(ModelData *data, Messages *out, Action action, double time, double step_size)
 {
-    ModelData snapshot = *data;
+    StepUndo undo;
     int before = out->count;
     char shown[40];
     Failure failure;
+    step_undo_keep(data, &undo);
     if (model_hooks.at_time != NULL) {
         failure = model_hooks.at_time(data, action == ACTION_START ? time : time + step_size);
     } else if (action == ACTION_START) {
@@ -45,7 +70,7 @@ static void undoable(ModelData *data, Messages *out, Action action, double time,
                      ": ", failure.message, ")", (const char *)NULL);
     }
     if (out->count != before) {
-        *data = snapshot;
+        step_undo_restore(data, &undo);
     }
 }
 

@@ -33,7 +33,9 @@
 #define FMU_MAX_STRING_BYTES (4 * FMU_MAX_STRING)
 
 typedef enum { VAR_REAL, VAR_INTEGER, VAR_BOOLEAN, VAR_STRING } VariableType;
-typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT } Causality;
+/* A local is computed as an output is (checked after each step, read, never set) but is the model's own: an
+ * internal state no host wires, in no list of outputs */
+typedef enum { CAUSALITY_PARAMETER, CAUSALITY_INPUT, CAUSALITY_OUTPUT, CAUSALITY_LOCAL } Causality;
 
 /* A refusal message: text, then the checked value or the bound it broke (as Python's repr(), or
  * in the display unit with format '.6g'), up to two values; generated from the Python checks. */
@@ -117,12 +119,13 @@ typedef struct {
     const char *resources; /* the resources folder, a path without a trailing separator; NULL: none */
 } ModelCache;
 
-/* Everything a step may change: the FMU state. Values are indexed by value reference; an
- * Integer or a Boolean (0 or 1) is held in int_value, a Real in real_value, a String in
- * string_value (NUL-terminated UTF-8 the instance owns; NULL for the other types). Strings are
- * parameters: a step never changes them, so a copy of ModelData made around a step may share
- * them; every other copy (an FMU state) owns copies of its own. ``cache`` points at the
- * instance's cache, never part of a state. */
+/* The FMU state. Values are indexed by value reference; an Integer or a Boolean (0 or 1) is held in
+ * int_value, a Real in real_value, a String in string_value (NUL-terminated UTF-8 the instance owns;
+ * NULL for the other types). Strings are parameters: a step never changes them, so a copy of ModelData
+ * made for a computation (Initialization Mode's values, the derivatives' point) may share them; every other
+ * copy (an FMU state) owns copies of its own.
+ * ``cache`` points at the instance's cache, never part of a state. A step (or a Model Exchange
+ * evaluation) changes the values of the outputs and locals and the internal slots alone (StepUndo). */
 typedef struct {
     double real_value[MODEL_VARIABLE_COUNT];
     int32_t int_value[MODEL_VARIABLE_COUNT];
@@ -132,6 +135,18 @@ typedef struct {
     int initialized;
     ModelCache *cache;
 } ModelData;
+
+/* What a step may change, kept to undo a refused one: the values of the outputs and locals (the states among
+ * them: model_real_computed, model_int_computed) and the internal slots. A model's hooks write nothing else
+ * (tests/native/test_native_fmus.py reads every parameter and input around steps). */
+typedef struct {
+    double real[MODEL_REAL_COMPUTED_COUNT + 1];
+    int32_t integer[MODEL_INT_COMPUTED_COUNT + 1];
+    double internal[FMU_INTERNAL_SLOTS];
+} StepUndo;
+
+void step_undo_keep(const ModelData *data, StepUndo *undo);
+void step_undo_restore(ModelData *data, const StepUndo *undo);
 
 typedef enum { MODE_INSTANTIATED, MODE_INITIALIZATION, MODE_STEP, MODE_TERMINATED, MODE_ERROR } Mode;
 

@@ -83,7 +83,7 @@ void model_exchange_evaluate(Instance *instance, ModelData *data)
 /* The outputs and derivatives at the instance's time, states and inputs, if any of them changed. */
 Status model_exchange_update(Instance *instance)
 {
-    ModelData snapshot;
+    StepUndo undo;
     if (!instance->model_exchange || !instance->stale || instance->mode != MODE_STEP) {
         return STATUS_OK;
     }
@@ -91,10 +91,10 @@ Status model_exchange_update(Instance *instance)
         return instance_fail(instance, instance->fmi_prefix, ": ", MODEL_NAME, "'s C port gives no evaluate hook, "
                              "which Model Exchange needs", (const char *)NULL);
     }
-    snapshot = instance->data;
+    step_undo_keep(&instance->data, &undo);
     model_exchange_evaluate(instance, &instance->data);
     if (instance->messages.count) {
-        instance->data = snapshot;
+        step_undo_restore(&instance->data, &undo);
     }
     instance->stale = instance->messages.count > 0;
     return instance_refusal(instance);

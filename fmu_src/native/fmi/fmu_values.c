@@ -63,6 +63,8 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
                                         : " is not of type String";
     } else if (setting && v->causality == CAUSALITY_OUTPUT) {
         problem = " is an output and cannot be set";
+    } else if (setting && v->causality == CAUSALITY_LOCAL) {
+        problem = " is a local variable and cannot be set";
     } else if (setting && instance->mode == MODE_STEP && v->causality == CAUSALITY_PARAMETER && !v->tunable) {
         problem = " is a fixed parameter and cannot be changed after initialisation";
     }
@@ -82,7 +84,8 @@ static int all_accessible(Instance *instance, const char *function, const uint32
                           const void *values, VariableType type, int setting)
 {
     size_t i;
-    if (!instance_allows(instance, setting ? SETTABLE_MODES : ANY_MODE, function)) {
+    if (!((setting ? SETTABLE_MODES : ANY_MODE) & MODE_BIT(instance->mode)) &&
+        !instance_allows(instance, setting ? SETTABLE_MODES : ANY_MODE, function)) { /* logs the misuse */
         return 0;
     }
     if (n > 0 && (vr == NULL || values == NULL)) {
@@ -102,8 +105,25 @@ static int all_accessible(Instance *instance, const char *function, const uint32
             instance->parameters_checked = 0; /* the next step checks the parameters again */
         }
     }
-    instance->stale = instance->stale || setting; /* Model Exchange: the outputs follow at the next get */
+    if (setting) {
+        instance->stale = 1; /* Model Exchange: the outputs follow at the next get */
+    }
     return 1;
+}
+
+/* The values a get reads now and the status it returns with them: Model Exchange's outputs brought up to date
+ * (model_exchange_update), Initialization Mode's computed (instance_readable); else the instance's, OK. */
+static const ModelData *values_to_get(Instance *instance, Status *status)
+{
+    Status initial;
+    const ModelData *values;
+    *status = instance->model_exchange ? model_exchange_update(instance) : STATUS_OK;
+    if (instance->mode != MODE_INITIALIZATION) {
+        return &instance->data;
+    }
+    values = instance_readable(instance, &initial);
+    *status = *status > initial ? *status : initial;
+    return values;
 }
 
 Status instance_set_real(Instance *instance, const char *function, const uint32_t vr[], size_t n,
@@ -173,37 +193,37 @@ Status instance_set_integer(Instance *instance, const char *function, const uint
 Status instance_get_real(Instance *instance, const char *function, const uint32_t vr[], size_t n, double value[])
 {
     size_t i;
-    Status status, initial;
+    Status status;
     const ModelData *values;
     int k;
     if (!all_accessible(instance, function, vr, n, value, VAR_REAL, 0)) {
         return STATUS_ERROR;
     }
-    status = model_exchange_update(instance);
-    values = instance_readable(instance, &initial);
+    values = values_to_get(instance, &status);
     for (i = 0; i < n; i++) {
-        k = vr[i] < MODEL_VARIABLE_COUNT ? -1 : instance_derivative_of(instance, vr[i]);
-        value[i] = vr[i] < MODEL_VARIABLE_COUNT ? values->real_value[vr[i]]
-                   : k >= 0                     ? DERIVATIVE_VALUE(k)
-                                                : values->time;
+        if (vr[i] < MODEL_VARIABLE_COUNT) {
+            value[i] = values->real_value[vr[i]];
+            continue;
+        }
+        k = instance_derivative_of(instance, vr[i]);
+        value[i] = k >= 0 ? DERIVATIVE_VALUE(k) : values->time;
     }
-    return status > initial ? status : initial;
+    return status;
 }
 
 Status instance_get_integer(Instance *instance, const char *function, const uint32_t vr[], size_t n, int32_t value[])
 {
     size_t i;
-    Status status, initial;
+    Status status;
     const ModelData *values;
     if (!all_accessible(instance, function, vr, n, value, VAR_INTEGER, 0)) {
         return STATUS_ERROR;
     }
-    status = model_exchange_update(instance);
-    values = instance_readable(instance, &initial);
+    values = values_to_get(instance, &status);
     for (i = 0; i < n; i++) {
         value[i] = values->int_value[vr[i]];
     }
-    return status > initial ? status : initial;
+    return status;
 }
 
 static int boolean_at(const void *values, size_t size, size_t i)
@@ -235,13 +255,12 @@ Status instance_get_boolean(Instance *instance, const char *function, const uint
                             size_t size)
 {
     size_t i;
-    Status status, initial;
+    Status status;
     const ModelData *values;
     if (!all_accessible(instance, function, vr, n, value, VAR_BOOLEAN, 0)) {
         return STATUS_ERROR;
     }
-    status = model_exchange_update(instance);
-    values = instance_readable(instance, &initial);
+    values = values_to_get(instance, &status);
     for (i = 0; i < n; i++) {
         unsigned char *at = (unsigned char *)value + i * size;
         int truth = values->int_value[vr[i]] != 0;
@@ -252,7 +271,7 @@ Status instance_get_boolean(Instance *instance, const char *function, const uint
             at[0] = (unsigned char)truth;
         }
     }
-    return status > initial ? status : initial;
+    return status;
 }
 
 /* Characters (code points, as Python's len()) of the UTF-8 ``text`` of ``length`` bytes. */

@@ -46,9 +46,10 @@ static double remainder_of(double a, double b)
     return mod;
 }
 
-/* One arm's track contact (rollers.RollerContacts, the parts the balance needs). */
+/* One arm's track contact (rollers.RollerContacts, the parts the balance needs), with the regularised signs
+ * of its rolling and skew speeds. */
 typedef struct {
-    double k[3], N, u[3], across, s[3], v_roll, v_skew, F_roll, F_skew, miss, pushed[3];
+    double k[3], N, u[3], across, s[3], v_roll, v_skew, roll_sign, skew_sign, F_roll, F_skew, miss, pushed[3];
 } Contact;
 
 /* The single roller on its track with contact normal at ``angle`` (rollers._skewed_slips and the
@@ -70,28 +71,51 @@ static void skewed_slips(Guard *guard, const Load *load, const double axis[3], d
     }
     c->v_roll = dot3(v0, c->u) + R * c->across * dot3(spin, axis);
     c->v_skew = dot3(v0, c->s);
+    c->roll_sign = slip_sign(guard, c->v_roll, load->slip_speed);
+    c->skew_sign = slip_sign(guard, c->v_skew, load->slip_speed);
     for (i = 0; i < 3; i++) {
-        g[i] = -load->mu_roll * slip_sign(guard, c->v_roll, load->slip_speed) * c->u[i]
-               - load->friction * slip_sign(guard, c->v_skew, load->slip_speed) * c->s[i];
+        g[i] = -load->mu_roll * c->roll_sign * c->u[i] - load->friction * c->skew_sign * c->s[i];
         c->pushed[i] = c->k[i] + g[i] * (i == 2 ? 0.0 : 1.0);
     }
     c->miss = remainder_of(atan2(c->pushed[1], c->pushed[0]) - target + PI, 2.0 * PI) - PI;
 }
 
-/* What the miss of the step's contacts needs (illinois.h) */
+#define PROBES_KEPT 2 /* each arm's latest probes: the method ends on one of its brackets' ends, mostly recent */
+
+/* What the miss of the step's contacts needs (illinois.h), and each arm's latest probes and their angles */
 typedef struct {
     Guard *guard;
     const Load *load;
     const double (*axis)[3];
     const double *zdot, *spin, *target;
+    Contact probe[3][PROBES_KEPT];
+    double probe_angle[3][PROBES_KEPT];
+    int probes[3];
 } MissContext;
 
 static double miss_at(void *context, int arm, double angle)
 {
     MissContext *at = (MissContext *)context;
-    Contact probe;
-    skewed_slips(at->guard, at->load, at->axis[arm], at->zdot[arm], at->spin, angle, at->target[arm], &probe);
-    return probe.miss;
+    int slot = at->probes[arm]++ % PROBES_KEPT;
+    Contact *probe = &at->probe[arm][slot];
+    at->probe_angle[arm][slot] = angle;
+    skewed_slips(at->guard, at->load, at->axis[arm], at->zdot[arm], at->spin, angle, at->target[arm], probe);
+    return probe->miss;
+}
+
+/* Arm ``arm``'s contact at ``angle``: a kept probe at the same angle, bit for bit (a zero's sign included), or
+ * computed afresh. */
+static void contact_at(MissContext *at, int arm, double angle, Contact *c)
+{
+    int k, kept = at->probes[arm] < PROBES_KEPT ? at->probes[arm] : PROBES_KEPT;
+    for (k = 0; k < kept; k++) {
+        double probed = at->probe_angle[arm][k];
+        if (probed == angle && signbit(probed) == signbit(angle)) {
+            *c = at->probe[arm][k];
+            return;
+        }
+    }
+    skewed_slips(at->guard, at->load, at->axis[arm], at->zdot[arm], at->spin, angle, at->target[arm], c);
 }
 
 /* The three single rollers' track contacts under the horizontal forces H (rollers._skewed_contact): the
@@ -106,13 +130,19 @@ static void skewed_contacts(Guard *guard, const Load *load, const double H[3][3]
         target[j] = atan2(H[j][1], H[j][0]);
         size[j] = root(guard, dot3(H[j], H[j]));
     }
-    context = (MissContext){guard, load, axis, zdot, spin, target};
+    context.guard = guard;
+    context.load = load;
+    context.axis = axis;
+    context.zdot = zdot;
+    context.spin = spin;
+    context.target = target;
+    context.probes[0] = context.probes[1] = context.probes[2] = 0;
     illinois_angles(miss_at, &context, target, load->friction, load->mu_roll, angle);
     for (j = 0; j < 3; j++) {
-        skewed_slips(guard, load, axis[j], zdot[j], spin, angle[j], target[j], &c[j]);
+        contact_at(&context, j, angle[j], &c[j]);
         c[j].N = size[j] / root(guard, dot3(c[j].pushed, c[j].pushed));
-        c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
-        c[j].F_skew = -load->friction * c[j].N * slip_sign(guard, c[j].v_skew, load->slip_speed);
+        c[j].F_roll = -load->mu_roll * c[j].N * c[j].roll_sign;
+        c[j].F_skew = -load->friction * c[j].N * c[j].skew_sign;
     }
 }
 
@@ -125,7 +155,8 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
     const double m = load->m, R = load->roller_radius, mu = load->friction;
     const double needle_share = load->roller_bore_radius / R; /* r_b / R */
     double centre[3][3], e[3][3], d[3][3], n[3][3], q[3][3], axis[3][3], length[3], groove_acc[3][3];
-    double zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], spin[3], load_moment[3], friction_h[3][3];
+    double zdot[3], zddot[3], v_trunnion[3], trunnion_sign[3], roll_sign[3], n_norm[3], spin[3], load_moment[3];
+    double friction_h[3][3];
     double N_trunnion[3], phi[3], force[3][3], friction[3][3], couple[3][3], H[3][3];
     double R_out[3] = {0.0, 0.0, 0.0}, R_in[3] = {0.0, 0.0, 0.0}, L[3] = {0.0, 0.0, 0.0}, power = 0.0;
     double relax = 1.0, last_lam[3] = {0.0, 0.0, 0.0}, last_mu[3] = {0.0, 0.0, 0.0};
@@ -154,6 +185,10 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
         zddot[j] = a->zddot;
         v_trunnion[j] = a->sigma * length[j];
         trunnion_sign[j] = slip_sign(guard, v_trunnion[j], load->slip_speed);
+        /* the double roller rolls at zdot_j whatever the forces: its rolling sign is the iterations' constant */
+        roll_sign[j] = load->tripod_type == TRIPOD_SPEC_SINGLE_ROLLER ? 0.0
+                                                                       : slip_sign(guard, zdot[j], load->slip_speed);
+        n_norm[j] = root(guard, a->exy2);
         friction_h[j][0] = friction_h[j][1] = friction_h[j][2] = 0.0;
     }
     for (i = 0; i < 3; i++) {
@@ -191,7 +226,7 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                 cross3(c[j].k, axis[j], lever);
                 c[j].v_roll = zdot[j];
                 c[j].v_skew = load->roller_bore_radius * (zdot[j] * axis[j][2] / R - dot3(spin, lever)); /* R16 */
-                c[j].F_roll = -load->mu_roll * c[j].N * slip_sign(guard, c[j].v_roll, load->slip_speed);
+                c[j].F_roll = -load->mu_roll * c[j].N * roll_sign[j];
                 c[j].F_skew = -mu * c[j].N * slip_sign(guard, c[j].v_skew, load->slip_speed);
                 for (i = 0; i < 3; i++) { /* R17, R18 */
                     friction[j][i] = (c[j].F_roll + needle_share * axis[j][2] * c[j].F_skew) * (i == 2 ? 1.0 : 0.0);
@@ -221,8 +256,7 @@ void roller_reactions(Guard *guard, const Arm arm[3], const double adj[3][3], do
                 change_h[i] = h - friction_h[j][i];
                 friction_h[j][i] = h;
             }
-            change = change + (fabs(new_lam[j] - lam[j]) * root(guard, arm[j].exy2)
-                               + fabs(new_mu[j] - mu_q[j]) * root(guard, arm[j].exy2) * length[j]
+            change = change + (fabs(new_lam[j] - lam[j]) * n_norm[j] + fabs(new_mu[j] - mu_q[j]) * n_norm[j] * length[j]
                                + root(guard, dot3(change_h, change_h)));
             scale = scale + (N_trunnion[j] + c[j].N);
         }

@@ -45,9 +45,10 @@ static double arcsine(Guard *guard, double a)
 
 /* ---- exact kinematics, tripod-plane formulation (plane_solver.py) ------------------------- */
 
-/* The star centre at one axis (x, y) and the terms its directional derivatives reuse. */
+/* The star centre at one axis (x, y) and the terms its directional derivatives reuse; arg(alpha) =
+ * atan2(ai, ar) is taken by the solver at its last iterate alone. */
 typedef struct {
-    double fx, fy, twist, orbit_r, orbit_i;
+    double fx, fy, orbit_r, orbit_i;
     double x, y, z, k, cb, sb, E1x, E1z, E2x, E2z, Ux, Uz, f1, f2, ar, ai, norm, tr, ti, qr, qi, turn3[2], r, l;
 } StarCentre;
 
@@ -56,8 +57,8 @@ typedef struct {
     double fx, fy, twist;
 } StarTangent;
 
-/* Star centre relative to P in tripod-plane coordinates, arg(alpha) and the centre's term in
- * turn3 = exp(3i chi); frame vectors mapped to the input frame by eq 2. */
+/* Star centre relative to P in tripod-plane coordinates and the centre's term in turn3 = exp(3i chi);
+ * frame vectors mapped to the input frame by eq 2. */
 static StarCentre star_centre(Guard *guard, double x, double y, const double turn3[2], double cb, double sb,
                               double r, double l)
 {
@@ -80,7 +81,6 @@ static StarCentre star_centre(Guard *guard, double x, double y, const double tur
     s.orbit_i = qr * turn3[1] + qi * turn3[0];
     s.fx = c1 - s.orbit_r;
     s.fy = c2 - s.orbit_i;
-    s.twist = atan2(ai, ar);
     s.x = x;
     s.y = y;
     s.z = z;
@@ -150,7 +150,7 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
     StarCentre f;
     StarTangent along_x = {0.0, 0.0, 0.0}, along_y = along_x;
     int i;
-    f.twist = f.orbit_r = f.orbit_i = 0.0;
+    f.orbit_r = f.orbit_i = 0.0;
     if (!warm) {
         double rho_over_l = divide(guard, r * (1.0 - cb), 2.0 * cb * l);
         x = rho_over_l * cosine(guard, 3.0 * phi_in);
@@ -186,7 +186,7 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
         return;
     }
     /* the last update moved (x, y) by (-dx, -dy): carry arg(alpha) along to first order */
-    twist = f.twist - (along_x.twist * dx + along_y.twist * dy);
+    twist = atan2(f.ai, f.ar) - (along_x.twist * dx + along_y.twist * dy);
     /* d(x, y)/d(phi_in) = -J^-1 dF/d(phi_in), dF/d(phi_in) = -3i orbit */
     dx_dphi = -(jyy * (3.0 * f.orbit_i) - jxy * (-3.0 * f.orbit_r)) / det;
     dy_dphi = -(jxx * (-3.0 * f.orbit_r) - jyx * (3.0 * f.orbit_i)) / det;
@@ -201,63 +201,84 @@ static void plane_solve(Guard *guard, double phi_in, double cb, double sb, doubl
 
 /* ---- reactions ----------------------------------------------------------------------------- */
 
+/* One arm in the friction balance: what its iterations do not change (reactions._friction_arm) */
+typedef struct {
+    double ex, ey, ez, exy2, e2, e_norm, ne_norm, n_norm; /* e_j, |n|^2, |e|^2, |e|, |n||e|, |n| */
+    double m_ax, m_ay, m_zddot, groove_sign, arm_sign;    /* m a_xy, m zddot, the slips' regularised signs */
+    double mu_arm[3], slip_arm[3];                        /* the moment arms of mu_j and phi_j */
+} FrictionArm;
+
 /* Arm forces with Coulomb friction in both sliding pairs of each arm, by successive substitution
  * from the frictionless forces (reactions._frictional_balance): lambda_j, mu_j, the slip forces
- * phi_j along the arms, the groove forces g_j and the dissipated power. */
+ * phi_j along the arms, the groove forces g_j and the dissipated power. Nothing in the iterations can
+ * fail as Python would: sigma_j's division has refused |n_j|^2 = 0 before, so |e_j| > 0, and every square
+ * root is of a sum of squares; their arithmetic runs unguarded, on copies the compiler may keep at hand. */
 static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[3][3], double inv_det,
                                const double load_moment[3], const Load *load, double lams[3], double mus[3],
                                double slips[3], double grooves[3], double *power)
 {
-    /* per arm, what the iterations do not change: |e|^2, |e|, |n||e|, |n| and the moment arms of mu_j and phi_j */
-    double signs[3][2], e2s[3], e_norms[3], ne_norms[3], n_norms[3], mu_arms[3][3], slip_arms[3][3];
-    double new_mus[3], new_lams[3], m = load->m, friction = load->friction;
-    int iteration, j;
+    FrictionArm fixed[3];
+    double lam_now[3], mu_now[3], new_mus[3], new_lams[3], slip_now[3] = {0.0, 0.0, 0.0};
+    double groove_now[3] = {0.0, 0.0, 0.0}, inverse[3][3], m = load->m, friction = load->friction;
+    int iteration = 0, i, j;
     for (j = 0; j < 3; j++) {
         const Arm *a = &arm[j];
-        signs[j][0] = slip_sign(guard, a->zdot, load->slip_speed);
-        signs[j][1] = slip_sign(guard, a->sigma * root(guard, a->exy2 + a->ez * a->ez), load->slip_speed);
-        e2s[j] = a->exy2 + a->ez * a->ez;
-        e_norms[j] = root(guard, e2s[j]);
-        ne_norms[j] = root(guard, a->exy2 * e2s[j]);
-        n_norms[j] = root(guard, a->exy2);
-        mu_arms[j][0] = a->dy * -a->exy2 - a->dz * a->ez * a->ey;
-        mu_arms[j][1] = a->dz * a->ez * a->ex + a->dx * a->exy2;
-        mu_arms[j][2] = a->dx * a->ez * a->ey - a->dy * a->ez * a->ex;
-        slip_arms[j][0] = a->dy * a->ez - a->dz * a->ey;
-        slip_arms[j][1] = a->dz * a->ex - a->dx * a->ez;
-        slip_arms[j][2] = a->dx * a->ey - a->dy * a->ex;
+        FrictionArm *f = &fixed[j];
+        f->ex = a->ex;
+        f->ey = a->ey;
+        f->ez = a->ez;
+        f->exy2 = a->exy2;
+        f->e2 = a->exy2 + a->ez * a->ez;
+        f->e_norm = root(guard, f->e2);
+        f->ne_norm = root(guard, a->exy2 * f->e2);
+        f->n_norm = root(guard, a->exy2);
+        f->m_ax = m * a->ax;
+        f->m_ay = m * a->ay;
+        f->m_zddot = m * a->zddot;
+        f->groove_sign = slip_sign(guard, a->zdot, load->slip_speed);
+        f->arm_sign = slip_sign(guard, a->sigma * f->e_norm, load->slip_speed);
+        f->mu_arm[0] = a->dy * -a->exy2 - a->dz * a->ez * a->ey;
+        f->mu_arm[1] = a->dz * a->ez * a->ex + a->dx * a->exy2;
+        f->mu_arm[2] = a->dx * a->ez * a->ey - a->dy * a->ez * a->ex;
+        f->slip_arm[0] = a->dy * a->ez - a->dz * a->ey;
+        f->slip_arm[1] = a->dz * a->ex - a->dx * a->ez;
+        f->slip_arm[2] = a->dx * a->ey - a->dy * a->ex;
+        lam_now[j] = lams[j];
+        mu_now[j] = mus[j];
+        for (i = 0; i < 3; i++) {
+            inverse[j][i] = adj[j][i];
+        }
     }
-    for (iteration = 0; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE;
-         iteration++) {
+    for (; iteration < TRIPOD_REACTIONS_MAX_FRICTION_ITERATIONS && guard->failure.kind == ERROR_NONE; iteration++) {
         double Mx = load_moment[0], My = load_moment[1], Mz = load_moment[2], change = 0.0, scale = 0.0;
         for (j = 0; j < 3; j++) {
-            const Arm *a = &arm[j];
-            double lam = lams[j], mu = mus[j], e2 = e2s[j];
-            double normal = root(guard, a->exy2 * (lam * lam + mu * mu * e2));
-            double slip = divide(guard, friction * normal * signs[j][1], e_norms[j]);
-            double Nx = m * a->ax + lam * a->ey + mu * a->ez * a->ex + slip * a->ex;
-            double Ny = m * a->ay - lam * a->ex + mu * a->ez * a->ey + slip * a->ey;
-            double groove = -friction * root(guard, Nx * Nx + Ny * Ny) * signs[j][0];
+            const FrictionArm *a = &fixed[j];
+            double lam = lam_now[j], mu = mu_now[j];
+            double normal = sqrt(a->exy2 * (lam * lam + mu * mu * a->e2));
+            double slip = friction * normal * a->arm_sign / a->e_norm;
+            double Nx = a->m_ax + lam * a->ey + mu * a->ez * a->ex + slip * a->ex;
+            double Ny = a->m_ay - lam * a->ex + mu * a->ez * a->ey + slip * a->ey;
+            double groove = -friction * sqrt(Nx * Nx + Ny * Ny) * a->groove_sign;
             /* plunger along Z': groove - F_z = m zddot with F_z = -mu |n|^2 + phi e_z */
-            double new_mu = divide(guard, m * a->zddot - groove + slip * a->ez, a->exy2);
-            Mx = Mx - new_mu * mu_arms[j][0] - slip * slip_arms[j][0];
-            My = My - new_mu * mu_arms[j][1] - slip * slip_arms[j][1];
-            Mz = Mz - new_mu * mu_arms[j][2] - slip * slip_arms[j][2];
-            change = change + fabs(new_mu - mu) * ne_norms[j];
+            double new_mu = (a->m_zddot - groove + slip * a->ez) / a->exy2;
+            Mx = Mx - new_mu * a->mu_arm[0] - slip * a->slip_arm[0];
+            My = My - new_mu * a->mu_arm[1] - slip * a->slip_arm[1];
+            Mz = Mz - new_mu * a->mu_arm[2] - slip * a->slip_arm[2];
+            change = change + fabs(new_mu - mu) * a->ne_norm;
             scale = scale + normal;
             new_mus[j] = new_mu;
-            slips[j] = slip;
-            grooves[j] = groove;
+            slip_now[j] = slip;
+            groove_now[j] = groove;
         }
         for (j = 0; j < 3; j++) {
-            new_lams[j] = (Mx * adj[j][0] + My * adj[j][1] + Mz * adj[j][2]) * inv_det;
+            new_lams[j] = (Mx * inverse[j][0] + My * inverse[j][1] + Mz * inverse[j][2]) * inv_det;
         }
         for (j = 0; j < 3; j++) {
-            change = change + fabs(new_lams[j] - lams[j]) * n_norms[j];
+            change = change + fabs(new_lams[j] - lam_now[j]) * fixed[j].n_norm;
         }
         for (j = 0; j < 3; j++) {
-            lams[j] = new_lams[j];
-            mus[j] = new_mus[j];
+            lam_now[j] = new_lams[j];
+            mu_now[j] = new_mus[j];
         }
         if (change <= TRIPOD_REACTIONS_FRICTION_TOLERANCE * scale) {
             break;
@@ -268,6 +289,10 @@ static void frictional_balance(Guard *guard, const Arm arm[3], const double adj[
     }
     *power = 0.0;
     for (j = 0; j < 3; j++) {
+        lams[j] = lam_now[j];
+        mus[j] = mu_now[j];
+        slips[j] = slip_now[j];
+        grooves[j] = groove_now[j];
         /* dissipation: -g_j zdot_j (groove) + phi_j sdot_j (arm), sdot_j |e_j| = sigma_j |e_j|^2 */
         *power = *power - grooves[j] * arm[j].zdot + slips[j] * arm[j].sigma * (arm[j].exy2 + arm[j].ez * arm[j].ez);
     }
@@ -459,13 +484,31 @@ static void leading_order_reactions(Guard *guard, const Load *load, double ratio
 
 /* ---- outputs (outputs.coupling_outputs) ------------------------------------------------------ */
 
-/* Components (x, y) in the bend plane's frame turned by psi about Z' into the housing's X'Y' (M8,
- * outputs.to_housing); at psi = 0 they stay as they are, a zero's sign included. */
-static void to_housing(Guard *guard, double *x, double *y, double psi)
+/* The turn by psi about Z' from the bend plane's frame into the housing's X'Y' (M8, outputs.to_housing):
+ * its cosine and sine, taken once for every vector the step turns; none at psi = 0. */
+typedef struct {
+    int turned;
+    double c, s;
+} HousingTurn;
+
+static HousingTurn housing_turn(Guard *guard, double psi)
 {
+    HousingTurn turn = {0, 1.0, 0.0};
     if (psi != 0.0) {
-        double c = cosine(guard, psi), s = sine(guard, psi), turned_x = c * *x - s * *y;
-        *y = s * *x + c * *y;
+        turn.turned = 1;
+        turn.c = cosine(guard, psi);
+        turn.s = sine(guard, psi);
+    }
+    return turn;
+}
+
+/* Components (x, y) in the bend plane's frame turned into the housing's; at psi = 0 they stay as they are, a
+ * zero's sign included. */
+static void to_housing(const HousingTurn *turn, double *x, double *y)
+{
+    if (turn->turned) {
+        double turned_x = turn->c * *x - turn->s * *y;
+        *y = turn->s * *x + turn->c * *y;
         *x = turned_x;
     }
 }
@@ -501,6 +544,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     double phi_in = VALUE(phi_in), r = VALUE(r), l = VALUE(l), T_load = VALUE(T_load);
     double cos_beta, sin_beta, rho, pin, phi_out = 0.0, ratio = 0.0, theta, omega_spin;
     double output_power, total, psi, psi_dot, phi, spin;
+    HousingTurn turn;
     if (INTEGER(beta_rate) != RATES_FROM_INPUTS) { /* the samples are kept for the automatic choice too */
         double samples[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
         int count = 1, k;
@@ -582,8 +626,9 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
     phi_out = phi_out + psi; /* (M2) */
     output_power = T_load * omega_spin;
     total = output_power + forces.P_friction;
-    to_housing(&guard, &forces.Rx_in, &forces.Ry_in, psi);
-    to_housing(&guard, &forces.Mx_in, &forces.My_in, psi);
+    turn = housing_turn(&guard, psi);
+    to_housing(&turn, &forces.Rx_in, &forces.Ry_in);
+    to_housing(&turn, &forces.Mx_in, &forces.My_in);
     VALUE(phi_out) = phi_out;
     VALUE(delta_phi) = phi_out - phi_in;
     VALUE(omega_out) = spin * ratio + psi_dot; /* (M7) */
@@ -625,7 +670,7 @@ static Failure evaluate(ModelData *data, double input_time, double elapsed)
         seed_x = tan_beta * m * a_sum;                                                       /* eq 33 */
         seed_y = divide(&guard, -3.0 * m * rho * rho * omega_squared * tan_beta * sine(&guard, 6.0 * seed_phi),
                         l);                                                                  /* eq 34 */
-        to_housing(&guard, &seed_x, &seed_y, psi);
+        to_housing(&turn, &seed_x, &seed_y);
         VALUE(Rx_in) = seed_x;
         VALUE(Ry_in) = seed_y;
     }
