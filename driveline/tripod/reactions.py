@@ -258,7 +258,7 @@ def slip_sign(speed: Real, slip_speed: float) -> Real:
     """Regularised sign of a sliding speed, ``u / sqrt(1 + u^2)`` with ``u = speed / slip_speed``:
     odd, smooth, within 1 % of the sign above 7 slip speeds."""
     u = speed / slip_speed
-    return u / (1.0 + u * u) ** 0.5
+    return u / lib(u).sqrt(1.0 + u * u)
 
 
 def _friction_arm(arm, xp):

@@ -28,21 +28,29 @@ void forces_elastic(const Layout *layout, const double maps[][3][6], int n, cons
     }
 }
 
-void forces_elastic_load(const Layout *layout, const double maps[][3][6], const double q[6], double out[6])
+void forces_generalised(const Layout *layout, const double maps[][3][6], const double forces[][3], double out[6])
 {
     int n, i, k;
     memset(out, 0, 6 * sizeof *out);
     for (n = 0; n < layout->count; n++) {
-        double f[3];
-        forces_elastic(layout, maps, n, q, f);
         for (i = 0; i < 6; i++) {
             double sum = 0.0;
             for (k = 0; k < 3; k++) {
-                sum += maps[n][k][i] * f[k];
+                sum += maps[n][k][i] * forces[n][k];
             }
             out[i] += sum;
         }
     }
+}
+
+void forces_elastic_load(const Layout *layout, const double maps[][3][6], const double q[6], double out[6])
+{
+    double f[MOUNTS_LAYOUT_MAX_MOUNTS][3];
+    int n;
+    for (n = 0; n < layout->count; n++) {
+        forces_elastic(layout, maps, n, q, f[n]);
+    }
+    forces_generalised(layout, maps, (const double(*)[3])f, out);
 }
 
 /* sum_i T_i^T A_i^T diag(rates_i) A_i T_i into ``out`` (6 x 6), the rates of mount i in rates[3 i ...] */

@@ -91,6 +91,8 @@ typedef struct {
 
 /* Mount n's elastic force along its axes at q (from the unloaded mounts) */
 void forces_elastic(const Layout *layout, const double maps[][3][6], int n, const double q[6], double out[3]);
+/* sum_n T_n^T A_n^T forces[n]: the generalised force of each mount's ``forces`` along its axes */
+void forces_generalised(const Layout *layout, const double maps[][3][6], const double forces[][3], double out[6]);
 /* forces.elastic_load, tangent_stiffness, elastic_energy, mean_elastic_load (its Jacobian left out when
  * ``jacobian`` is NULL) */
 void forces_elastic_load(const Layout *layout, const double maps[][3][6], const double q[6], double out[6]);

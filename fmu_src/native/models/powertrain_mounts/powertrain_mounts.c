@@ -52,6 +52,7 @@ typedef struct {
     int dominant[6];
     int progressive, size; /* a mount's characteristic is nonlinear; the state's length, 12 and the branches */
     Branches branches;
+    int idle[BRANCH_SLOTS], idle_count; /* the branch slots no branch takes */
     int has_propagator, has_matrices;
     Propagator propagator;
     StepMatrices matrices; /* of the last step size, progressive mounts' */
@@ -318,6 +319,21 @@ static void modes(System *s, double stiffness[6][6], int with_branches)
 }
 
 /* exact_step.state_matrices (with the branches) and system.input_map */
+/* The slots no branch of ``s->branches`` takes, in s->idle */
+static void idle_slots(System *s)
+{
+    int taken[BRANCH_SLOTS] = {0}, k;
+    for (k = 0; k < s->branches.count; k++) {
+        taken[s->branches.slots[k]] = 1;
+    }
+    s->idle_count = 0;
+    for (k = 0; k < BRANCH_SLOTS; k++) {
+        if (!taken[k]) {
+            s->idle[s->idle_count++] = k;
+        }
+    }
+}
+
 static int state_and_inputs(System *s, double centres[2][3], double frames[2][3][3])
 {
     int i, side, k;
@@ -432,6 +448,7 @@ static int operating_point(System *s, const ModelData *data, double centres[2][3
         return 0;
     }
     s->size = 12 + forces_branch_map(&s->layout, (const double(*)[3][6])s->maps, s->operating, &s->branches);
+    idle_slots(s);
     if (!state_and_inputs(s, centres, frames)) {
         snprintf(error, ERROR_SIZE, "Singular matrix");
         return 0;
@@ -577,8 +594,10 @@ static void generalised(const System *s, const ModelData *data, int rates, doubl
     }
 }
 
-/* MountSystem.accelerations: q'' at ``state`` under the generalised ``force`` */
-static void accelerations(const System *s, const double *state, const double force[6], double out[6])
+/* MountSystem.accelerations: q'' at ``state`` under the generalised ``force``, the mounts' elastic forces along
+ * their axes ``springs`` (progressive mounts') */
+static void accelerations(const System *s, const double *state, const double force[6], const double springs[][3],
+                          double out[6])
 {
     int i, k;
     if (!s->progressive) {
@@ -595,11 +614,8 @@ static void accelerations(const System *s, const double *state, const double for
         return;
     }
     {
-        double q[6], elastic[6], total[6];
-        for (i = 0; i < 6; i++) {
-            q[i] = s->weight_sag[i] + state[i];
-        }
-        forces_elastic_load(&s->layout, MAPS(s), q, elastic);
+        double elastic[6], total[6];
+        forces_generalised(&s->layout, MAPS(s), springs, elastic);
         for (i = 0; i < 6; i++) {
             double viscous = 0.0, branches = 0.0;
             for (k = 0; k < 6; k++) {
@@ -620,52 +636,55 @@ static void accelerations(const System *s, const double *state, const double for
 }
 
 /* PowertrainMountsModel._show: motion and mount forces of ``state`` (q, q', z) under ``force``; the branch
- * forces into the internal state */
+ * forces into the internal state. Each mount's elastic force and speed along its axes (R q' of its branches,
+ * whose rows are the mount's) are computed once, for the accelerations, branch rates and mount forces. */
 static void show(const System *s, ModelData *data, const double *state, const double force[6])
 {
-    double q[6], acceleration[6];
+    double q[6], acceleration[6], springs[MOUNTS_LAYOUT_MAX_MOUNTS][3], speeds[3 * MOUNTS_LAYOUT_MAX_MOUNTS];
     int i, k, n, first_branch = 0;
-    accelerations(s, state, force, acceleration);
+    for (i = 0; i < 6; i++) {
+        q[i] = s->weight_sag[i] + state[i];
+    }
+    for (n = 0; n < s->layout.count; n++) {
+        forces_elastic(&s->layout, MAPS(s), n, q, springs[n]);
+        for (k = 0; k < 3; k++) {
+            double speed = 0.0;
+            for (i = 0; i < 6; i++) {
+                speed += s->maps[n][k][i] * state[6 + i];
+            }
+            speeds[3 * n + k] = speed;
+        }
+    }
+    accelerations(s, state, force, (const double(*)[3])springs, acceleration);
     for (i = 0; i < 12; i++) {
         data->real_value[STATE_VARIABLES[i]] = state[i];
     }
     for (i = 0; i < 6; i++) {
         data->real_value[ACCELERATION_VARIABLES[i]] = acceleration[i];
-        q[i] = s->weight_sag[i] + state[i];
     }
-    for (k = 0; k < FMU_INTERNAL_SLOTS; k++) {
-        data->internal[k] = k < s->branches.count ? state[12 + k] : 0.0;
+    memcpy(data->internal, state + 12, s->branches.count * sizeof *state);
+    memset(data->internal + s->branches.count, 0, (FMU_INTERNAL_SLOTS - s->branches.count) * sizeof *state);
+    for (k = 0; k < s->idle_count; k++) {
+        data->real_value[BRANCH_VARIABLES[s->idle[k]]] = data->real_value[BRANCH_RATE_VARIABLES[s->idle[k]]] = 0.0;
     }
-    for (k = 0; k < BRANCH_SLOTS; k++) {
-        data->real_value[BRANCH_VARIABLES[k]] = data->real_value[BRANCH_RATE_VARIABLES[k]] = 0.0;
-    }
-    for (k = 0; k < s->branches.count; k++) { /* MountSystem.derivatives: z' = g (R q') - z / tau */
-        double speed = 0.0;
-        for (i = 0; i < 6; i++) {
-            speed += s->branches.rows[k][i] * state[6 + i];
-        }
-        data->real_value[BRANCH_VARIABLES[s->branches.slots[k]]] = state[12 + k];
-        data->real_value[BRANCH_RATE_VARIABLES[s->branches.slots[k]]] =
-            s->branches.gains[k] * speed - state[12 + k] / s->branches.times[k];
+    for (k = 0; k < s->branches.count; k++) { /* MountSystem.derivatives: z' = g (R q') - z / tau, slot (3 n + axis) */
+        int slot = s->branches.slots[k];
+        data->real_value[BRANCH_VARIABLES[slot]] = state[12 + k];
+        data->real_value[BRANCH_RATE_VARIABLES[slot]] =
+            s->branches.gains[k] * speeds[slot / MOUNTS_RUBBER_BRANCHES] - state[12 + k] / s->branches.times[k];
     }
     for (n = 0; n < MOUNTS_LAYOUT_MAX_MOUNTS; n++) { /* MountSystem.mount_forces */
         double local[3] = {0, 0, 0};
         int first = V_F_x_mount1 + 3 * n;
         if (n < s->layout.count) {
             const Mount *m = &s->layout.mounts[n];
-            const double(*map)[6] = s->maps[n];
-            double spring[3];
-            forces_elastic(&s->layout, MAPS(s), n, q, spring);
             for (k = 0; k < 3; k++) {
-                double speed = 0.0, branches = 0.0;
+                double branches = 0.0;
                 int j;
-                for (i = 0; i < 6; i++) {
-                    speed += map[k][i] * state[6 + i];
-                }
                 for (j = 0; j < m->branch_count; j++) {
                     branches += state[12 + first_branch + k * m->branch_count + j];
                 }
-                local[k] = spring[k] + m->damping[k] * speed + branches;
+                local[k] = springs[n][k] + m->damping[k] * speeds[3 * n + k] + branches;
             }
             first_branch += 3 * m->branch_count;
             for (i = 0; i < 3; i++) {

@@ -70,7 +70,7 @@ typedef struct {
 static inline double slip_sign(Guard *guard, double speed, double slip_speed)
 {
     double u = divide(guard, speed, slip_speed);
-    return divide(guard, u, pow(1.0 + u * u, 0.5));
+    return divide(guard, u, sqrt(1.0 + u * u));
 }
 
 /* The frame and motion of the output shaft that the rollers' reactions need (exact_reactions' steps 1-3): the
