@@ -104,7 +104,7 @@ def main(argv: list[str] | None = None) -> None:
         "CPU by time.process_time"), found, args.update_docs)
     for path in {args.figure, FIGURE if args.update_docs else None} - {None}:
         subtitle = (f"The native VehicleLaunch.ssp's launch, 140 N.m for 4 s (measured {measurement.date:%Y-%m-%d}):\n"
-                    "the right joint in phase (dashed) or 60 deg ahead (solid), the housings held or moving")
+                    "the right joint in phase or 60 deg ahead, the housings held (solid) or moving (dashed)")
         print(f"figure: {save(launch_study.housing_motion_figure(drawn, subtitle), path)}")
 
 

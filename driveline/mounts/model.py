@@ -100,11 +100,7 @@ class PowertrainMountsModel(SteppedModel):
     def start(self, start_time: float) -> None:
         system = self._system
         force = system.inputs @ self._values(INPUTS)
-        if system.progressive:
-            sag = system.equilibrium(system.weight + force) - system.weight_sag
-        else:
-            sag = system.body.static_displacement(force)
-        state = np.concatenate([sag, np.zeros(system.size - 6)])
+        state = np.concatenate([system.start_displacement(force), np.zeros(system.size - 6)])
         self._show(state, force)
         for side in SIDES:
             reason = self._limit_error(side)

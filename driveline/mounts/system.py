@@ -103,6 +103,13 @@ class MountSystem:
         """``Q`` of the static equilibrium under the generalised ``load`` (the weight's included)."""
         return _equilibrium(self.body, load)
 
+    def start_displacement(self, force: np.ndarray) -> np.ndarray:
+        """``q`` of the static equilibrium under the generalised ``force`` and the weight, from the weight's: where
+        the model starts (``K^-1 force`` on linear mounts, Newton's root of the characteristics on progressive)."""
+        if self.progressive:
+            return self.equilibrium(self.weight + force) - self.weight_sag
+        return self.body.static_displacement(force)
+
     def static_sag(self, g: float, mean_torque: float) -> np.ndarray:
         """Static displacement from the unloaded mounts under the weight and ``-mean_torque`` about the motor axis."""
         return self.equilibrium(self.body.gravity(g) + _torque(self.placement, mean_torque))

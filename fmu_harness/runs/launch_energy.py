@@ -6,13 +6,16 @@ relaxation, eq V6, stores ``sigma (L^2 / C) ln cosh(C s / L)`` with ``F = L tanh
 dissipated by the halfshafts' damping, the joints' friction (``P_friction``), the tyres' slip
 (``F (|v| + v_low) s``) and the road load. The powertrain on its mounts has its own balance: the
 work of the joints' housing loads and of the drive's reaction torque (``T_reaction``) goes into its
-kinetic and elastic energy and the mounts' damping.
+kinetic and elastic energy and the mounts' damping. That balance is the linear mounts' (``K``, ``C``): the
+launch runs here on the linear layout (``transverse_fwd_powertrain``), not PowertrainMounts' rubber default,
+whose snubbers' and Maxwell branches' energy tests/core/test_mounts_rubber.py balances on its own.
 The dissipated powers are integrated with the state (quadrature states), so the balance holds to the
 integration's tolerance, not a quadrature rule's.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -20,19 +23,26 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from driveline.mounts.rigid_body import COORDINATES
-from driveline.mounts.spec import REACTIONS
+from driveline.mounts.spec import REACTIONS, SHARED_LAYOUT
 from driveline.tripod.exact import exact_pose
 from driveline.vehicle import dynamics
 from driveline.vehicle.dynamics import Joints
 
 from . import system
-from .launch_reference import ATOL, MOUNTS_STATE, PHI_IN, RTOL, LaunchEquations, launch_parameters
+from .launch_reference import ATOL, PHI_IN, RTOL, LaunchEquations, launch_parameters
 
 #: The integrated powers (quadrature states), in this order.
 POWERS = ("motor work", "halfshaft damping", "joint friction", "tyre slip", "road load", "housing loads' work",
           "mount damping")
 #: Step of the central difference of the plungers' travel in phi_in [rad] (error ~1e-12 of the speed).
 TRAVEL_STEP = 1e-6
+
+
+def _linear(overrides: dict | None = None) -> dict:
+    """``overrides`` with the mounts on the linear layout (unless they name one)."""
+    found = {name: dict(values) for name, values in (overrides or {}).items()}
+    found["mounts"] = {"layout": SHARED_LAYOUT} | found.get("mounts", {})
+    return found
 
 
 def powers(equations: LaunchEquations, y: np.ndarray, found: dict) -> list[float]:
@@ -45,7 +55,7 @@ def powers(equations: LaunchEquations, y: np.ndarray, found: dict) -> list[float
     tyres = sum(dynamics.tyre_force(drive, state[slip], mu) * slip_speed * state[slip]
                 for slip, mu in ((dynamics.SLIP_LEFT, drive.mu_road_left), (dynamics.SLIP_RIGHT, drive.mu_road_right)))
     mounts = equations.mounts
-    velocity = y[MOUNTS_STATE][6:]
+    velocity = y[equations.mounts_state][6:]
     return [found["T_motor"] * drive.ratio * case, damping, sum(j["P_friction"] for j in found["joints"]), tyres,
             dynamics.road_load(drive, state[dynamics.SPEED]) * state[dynamics.SPEED],
             float(found["force"] @ velocity), float(velocity @ mounts.body.damping @ velocity)]
@@ -72,7 +82,7 @@ def stored(equations: LaunchEquations, y: np.ndarray, found: dict) -> dict[str, 
         zdot = omega * (travel[1] - travel[0]) / (2.0 * TRAVEL_STEP)
         plungers += 0.5 * p["m_plunger"] * (3.0 * (omega * p["r"]) ** 2 + float(zdot @ zdot))
     body = equations.mounts.body
-    q, velocity = y[MOUNTS_STATE][:6], y[MOUNTS_STATE][6:]
+    q, velocity = y[equations.mounts_state][:6], y[equations.mounts_state][6:]
     mounts = 0.5 * float(velocity @ body.mass @ velocity + q @ body.stiffness @ q)
     return {"drive": kinetic, "halfshafts": springs, "tyres": tyres, "plungers": plungers, "mounts": mounts}
 
@@ -80,7 +90,7 @@ def stored(equations: LaunchEquations, y: np.ndarray, found: dict) -> dict[str, 
 def balance(stop_time: float, overrides: dict | None = None) -> dict[str, float]:
     """The monolithic launch's energies at ``stop_time`` [J]: each integrated power of :data:`POWERS`,
     each stored energy's change, and the loop's and the mounting's residuals relative to the work put in."""
-    equations = LaunchEquations(launch_parameters(overrides))
+    equations = LaunchEquations(launch_parameters(_linear(overrides)))
     size = len(equations.start())
 
     def rates(t: float, y: np.ndarray) -> np.ndarray:
@@ -131,7 +141,7 @@ def _cosimulation_state(equations: LaunchEquations, row: dict[str, float]) -> tu
         y[slip] = row[f"drive.slip_{wheel}"]
         y[PHI_IN[i]] = sides[i]["phi_in"]
     y[dynamics.SPEED] = row["drive.v_x"]
-    y[MOUNTS_STATE] = [row[f"mounts.{name}"] for name in (*COORDINATES, *(f"{c}_dot" for c in COORDINATES))]
+    y[equations.mounts_state] = [row[f"mounts.{name}"] for name in (*COORDINATES, *(f"{c}_dot" for c in COORDINATES))]
     found = {"placed": placed, "T_motor": row["motor.T_motor"], "joints": sides, "omega_in": omega,
              "force": equations.mounts.inputs @ equations.mount_loads(sides, row["drive.T_reaction"])}
     return y, found
@@ -141,9 +151,11 @@ def cosimulation_balance(models: Path, natives: Path | None, step: float, stop_t
     """:func:`balance` of the launch in the project's Jacobi master at ``step``: the stored energies from
     the outputs at ``stop_time``, the powers from the outputs at each communication point integrated by
     the trapezoidal rule (from the start, at rest)."""
-    equations = LaunchEquations(launch_parameters())
+    equations = LaunchEquations(launch_parameters(_linear()))
     launch = system.vehicle_launch(housing_motion=False)
-    launch = system.System(launch.name, launch.components, launch.connections, stop_time, step)
+    components = tuple(dataclasses.replace(c, parameters={**c.parameters, "layout": SHARED_LAYOUT})
+                       if c.name == "mounts" else c for c in launch.components)
+    launch = system.System(launch.name, components, launch.connections, stop_time, step)
     outputs = launch.outputs()
     rows = system.simulate(launch, models, outputs, natives=natives)
     start = equations.start()

@@ -3,7 +3,8 @@
 The physics cores of the launch's components called directly, with the parameters of
 :func:`.system.vehicle_launch`: TorqueSource's ramp, VehicleDriveline's equations (eqs V1-V8), both
 TripodCouplings' exact kinematics and reactions with friction, PowertrainMounts' equations of motion
-``M q'' + C q' + K q = G u``; integrated together by ``scipy.integrate.solve_ivp`` at a tight
+(``M q'' + C q' + K q = G u`` on linear mounts; on the rubber default the characteristics' forces and the
+Maxwell branches' forces as states, ``MountSystem.derivatives``); integrated together by ``scipy.integrate.solve_ivp`` at a tight
 tolerance. The joints have no state beyond their input angle, so each side gear's angle joins the
 drive's state. A joint's ``T_in`` depends on its input acceleration (the plungers' inertia) and the side
 gears' accelerations on both ``T_in``: that algebraic loop, which the co-simulation breaks by a
@@ -60,7 +61,7 @@ LOOP_TOLERANCE = 1e-11
 MAX_LOOP_ITERATIONS = 50
 DRIVE_STATES = dynamics.STATE_SIZE
 PHI_IN = (DRIVE_STATES, DRIVE_STATES + 1)  # left and right joints' input angle, each in its own frame
-MOUNTS_STATE = slice(DRIVE_STATES + 2, DRIVE_STATES + 14)
+MOUNTS_START = DRIVE_STATES + 2  # the mounts' state (q, q', the branches' forces) from here to the end
 
 
 def _configured(model_class, parameters: Mapping[str, object]):
@@ -87,6 +88,7 @@ class LaunchEquations:
         if errors:
             raise ValueError("; ".join(errors))
         self.mounts = mounts._system
+        self.mounts_state = slice(MOUNTS_START, MOUNTS_START + self.mounts.size)
         self._warm: dict[str, Solution | None] = {side: None for side in system.SIDES}
         self._alpha = [0.0, 0.0]
 
@@ -136,10 +138,10 @@ class LaunchEquations:
         placed = placed._replace(T_in_left=joints[0]["T_in"], T_in_right=-joints[1]["T_in"])
         reaction = dynamics.reaction_torque(self.drive, placed, rates[dynamics.CASE])
         force = self.mounts.inputs @ self.mount_loads(joints, reaction)
-        mount_state = np.asarray(y[MOUNTS_STATE], dtype=float)
+        mount_state = np.asarray(y[self.mounts_state], dtype=float)
         return {"drive_rates": rates, "omega_in": omega, "joints": joints, "T_motor": T_motor, "loads": loads,
                 "placed": placed, "force": force, "reaction": reaction,
-                "mount_rates": self.mounts.a @ mount_state + self.mounts.b @ force,
+                "mount_rates": self.mounts.derivatives(mount_state, force),
                 "mount_accelerations": self.mounts.accelerations(mount_state, force)}
 
     @staticmethod
@@ -161,10 +163,10 @@ class LaunchEquations:
         phi = [float(self.joints[side]["phi_in_start"]) for side in system.SIDES]
         placed = Joints(0.0, 0.0, self._kinematics("left", phi[0])[0], -self._kinematics("right", phi[1])[0], 0.0, 0.0)
         drive = dynamics.start_state(self.drive, self.v_start, placed)
-        y = np.concatenate([drive, phi, np.zeros(12)])
+        y = np.concatenate([drive, phi, np.zeros(self.mounts.size)])
         found = self.evaluate(0.0, y)
         force = self.mounts.inputs @ self.mount_loads(found["joints"], found["reaction"])
-        y[MOUNTS_STATE.start:MOUNTS_STATE.start + 6] = self.mounts.body.static_displacement(force)
+        y[MOUNTS_START:MOUNTS_START + 6] = self.mounts.start_displacement(force)
         return y
 
     def signals(self, t: float, y: np.ndarray) -> dict[str, float]:

@@ -14,8 +14,9 @@ launch is docs/vehicle_launch.md's "The powertrain's motion in the joints"), run
 in Gauss-Seidel order at 0.8 ms, its stable limit, where a 40 s launch costs about 4 s of CPU.
 
 The powertrain's response is split into its modes with the core's mass-normalised mode shapes of the
-default layout (``driveline.mounts``): mode j's share of the accelerations at the centre of gravity,
-``phi_j phi_j^T M q''``, read in its dominant coordinate. Each mode's third order over the halfshaft
+package's mounts (``driveline.mounts``: the default layout, on rubber, linearised about the weight's
+equilibrium, its operating point at the package's ``T_mean`` 0): mode j's share of the accelerations at the
+centre of gravity, ``phi_j phi_j^T M q''``, read in its dominant coordinate. Each mode's third order over the halfshaft
 speed (:mod:`.order_tracking`) peaks near its crossing, later by the sweep: the single-mode reference
 (:func:`swept_peak`) gives where a mode of that frequency and damping passed at the launch's own speed
 history peaks.
@@ -34,8 +35,10 @@ from matplotlib.figure import Figure
 from scipy.signal import lsim
 
 from driveline.catalog import MODELS
-from driveline.mounts.layout import load_layout, shipped_layout
-from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody, modes
+from driveline.mounts.model import PowertrainMountsModel
+from driveline.mounts.rigid_body import COORDINATES, Modes, RigidBody
+from driveline.mounts.spec import DEFAULT_LAYOUT
+from driveline.vehicle.dynamics import GRAVITY
 
 from ..runs import ssp_package
 from ..runs.system import LAUNCH_ORDER, run_jacobi
@@ -53,7 +56,7 @@ position (moving, the grooves' friction on the housing's speed damps the mount m
 STOP_TIME = 40.0  # [s]
 STEP = 8e-4  # Gauss-Seidel's longest stable step (docs/vehicle_launch.md) [s]
 EVERY = 4  # the CSV file holds every 4th communication point (3.2 ms)
-LAYOUT = "transverse_fwd_powertrain"  # PowertrainMounts' default layout
+LAYOUT = DEFAULT_LAYOUT  # the package's mounts' layout: PowertrainMounts' default
 KMH = 3.6
 SHAFT = "joint_left.phi_out"  # the left halfshaft's angle, whose orders the study tracks
 RESPONSE = "mounts.pitch_ddot"  # the spectrogram's signal: the coordinate that responds most
@@ -107,14 +110,18 @@ def run(package: Path, torque: float = TORQUE, stop_time: float = STOP_TIME, ste
     return Launch(rows[:, 0], {name: rows[:, k + 1] for k, name in enumerate(outputs)})
 
 
-def powertrain_modes() -> tuple[RigidBody, Modes]:
-    body = RigidBody.of(load_layout(shipped_layout(LAYOUT)))
-    return body, modes(body)
-
-
-def modal_damping(body: RigidBody, found: Modes) -> np.ndarray:
-    """Each mode's damping ratio, the diagonal of ``Phi^T C Phi`` over ``2 omega_j``."""
-    return np.diag(found.shapes.T @ body.damping @ found.shapes) / (4.0 * np.pi * found.frequencies)
+def powertrain_modes(layout: str = LAYOUT) -> tuple[RigidBody, Modes]:
+    """The package's powertrain and its modes, as its ``PowertrainMounts`` outputs them: ``layout`` at the
+    package's ``g``, linearised about the operating point of ``T_mean`` 0 (the branches' storage stiffness at
+    each mode's frequency, the stops' tangent rates; ``damping_ratios``: equation (4) of
+    docs/powertrain_mounts.md)."""
+    model = PowertrainMountsModel()
+    model.layout, model.g = layout, GRAVITY
+    errors = model.initialize(0.0)
+    if errors:
+        raise ValueError(errors[0])
+    system = model._system
+    return system.body, system.operating_modes(system.static_sag(model.g, model.T_mean))
 
 
 def modal_accelerations(body: RigidBody, found: Modes, accelerations: np.ndarray) -> np.ndarray:
@@ -165,7 +172,7 @@ def third_order_peaks(launch: Launch) -> tuple[list[Peak], np.ndarray, np.ndarra
     """Each mode's peak, the order tracking's speeds [rad/s] and each mode's third-order amplitude
     there (modes x speeds, the unit of its dominant coordinate's acceleration)."""
     body, found = powertrain_modes()
-    damping = modal_damping(body, found)
+    damping = found.damping_ratios
     shares = modal_accelerations(body, found, launch.accelerations())
     tracks = [order_tracking.order_track(launch.time, launch.shaft_angle, shares[:, j], 3) for j in range(6)]
     speeds = tracks[0][0]
@@ -199,6 +206,9 @@ def peak_row(peak: Peak, end_speed: float, end_amplitude: float) -> tuple:
             100.0 * (end_speed / peak.crossing - 1.0), end_speed, end_amplitude)
 
 
+#: The sizes [pt] of the modes' peak rings on the orders figure's lower panel, each at least 2.5 pt (3.5 px) from
+#: the others' and from the crossings' 10 pt (4.2 px at the figures' 120 dpi), so that rings that overlap nest
+PEAK_RINGS = (20.5, 18.0, 15.5, 13.0, 6.5, 4.0)
 TAKE_OFF = 2.0  # the torque panel's span [s]: the ramp and the halfshafts' wind-up, then the torques hold
 
 
@@ -306,12 +316,14 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
                     label=f"mode {peak.mode} ({peak.coordinate}): {peak.difference:+.1f} %")
         bottom.plot(peak.crossing, np.interp(peak.crossing, speeds, amplitude) / peak.measured[0],
                     **(ring | {"mec": color, "ms": 10}), label=f"_crossing {peak.mode}")
-        bottom.plot(peak.measured[1], 1.0, **(dot | {"color": color}), label=f"_peak {peak.mode}")
+        bottom.plot(peak.measured[1], 1.0, **(ring | {"mec": color, "ms": PEAK_RINGS[peak.mode - 1], "zorder": 4}),
+                    label=f"_peak {peak.mode}")
     bottom.set_ylim(0.0, 1.1)
     bottom.set_xlabel("left halfshaft speed [rad/s]")
     bottom.set_ylabel("third-order amplitude / its peak [1]")
-    bottom.set_title("Each mount mode's share of the powertrain's acceleration, third order: crossing (ring), "
-                     "peak (dot),\nthe peak's speed against the crossing's", fontsize=10)
+    bottom.set_title("Each mount mode's share of the powertrain's acceleration, third order: crossing (ring of one "
+                     "size), peak\n(a ring of the mode's size: peaks close in speed nest), the peak's speed against "
+                     "the crossing's", fontsize=10)
     bottom.legend(loc="upper left", fontsize=8)
     bottom.grid(alpha=0.3)
     return fig
@@ -322,9 +334,10 @@ def orders_figure(launch: Launch, peaks: list[Peak], speeds: np.ndarray, amplitu
 HOUSING_PANELS = (("mounts.y_ddot", "lateral acceleration y_ddot", "m/s2"),
                   ("mounts.yaw_ddot", "yaw acceleration yaw_ddot", "rad/s2"),
                   ("mounts.pitch_ddot", "pitch acceleration pitch_ddot", "rad/s2"))
-#: How each launch is drawn: the housings' motion by colour, the right joint's phase by line style
-HOUSING_STYLE = {False: (VERMILLION, "housings held"), True: (BLUE, "housings moving")}
-PHASE_STYLE = {0.0: "--", 60.0: "-"}
+#: How each launch is drawn: the housings held solid, moving dashed (drawn over the held ones, whose curves show
+#: between the dashes where the two coincide, as in phase on rubber); a colour for each launch
+HOUSING_STYLE = {False: ("-", "housings held"), True: ("--", "housings moving")}
+LAUNCH_COLOURS = {(0.0, False): ORANGE, (0.0, True): SKY, (60.0, False): VERMILLION, (60.0, True): BLUE}
 
 
 def housing_tracks(time: np.ndarray, shaft_angle: np.ndarray,
@@ -346,9 +359,9 @@ def housing_motion_figure(tracks: dict[tuple[float, bool], dict[str, tuple[np.nd
         low, high = np.inf, 0.0
         for (phase, moving), found in sorted(tracks.items(), key=lambda item: (item[0][1], -item[0][0])):
             speeds, amplitude = found[name]
-            color, housings = HOUSING_STYLE[moving]
+            style, housings = HOUSING_STYLE[moving]
             shown = amplitude > 0.0
-            ax.plot(speeds[shown], amplitude[shown], PHASE_STYLE.get(phase, ":"), color=color, lw=1.3,
+            ax.plot(speeds[shown], amplitude[shown], style, color=LAUNCH_COLOURS.get((phase, moving), YELLOW), lw=1.3,
                     label=f"right joint {phase:g} deg ahead, {housings}")
             low, high = min(low, amplitude[shown].min()), max(high, amplitude[shown].max())
         ax.set_yscale("log")

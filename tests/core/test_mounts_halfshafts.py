@@ -1,7 +1,11 @@
 """PowertrainMounts' halfshaft outputs (driveline/mounts/halfshafts.py): at the design position the design
 geometry; under load against the powertrain's exact rigid motion handed to driveline/halfshaft/geometry.py
 (a turned frame, within the second order the linear model drops); their rates against central differences
-of a run; the switch that holds the design; the joints' limits refused at initialisation in one line."""
+of a run; the switch that holds the design; the joints' limits refused at initialisation in one line.
+
+On the linear layout (``transverse_fwd_powertrain``): the geometry's tests want a motion proportional to the
+loads (the orders of the differences) and an equilibrium reached exactly (rates 0 at rest, not Newton's
+rounding); the progressive default's motion enters the same outputs through the same code."""
 
 from __future__ import annotations
 
@@ -15,7 +19,7 @@ from driveline.halfshaft.geometry import HousingMotion, shaft_geometry
 from driveline.mounts.halfshafts import GEOMETRY
 from driveline.mounts.model import PowertrainMountsModel
 from driveline.mounts.rigid_body import COORDINATES
-from driveline.mounts.spec import DESIGN, SIDES
+from driveline.mounts.spec import DESIGN, SHARED_LAYOUT, SIDES
 
 VELOCITIES = tuple(f"{name}_dot" for name in COORDINATES)
 ACCELERATIONS = tuple(f"{name}_ddot" for name in COORDINATES)
@@ -23,7 +27,7 @@ ACCELERATIONS = tuple(f"{name}_ddot" for name in COORDINATES)
 
 def _model(**values) -> PowertrainMountsModel:
     model = PowertrainMountsModel()
-    for name, value in values.items():
+    for name, value in {"layout": SHARED_LAYOUT, **values}.items():
         setattr(model, name, value)
     return model
 

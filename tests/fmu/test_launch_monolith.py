@@ -2,7 +2,14 @@
 model pages (``support.launch_monolith``): the third-order peaks of the powertrain's lateral, yaw and pitch
 accelerations and of mode 1 at the right joint's phases, with the housings held and, where the package has
 it, moving with the powertrain; the model's halfshaft geometry on a moving powertrain against the project's
-core (``driveline.halfshaft.geometry``), a second computation of H1-H4."""
+core (``driveline.halfshaft.geometry``), a second computation of H1-H4.
+
+The package's mounts run the linear layout here (``transverse_fwd_powertrain``, the one the model reads), not
+their rubber default: the model checks the loop's wiring, the joints' kinetics and the housings' geometry, and
+its powertrain is equation (1) with viscous mounts; the rubber's snubbers and Maxwell branches are checked
+against computations of their own (tests/core/test_mounts_rubber.py: the loss factor from a time-domain run,
+the equilibrium against a second writing, the exact steps against solve_ivp of an independently assembled
+state matrix, free decays of every mode)."""
 
 from __future__ import annotations
 
@@ -13,6 +20,7 @@ import numpy as np
 import pytest
 
 from driveline.halfshaft.geometry import HousingMotion, shaft_geometry
+from driveline.mounts.spec import SHARED_LAYOUT
 from fmu_harness.runs import system
 from fmu_harness.studies import launch_study, order_tracking
 from support import launch_monolith
@@ -40,10 +48,11 @@ def package(fmi2_dir, native_dir):
 def package_peaks(package, phase: float, moving: bool) -> dict[str, float]:
     """The package's launch (140 N.m, 4 s, Gauss-Seidel at 2e-4 s), the housings moving or held: each
     third-order peak, tracked in the left halfshaft's angle."""
-    changes = {"joint_right": {"phi_in_start": phase}} | ({"mounts": {"housing_motion": int(moving)}} if MOVING else {})
+    mounts = {"layout": SHARED_LAYOUT} | ({"housing_motion": int(moving)} if MOVING else {})
+    changes = {"joint_right": {"phi_in_start": phase}, "mounts": mounts}
     run = launch_study.run(package, torque=140.0, stop_time=4.0, step=2e-4, changes=changes)
     accelerations = run.accelerations()
-    body, found = launch_study.powertrain_modes()
+    body, found = launch_study.powertrain_modes(SHARED_LAYOUT)
     signals = {name: accelerations[:, k] for name, (_, k) in SIGNALS.items()}
     signals["mode 1"] = launch_study.modal_accelerations(body, found, accelerations)[:, 0]
     return {name: order_tracking.third_order_peak(run.time, run.shaft_angle, signal)[0]

@@ -39,6 +39,13 @@ from support.native_rotor import SOLVE_ROUNDING
 PROVIDING = [name for name in native.native_models() if native.provides_derivatives(name)]
 INTERFACES = ("ModelExchange", "CoSimulation")
 FMU_TOLERANCE = 1e-7
+#: The FMU's differences are taken with the step and its half: the half step's truncation c h^2 / 4 is a third of
+#: the two differences' gap (allowed twice, for the h^4 remainder and the gap's own rounding). Below the bound
+#: where the outputs are smooth on the step's scale; PowertrainMounts' snubber blends are not: their stop rates
+#: (up to 24 times the linear rate) come in over millimetres (the force's third derivative up to 6 k_s / w^2), and a micrometre's step
+#: truncates by up to 1.2e-6 of a row's scale on the rubber default (measured 2026-12-07).
+HALF_STEP = derivatives.FMU_STEP / 2
+TRUNCATION_SHARE = 2.0 / 3.0
 CORE_TOLERANCE = 1e-10
 TIME = 0.05  # s: a point of a source away from t = 0
 SHIFT = 0.4  # rad: the states moved from their start, away from the joints' symmetric positions
@@ -174,12 +181,14 @@ def test_directional_derivatives_equal_central_differences_of_the_fmu(native_dir
     for n, point in enumerate(_points(name)):
         model = _at_point(path, fmi, point, tmp_path / str(n))
         jacobian = derivatives.exact(model.fmu, name, fmi)
-        differences, values = derivatives.fmu_differences(model, name)
+        coarse, _ = derivatives.fmu_differences(model, name)
+        differences, values = derivatives.fmu_differences(model, name, HALF_STEP)
         at = np.array(model.get(columns), dtype=float)
-        rounding = np.maximum(10 * np.finfo(float).eps, _rounding(name, rows)) * np.abs(values) / derivatives.FMU_STEP
+        rounding = np.maximum(10 * np.finfo(float).eps, _rounding(name, rows)) * np.abs(values) / HALF_STEP
         bound = derivatives.row_bounds(name, FMU_TOLERANCE, CORE_TOLERANCE)[0]
         allowed = (bound + rounding / derivatives.row_scales(jacobian, at))[:, None]  # the difference's, scaled
-        assert np.all(derivatives.scaled_error(jacobian, differences, at) <= allowed), point
+        truncation = TRUNCATION_SHARE * derivatives.scaled_error(coarse, differences, at)
+        assert np.all(derivatives.scaled_error(jacobian, differences, at) <= allowed + truncation), point
         declared = {u.variable.name: {k.name for k in u.dependencies}
                     for u in (*model.description.outputs, *model.description.derivatives)}
         for i, row in enumerate(rows):
@@ -204,7 +213,7 @@ def test_directional_derivatives_equal_the_python_cores_extrapolated_differences
         at = np.array([values[c] for c in columns], dtype=float)
         error = derivatives.scaled_error(jacobian, reference, at)
         outputs = derivatives.core_rows(name, values, TIME)
-        rounding = derivatives.EXTRAPOLATION_ROUNDING * _rounding(name, rows) * np.abs(outputs) / derivatives.CORE_STEP
+        rounding = derivatives.EXTRAPOLATION_ROUNDING * _rounding(name, rows) * np.abs(outputs) / derivatives.core_step(name)
         tables = CORE_AGREEMENT[name](name, values, dict(zip(rows, outputs))) if name in CORE_AGREEMENT else {}
         slopes = np.array([tables.get(row, 0.0) for row in rows]) * np.max(derivatives.scales(at), initial=1.0)
         bound = derivatives.row_bounds(name, FMU_TOLERANCE, CORE_TOLERANCE)[1]

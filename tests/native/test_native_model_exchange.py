@@ -32,6 +32,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 
 from driveline.catalog import MODELS
+from driveline.mounts.spec import SHARED_LAYOUT
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, LoggedInstance, StepRefused
 from support.dependency_points import points
@@ -46,7 +47,7 @@ LOAD_STEPS = {"PowertrainMounts": {"F_z": 4000.0, "M_y": 800.0, "Rx_in_left": -9
 LOAD_STEP_TIME = 0.1  # s
 #: Euler's output intervals where ten default steps are beyond its stability: explicit Euler on a mode
 #: of damping ratio zeta and angular frequency w grows for h > 2 zeta / (w (1 + zeta^2)), for
-#: PowertrainMounts' default layout 1.76e-3 s (its 9.1 Hz mode, zeta 0.050)
+#: PowertrainMounts' linear layout 1.76e-3 s (its 9.1 Hz mode, zeta 0.050)
 EULER_INTERVALS = {"PowertrainMounts": (1e-3, 1e-4)}
 
 
@@ -94,11 +95,16 @@ def _load_steps(name: str) -> np.ndarray | None:
 #: Runs that excite a model its start values leave at rest, (start values, stop time): VehicleDriveline
 #: rolling at 5 m/s into its joints' output shafts held at rest (the halfshafts twist, the wheels oscillate
 #: against their tyres' slip, the car slows) while the motor drives the side gears, over 0.5 s.
-RUNS = {"VehicleDriveline": ({"v_start": 5.0, "T_motor": 100.0}, 0.5)}
+#: PowertrainMounts on its linear layout, whose co-simulation steps exactly (matrix exponential), the reference this
+#: test needs; on the rubber default co-simulation's implicit midpoint rule errs by O(h^2) itself (6.9e-3 of an
+#: output's largest at 0.5 ms under LOAD_STEPS), and tests/native/test_native_mounts_model_exchange.py checks that
+#: it converges to Model Exchange at second order.
+RUNS = {"VehicleDriveline": ({"v_start": 5.0, "T_motor": 100.0}, 0.5),
+        "PowertrainMounts": ({"layout": SHARED_LAYOUT}, None)}
 #: CVODE's global error in units of its relative tolerance, at 1e-5 and 1e-8 (FMPy's CVODE takes its
 #: absolute tolerance as the relative one times each state's nominal, State.nominal): the source's phase
 #: 2 to 6; PowertrainMounts 73 and 219 (measured 2026-12-07; 33 and 118 before its 96 Maxwell-branch states,
-#: idle on the default layout: CVODE's root-mean-square error norm averages over 108 states instead of 12, which
+#: idle on the linear layout: CVODE's root-mean-square error norm averages over 108 states instead of 12, which
 #: loosens its control by sqrt(108 / 12) = 3; 230 and 800 with the nominal 1 its millimetres and milliradians had
 #: before); VehicleDriveline 80 and 272 (measured 2026-11-27; 140 and 270
 #: with nominals 1: the largest in the wheels' accelerations, 20 periods of the 200 rad/s wheel-on-tyre

@@ -74,4 +74,5 @@ class NativeFamily(Family):
         compared = within_the_agreement_range(core_rows)
         if compared:
             beyond = rows_beyond_tolerance(outputs, core_rows[:compared], rows[:compared])
-            assert not np.any(beyond), beyond
+            assert not np.any(beyond), {outputs[j]: (int(np.flatnonzero(beyond[:, j])[0]), float(np.abs(beyond[:, j]).max()))
+                                        for j in np.flatnonzero(np.any(beyond, axis=0))}  # first row, largest

@@ -56,6 +56,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
+#: The linear layout (viscous mounts, equation (1)), not PowertrainMounts' rubber default: its comparison binds it
 LAYOUT = Path(__file__).resolve().parents[2] / "driveline" / "mounts" / "data" / "transverse_fwd_powertrain.toml"
 G = 9.80665  # the launch's one value of g [m/s2]
 COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")

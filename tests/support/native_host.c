@@ -7,7 +7,8 @@
  * number with 17 significant digits (the reference of a run on another platform).
  * SCENARIO is a text file: "inputs N vr...", "outputs M vr...", "parameters P (vr value)...",
  * "integers Q (vr value)...", "booleans B (vr 0|1)...", "strings S (vr text)..." (parameters set in
- * initialisation mode; a text has no blanks; each is read back), "tolerance x", "steps K h",
+ * initialisation mode; a text has no blanks; each is read back), "tolerance x", "limits M (floor weight)..."
+ * (each output's scale floor and its tolerance as a multiple of x), "steps K h",
  * then K + 1 rows "t u_1..u_N y_1..y_M": the inputs at t_k and the outputs a reference FMU gave at
  * t_k (row 0: after initialisation). The host loads the FMU's shared library (dlopen; LoadLibrary in
  * its Windows build), runs two instances
@@ -17,8 +18,9 @@
  * reason, outputs unchanged) that ends fmusim's retry loop (retry_until_stopped) at once, logged once.
  * Before that it asks the second instance for the directional derivatives of the outputs with respect to
  * the inputs (a seed of ones): finite numbers, or Error with one logged reason from an FMU without them.
- * It prints the largest deviation from the reference, relative to each output's largest
- * magnitude, and exits 0 when every check held and the deviation is at most the tolerance.
+ * It prints the largest deviation from the reference, relative to each output's largest magnitude (at
+ * least its floor) and divided by its weight, and exits 0 when every check held and that deviation is at
+ * most the tolerance.
  */
 #include <math.h>
 #include <stdarg.h>
@@ -40,6 +42,7 @@ typedef struct {
     int integer[MAX_SIGNALS], boolean[MAX_SIGNALS];
     char *string[MAX_SIGNALS];
     double step_size, tolerance;
+    double floor[MAX_SIGNALS], weight[MAX_SIGNALS]; /* each output's scale floor, its tolerance's multiple */
     double *time, *input, *expected; /* rows of the scenario */
 } Scenario;
 
@@ -485,7 +488,7 @@ static int load3(Host *host)
 static int read_scenario(const char *path, Scenario *s)
 {
     FILE *file = fopen(path, "r");
-    int ok, k, i;
+    int ok, k, i, limits = 0;
     if (file == NULL) {
         return 0;
     }
@@ -515,6 +518,10 @@ static int read_scenario(const char *path, Scenario *s)
         ok = s->string[i] != NULL && fscanf(file, "%u %4095s", &s->string_vr[i], s->string[i]) == 2;
     }
     ok = ok && fscanf(file, " tolerance %lf", &s->tolerance) == 1;
+    ok = ok && fscanf(file, " limits %d", &limits) == 1 && limits == s->outputs;
+    for (i = 0; ok && i < s->outputs; i++) {
+        ok = fscanf(file, "%lf %lf", &s->floor[i], &s->weight[i]) == 2 && s->floor[i] >= 0.0 && s->weight[i] > 0.0;
+    }
     ok = ok && fscanf(file, " steps %d %lf", &s->steps, &s->step_size) == 2 && s->steps > 1 && s->steps < 1000000;
     if (ok) {
         s->time = malloc(sizeof(double) * (size_t)(s->steps + 1));
@@ -637,12 +644,12 @@ int main(int argc, char **argv)
         failed = memcmp(&outputs[k * s.outputs], &replay[k * s.outputs], sizeof(double) * (size_t)s.outputs) != 0;
     }
     for (i = 0; !failed && i < s.outputs; i++) { /* deviation relative to each output's largest magnitude */
-        double largest = 0.0, worst = 0.0;
+        double largest = s.floor[i], worst = 0.0;
         for (k = 0; k <= s.steps; k++) {
             largest = fmax(largest, fabs(s.expected[k * s.outputs + i]));
             worst = fmax(worst, fabs(outputs[k * s.outputs + i] - s.expected[k * s.outputs + i]));
         }
-        deviation = fmax(deviation, largest > 0.0 ? worst / largest : worst);
+        deviation = fmax(deviation, (largest > 0.0 ? worst / largest : worst) / s.weight[i]);
     }
     /* the directional derivatives on b: finite, or refused (Error) with one reason logged */
     for (i = 0; i < s.inputs; i++) {
