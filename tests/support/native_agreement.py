@@ -65,6 +65,12 @@ SCALE_FLOOR = {"resonance_margin": 1.0} | dict.fromkeys(SHARES, 1.0)
 # micrometres and accelerates it by some 5e-3 m/s2).
 SCALE_FLOOR |= {f"{name}{suffix}": floor for name in COORDINATES for suffix, floor in (("", 1e-5), ("_dot", 1e-4),
                                                                                       ("_ddot", 1e-2))}
+# The wind-up is the rotation about the drive axis between two equilibria, each a Newton root settled to 1e-14 of
+# the displacement (some 5e-17 rad on the default's sag of a few milliradians): under a mean torque near zero
+# (a drawn -0.0019 N.m winds up some 2e-8 rad) the two cores' wind-ups differ by that rounding (measured 1.4e-11 of
+# such a wind-up: 2.8e-19 rad, 2026-12-07). Its floor of 1e-3 rad makes the tolerance 1e-15 rad, ten times the two
+# roots' bound and far below any wind-up a drive torque gives (1.5 deg, 0.025 rad, at 1.1 kN.m).
+SCALE_FLOOR |= {"wind_up": 1e-3}
 # The branches' forces follow that motion through their rates (1e4 to 1e5 N/m): their floors are the motion's
 # times 1e5 N/m, 1 N and 10 N/s.
 SCALE_FLOOR |= dict.fromkeys(BRANCH_FORCES, 1.0) | dict.fromkeys(BRANCH_RATES, 10.0)
