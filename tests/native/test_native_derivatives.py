@@ -42,8 +42,8 @@ FMU_TOLERANCE = 1e-7
 #: The FMU's differences are taken with the step and its half: the half step's truncation c h^2 / 4 is a third of
 #: the two differences' gap (allowed twice, for the h^4 remainder and the gap's own rounding). Below the bound
 #: where the outputs are smooth on the step's scale; PowertrainMounts' snubber blends are not: their stop rates
-#: (up to 24 times the linear rate) come in over millimetres (the force's third derivative up to 6 k_s / w^2), and a micrometre's step
-#: truncates by up to 1.2e-6 of a row's scale on the rubber default (measured 2026-12-07).
+#: (up to 24 times the linear rate) come in over millimetres (the force's third derivative up to 6 k_s / w^2),
+#: and a micrometre's step truncates by up to 1.2e-6 of a row's scale on the rubber default (measured 2026-12-07).
 HALF_STEP = derivatives.FMU_STEP / 2
 TRUNCATION_SHARE = 2.0 / 3.0
 CORE_TOLERANCE = 1e-10

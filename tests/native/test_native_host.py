@@ -14,7 +14,7 @@ import pytest
 
 from driveline.catalog import MODELS
 from fmu_harness.packaging import native, toolchain
-from support.native_host import HOST_SOURCE, RUNS, TOLERANCES, host_command
+from support.native_host import HOST_SOURCE, RUNS, host_command, host_tolerance
 
 VALGRIND = ("valgrind", "--error-exitcode=99", "--leak-check=full", "--show-leak-kinds=definite,indirect,possible",
             "--errors-for-leak-kinds=definite,indirect,possible")
@@ -36,7 +36,7 @@ def test_host_runs_the_standard_scenario_like_the_python_fmu(host, native_dir, f
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "checks passed" in done.stdout
-    assert float(re.search(r"deviation (\S+),", done.stdout).group(1)) <= TOLERANCES.get(name, 1e-12)
+    assert float(re.search(r"deviation (\S+),", done.stdout).group(1)) <= host_tolerance(name)
     reason = "is not finite" if MODELS[name].spec.of("input") else "step size must be positive"
     assert reason in done.stderr  # the refused step's reason reached the host's logger
 

@@ -17,7 +17,7 @@ import pytest
 from fmpy.validation import validate_fmu
 
 from fmu_harness.packaging import native, toolchain
-from support.native_host import HOST_SOURCE, RUNS, TOLERANCES, host_command
+from support.native_host import HOST_SOURCE, RUNS, host_command, host_tolerance
 
 lief = pytest.importorskip("lief", reason="the binaries' structural checks need lief (pip install lief)")
 
@@ -25,7 +25,7 @@ EMULATED = {"x86_64-windows": "wine (Debian: apt-get install wine wine64)",
             "aarch64-linux": "qemu-aarch64 (Debian: apt-get install qemu-user) and the aarch64 C library "
                              "(Debian: apt-get install libc6-arm64-cross)"}
 
-#: Where an emulated binary may depart from the x86_64 Linux one more than TOLERANCES allow: the
+#: Where an emulated binary may depart from the x86_64 Linux one more than host_tolerance allows: the
 #: tripod's exact kinematics with friction, where the last-bit differences of the Windows C library's
 #: trigonometric functions from glibc's reach the outputs as 1e-10 relative (1.9e-10 measured with the
 #: closure's analytic Jacobian, 2.4e-10 with the forward-difference one it replaced: the closure is
@@ -197,7 +197,7 @@ def test_emulated_binary_reproduces_the_x86_64_binary(hosts, release_dir, fmu_pa
                                                       name, parameters, fmi):
     """The standard scenario (and the modes it leaves out) through the platform's binary, in the
     platform's build of the C host under wine or qemu: two instances, a state stored, serialized
-    and restored, a refused step; outputs equal to the x86_64 Linux binary's within TOLERANCES
+    and restored, a refused step; outputs equal to the x86_64 Linux binary's within host_tolerance
     (relative to each output's largest magnitude; PLATFORM_TOLERANCES where a model amplifies the
     C libraries' last-bit differences). Bit for bit where the platform's C library
     rounds its functions as glibc's x86_64 build does (printed: ``pytest -s``)."""
@@ -206,7 +206,7 @@ def test_emulated_binary_reproduces_the_x86_64_binary(hosts, release_dir, fmu_pa
     work = tmp_path_factory.mktemp(f"{name}_{fmi}")
     arguments, reference = _x86_64_run(hosts, release_dir, fmu_path, name, fmi, parameters, work / "x86_64")
     library = native.library_path(Path(arguments[4]).parent, name, fmi, toolchain.BY_TUPLE[platform])
-    tolerance = PLATFORM_TOLERANCES.get((platform, name), TOLERANCES.get(name, 1e-12))
+    tolerance = PLATFORM_TOLERANCES.get((platform, name), host_tolerance(name))
     scenario = _with_expected(Path(arguments[3]), reference, tolerance, work / f"{platform}.scenario")
     outputs = work / f"{platform}.txt"
     # on Windows the resources folder as a Windows path (wine's drive Z: is /): FMI 2.0 hands it

@@ -29,6 +29,12 @@ TOLERANCES = {"CriticalSpeeds": 1e-9}
 RUNS = [(name, parameters) for name in native.native_models() for parameters in ({}, *MODES.get(name, ()))]
 
 
+def host_tolerance(name: str) -> float:
+    """Model ``name``'s largest deviation from the Python FMU in the host (:data:`TOLERANCES`, else the
+    native agreement's)."""
+    return TOLERANCES.get(name, TOLERANCE)
+
+
 def _weight(output: str, tolerance: float) -> float:
     """An output's tolerance as a multiple of its model's: what support.native_agreement allows it beyond."""
     return max(1.0, SIGNAL_TOLERANCE.get(output, TOLERANCE) / tolerance)
@@ -44,7 +50,7 @@ def host_command(native_dir: Path, fmu_path, name: str, fmi: str, work: Path, pa
     library = native.host_library(unzipdir, name, fmi)
     spec = MODELS[name].spec
     case = scenario(spec)
-    tolerance = TOLERANCES.get(name, TOLERANCE)
+    tolerance = host_tolerance(name)
     references = {v.name: v.valueReference for v in description.modelVariables}
     outputs = [v.name for v in spec.of("output") if v.type == "Real"]
     with FmuInstance(fmu_path(name, fmi)) as fmu:
