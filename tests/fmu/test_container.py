@@ -108,7 +108,8 @@ def test_the_drives_step_limit_holds_inside(packages, tmp_path):
 def test_the_container_is_a_valid_fmu_and_the_same_bytes_again(packages, tmp_path):
     """fmpy validate finds nothing; two builds are equal byte for byte (sorted entries at one fixed time, no
     build time, a token from the contents); each exposed variable carries its component's unit; the
-    package's bindings are the start values."""
+    package's bindings are the start values; the embedded FMUs travel with their binaries and descriptions but
+    without their documentation and sources, the container with the package's page and the licence."""
     read, fmus = _fmus(packages["VehicleLaunch"], tmp_path / "package")
     first = container.build(read, fmus, tmp_path / "first.fmu", 1e-4)
     second = container.build(read, fmus, tmp_path / "second.fmu", 1e-4)
@@ -117,6 +118,12 @@ def test_the_container_is_a_valid_fmu_and_the_same_bytes_again(packages, tmp_pat
     with zipfile.ZipFile(first) as built:
         assert {entry.date_time for entry in built.infolist()} == {archive.FIXED_TIME}
         description = built.read("modelDescription.xml")
+        names = built.namelist()
+    embedded = {name.split("/")[1] for name in names if name.startswith("resources/") and name.count("/") > 1}
+    assert len(embedded) == len(read.components)
+    assert {f"resources/{index}/modelDescription.xml" for index in embedded} <= set(names)
+    assert not [name for name in names if "/documentation/" in name or "/sources/" in name]
+    assert {"documentation/index.html", "documentation/licenses/LICENSE.txt"} <= set(names)
     assert b"generationDateAndTime" not in description
     from fmpy import read_model_description
 
