@@ -37,7 +37,7 @@ def ramp(x: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``rho(x)`` of equation (C2), elementwise."""
     x, w = np.broadcast_arrays(np.asarray(x, float), np.asarray(w, float))
     u = np.clip(x, 0.0, w)  # the cubic's piece evaluated within its range only (no overflow far out)
-    return np.where(x >= w, x - 0.5 * w, u * u * u / (w * w) - u ** 4 / (2.0 * w ** 3))
+    return np.where(x >= w, x - 0.5 * w, u * u * u / (w * w) - u * u * (u * u) / (2.0 * (w * w * w)))
 
 
 def ramp_slope(x: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -51,7 +51,7 @@ def ramp_integral(x: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``P(x)``, the integral of rho from 0, elementwise."""
     x, w = np.broadcast_arrays(np.asarray(x, float), np.asarray(w, float))
     u, beyond = np.clip(x, 0.0, w), np.maximum(x - w, 0.0)
-    return u ** 4 / (4.0 * w * w) - u ** 5 / (10.0 * w ** 3) + beyond * (0.5 * beyond + 0.5 * w)
+    return u * u * (u * u) / (4.0 * w * w) - u * u * (u * u) * u / (10.0 * (w * w * w)) + beyond * (0.5 * beyond + 0.5 * w)
 
 
 def force(d: np.ndarray, rate: np.ndarray, gap: np.ndarray, stop_rate: np.ndarray,
@@ -78,7 +78,7 @@ def _ramp_value(x: float, w: float) -> float:
         return 0.0
     if x >= w:
         return x - 0.5 * w
-    return x * x * x / (w * w) - x ** 4 / (2.0 * w ** 3)
+    return x * x * x / (w * w) - x * x * (x * x) / (2.0 * (w * w * w))
 
 
 def _mean_ramp(a: float, b: float, w: float) -> float:

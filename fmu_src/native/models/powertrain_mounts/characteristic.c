@@ -6,14 +6,14 @@
 #include <math.h>
 
 /* rho(x) of equation (C2) (characteristic.ramp: the cubic's piece evaluated within its range only; at x <= 0
- * its 0 / w^2 - 0 / (2 w^3) is +0 without the powers, unless w^3 underflows) */
+ * its 0 / w^2 - 0 / (2 w^3) is +0, unless w^3 underflows; powers as products, the same in both cores) */
 static double ramp(double x, double w)
 {
     double u = fmin(fmax(x, 0.0), w);
     if (x <= 0.0 && w * w * w > 0.0) {
         return 0.0;
     }
-    return x >= w ? x - 0.5 * w : u * u * u / (w * w) - pow(u, 4.0) / (2.0 * pow(w, 3.0));
+    return x >= w ? x - 0.5 * w : u * u * u / (w * w) - u * u * (u * u) / (2.0 * (w * w * w));
 }
 
 /* rho'(x) (characteristic.ramp_slope) */
@@ -27,7 +27,7 @@ static double ramp_slope(double x, double w)
 static double ramp_integral(double x, double w)
 {
     double u = fmin(fmax(x, 0.0), w), beyond = fmax(x - w, 0.0);
-    return pow(u, 4.0) / (4.0 * w * w) - pow(u, 5.0) / (10.0 * pow(w, 3.0)) + beyond * (0.5 * beyond + 0.5 * w);
+    return u * u * (u * u) / (4.0 * w * w) - u * u * (u * u) * u / (10.0 * (w * w * w)) + beyond * (0.5 * beyond + 0.5 * w);
 }
 
 double characteristic_force(const Mount *m, int k, double d)
@@ -61,7 +61,7 @@ static double ramp_value(double x, double w)
     if (x >= w) {
         return x - 0.5 * w;
     }
-    return x * x * x / (w * w) - pow(x, 4.0) / (2.0 * pow(w, 3.0));
+    return x * x * x / (w * w) - x * x * (x * x) / (2.0 * (w * w * w));
 }
 
 /* characteristic._mean_ramp: the mean of rho over [a, b] (a != b), piecewise Gauss-Legendre (exact) */
