@@ -35,6 +35,10 @@ from .forces import MAX_NEWTON, NEWTON_CONTRACTION, NEWTON_STEP, BranchMap, mean
 from .layout import Layout
 
 
+#: Why a step whose matrices are beyond the range of numbers (a step of about 1e-150 s or less) is refused.
+TOO_SHORT = "the step is too short for the implicit step (2 M / h^2 is beyond the range of numbers)"
+
+
 @dataclass(frozen=True)
 class StepParts:
     """What a step changed, for the energy balance: dq, mean load, mean branch forces."""
@@ -60,10 +64,13 @@ class StepMatrices:
 
     @classmethod
     def of(cls, mass: np.ndarray, damping: np.ndarray, branches: BranchMap, h: float) -> StepMatrices:
-        shrink = 0.5 * h / branches.times
-        gain = branches.gains / (1.0 + shrink)
-        resistance = damping / h + branches.rows.T @ ((0.5 * gain)[:, None] * branches.rows)
-        return cls(h, (1.0 - shrink) / (1.0 + shrink), gain, resistance, 2.0 * mass / (h * h) + resistance)
+        """The matrices of steps of ``h`` (for a step too short, below about 1e-150 s, 2 M / h^2 is beyond the
+        range of numbers: the step refuses it, :data:`TOO_SHORT`)."""
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            shrink = 0.5 * h / branches.times
+            gain = branches.gains / (1.0 + shrink)
+            resistance = damping / h + branches.rows.T @ ((0.5 * gain)[:, None] * branches.rows)
+            return cls(h, (1.0 - shrink) / (1.0 + shrink), gain, resistance, 2.0 * mass / (h * h) + resistance)
 
 
 def implicit_step(layout: Layout, mass: np.ndarray, damping: np.ndarray, branches: BranchMap,
@@ -93,6 +100,8 @@ def _solve(layout: Layout, mass: np.ndarray, branches: BranchMap, weight: np.nda
            state: np.ndarray, f0: np.ndarray, f1: np.ndarray, matrices: StepMatrices) -> tuple[np.ndarray, StepParts]:
     q0, v0, z0 = state[:6], state[6:12], state[12:]
     h = matrices.h
+    if not np.all(np.isfinite(matrices.jacobian)):  # the residual's terms then overflow in an order of their sum
+        raise ArithmeticError(TOO_SHORT)
     z_keep = matrices.keep * z0
     mean_load = f0 + 0.5 * h * f1
     load = mean_load + weight - branches.rows.T @ (0.5 * (z0 + z_keep))  # less the branches' forces held from z0

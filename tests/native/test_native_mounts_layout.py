@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from driveline.mounts.implicit_step import TOO_SHORT
 from driveline.mounts.spec import SHARED_LAYOUT, derivative_name
 from fmu_harness.packaging import native
 from fmu_harness.runs.runner import FmuInstance, StepRefused
@@ -121,6 +122,27 @@ def test_on_the_rubber_default_a_huge_step_lands_at_the_static_equilibrium(nativ
     # their rounding (eps m g over the inertia: some 1e-14, the floor of support.native_agreement)
     assert np.all(np.abs([python[1], native_values[1]]) <= 1e-3 / step)
     assert np.all(np.abs(np.concatenate([python[2:], native_values[2:]])) <= 1e-12)
+
+
+@pytest.mark.parametrize("step", [5e-324, 1e-300, 1e-160])
+def test_on_the_rubber_default_a_step_too_short_for_its_matrices_is_refused_alike(native_dir, fmu_path, fmi, step):
+    """The implicit step's Jacobian holds 2 M / h^2: below about 1e-150 s it is beyond the range of numbers, and
+    the residual's terms would overflow or not by the order of their sums (numpy's and C's differ): both families
+    refuse the step before, word for word, after steps that set the powertrain moving (found by the property
+    test: two steps of 1/128 s, then one of 5e-324 s), and the instance steps on at an ordinary step after it."""
+    found = []
+    for path in (fmu_path(NAME, fmi), native.fmu_path(native_dir, NAME, fmi)):
+        with FmuInstance(path) as fmu:
+            fmu.initialize({"F_z": 100.0})
+            fmu.step(2 ** -7)
+            fmu.step(2 ** -7)
+            with pytest.raises(StepRefused) as refused:
+                fmu.step(step)
+            fmu.step(1e-3)
+            found.append((refused.value.messages, fmu.get(["z"])[0]))
+    (python_messages, python_z), (native_messages, native_z) = found
+    assert len(python_messages) == 1 and TOO_SHORT in python_messages[0] and native_messages == python_messages
+    assert abs(native_z - python_z) <= 1e-10 * abs(python_z)
 
 
 RUBBER = Path(__file__).parents[2] / "driveline" / "mounts" / "data" / "transverse_fwd_powertrain_rubber.toml"

@@ -42,6 +42,12 @@ ErrorKind implicit_step(const StepSystem *s, const StepMatrices *m, const double
     double load[6], z_keep[MOUNTS_MAX_BRANCHES], big_q0[6], dq[6], moved[6], factors[6][6];
     double previous = HUGE_VAL;
     int pivots[6], fresh = 1, iteration, n, i, j;
+    for (i = 0; i < 36; i++) { /* implicit_step.TOO_SHORT: the residual's terms would overflow in an order of their sum */
+        if (!isfinite(m->jacobian[i / 6][i % 6])) {
+            *message = "the step is too short for the implicit step (2 M / h^2 is beyond the range of numbers)";
+            return ERROR_ARITHMETIC;
+        }
+    }
     for (n = 0; n < b->count; n++) {
         z_keep[n] = m->keep[n] * z0[n];
     }
