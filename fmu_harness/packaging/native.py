@@ -29,6 +29,7 @@ from __future__ import annotations
 import hashlib
 import math
 import re
+import sys
 import tempfile
 import textwrap
 import uuid
@@ -328,6 +329,23 @@ def _extra_message(model: type[SteppedModel], probe: dict[str, float]) -> str:
     return f"    {{V_{shown}, {_template(errors[0])}}},"
 
 
+def _checked_range(variable: Variable) -> str:
+    """The closed interval of doubles in which ``variable`` needs no message of the range checks (a Real finite,
+    an exclusive bound the next double inward), as a C initialiser of a CheckedRange."""
+    real = variable.type == "Real"
+    low, high = (-sys.float_info.max, sys.float_info.max) if real else (-math.inf, math.inf)
+    if variable.min is not None:
+        low = max(low, math.nextafter(variable.min, math.inf) if variable.min_exclusive else float(variable.min))
+    if variable.max is not None:
+        high = min(high, math.nextafter(variable.max, -math.inf) if variable.max_exclusive else float(variable.max))
+    return f"{{V_{variable.name}, {int(real)}, {_c_double(low)}, {_c_double(high)}}}"
+
+
+def _ranges(variables: list[Variable]) -> str:
+    """The variables' CheckedRange entries, an empty one after them, as the lines of a C initialiser."""
+    return "\n    " + ",\n    ".join([*(_checked_range(v) for v in variables), "{-1, 0, 0.0, 0.0}"]) + "\n"
+
+
 def _references(variables: list[Variable]) -> str:
     """The variables' value references, -1 after them, as the lines of a C initialiser."""
     references = ", ".join([*(f"V_{v.name}" for v in variables), "-1"])
@@ -426,6 +444,8 @@ const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 
 /* -1 ends each list */
 const int model_checked[MODEL_CHECKED_COUNT + 1] = {{{_references(checked)}}};
+/* where each of them needs no message, -1 after them */
+const CheckedRange model_checked_ranges[MODEL_CHECKED_COUNT + 1] = {{{_ranges(checked)}}};
 const int model_checked_from[{len(groups) + 1}] = {{{", ".join(map(str, starts))}}};
 const int model_real_computed[MODEL_REAL_COMPUTED_COUNT + 1] = {{{_references(real_computed)}}};
 const int model_int_computed[MODEL_INT_COMPUTED_COUNT + 1] = {{{_references(int_computed)}}};

@@ -43,12 +43,14 @@ static void add_message(Messages *out, const MessageTemplate *message, const Var
     messages_add(out, text, (const char *)NULL);
 }
 
+#if MODEL_EXTRA_MESSAGE_COUNT > 0 || MODEL_RELATION_COUNT > 0 /* what the model's own checks and its relations read */
 static double value_of(const ModelData *data, int variable)
 {
     VariableType type = model_variables[variable].type;
     return type == VAR_INTEGER || type == VAR_BOOLEAN ? (double)data->int_value[variable]
                                                       : data->real_value[variable];
 }
+#endif
 
 #if MODEL_EXTRA_MESSAGE_COUNT > 0
 void messages_add_extra(Messages *out, const ModelData *data, int message)
@@ -75,9 +77,14 @@ static void range_errors(const ModelData *data, CheckedGroup group, Messages *ou
 {
     int k;
     for (k = model_checked_from[group]; k < model_checked_from[group + 1]; k++) {
-        const VariableInfo *v = &model_variables[model_checked[k]];
+        const CheckedRange *range = &model_checked_ranges[k];
+        const VariableInfo *v;
         const MessageTemplate *message = NULL;
-        double value = value_of(data, model_checked[k]);
+        double value = range->real ? data->real_value[range->variable] : (double)data->int_value[range->variable];
+        if (value >= range->low && value <= range->high) {
+            continue; /* the common case: nothing to say */
+        }
+        v = &model_variables[model_checked[k]];
         if (v->type == VAR_REAL && !isfinite(value)) {
             message = &v->not_finite;
         } else if (v->has_min && (v->min_exclusive ? !(value > v->min) : value < v->min)) {

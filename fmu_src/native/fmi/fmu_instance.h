@@ -64,6 +64,13 @@ typedef struct {
     const char *start_string; /* a String's start value, else NULL */
 } VariableInfo;
 
+/* The closed interval of doubles in which a checked variable needs no message of the range checks (a Real
+ * finite, an exclusive bound the next double inward): the checks' common case in a few instructions. */
+typedef struct {
+    int variable, real;
+    double low, high;
+} CheckedRange;
+
 typedef enum { OP_LT, OP_LE, OP_GT, OP_GE } Operator;
 
 /* A declared relation ``lhs op scale * rhs + offset`` (rhs: a variable, or ``constant`` if -1). */
@@ -90,6 +97,8 @@ typedef struct {
 } InputDerivative;
 
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
+/* model_checked's ranges (generated beside it) */
+extern const CheckedRange model_checked_ranges[MODEL_CHECKED_COUNT + 1];
 #if MODEL_STATE_COUNT > 0
 /* Model Exchange: the continuous states, the variables their time derivatives are, their nominal values */
 extern const int model_states[MODEL_STATE_COUNT];

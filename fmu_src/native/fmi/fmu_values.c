@@ -79,9 +79,33 @@ static int accessible(Instance *instance, const char *function, uint32_t referen
 
 #define SETTABLE_MODES (MODE_BIT(MODE_INSTANTIATED) | MODE_BIT(MODE_INITIALIZATION) | MODE_BIT(MODE_STEP))
 
-/* 1 when the call may get or set these ``n`` references now (checked before any value moves). */
-static int all_accessible(Instance *instance, const char *function, const uint32_t vr[], size_t n,
-                          const void *values, VariableType type, int setting)
+/* 1 when the call is the common case (a mode that allows it, arrays given, every reference one of the spec's
+ * variables of ``type``: any to get, an input to set), which needs no message. */
+static int commonly_accessible(const Instance *instance, const uint32_t vr[], size_t n, const void *values,
+                               VariableType type, int setting)
+{
+    size_t i;
+    if (!((setting ? SETTABLE_MODES : ANY_MODE) & MODE_BIT(instance->mode)) ||
+        (n > 0 && (vr == NULL || values == NULL))) {
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        const VariableInfo *v;
+        if (vr[i] >= MODEL_VARIABLE_COUNT) {
+            return 0;
+        }
+        v = &model_variables[vr[i]];
+        if (v->type != type || (setting && v->causality != CAUSALITY_INPUT)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* all_accessible beyond the common case: each reference checked, the first refusal logged; a parameter set
+ * has the parameters checked again at the next step. */
+static int checked_accessible(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                              const void *values, VariableType type, int setting)
 {
     size_t i;
     if (!((setting ? SETTABLE_MODES : ANY_MODE) & MODE_BIT(instance->mode)) &&
@@ -95,15 +119,23 @@ static int all_accessible(Instance *instance, const char *function, const uint32
     }
     for (i = 0; i < n; i++) {
         const VariableInfo *v = vr[i] < MODEL_VARIABLE_COUNT ? &model_variables[vr[i]] : NULL;
-        if (v != NULL && v->type == type && (!setting || v->causality == CAUSALITY_INPUT)) {
-            continue; /* the common cases: a variable of the spec to get, an input to set */
-        }
         if (!accessible(instance, function, vr[i], type, setting)) {
             return 0;
         }
         if (setting && v != NULL && v->causality == CAUSALITY_PARAMETER) {
             instance->parameters_checked = 0; /* the next step checks the parameters again */
         }
+    }
+    return 1;
+}
+
+/* 1 when the call may get or set these ``n`` references now (checked before any value moves). */
+static int all_accessible(Instance *instance, const char *function, const uint32_t vr[], size_t n,
+                          const void *values, VariableType type, int setting)
+{
+    if (!commonly_accessible(instance, vr, n, values, type, setting) &&
+        !checked_accessible(instance, function, vr, n, values, type, setting)) {
+        return 0;
     }
     if (setting) {
         instance->stale = 1; /* Model Exchange: the outputs follow at the next get */
@@ -130,6 +162,11 @@ Status instance_set_real(Instance *instance, const char *function, const uint32_
                          const double value[])
 {
     size_t i;
+    if (n == 1 && commonly_accessible(instance, vr, 1, value, VAR_REAL, 1)) { /* a container's call, inlined */
+        instance->data.real_value[vr[0]] = value[0];
+        instance->stale = 1;
+        return STATUS_OK;
+    }
     if (!all_accessible(instance, function, vr, n, value, VAR_REAL, 1)) {
         return STATUS_ERROR;
     }
@@ -196,6 +233,11 @@ Status instance_get_real(Instance *instance, const char *function, const uint32_
     Status status;
     const ModelData *values;
     int k;
+    if (n == 1 && !instance->model_exchange && instance->mode != MODE_INITIALIZATION &&
+        commonly_accessible(instance, vr, 1, value, VAR_REAL, 0)) { /* a container's call: the value as it is */
+        value[0] = instance->data.real_value[vr[0]];
+        return STATUS_OK;
+    }
     if (!all_accessible(instance, function, vr, n, value, VAR_REAL, 0)) {
         return STATUS_ERROR;
     }

@@ -3,7 +3,13 @@
  * row of partial derivatives per result. Each operation is the chain rule of the operator or libm function
  * it replaces. The including file defines DUAL_SIZE, its number of knowns, before it includes this header
  * (one size per C file: TripodCoupling's Jacobian columns, PowertrainMounts' halfshaft jets). Header only
- * (static inline functions, no state), standard C99 that MSVC compiles (no complex arithmetic). */
+ * (static inline functions, no state), standard C99 that MSVC compiles (no complex arithmetic).
+ *
+ * A file that also evaluates its formulas for their values alone defines DUAL_OPTIONAL: each dual number then
+ * says whether it carries partial derivatives (a known does, a constant does not), an operation on numbers
+ * that carry none computes the value alone (its partial derivatives 0, set without arithmetic); the values are
+ * those of the full evaluation bit for bit, and so are the partial derivatives of the numbers that carry them
+ * (up to the sign of a zero that passed through constants alone). Without DUAL_OPTIONAL every number carries them. */
 #ifndef LIB_DUAL_H
 #define LIB_DUAL_H
 
@@ -19,7 +25,27 @@
 
 typedef struct {
     double v, d[DUAL_SIZE];
+#ifdef DUAL_OPTIONAL
+    int carries; /* 1: d holds partial derivatives; 0: d is 0 */
+#endif
 } Dual;
+
+#ifdef DUAL_OPTIONAL
+#define DUAL_CARRIES(a) ((a).carries)
+#define DUAL_MARK(r, carrying) ((r).carries = (carrying))
+#else
+#define DUAL_CARRIES(a) 1
+#define DUAL_MARK(r, carrying) ((void)0)
+#endif
+
+/* r's partial derivatives 0, for a result whose operands carry none */
+static inline void dual_zero(Dual *r)
+{
+    int c;
+    for (c = 0; c < DUAL_SIZE; c++) {
+        r->d[c] = 0.0;
+    }
+}
 
 /* v with the partial derivatives ``slope`` times a's: f(a) with f(a.v) = v, f'(a.v) = slope */
 static inline Dual dual_chain(Dual a, double v, double slope)
@@ -27,6 +53,11 @@ static inline Dual dual_chain(Dual a, double v, double slope)
     Dual r;
     int c;
     r.v = v;
+    DUAL_MARK(r, DUAL_CARRIES(a));
+    if (!DUAL_CARRIES(a)) {
+        dual_zero(&r);
+        return r;
+    }
     for (c = 0; c < DUAL_SIZE; c++) {
         r.d[c] = slope * a.d[c];
     }
@@ -40,6 +71,11 @@ static inline Dual dual_chain_over(Dual a, double v, double denominator)
     Dual r;
     int c;
     r.v = v;
+    DUAL_MARK(r, DUAL_CARRIES(a));
+    if (!DUAL_CARRIES(a)) {
+        dual_zero(&r);
+        return r;
+    }
     for (c = 0; c < DUAL_SIZE; c++) {
         r.d[c] = a.d[c] / denominator;
     }
@@ -50,11 +86,9 @@ static inline Dual dual_chain_over(Dual a, double v, double denominator)
 static inline Dual dual_constant(double v)
 {
     Dual r;
-    int c;
     r.v = v;
-    for (c = 0; c < DUAL_SIZE; c++) {
-        r.d[c] = 0.0;
-    }
+    DUAL_MARK(r, 0);
+    dual_zero(&r);
     return r;
 }
 
@@ -62,6 +96,7 @@ static inline Dual dual_constant(double v)
 static inline Dual dual_known(double v, int column)
 {
     Dual r = dual_constant(v);
+    DUAL_MARK(r, 1);
     r.d[column] = 1.0;
     return r;
 }
@@ -70,6 +105,11 @@ static inline Dual dual_add(Dual a, Dual b)
 {
     int c;
     a.v += b.v;
+    if (!DUAL_CARRIES(a) && !DUAL_CARRIES(b)) {
+        dual_zero(&a);
+        return a;
+    }
+    DUAL_MARK(a, 1);
     for (c = 0; c < DUAL_SIZE; c++) {
         a.d[c] += b.d[c];
     }
@@ -80,6 +120,11 @@ static inline Dual dual_sub(Dual a, Dual b)
 {
     int c;
     a.v -= b.v;
+    if (!DUAL_CARRIES(a) && !DUAL_CARRIES(b)) {
+        dual_zero(&a);
+        return a;
+    }
+    DUAL_MARK(a, 1);
     for (c = 0; c < DUAL_SIZE; c++) {
         a.d[c] -= b.d[c];
     }
@@ -91,6 +136,11 @@ static inline Dual dual_mul(Dual a, Dual b)
     Dual r;
     int c;
     r.v = a.v * b.v;
+    DUAL_MARK(r, DUAL_CARRIES(a) || DUAL_CARRIES(b));
+    if (!DUAL_CARRIES(r)) {
+        dual_zero(&r);
+        return r;
+    }
     for (c = 0; c < DUAL_SIZE; c++) {
         r.d[c] = a.d[c] * b.v + a.v * b.d[c];
     }
@@ -102,6 +152,11 @@ static inline Dual dual_div(Dual a, Dual b)
     Dual r;
     int c;
     r.v = a.v / b.v;
+    DUAL_MARK(r, DUAL_CARRIES(a) || DUAL_CARRIES(b));
+    if (!DUAL_CARRIES(r)) {
+        dual_zero(&r);
+        return r;
+    }
     for (c = 0; c < DUAL_SIZE; c++) {
         r.d[c] = (a.d[c] - r.v * b.d[c]) / b.v;
     }
@@ -180,6 +235,11 @@ static inline Dual dual_atan2(Dual y, Dual x)
     double norm = x.v * x.v + y.v * y.v;
     int c;
     r.v = atan2(y.v, x.v);
+    DUAL_MARK(r, DUAL_CARRIES(x) || DUAL_CARRIES(y));
+    if (!DUAL_CARRIES(r)) {
+        dual_zero(&r);
+        return r;
+    }
     for (c = 0; c < DUAL_SIZE; c++) {
         r.d[c] = (x.v * y.d[c] - y.v * x.d[c]) / norm;
     }

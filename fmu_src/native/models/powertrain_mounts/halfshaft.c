@@ -5,13 +5,15 @@
  * The geometry is evaluated once in dual numbers (lib/dual.h): each quantity carries its partial derivatives
  * by the wheel centre in the housing frame and its rates, (a, a', a''), nine numbers; a = F^T (W - O - T(W) q),
  * a' = -F^T T(W) q', a'' = -F^T T(W) q'' turn them into derivatives by (q, q', q''). The values are those of
- * the Python core's operations, in its order.
+ * the Python core's operations, in its order. Without ``partial`` (a step's outputs) the knowns enter as
+ * constants, and the same operations give the values alone.
  */
 #include <math.h>
 
 #include "mounts.h"
 
 #define DUAL_SIZE HALFSHAFT_JET
+#define DUAL_OPTIONAL /* a step's outputs take the values alone */
 #include "lib/dual.h"
 
 /* sqrt, its derivative a' / (2 sqrt a) taken 0 at 0 (a straight shaft: rho's one-sided slope, no bend plane) */
@@ -19,6 +21,12 @@ static Dual root(Dual a)
 {
     double v = sqrt(a.v);
     return v > 0.0 ? dual_chain_over(a, v, 2.0 * v) : dual_constant(v);
+}
+
+/* the known ``column`` at v, a constant when no partial derivatives are asked for */
+static Dual known(double v, int column, const void *partial)
+{
+    return partial != NULL ? dual_known(v, column) : dual_constant(v);
 }
 
 /* atan2, its derivative taken 0 at the origin */
@@ -90,10 +98,10 @@ int halfshaft_geometry(const Halfshaft *shaft, const double q[6], const double v
     in_housing(shaft, q, 0, a[0]);
     in_housing(shaft, velocity, 1, a[1]);
     in_housing(shaft, acceleration, 2, a[2]);
-    ax = dual_known(a[0][0], 0), ay = dual_known(a[0][1], 1), az = dual_known(a[0][2], 2);
+    ax = known(a[0][0], 0, partial), ay = known(a[0][1], 1, partial), az = known(a[0][2], 2, partial);
     for (k = 0; k < 3; k++) {
-        a1[k] = dual_known(a[1][k], 3 + k);
-        a2[k] = dual_known(a[2][k], 6 + k);
+        a1[k] = known(a[1][k], 3 + k, partial);
+        a2[k] = known(a[2][k], 6 + k, partial);
     }
     rho2 = dual_add(dual_mul(ax, ax), dual_mul(ay, ay));
     if (!(rho2.v < length2)) {
