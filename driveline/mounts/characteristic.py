@@ -51,7 +51,8 @@ def ramp_integral(x: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``P(x)``, the integral of rho from 0, elementwise."""
     x, w = np.broadcast_arrays(np.asarray(x, float), np.asarray(w, float))
     u, beyond = np.clip(x, 0.0, w), np.maximum(x - w, 0.0)
-    return u * u * (u * u) / (4.0 * w * w) - u * u * (u * u) * u / (10.0 * (w * w * w)) + beyond * (0.5 * beyond + 0.5 * w)
+    fourth = u * u * (u * u)
+    return fourth / (4.0 * w * w) - fourth * u / (10.0 * (w * w * w)) + beyond * (0.5 * beyond + 0.5 * w)
 
 
 def force(d: np.ndarray, rate: np.ndarray, gap: np.ndarray, stop_rate: np.ndarray,

@@ -406,7 +406,6 @@ def variable_table(model: type[SteppedModel], token: str) -> dict[str, str]:
  * sum of the Real outputs and locals shows that they are before their bounds are checked: model_real_computed) */
 #define MODEL_CHECKED_COUNT {len(checked)}
 #define MODEL_REAL_COMPUTED_COUNT {len(real_computed)}
-extern const int model_checked[MODEL_CHECKED_COUNT + 1];
 extern const int model_checked_from[{len(groups) + 1}];
 extern const int model_real_computed[MODEL_REAL_COMPUTED_COUNT + 1];
 /* the Integer and Boolean outputs and locals: with the Real ones, the values a step may change (StepUndo) */
@@ -443,8 +442,7 @@ const VariableInfo model_variables[MODEL_VARIABLE_COUNT] = {{
 }};
 
 /* -1 ends each list */
-const int model_checked[MODEL_CHECKED_COUNT + 1] = {{{_references(checked)}}};
-/* where each of them needs no message, -1 after them */
+/* the variables the range checks read and where each needs no message, an empty entry after them */
 const CheckedRange model_checked_ranges[MODEL_CHECKED_COUNT + 1] = {{{_ranges(checked)}}};
 const int model_checked_from[{len(groups) + 1}] = {{{", ".join(map(str, starts))}}};
 const int model_real_computed[MODEL_REAL_COMPUTED_COUNT + 1] = {{{_references(real_computed)}}};

@@ -62,7 +62,7 @@ void messages_add_extra(Messages *out, const ModelData *data, int message)
 
 /* ---- checks (SteppedModel.parameter_errors, input_errors, output_errors) --------------- */
 
-/* The groups of model_checked (model_checked_from): the parameters, the inputs, the outputs and locals. */
+/* The groups of model_checked_ranges (model_checked_from): the parameters, the inputs, the outputs and locals. */
 typedef enum { CHECKED_PARAMETERS, CHECKED_INPUTS, CHECKED_COMPUTED } CheckedGroup;
 
 static const char *causality_name(Causality causality)
@@ -84,7 +84,7 @@ static void range_errors(const ModelData *data, CheckedGroup group, Messages *ou
         if (value >= range->low && value <= range->high) {
             continue; /* the common case: nothing to say */
         }
-        v = &model_variables[model_checked[k]];
+        v = &model_variables[range->variable];
         if (v->type == VAR_REAL && !isfinite(value)) {
             message = &v->not_finite;
         } else if (v->has_min && (v->min_exclusive ? !(value > v->min) : value < v->min)) {

@@ -97,7 +97,7 @@ typedef struct {
 } InputDerivative;
 
 extern const VariableInfo model_variables[MODEL_VARIABLE_COUNT];
-/* model_checked's ranges (generated beside it) */
+/* the variables the range checks read, by group (model_checked_from), with their ranges: generated */
 extern const CheckedRange model_checked_ranges[MODEL_CHECKED_COUNT + 1];
 #if MODEL_STATE_COUNT > 0
 /* Model Exchange: the continuous states, the variables their time derivatives are, their nominal values */

@@ -26,8 +26,8 @@ static double ramp_slope(double x, double w)
 /* P(x), the integral of rho from 0 (characteristic.ramp_integral) */
 static double ramp_integral(double x, double w)
 {
-    double u = fmin(fmax(x, 0.0), w), beyond = fmax(x - w, 0.0);
-    return u * u * (u * u) / (4.0 * w * w) - u * u * (u * u) * u / (10.0 * (w * w * w)) + beyond * (0.5 * beyond + 0.5 * w);
+    double u = fmin(fmax(x, 0.0), w), beyond = fmax(x - w, 0.0), fourth = u * u * (u * u);
+    return fourth / (4.0 * w * w) - fourth * u / (10.0 * (w * w * w)) + beyond * (0.5 * beyond + 0.5 * w);
 }
 
 double characteristic_force(const Mount *m, int k, double d)
