@@ -47,15 +47,25 @@ static inline void dual_zero(Dual *r)
     }
 }
 
+/* r marked as ``carrying`` partial derivatives or not; 1 when it carries none (its partial derivatives then
+ * set 0: the operation's value is all), 0 when the operation computes them (always without DUAL_OPTIONAL) */
+static inline int dual_values_only(Dual *r, int carrying)
+{
+    DUAL_MARK(*r, carrying);
+    if (carrying) {
+        return 0;
+    }
+    dual_zero(r);
+    return 1;
+}
+
 /* v with the partial derivatives ``slope`` times a's: f(a) with f(a.v) = v, f'(a.v) = slope */
 static inline Dual dual_chain(Dual a, double v, double slope)
 {
     Dual r;
     int c;
     r.v = v;
-    DUAL_MARK(r, DUAL_CARRIES(a));
-    if (!DUAL_CARRIES(a)) {
-        dual_zero(&r);
+    if (dual_values_only(&r, DUAL_CARRIES(a))) {
         return r;
     }
     for (c = 0; c < DUAL_SIZE; c++) {
@@ -71,9 +81,7 @@ static inline Dual dual_chain_over(Dual a, double v, double denominator)
     Dual r;
     int c;
     r.v = v;
-    DUAL_MARK(r, DUAL_CARRIES(a));
-    if (!DUAL_CARRIES(a)) {
-        dual_zero(&r);
+    if (dual_values_only(&r, DUAL_CARRIES(a))) {
         return r;
     }
     for (c = 0; c < DUAL_SIZE; c++) {
@@ -87,8 +95,7 @@ static inline Dual dual_constant(double v)
 {
     Dual r;
     r.v = v;
-    DUAL_MARK(r, 0);
-    dual_zero(&r);
+    (void)dual_values_only(&r, 0);
     return r;
 }
 
@@ -105,11 +112,9 @@ static inline Dual dual_add(Dual a, Dual b)
 {
     int c;
     a.v += b.v;
-    if (!DUAL_CARRIES(a) && !DUAL_CARRIES(b)) {
-        dual_zero(&a);
+    if (dual_values_only(&a, DUAL_CARRIES(a) || DUAL_CARRIES(b))) {
         return a;
     }
-    DUAL_MARK(a, 1);
     for (c = 0; c < DUAL_SIZE; c++) {
         a.d[c] += b.d[c];
     }
@@ -120,11 +125,9 @@ static inline Dual dual_sub(Dual a, Dual b)
 {
     int c;
     a.v -= b.v;
-    if (!DUAL_CARRIES(a) && !DUAL_CARRIES(b)) {
-        dual_zero(&a);
+    if (dual_values_only(&a, DUAL_CARRIES(a) || DUAL_CARRIES(b))) {
         return a;
     }
-    DUAL_MARK(a, 1);
     for (c = 0; c < DUAL_SIZE; c++) {
         a.d[c] -= b.d[c];
     }
@@ -136,9 +139,7 @@ static inline Dual dual_mul(Dual a, Dual b)
     Dual r;
     int c;
     r.v = a.v * b.v;
-    DUAL_MARK(r, DUAL_CARRIES(a) || DUAL_CARRIES(b));
-    if (!DUAL_CARRIES(r)) {
-        dual_zero(&r);
+    if (dual_values_only(&r, DUAL_CARRIES(a) || DUAL_CARRIES(b))) {
         return r;
     }
     for (c = 0; c < DUAL_SIZE; c++) {
@@ -152,9 +153,7 @@ static inline Dual dual_div(Dual a, Dual b)
     Dual r;
     int c;
     r.v = a.v / b.v;
-    DUAL_MARK(r, DUAL_CARRIES(a) || DUAL_CARRIES(b));
-    if (!DUAL_CARRIES(r)) {
-        dual_zero(&r);
+    if (dual_values_only(&r, DUAL_CARRIES(a) || DUAL_CARRIES(b))) {
         return r;
     }
     for (c = 0; c < DUAL_SIZE; c++) {
@@ -235,9 +234,7 @@ static inline Dual dual_atan2(Dual y, Dual x)
     double norm = x.v * x.v + y.v * y.v;
     int c;
     r.v = atan2(y.v, x.v);
-    DUAL_MARK(r, DUAL_CARRIES(x) || DUAL_CARRIES(y));
-    if (!DUAL_CARRIES(r)) {
-        dual_zero(&r);
+    if (dual_values_only(&r, DUAL_CARRIES(x) || DUAL_CARRIES(y))) {
         return r;
     }
     for (c = 0; c < DUAL_SIZE; c++) {
